@@ -1,0 +1,10 @@
+"""Pure collision geometry, no ECS: pairwise queries, rays, sweeps and batch kernels.
+
+The public contract (see ``docs/collision.md``): world units, y up, radians counter-clockwise;
+touching is not a collision; normals point from A toward B; grazing rays and sweeps miss.
+"""
+
+from .collide import collide
+from .results import Contact, Impact, RayHit, Vec2
+
+__all__ = ["Contact", "Impact", "RayHit", "Vec2", "collide"]

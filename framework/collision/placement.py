@@ -1,0 +1,54 @@
+"""Placing shapes in the world, relative to a local origin.
+
+Every query subtracts a local origin (the first shape's position) before any arithmetic, so a
+scene at x = 1e9 gives the answers of the same scene at the origin, to float64 rounding.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..shapes import AABB, Circle, Polygon, Shape
+from ..validation import InvalidValue, finite
+
+__all__ = ["pose", "outline", "check_shape"]
+
+
+def check_shape(name: str, shape: object) -> Shape:
+    if not isinstance(shape, (AABB, Circle, Polygon)):
+        raise InvalidValue(f"{name} must be an AABB, Circle or Polygon, got {shape!r}")
+    return shape
+
+
+def pose(name: str, transform: object) -> tuple[float, float, float]:
+    """``(x, y, rotation)`` of a Transform (or an ``(x, y[, rotation])`` sequence), checked finite."""
+    if hasattr(transform, "x") and hasattr(transform, "y"):
+        return (
+            finite(f"{name}.x", transform.x),  # type: ignore[union-attr]
+            finite(f"{name}.y", transform.y),  # type: ignore[union-attr]
+            finite(f"{name}.rotation", getattr(transform, "rotation", 0.0)),
+        )
+    try:
+        n = len(transform)  # type: ignore[arg-type]
+    except TypeError:
+        n = -1
+    if n not in (2, 3) or isinstance(transform, (str, bytes)):
+        raise InvalidValue(f"{name} must be a Transform or an (x, y[, rotation]) tuple, got {transform!r}")
+    seq = transform  # type: ignore[assignment]
+    rot = seq[2] if n == 3 else 0.0  # type: ignore[index]
+    return (finite(f"{name}[0]", seq[0]), finite(f"{name}[1]", seq[1]),  # type: ignore[index]
+            finite(f"{name}[2]", rot))
+
+
+def outline(shape: AABB | Polygon, x: float, y: float, rotation: float) -> list[tuple[float, float]]:
+    """World outline (counter-clockwise) of a box or polygon whose hitbox origin is at (x, y).
+
+    (x, y) is already relative to the query's local origin. AABBs ignore ``rotation``.
+    """
+    if isinstance(shape, AABB):
+        hw, hh = shape.width * 0.5, shape.height * 0.5
+        return [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)]
+    if rotation == 0.0:
+        return [(px + x, py + y) for px, py in shape.points]
+    c, s = math.cos(rotation), math.sin(rotation)
+    return [(c * px - s * py + x, s * px + c * py + y) for px, py in shape.points]
