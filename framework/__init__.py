@@ -1,7 +1,32 @@
-"""A 2D game framework on esper, built around a fast, numerically sound collision pipeline."""
+"""A 2D game framework on esper, built around a fast, numerically sound collision pipeline.
 
-from .components import Transform
-from .shapes import AABB, Circle, Polygon
+Importing it (and running scenes without a renderer) never imports pyglet's GL modules.
+"""
 
-__all__ = ["AABB", "Circle", "Polygon", "Transform"]
+from typing import Any
+
+from .components import Body, Hitbox, Transform, Velocity
+from .shapes import AABB, Circle, Polygon, Shape
+from .validation import InvalidValue
+
+__all__ = [
+    "AABB", "Body", "Circle", "CollisionEvent", "Contact", "Hitbox", "Impact", "InvalidValue", "Polygon",
+    "RayHit", "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Transform", "Vec2", "Velocity",
+    "collide",
+]
 __version__ = "0.1.0"
+
+_LAZY = {
+    "Contact": "collision", "Impact": "collision", "RayHit": "collision", "Vec2": "collision",
+    "collide": "collision", "CollisionEvent": "events", "STAGES": "scene", "Scene": "scene",
+    "SceneClosed": "scene", "SceneHit": "scene",
+}
+
+
+def __getattr__(name: str) -> Any:
+    # The scene and the queries load on first use, so `import framework` stays light.
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module 'framework' has no attribute {name!r}")

@@ -1,33 +1,222 @@
 """Components: small, validated data that systems process.
 
 Constructors refuse NaN, inf and wrong types at once. Attributes stay plain and mutable
-(``t.x += 1`` in game code), so a bad value written later is caught when the scene next steps.
+(``t.x += 1`` in game code). A bad value written later is kept as written and reported by the
+scene's next ``step`` (a ``ValueError`` naming the entity and the field), which then changes
+nothing.
+
+Inside a scene, the hot fields of :class:`Transform` and :class:`Velocity` live in the scene's
+columnar store (numpy arrays) and the component objects are views of one row: the pipeline works
+on whole columns and never gathers from, or writes back to, thousands of Python objects. Outside
+a scene, a component keeps its own values.
 """
 
 from __future__ import annotations
 
-from .validation import finite
+from enum import Enum
+from typing import TYPE_CHECKING, Any
 
-__all__ = ["Transform"]
+from .shapes import AABB, Circle, Polygon, Shape
+from .validation import InvalidValue, finite, vector2
+
+if TYPE_CHECKING:
+    from .store import BodyStore
+
+__all__ = ["Body", "Hitbox", "Transform", "Velocity"]
 
 
-class Transform:
+class _Columns:
+    """Base of components whose float fields may be views of a row of a :class:`BodyStore`."""
+
+    __slots__ = ("_own", "_store", "_entity")
+    _fields: tuple[str, ...] = ()
+    _columns: tuple[str, ...] = ()  # the store column of each field
+
+    def __init__(self, *values: object) -> None:
+        self._store: BodyStore | None = None
+        self._entity = -1
+        self._own = [finite(f"{type(self).__name__} {name}", v) for name, v in zip(self._fields, values)]
+
+    def _get(self, i: int) -> Any:
+        store = self._store
+        if store is None:
+            return self._own[i]
+        return store.read(self._entity, self._columns[i])
+
+    def _set(self, i: int, value: object) -> None:
+        store = self._store
+        if store is None:
+            self._own[i] = value
+        else:
+            store.write(self._entity, self._columns[i], value)
+
+    def _values(self) -> tuple[Any, ...]:
+        return tuple(self._get(i) for i in range(len(self._fields)))
+
+    def __repr__(self) -> str:
+        inner = ", ".join(f"{n}={v!r}" for n, v in zip(self._fields, self._values()))
+        return f"{type(self).__name__}({inner})"
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return self._values() == other._values()  # type: ignore[attr-defined]
+
+    __hash__ = None  # type: ignore[assignment]  # mutable
+
+
+def _field(i: int, doc: str) -> property:
+    return property(lambda self: self._get(i), lambda self, v: self._set(i, v), doc=doc)
+
+
+class Transform(_Columns):
     """Where an entity is: position ``(x, y)`` in world units (y up) and ``rotation`` in radians,
     counter-clockwise. A hitbox's shape rotates about its hitbox origin."""
 
-    __slots__ = ("x", "y", "rotation")
+    __slots__ = ()
+    _fields = ("x", "y", "rotation")
+    _columns = ("x", "y", "rot")
 
     def __init__(self, x: float = 0.0, y: float = 0.0, rotation: float = 0.0) -> None:
-        self.x = finite("Transform x", x)
-        self.y = finite("Transform y", y)
-        self.rotation = finite("Transform rotation", rotation)
+        super().__init__(x, y, rotation)
+
+    x = _field(0, "World x of the entity's origin.")
+    y = _field(1, "World y of the entity's origin (y up).")
+    rotation = _field(2, "Rotation in radians, counter-clockwise.")
+
+
+class Velocity(_Columns):
+    """Linear velocity ``(x, y)`` in world units per second and ``angular`` in radians per second.
+
+    Only entities with a Velocity are integrated by the movement system."""
+
+    __slots__ = ()
+    _fields = ("x", "y", "angular")
+    _columns = ("vx", "vy", "w")
+
+    def __init__(self, x: float = 0.0, y: float = 0.0, angular: float = 0.0) -> None:
+        super().__init__(x, y, angular)
+
+    x = _field(0, "Velocity along x, world units per second.")
+    y = _field(1, "Velocity along y, world units per second.")
+    angular = _field(2, "Angular velocity, radians per second (counter-clockwise).")
+
+
+class Body(Enum):
+    """How the response treats a body.
+
+    - ``DYNAMIC``: moved by its velocity and pushed by contacts.
+    - ``KINEMATIC``: moved by its velocity or by game code; pushes dynamic bodies, is never pushed.
+    - ``STATIC``: never moves (no Velocity); hashed once; static-static pairs are never tested.
+    """
+
+    DYNAMIC = "dynamic"
+    KINEMATIC = "kinematic"
+    STATIC = "static"
+
+
+_HITBOX_FIELDS = ("shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd")
+_ALL_BITS = 0xFFFFFFFF
+
+
+class Hitbox:
+    """The collision shape of an entity and how it takes part in collisions.
+
+    - ``shape``: an :class:`~framework.shapes.AABB`, :class:`~framework.shapes.Circle` or
+      :class:`~framework.shapes.Polygon`.
+    - ``offset``: the hitbox origin relative to the entity's Transform; it turns with the
+      transform's rotation (an AABB's box itself never turns).
+    - ``layer`` / ``mask``: 32-bit collision filter. A pair is tested only when each one's layer
+      meets the other's mask (``a.layer & b.mask and b.layer & a.mask``).
+    - ``sensor``: reports collision events but never takes part in the response.
+    - ``body``: :class:`Body` kind (or its name: ``"dynamic"``, ``"kinematic"``, ``"static"``).
+    - ``mass``: > 0, used to split push-outs and impulses between two dynamic bodies;
+      ``math.inf`` makes a dynamic body immovable by contacts.
+    - ``restitution``: 0 (slide) to 1 (elastic bounce); a pair uses the larger of the two.
+    - ``ccd``: continuous detection. The body is swept along its motion each step so it cannot
+      pass through thin walls; bodies without it pay nothing for it.
+    """
+
+    __slots__ = ("_store", "_entity") + tuple("_" + f for f in _HITBOX_FIELDS)
+
+    def __init__(
+        self,
+        shape: Shape,
+        offset: tuple[float, float] = (0.0, 0.0),
+        *,
+        layer: int = 1,
+        mask: int = _ALL_BITS,
+        sensor: bool = False,
+        body: Body | str = Body.DYNAMIC,
+        mass: float = 1.0,
+        restitution: float = 0.0,
+        ccd: bool = False,
+    ) -> None:
+        object.__setattr__(self, "_store", None)
+        object.__setattr__(self, "_entity", -1)
+        for name, value in zip(
+            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd)
+        ):
+            object.__setattr__(self, "_" + name, check_hitbox_field(name, value))
+
+    def __getattr__(self, name: str) -> Any:
+        if name in _HITBOX_FIELDS:
+            return object.__getattribute__(self, "_" + name)
+        raise AttributeError(f"Hitbox has no attribute {name!r}")
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name not in _HITBOX_FIELDS:
+            raise AttributeError(f"Hitbox has no attribute {name!r}")
+        # Kept as given; checked when the scene next steps (or at once outside a scene).
+        if self._store is None:
+            value = check_hitbox_field(name, value)
+        else:
+            self._store.hitbox_changed(self._entity)
+        object.__setattr__(self, "_" + name, value)
+
+    @property
+    def inverse_mass(self) -> float:
+        return 0.0 if self._body is not Body.DYNAMIC else 1.0 / self._mass
 
     def __repr__(self) -> str:
-        return f"Transform(x={self.x!r}, y={self.y!r}, rotation={self.rotation!r})"
+        inner = ", ".join(f"{f}={object.__getattribute__(self, '_' + f)!r}" for f in _HITBOX_FIELDS)
+        return f"Hitbox({inner})"
 
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Transform):
-            return NotImplemented
-        return (self.x, self.y, self.rotation) == (other.x, other.y, other.rotation)
 
-    __hash__ = None  # type: ignore[assignment]  # mutable
+def check_hitbox_field(name: str, value: object) -> Any:
+    """Validate one Hitbox field; return its normalised value or raise :class:`InvalidValue`."""
+    if name == "shape":
+        if not isinstance(value, (AABB, Circle, Polygon)):
+            raise InvalidValue(f"Hitbox shape must be an AABB, Circle or Polygon, got {value!r}")
+        return value
+    if name == "offset":
+        return vector2("Hitbox offset", value)
+    if name in ("layer", "mask"):
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= int(value) <= _ALL_BITS:
+            raise InvalidValue(f"Hitbox {name} must be an int in [0, 2**32), got {value!r}")
+        return int(value)
+    if name in ("sensor", "ccd"):
+        if not isinstance(value, bool):
+            raise InvalidValue(f"Hitbox {name} must be True or False, got {value!r}")
+        return value
+    if name == "body":
+        try:
+            return Body(value.value if isinstance(value, Body) else value)
+        except ValueError:
+            raise InvalidValue(
+                f"Hitbox body must be 'dynamic', 'kinematic' or 'static', got {value!r}"
+            ) from None
+    if name == "mass":
+        if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
+            raise InvalidValue(f"Hitbox mass must be a number > 0, got {value!r}")
+        m = float(value)  # type: ignore[arg-type]
+        if not (m > 0.0):  # inf allowed: immovable
+            raise InvalidValue(f"Hitbox mass must be > 0 (math.inf for immovable), got {value!r}")
+        return m
+    if name == "restitution":
+        r = finite("Hitbox restitution", value)
+        if not 0.0 <= r <= 1.0:
+            raise InvalidValue(f"Hitbox restitution must be in [0, 1], got {value!r}")
+        return r
+    raise AttributeError(name)
+

@@ -21,10 +21,11 @@ from .validation import InvalidValue, finite, positive
 
 __all__ = ["AABB", "Circle", "Polygon", "Shape"]
 
-# Relative size below which the turn at a vertex counts as no turn at all (|cross| <= this times
-# the product of the two edge lengths, i.e. |sin(angle)| <= 1e-12). Such a vertex is dropped if
-# the outline runs straight on, and makes the polygon a spike if the outline doubles back.
-_COLLINEAR_SIN = 1e-12
+# Tolerance of the "collinear" test: a vertex within this fraction of the polygon's extent (plus a
+# few units of rounding of its coordinates) of the line through its neighbours is on that line.
+# It is a distance, not an angle: rounding moves points by a distance, whatever the edge lengths.
+_COLLINEAR_REL = 1e-12
+_ROUNDING = 16.0 * 2.0**-52
 
 
 class Shape:
@@ -48,8 +49,8 @@ class AABB(Shape):
     kind: ClassVar[str] = "aabb"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "width", positive("AABB width", self.width))
-        object.__setattr__(self, "height", positive("AABB height", self.height))
+        object.__setattr__(self, "width", _halvable("AABB width", self.width))
+        object.__setattr__(self, "height", _halvable("AABB height", self.height))
 
     @property
     def half_width(self) -> float:
@@ -101,8 +102,8 @@ class Polygon(Shape):
     @classmethod
     def box(cls, width: float, height: float) -> Polygon:
         """A ``width`` x ``height`` box centred on the origin that rotates with its transform."""
-        hw = positive("Polygon.box width", width) * 0.5
-        hh = positive("Polygon.box height", height) * 0.5
+        hw = _halvable("Polygon.box width", width) * 0.5
+        hh = _halvable("Polygon.box height", height) * 0.5
         return cls([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
 
     @property
@@ -113,21 +114,79 @@ class Polygon(Shape):
         return len(self.points)
 
 
+def _halvable(name: str, value: object) -> float:
+    """A positive size whose half is still > 0 (only the smallest subnormal, 5e-324, is not)."""
+    x = positive(name, value)
+    if x * 0.5 == 0.0:
+        raise InvalidValue(f"{name} must be finite and > 0 with a half > 0, got {value!r}")
+    return x
+
+
+def _cross(ax: float, ay: float, bx: float, by: float) -> float:
+    return ax * by - ay * bx
+
+
+def _segments_cross(p: tuple[float, float], q: tuple[float, float],
+                    r: tuple[float, float], s: tuple[float, float]) -> bool:
+    """Closed segments pq and rs share a point (used only to word an error message)."""
+    d1 = _cross(q[0] - p[0], q[1] - p[1], r[0] - p[0], r[1] - p[1])
+    d2 = _cross(q[0] - p[0], q[1] - p[1], s[0] - p[0], s[1] - p[1])
+    d3 = _cross(s[0] - r[0], s[1] - r[1], p[0] - r[0], p[1] - r[1])
+    d4 = _cross(s[0] - r[0], s[1] - r[1], q[0] - r[0], q[1] - r[1])
+    if ((d1 > 0) != (d2 > 0) or d1 == 0 or d2 == 0) and ((d3 > 0) != (d4 > 0) or d3 == 0 or d4 == 0):
+        def within(a: tuple[float, float], b: tuple[float, float], c: tuple[float, float]) -> bool:
+            return min(a[0], b[0]) <= c[0] <= max(a[0], b[0]) and min(a[1], b[1]) <= c[1] <= max(a[1], b[1])
+        if d1 == d2 == 0:  # collinear: overlapping only if one holds an end of the other
+            return within(p, q, r) or within(p, q, s) or within(r, s, p) or within(r, s, q)
+        return True
+    return False
+
+
+def _self_intersecting(pts: list[tuple[float, float]]) -> bool:
+    n = len(pts)
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue  # adjacent through the closing edge
+            if _segments_cross(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n]):
+                return True
+    return False
+
+
 def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, float], ...]:
-    """Validate a convex outline; return it counter-clockwise from its lowest-leftmost vertex."""
+    """Validate a convex outline; return it counter-clockwise from its lowest-leftmost vertex.
+
+    Every decision is made on the points scaled by a power of two (exact), so that neither huge nor
+    tiny coordinates overflow or underflow, and in an order that does not depend on where the
+    outline starts or which way it winds: equal outlines give the same Polygon bit for bit.
+    """
+    if isinstance(points, (str, bytes)):
+        raise InvalidValue(f"Polygon points must be a sequence of (x, y) pairs, got {points!r}")
     try:
         raw = list(points)
     except TypeError:
         raise InvalidValue(f"Polygon points must be a sequence of (x, y) pairs, got {points!r}") from None
+    # Name the bad value as the caller wrote it (a tuple stays a tuple); a one-shot iterator is
+    # shown as the list of what it gave.
+    shown = repr(points) if hasattr(points, "__len__") and hasattr(points, "__getitem__") else repr(raw)
     pts: list[tuple[float, float]] = []
     for i, p in enumerate(raw):
+        if isinstance(p, (str, bytes)):
+            raise InvalidValue(f"Polygon point {i} must be an (x, y) pair, got {p!r}")
         try:
             n = len(p)
         except TypeError:
             raise InvalidValue(f"Polygon point {i} must be an (x, y) pair, got {p!r}") from None
-        if n != 2 or isinstance(p, (str, bytes)):
+        if n != 2:
             raise InvalidValue(f"Polygon point {i} must be an (x, y) pair, got {p!r}")
-        pts.append((finite(f"Polygon point {i} x", p[0]), finite(f"Polygon point {i} y", p[1])))
+        # "+ 0.0" turns -0.0 into 0.0, so equal outlines are equal bit for bit.
+        x = finite(f"Polygon point {i} x", p[0]) + 0.0
+        y = finite(f"Polygon point {i} y", p[1]) + 0.0
+        if not math.isfinite(math.hypot(x, y)):
+            raise InvalidValue(
+                f"Polygon point {i} {p!r} is too far from the origin: its distance overflows float64"
+            )
+        pts.append((x, y))
 
     # Drop repeated points (consecutive ones, including the closing repeat of the first point).
     out: list[tuple[float, float]] = []
@@ -137,56 +196,75 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
     while len(out) > 1 and out[0] == out[-1]:
         out.pop()
     if len(set(out)) != len(out):
-        raise InvalidValue(f"Polygon outline visits a point twice, so it is not convex: {raw!r}")
+        raise InvalidValue(f"Polygon outline visits a point twice, so it is not convex: {shown}")
+    if len(out) < 3:
+        raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {shown}")
 
-    if len(out) >= 3:
-        x0, y0 = out[0]
-        ext = max(math.hypot(x - x0, y - y0) for x, y in out)
-        area2 = abs(sum(
-            (out[i][0] - x0) * (out[i + 1][1] - y0) - (out[i][1] - y0) * (out[i + 1][0] - x0)
-            for i in range(1, len(out) - 1)
-        ))
-        if area2 <= _COLLINEAR_SIN * ext * ext:
-            raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {raw!r}")
+    # Scale by a power of two so the largest coordinate is in [0.5, 1): exact, and no product
+    # below can overflow or lose a tiny polygon to underflow.
+    k = math.frexp(max(max(abs(x), abs(y)) for x, y in out))[1]
+    q = [(math.ldexp(x, -k), math.ldexp(y, -k)) for x, y in out]
+    xs, ys = [p[0] for p in q], [p[1] for p in q]
+    ext = max(max(xs) - min(xs), max(ys) - min(ys))
+    thr = _COLLINEAR_REL * ext + _ROUNDING * max(max(map(abs, xs)), max(map(abs, ys)))
+
+    # All points on one line (within thr of the line through the lexicographic extremes, which are
+    # the two ends when they are collinear). Not a signed-area test: a bow-tie's area cancels.
+    lo, hi = min(q), max(q)
+    lx, ly = hi[0] - lo[0], hi[1] - lo[1]
+    span = math.hypot(lx, ly)
+    if max(abs(_cross(lx, ly, x - lo[0], y - lo[1])) for x, y in q) <= thr * span:
+        raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {shown}")
 
     # Drop vertices where the outline runs straight on; a vertex where it doubles back is a spike.
-    changed = True
-    while changed and len(out) >= 3:
-        changed = False
-        for i in range(len(out)):
-            ax, ay = out[i - 1]
-            bx, by = out[i]
-            cx, cy = out[(i + 1) % len(out)]
+    # A vertex is degenerate when its triangle with its two neighbours is thinner than thr (the
+    # triangle's least height: twice its area over its longest side). The thinnest goes first, so
+    # the result does not depend on the starting point or the winding.
+    idx = list(range(len(out)))
+    while len(idx) >= 3:
+        best = None
+        for j in range(len(idx)):
+            ax, ay = q[idx[j - 1]]
+            bx, by = q[idx[j]]
+            cx, cy = q[idx[(j + 1) % len(idx)]]
             e1x, e1y, e2x, e2y = bx - ax, by - ay, cx - bx, cy - by
-            cross = e1x * e2y - e1y * e2x
-            if abs(cross) <= _COLLINEAR_SIN * math.hypot(e1x, e1y) * math.hypot(e2x, e2y):
-                if e1x * e2x + e1y * e2y < 0.0:
-                    raise InvalidValue(
-                        f"Polygon outline doubles back on itself at point {out[i]!r} "
-                        f"(a spike is not convex): {raw!r}"
-                    )
-                del out[i]
-                changed = True
-                break
-    if len(out) < 3:
-        raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {raw!r}")
+            side = max(math.hypot(e1x, e1y), math.hypot(e2x, e2y), math.hypot(cx - ax, cy - ay))
+            h = abs(_cross(e1x, e1y, e2x, e2y)) / side
+            key = (h, q[idx[j]])
+            if best is None or key < best[0]:
+                best = (key, j, e1x * e2x + e1y * e2y)
+        assert best is not None
+        (h, _), j, dot = best
+        if h > thr:
+            break
+        if dot < 0.0:
+            raise InvalidValue(
+                f"Polygon outline doubles back on itself at point {out[idx[j]]!r} "
+                f"(a spike is not convex): {shown}"
+            )
+        del idx[j]
+    if len(idx) < 3:
+        raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {shown}")
 
     # Convex: every turn has the same sign, and the outline turns once around (not a star).
+    n = len(idx)
     turns = []
-    for i in range(len(out)):
-        ax, ay = out[i - 1]
-        bx, by = out[i]
-        cx, cy = out[(i + 1) % len(out)]
+    for j in range(n):
+        ax, ay = q[idx[j - 1]]
+        bx, by = q[idx[j]]
+        cx, cy = q[idx[(j + 1) % n]]
         e1x, e1y, e2x, e2y = bx - ax, by - ay, cx - bx, cy - by
-        turns.append(math.atan2(e1x * e2y - e1y * e2x, e1x * e2x + e1y * e2y))
-    if not (all(t > 0 for t in turns) or all(t < 0 for t in turns)):
-        bad = next(
-            out[i] for i, t in enumerate(turns) if (t > 0) != (turns[0] > 0)
-        )
-        raise InvalidValue(f"Polygon is not convex (the outline turns the other way at {bad!r}): {raw!r}")
-    if abs(abs(sum(turns)) - 2.0 * math.pi) > 1e-6:
-        raise InvalidValue(f"Polygon outline winds around more than once, so it is not convex: {raw!r}")
+        turns.append(math.atan2(_cross(e1x, e1y, e2x, e2y), e1x * e2x + e1y * e2y))
+    same_sign = all(t > 0 for t in turns) or all(t < 0 for t in turns)
+    if not same_sign or abs(abs(sum(turns)) - 2.0 * math.pi) > 1e-6:
+        if _self_intersecting([q[i] for i in idx]):
+            raise InvalidValue(
+                f"Polygon outline crosses itself (self-intersecting), so it is not convex: {shown}"
+            )
+        bad = next((out[idx[j]] for j, t in enumerate(turns) if (t > 0) != (sum(turns) > 0)), out[idx[0]])
+        raise InvalidValue(f"Polygon is not convex (the outline turns the other way at {bad!r}): {shown}")
+    res = [out[i] for i in idx]
     if turns[0] < 0:
-        out.reverse()
-    start = min(range(len(out)), key=lambda i: (out[i][1], out[i][0]))
-    return tuple(out[start:] + out[:start])
+        res.reverse()
+    start = min(range(len(res)), key=lambda i: (res[i][1], res[i][0]))
+    return tuple(res[start:] + res[:start])

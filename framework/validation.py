@@ -23,7 +23,11 @@ def _as_float(name: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, Real):
         # numpy scalars are registered as numbers.Real; anything else is refused.
         raise InvalidValue(f"{name} must be a real number, got {value!r}")
-    return float(value)
+    try:
+        return float(value)
+    except (OverflowError, ValueError):
+        # An int or Fraction beyond float64's range (e.g. 10**400): not a finite float.
+        raise InvalidValue(f"{name} must be finite (within float64 range), got {value!r}") from None
 
 
 def finite(name: str, value: object) -> float:

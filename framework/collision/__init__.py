@@ -5,6 +5,8 @@ touching is not a collision; normals point from A toward B; grazing rays and swe
 """
 
 from .collide import collide
+from .ray import raycast
 from .results import Contact, Impact, RayHit, Vec2
+from .sweep import time_of_impact
 
-__all__ = ["Contact", "Impact", "RayHit", "Vec2", "collide"]
+__all__ = ["Contact", "Impact", "RayHit", "Vec2", "collide", "raycast", "time_of_impact"]

@@ -1,122 +1,205 @@
 """Pairwise overlap tests with contact normal, depth and point, for every pair of shape kinds.
 
-The overlap decision is made on exact-as-possible quantities (unnormalised edge normals, squared
-distances scaled by powers of two), so "touching is not a collision" holds exactly on integer and
-dyadic coordinates; only the winning axis is normalised afterwards.
-
 Depth is the penetration depth, i.e. the distance from the origin to the boundary of the Minkowski
 difference A - B. Its faces are A's faces and B's faces turned around, so for boxes and polygons
 the shortest push-out is found among those face normals: along an axis ``n`` B must move
 ``max(A.n) - min(B.n)`` forward, or ``max(B.n) - min(A.n)`` backward (the full push-out, also for a
 shape contained in the other, not the overlap of the two shadows).
+
+Numerics, in three layers:
+
+1. **A local frame.** Each pair is worked relative to one shape's position (A's; the polygon's for
+   a polygon-circle pair, whichever comes first), with shapes in their own local coordinates and
+   B's offset kept apart: a projection is ``u . local + u . offset``. So a scene at x = 1e9 gives
+   the answers of the scene at the origin, and swapping A and B gives bit-identical depths and
+   exactly negated normals.
+2. **A power-of-two scale.** The frame is scaled by ``2**-k`` so that the largest offset or
+   bounding radius is about 1. Scaling by a power of two is exact, so ordinary scenes get the
+   unscaled answers bit for bit, while radii of 1e-200 or 1e300 neither underflow nor overflow.
+3. **Exact arithmetic near touching.** Floats decide wherever the answer is clear by far more than
+   their rounding error. Inside a thin band around "touching" the decision is redone with exact
+   integers (every float is an integer times a power of two), so touching is never a collision and
+   an overlap of one ulp always is; the depth is then computed from the exact overlap, so it is
+   > 0 whenever a contact is returned.
 """
 
 from __future__ import annotations
 
 import math
 
-from ..shapes import AABB, Circle, Polygon, Shape
-from .placement import check_shape, outline, pose
+from ..shapes import Circle, Shape
+from ..validation import InvalidValue
+from .placement import check_shape, local_outline, pose
 from .results import Contact, Vec2
 from .tiebreak import pick
 
 __all__ = ["collide"]
 
 Pts = list[tuple[float, float]]
+# (nx, ny, depth, px, py) in the scaled local frame; the normal already points from A toward B.
+Res = tuple[float, float, float, float, float]
+# Exact values as (float, exponent) terms: each stands for float * 2**exponent.
+Terms = tuple[tuple[float, int], ...]
+
+# Half-width of the band, relative to the magnitudes involved, inside which the float result is not
+# trusted and the overlap is decided exactly. Float rounding is below 1e-15 of those magnitudes;
+# the band only has to be wider than that, and narrow enough to be rare.
+_BAND = 1e-13
+# Smallest positive float: the floor of an exactly-decided depth, so "depth > 0" holds even in
+# cases (an overlap far below the scene's resolution) where the division underflows.
+_TINY = 5e-324
 
 
 def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: object) -> Contact | None:
     """Contact of B against A, or ``None`` unless their interiors overlap (touching is no contact).
 
     The normal points from A toward B; moving B by ``normal * depth`` leaves them touching.
+    Transforms may be :class:`~framework.components.Transform` objects or ``(x, y[, rotation])``
+    tuples; bad shapes or non-finite transform fields raise ``ValueError`` naming the field.
     """
     check_shape("shape_a", shape_a)
     check_shape("shape_b", shape_b)
     ax, ay, ar = pose("transform_a", transform_a)
     bx, by, br = pose("transform_b", transform_b)
-    # Work relative to A's position: B's offset is the only large-magnitude subtraction.
-    dx, dy = bx - ax, by - ay
-    size = shape_a.bounding_radius + shape_b.bounding_radius
-    if isinstance(shape_a, Circle):
-        if isinstance(shape_b, Circle):
-            res = circle_circle(0.0, 0.0, shape_a.radius, dx, dy, shape_b.radius)
-        else:
-            # Computed as B against A, with the normal turned around to point from A to B.
-            res = polygon_circle(
-                outline(shape_b, dx, dy, br), 0.0, 0.0, shape_a.radius, size, flip=True
-            )
-    elif isinstance(shape_b, Circle):
-        res = polygon_circle(outline(shape_a, 0.0, 0.0, ar), dx, dy, shape_b.radius, size)
+    if isinstance(shape_a, Circle) and not isinstance(shape_b, Circle):
+        # Polygon-circle pairs are worked in the polygon's frame whichever comes first.
+        ox, oy = bx, by
+        found = _pair(shape_b, bx, by, br, shape_a, ax, ay, flip=True)
     else:
-        res = polygon_polygon(outline(shape_a, 0.0, 0.0, ar), outline(shape_b, dx, dy, br), size)
-    if res is None:
+        ox, oy = ax, ay
+        found = _pair(shape_a, ax, ay, ar, shape_b, bx, by, br)
+    if found is None:
         return None
-    nx, ny, depth, px, py = res
+    (nx, ny, depth, px, py), k = found
+    try:
+        depth = math.ldexp(depth, k)
+        px, py = ox + math.ldexp(px, k), oy + math.ldexp(py, k)
+    except OverflowError:
+        px = math.inf
+    if not (math.isfinite(depth) and math.isfinite(px) and math.isfinite(py)):
+        raise InvalidValue(
+            f"collide: the contact of {shape_a!r} at {(ax, ay)!r} and {shape_b!r} at {(bx, by)!r} "
+            "is beyond float64's range"
+        )
     # "+ 0.0" turns a -0.0 component into 0.0, so normals compare and print cleanly.
-    return Contact(Vec2(nx + 0.0, ny + 0.0), depth, Vec2(px + ax, py + ay))
+    return Contact(Vec2(nx + 0.0, ny + 0.0), depth, Vec2(px, py))
+
+
+def _pair(
+    sa: Shape, ox: float, oy: float, rot_a: float, sb: Shape, qx: float, qy: float, rot_b: float = 0.0,
+    flip: bool = False,
+) -> tuple[Res, int] | None:
+    """``sa`` at (ox, oy) against ``sb`` at (qx, qy): the result in ``sa``'s frame scaled by 2**-k.
+
+    With ``flip`` the caller's A is ``sb`` (a circle): normals are turned to point from it.
+    """
+    ra, rb = sa.bounding_radius, sb.bounding_radius
+    # Halves first: 0.5 * q - 0.5 * o never overflows, and halving is exact above the subnormals.
+    hx, hy = 0.5 * qx - 0.5 * ox, 0.5 * qy - 0.5 * oy
+    k = math.frexp(max(abs(hx), abs(hy), 0.5 * ra, 0.5 * rb))[1]
+    dx, dy = math.ldexp(hx, 1 - k), math.ldexp(hy, 1 - k)
+    # The exact offset (q - o) * 2**-k, as (value, exponent) terms for the exact fallback.
+    off = ((qx, -k), (ox, -k), (qy, -k), (oy, -k))
+    size = math.ldexp(ra, -k) + math.ldexp(rb, -k)
+    if isinstance(sa, Circle):
+        assert isinstance(sb, Circle)
+        res = circle_circle(math.ldexp(sa.radius, -k), math.ldexp(sb.radius, -k), dx, dy, off)
+    elif isinstance(sb, Circle):
+        res = polygon_circle(local_outline(sa, rot_a, k), dx, dy, math.ldexp(sb.radius, -k), off, size,
+                             flip)
+    else:
+        res = polygon_polygon(local_outline(sa, rot_a, k), local_outline(sb, rot_b, k), dx, dy, off, size)
+    return None if res is None else (res, k)
+
+
+# --- exact arithmetic -------------------------------------------------------------------------
+
+def _ints(*terms: tuple[float, int]) -> tuple[list[int], int]:
+    """Integers ``n_i`` and one exponent ``e`` with ``value_i * 2**shift_i == n_i * 2**e`` exactly."""
+    parts = []
+    for v, shift in terms:
+        num, den = v.as_integer_ratio()  # den is a power of two
+        parts.append((num, shift - den.bit_length() + 1))
+    e = min(p[1] for p in parts)
+    return [num << (q - e) for num, q in parts], e
+
+
+def _to_float(n: int, e: int) -> float:
+    """``n * 2**e`` as a float, to within 2**-63 relative; nonzero stays nonzero (bar underflow)."""
+    s = max(0, n.bit_length() - 64)
+    m = float(n >> s) if n >= 0 else -float((-n) >> s)
+    return math.ldexp(m, e + s)
+
+
+def _exact_offset(off: Terms, *more: tuple[float, int]) -> tuple[int, int, list[int], int]:
+    """The exact offset (as integers) and the extra terms ``more``, all over one exponent."""
+    n, e = _ints(*off, *more)
+    return n[0] - n[1], n[2] - n[3], n[4:], e
 
 
 # --- circle / circle -------------------------------------------------------------------------
 
 def circle_circle(
-    ax: float, ay: float, ra: float, bx: float, by: float, rb: float
-) -> tuple[float, float, float, float, float] | None:
-    """Circles at (ax, ay) and (bx, by): ``(nx, ny, depth, px, py)`` or ``None``."""
-    dx, dy = bx - ax, by - ay
+    ra: float, rb: float, dx: float, dy: float, off: Terms
+) -> Res | None:
+    """Circle A (radius ``ra``) at the origin, circle B (``rb``) at (dx, dy)."""
     rsum = ra + rb
-    # Compare squared lengths after scaling by a power of two (exact), so that neither huge nor
-    # tiny radii overflow or underflow, and integer touching stays exactly touching.
-    k = math.frexp(max(abs(dx), abs(dy), rsum))[1]
-    sx, sy, sr = math.ldexp(dx, -k), math.ldexp(dy, -k), math.ldexp(rsum, -k)
-    if sx * sx + sy * sy >= sr * sr:
+    d2, r2 = dx * dx + dy * dy, rsum * rsum
+    band = _BAND * (d2 + r2)
+    if d2 >= r2 + band:
         return None
     dist = math.hypot(dx, dy)
+    if d2 > r2 - band:
+        # Too close to touching for floats: decide on the exact |d|^2 < (ra + rb)^2, and take the
+        # depth from the exact (ra + rb)^2 - |d|^2 = depth * (ra + rb + |d|).
+        ex, ey, (era, erb), e = _exact_offset(off, (ra, 0), (rb, 0))
+        num = (era + erb) ** 2 - ex * ex - ey * ey
+        if num <= 0:
+            return None
+        depth = max(_to_float(num, 2 * e) / (rsum + dist), _TINY)
+    else:
+        depth = rsum - dist
     if dist > 0.0:
         nx, ny = dx / dist, dy / dist
     else:  # coincident centres: the direction is undefined, push up
         nx, ny = 0.0, 1.0
-    depth = rsum - dist
     # The overlap meets the centre line in [lo, hi] (distances from A's centre along n).
     lo = max(-ra, dist - rb)
     hi = min(ra, dist + rb)
     mid = 0.5 * (lo + hi)
-    return nx, ny, depth, ax + nx * mid, ay + ny * mid
+    return nx, ny, depth, nx * mid, ny * mid
 
 
 # --- polygon / circle ------------------------------------------------------------------------
 
 def polygon_circle(
-    poly: Pts, cx: float, cy: float, r: float, size: float, flip: bool = False
-) -> tuple[float, float, float, float, float] | None:
-    """Convex CCW polygon A against circle B at (cx, cy): ``(nx, ny, depth, px, py)`` or ``None``.
+    poly: Pts, cx: float, cy: float, r: float, off: Terms, size: float,
+    flip: bool = False,
+) -> Res | None:
+    """Convex CCW polygon A at the origin against circle B (radius ``r``) at (cx, cy).
 
-    With ``flip`` the normal points from the circle to the polygon (the circle is shape A).
+    With ``flip`` the normal points from the circle to the polygon (the circle is the caller's A).
     """
     f = -1.0 if flip else 1.0
     n = len(poly)
+    rp = max(math.hypot(x, y) for x, y in poly)
+    tol = _BAND * (abs(cx) + abs(cy) + rp + r)  # on distances
     seps = []  # unnormalised signed distances of the centre outside each face
-    inside = True
     for i in range(n):
         x0, y0 = poly[i]
         x1, y1 = poly[(i + 1) % n]
         ex, ey = x1 - x0, y1 - y0
-        s = ey * (cx - x0) - ex * (cy - y0)  # outward normal (ey, -ex) of a CCW outline
-        seps.append(s)
-        if s > 0.0:
-            inside = False
-    if inside:
+        seps.append(ey * (cx - x0) - ex * (cy - y0))  # outward normal (ey, -ex) of a CCW outline
+    if all(s <= 0.0 for s in seps):
         # Centre inside (or on the boundary): push out through the nearest face, plus the radius.
-        cands = []
-        for i in range(n):
-            x0, y0 = poly[i]
-            x1, y1 = poly[(i + 1) % n]
-            ex, ey = x1 - x0, y1 - y0
-            ln = math.hypot(ex, ey)
-            cands.append((r - seps[i] / ln, f * ey / ln, -f * ex / ln))
-        depth, nx, ny = pick(cands, size)
-        return nx, ny, depth, cx, cy
-    # Centre outside: the closest point of the polygon is on a face whose region holds the
-    # centre (s > 0 and the projection falls within the edge), or else it is a vertex.
+        cands = _inside_candidates(poly, seps, r, f)
+        if min(c[0] for c in cands) > tol:
+            depth, nx, ny = pick(cands, size)
+            return nx, ny, depth, cx, cy
+        return _polygon_circle_exact(poly, cx, cy, r, off, size, f)
+    # Centre outside: the closest point of the polygon is on a face whose region holds the centre
+    # (s > 0 and the projection falls within the edge), or else it is the nearest vertex.
+    dist = None
     for i in range(n):
         s = seps[i]
         if s <= 0.0:
@@ -127,67 +210,187 @@ def polygon_circle(
         e2 = ex * ex + ey * ey
         t = (cx - x0) * ex + (cy - y0) * ey
         if 0.0 <= t <= e2:
-            # distance = s / |e|; compare s^2 < r^2 |e|^2 after an exact power-of-two scaling.
-            k = math.frexp(max(s, r * math.sqrt(e2)))[1]
-            ss, sr = math.ldexp(s, -k), math.ldexp(r, -k)
-            if ss * ss >= sr * sr * e2:
-                return None
             ln = math.sqrt(e2)
             nx, ny = ey / ln, -ex / ln
             dist = s / ln
-            # Closest point on the face, found from the centre (no division by e2 needed).
-            return f * nx, f * ny, r - dist, cx - nx * dist, cy - ny * dist
-    best = None
-    for vx, vy in poly:
+            px, py = cx - nx * dist, cy - ny * dist  # closest point on the face
+            break
+    if dist is None:
+        # Squared distances in one frame (no per-vertex rescaling), so the nearest vertex wins.
+        vx, vy = min(poly, key=lambda v: (cx - v[0]) ** 2 + (cy - v[1]) ** 2)
         ddx, ddy = cx - vx, cy - vy
-        k = math.frexp(max(abs(ddx), abs(ddy), r))[1]
-        sx, sy, sr = math.ldexp(ddx, -k), math.ldexp(ddy, -k), math.ldexp(r, -k)
-        d2 = sx * sx + sy * sy
-        if best is None or d2 < best[0]:
-            best = (d2, sr * sr, vx, vy, ddx, ddy)
-    assert best is not None
-    d2, r2, vx, vy, ddx, ddy = best
-    if d2 >= r2:
+        dist = math.hypot(ddx, ddy)
+        nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, 1.0)
+        px, py = vx, vy
+    if dist == 0.0:
+        return _polygon_circle_exact(poly, cx, cy, r, off, size, f)
+    if dist >= r + tol:
         return None
+    if dist > r - tol:
+        return _polygon_circle_exact(poly, cx, cy, r, off, size, f)
+    return f * nx, f * ny, r - dist, px, py
+
+
+def _inside_candidates(poly: Pts, seps: list[float], r: float, f: float) -> list[tuple[float, float, float]]:
+    n = len(poly)
+    cands = []
+    for i in range(n):
+        x0, y0 = poly[i]
+        x1, y1 = poly[(i + 1) % n]
+        ex, ey = x1 - x0, y1 - y0
+        ln = math.hypot(ex, ey)
+        cands.append((r - seps[i] / ln, f * ey / ln, -f * ex / ln))
+    return cands
+
+
+def _polygon_circle_exact(
+    poly: Pts, cx: float, cy: float, r: float, off: Terms, size: float, f: float
+) -> Res | None:
+    """:func:`polygon_circle` decided on exact integers (for centres within rounding of touching)."""
+    n = len(poly)
+    ecx, ecy, rest, e = _exact_offset(off, (r, 0), *((c, 0) for p in poly for c in p))
+    er, pts = rest[0], [(rest[1 + 2 * i], rest[2 + 2 * i]) for i in range(n)]
+    seps = []
+    for i in range(n):
+        x0, y0 = pts[i]
+        x1, y1 = pts[(i + 1) % n]
+        seps.append((y1 - y0) * (ecx - x0) - (x1 - x0) * (ecy - y0))
+    if all(s <= 0 for s in seps):
+        # Inside or on the boundary: always an overlap (r > 0), depth r + distance to the face.
+        cands = _inside_candidates(poly, [_to_float(s, 2 * e) for s in seps], r, f)
+        depth, nx, ny = pick(cands, size)
+        return nx, ny, max(depth, _TINY), cx, cy
+    for i in range(n):
+        s = seps[i]
+        if s <= 0:
+            continue
+        x0, y0 = pts[i]
+        x1, y1 = pts[(i + 1) % n]
+        ex, ey = x1 - x0, y1 - y0
+        e2 = ex * ex + ey * ey
+        t = (ecx - x0) * ex + (ecy - y0) * ey
+        if 0 <= t <= e2:
+            # distance s / |e| < r  <=>  s^2 < r^2 |e|^2; depth = (r^2 |e|^2 - s^2) / (|e| (r |e| + s)).
+            num = er * er * e2 - s * s
+            if num <= 0:
+                return None
+            fx0, fy0 = poly[i]
+            fx1, fy1 = poly[(i + 1) % n]
+            fex, fey = fx1 - fx0, fy1 - fy0
+            ln = math.hypot(fex, fey)
+            fs = _to_float(s, 2 * e)
+            depth = max(_to_float(num, 4 * e) / (ln * (r * ln + fs)), _TINY)
+            nx, ny = fey / ln, -fex / ln
+            dist = fs / ln
+            return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
+    j = min(range(n), key=lambda i: (ecx - pts[i][0]) ** 2 + (ecy - pts[i][1]) ** 2)
+    d2 = (ecx - pts[j][0]) ** 2 + (ecy - pts[j][1]) ** 2
+    num = er * er - d2
+    if num <= 0:
+        return None
+    vx, vy = poly[j]
+    ddx, ddy = _to_float(ecx - pts[j][0], e), _to_float(ecy - pts[j][1], e)
     dist = math.hypot(ddx, ddy)
-    return f * ddx / dist, f * ddy / dist, r - dist, vx, vy
+    depth = max(_to_float(num, 2 * e) / (r + dist), _TINY)
+    return f * ddx / dist, f * ddy / dist, depth, vx, vy
 
 
 # --- polygon / polygon (AABBs are polygons here) ----------------------------------------------
 
-def polygon_polygon(pa: Pts, pb: Pts, size: float) -> tuple[float, float, float, float, float] | None:
-    """Convex CCW outlines A and B (same local frame): ``(nx, ny, depth, px, py)`` or ``None``."""
+def _edge(poly: Pts, i: int) -> tuple[float, float]:
+    """Outward normal (unnormalised: exact for dyadic input) of edge ``i`` of a CCW outline."""
+    x0, y0 = poly[i]
+    x1, y1 = poly[(i + 1) % len(poly)]
+    return y1 - y0, x0 - x1
+
+
+def _axes(pa: Pts, pb: Pts) -> list[tuple[int, int]]:
+    """The edges ``(0 for A / 1 for B, index)`` whose normals are the SAT axes.
+
+    An edge scaled away to nothing gives no axis; an axis equal or opposite to an earlier one
+    (a box's opposite sides) adds nothing, since both directions of every axis are tried.
+    """
+    edges = []
+    seen: set[tuple[float, float]] = set()
+    for which, poly in enumerate((pa, pb)):
+        for i in range(len(poly)):
+            ux, uy = _edge(poly, i)
+            if (ux == 0.0 and uy == 0.0) or (ux, uy) in seen or (-ux, -uy) in seen:
+                continue
+            seen.add((ux, uy))
+            edges.append((which, i))
+    return edges
+
+
+def _extent(poly: Pts, ux: float, uy: float) -> tuple[float, float]:
+    lo = hi = ux * poly[0][0] + uy * poly[0][1]
+    for x, y in poly:
+        p = ux * x + uy * y
+        if p < lo:
+            lo = p
+        elif p > hi:
+            hi = p
+    return lo, hi
+
+
+def polygon_polygon(
+    pa: Pts, lb: Pts, dx: float, dy: float, off: Terms, size: float
+) -> Res | None:
+    """Convex CCW outline A at the origin and B (outline ``lb`` about its own origin) at (dx, dy)."""
+    edges = _axes(pa, lb)
+    axes = [_edge(lb if which else pa, i) for which, i in edges]
+    mag = size + abs(dx) + abs(dy)
+    overlaps = []  # per axis: how far B must move forward (+u) and backward (-u), times |u|
+    borderline = False
+    for ux, uy in axes:
+        amin, amax = _extent(pa, ux, uy)
+        bmin, bmax = _extent(lb, ux, uy)
+        ud = ux * dx + uy * dy
+        fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
+        least = min(fwd, bwd)
+        tol = _BAND * (abs(ux) + abs(uy)) * mag
+        if least < -tol:
+            return None  # a separating axis, clear of rounding
+        if least <= tol:
+            borderline = True
+        overlaps.append((fwd, bwd))
+    if not axes:
+        return None  # both shapes vanish at this scale: two points apart
+    if borderline:
+        exact = _polygon_polygon_exact(pa, lb, off, edges)
+        if exact is None:
+            return None  # a separating axis (touching counts as separated)
+        overlaps = exact
     cands: list[tuple[float, float, float]] = []
-    for poly in (pa, pb):
-        n = len(poly)
-        for i in range(n):
-            x0, y0 = poly[i]
-            x1, y1 = poly[(i + 1) % n]
-            # Unnormalised axis (outward normal of this edge); exact for dyadic input.
-            ux, uy = y1 - y0, x0 - x1
-            amin = amax = ux * pa[0][0] + uy * pa[0][1]
-            for x, y in pa:
-                p = ux * x + uy * y
-                if p < amin:
-                    amin = p
-                elif p > amax:
-                    amax = p
-            bmin = bmax = ux * pb[0][0] + uy * pb[0][1]
-            for x, y in pb:
-                p = ux * x + uy * y
-                if p < bmin:
-                    bmin = p
-                elif p > bmax:
-                    bmax = p
-            if amax <= bmin or bmax <= amin:
-                return None  # a separating axis (touching counts as separated)
-            ln = math.hypot(ux, uy)
-            nx, ny = ux / ln, uy / ln
-            cands.append(((amax - bmin) / ln, nx, ny))
-            cands.append(((bmax - amin) / ln, -nx, -ny))
+    for (ux, uy), (fwd, bwd) in zip(axes, overlaps, strict=True):
+        ln = math.hypot(ux, uy)
+        nx, ny = ux / ln, uy / ln
+        cands.append((max(fwd / ln, _TINY), nx, ny))
+        cands.append((max(bwd / ln, _TINY), -nx, -ny))
     depth, nx, ny = pick(cands, size)
+    pb = [(x + dx, y + dy) for x, y in lb]
     px, py = overlap_point(pa, pb, nx, ny, depth, size)
     return nx, ny, depth, px, py
+
+
+def _polygon_polygon_exact(
+    pa: Pts, lb: Pts, off: Terms, edges: list[tuple[int, int]]
+) -> list[tuple[float, float]] | None:
+    """The SAT on exact integers: ``None`` if separated or touching, else the per-axis overlaps."""
+    ex, ey, rest, e = _exact_offset(off, *((c, 0) for p in pa + lb for c in p))
+    pts = [(rest[2 * i], rest[2 * i + 1]) for i in range(len(rest) // 2)]
+    ia, ib = pts[: len(pa)], pts[len(pa):]
+    out = []
+    for which, i in edges:
+        ux, uy = _edge(ib if which else ia, i)  # type: ignore[arg-type]
+        amin, amax = _extent(ia, ux, uy)  # type: ignore[arg-type]
+        bmin, bmax = _extent(ib, ux, uy)  # type: ignore[arg-type]
+        ud = ux * ex + uy * ey
+        fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
+        if fwd <= 0 or bwd <= 0:
+            return None
+        out.append((_to_float(fwd, 2 * e), _to_float(bwd, 2 * e)))
+    return out
 
 
 def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:

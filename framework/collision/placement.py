@@ -11,7 +11,7 @@ import math
 from ..shapes import AABB, Circle, Polygon, Shape
 from ..validation import InvalidValue, finite
 
-__all__ = ["pose", "outline", "check_shape"]
+__all__ = ["pose", "outline", "local_outline", "check_shape"]
 
 
 def check_shape(name: str, shape: object) -> Shape:
@@ -52,3 +52,20 @@ def outline(shape: AABB | Polygon, x: float, y: float, rotation: float) -> list[
         return [(px + x, py + y) for px, py in shape.points]
     c, s = math.cos(rotation), math.sin(rotation)
     return [(c * px - s * py + x, s * px + c * py + y) for px, py in shape.points]
+
+
+def local_outline(shape: AABB | Polygon, rotation: float, k: int = 0) -> list[tuple[float, float]]:
+    """Outline (counter-clockwise) of a box or polygon about its own hitbox origin, rotated, and
+    scaled by ``2**-k`` (exact, bar underflow) before rotating so that nothing overflows.
+
+    AABBs ignore ``rotation``. A query that scales its whole scene by the same power of two gets
+    the answers of the unscaled scene bit for bit, without overflow or underflow at the extremes.
+    """
+    if isinstance(shape, AABB):
+        hw, hh = math.ldexp(shape.width, -1 - k), math.ldexp(shape.height, -1 - k)
+        return [(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)]
+    pts = [(math.ldexp(px, -k), math.ldexp(py, -k)) for px, py in shape.points]
+    if rotation == 0.0:
+        return pts
+    c, s = math.cos(rotation), math.sin(rotation)
+    return [(c * px - s * py, s * px + c * py) for px, py in pts]

@@ -1,0 +1,105 @@
+"""Collision events: ``started``, ``ongoing`` and ``ended``, one record per pair and step.
+
+A pair is named by its two entities, smaller id first (``a < b``); the normal points from ``a``
+toward ``b``. ``started`` is the first step of an overlap, ``ongoing`` every later step of it,
+``ended`` the first step without it (also when either entity was despawned); an ``ended`` event
+carries the contact of the last step the pair overlapped.
+
+The tracker keeps the active pairs as a sorted array of int64 keys ``a << 32 | b`` so a step's
+bookkeeping is a couple of vectorised set operations, whatever the number of pairs.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, NamedTuple
+
+import numpy as np
+
+from .collision.results import Vec2
+
+__all__ = ["CollisionEvent", "PairTracker", "STARTED", "ONGOING", "ENDED"]
+
+STARTED: Literal["started"] = "started"
+ONGOING: Literal["ongoing"] = "ongoing"
+ENDED: Literal["ended"] = "ended"
+
+
+class CollisionEvent(NamedTuple):
+    """One pair's collision state change in one step."""
+
+    kind: Literal["started", "ongoing", "ended"]
+    a: int
+    b: int
+    normal: Vec2  # unit, from a toward b
+    depth: float
+    point: Vec2
+
+    def flipped(self) -> CollisionEvent:
+        """The same event seen from ``b``: entities swapped, normal negated."""
+        return CollisionEvent(
+            self.kind, self.b, self.a, Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0), self.depth, self.point
+        )
+
+
+class StepContacts(NamedTuple):
+    """This step's overlapping pairs as arrays (entity ids, a < b), sorted by (a, b)."""
+
+    a: np.ndarray
+    b: np.ndarray
+    nx: np.ndarray
+    ny: np.ndarray
+    depth: np.ndarray
+    px: np.ndarray
+    py: np.ndarray
+
+    @classmethod
+    def empty(cls) -> StepContacts:
+        z = np.zeros(0)
+        i = np.zeros(0, dtype=np.int64)
+        return cls(i, i, z, z, z, z, z)
+
+    def take(self, idx: np.ndarray) -> StepContacts:
+        return StepContacts(*(arr[idx] for arr in self))
+
+
+def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return (a.astype(np.int64) << 32) | b.astype(np.int64)
+
+
+class PairTracker:
+    """Turns each step's overlapping pairs into started / ongoing / ended events."""
+
+    def __init__(self) -> None:
+        self.active = StepContacts.empty()
+        self.keys = np.zeros(0, dtype=np.int64)
+
+    def update(self, now: StepContacts) -> tuple[np.ndarray, np.ndarray, StepContacts]:
+        """Record this step's pairs; return (started mask over ``now``, ongoing mask, ended pairs)."""
+        keys = pair_keys(now.a, now.b)
+        was = np.isin(keys, self.keys, assume_unique=True)
+        gone = ~np.isin(self.keys, keys, assume_unique=True)
+        ended = self.active.take(np.flatnonzero(gone))
+        self.active, self.keys = now, keys
+        return ~was, was, ended
+
+    def forget(self) -> StepContacts:
+        """End every active pair (the scene is closing); return them."""
+        ended, self.active, self.keys = self.active, StepContacts.empty(), np.zeros(0, dtype=np.int64)
+        return ended
+
+
+def to_events(
+    contacts: StepContacts, started: np.ndarray, ongoing: np.ndarray, ended: StepContacts
+) -> list[CollisionEvent]:
+    """Event records, sorted by pair (a, b), then ended before started before ongoing."""
+    out: list[tuple[int, int, int, CollisionEvent]] = []
+    for group, kind, order in ((ended, ENDED, 0), (contacts, None, 1)):
+        if len(group.a) == 0:
+            continue
+        cols = [arr.tolist() for arr in group]
+        st = started.tolist() if kind is None else None
+        for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
+            k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
+            out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py))))
+    out.sort(key=lambda t: (t[0], t[1], t[2]))
+    return [t[3] for t in out]

@@ -1,0 +1,596 @@
+"""The scene: one esper world, its columnar store and the collision pipeline that steps it.
+
+A step runs, in this order: movement (integrate Velocity, optional gravity) -> continuous
+detection (only for ``ccd`` bodies) -> broad phase -> narrow phase (contacts and events) ->
+response -> render (only with a renderer attached). Game code adds its own systems before or after
+any stage with :meth:`Scene.add_system`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Callable, Iterable
+from typing import Any, NamedTuple
+
+import esper
+import numpy as np
+
+from .collision import batch
+from .collision.broad_phase import SpatialHash
+from .collision.placement import check_shape
+from .collision.ray import raycast as _raycast
+from .collision.results import RayHit, Vec2
+from .components import Body, Hitbox, Transform, Velocity
+from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, to_events
+from .shapes import AABB, Circle
+from .store import STATIC, BodyStore
+from .systems.ccd import sweep_ccd_bodies
+from .systems.geometry import Geometry
+from .systems.movement import integrate
+from .systems.narrow_phase import filter_layers, pair_contacts
+from .systems.response import resolve
+from .validation import InvalidValue, finite, positive, vector2
+
+__all__ = ["Scene", "SceneClosed", "SceneHit", "STAGES"]
+
+STAGES = ("movement", "ccd", "broad_phase", "narrow_phase", "response", "render")
+_ALL_BITS = 0xFFFFFFFF
+_scene_ids = itertools.count(1)
+_NO_SUPPORT = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0))
+
+System = Callable[["Scene", float], Any]
+
+
+class SceneClosed(RuntimeError, ValueError):
+    """The scene was closed; it can no longer be stepped or changed."""
+
+
+class SceneHit(NamedTuple):
+    """A scene raycast hit: the entity, and where and how the ray entered its hitbox."""
+
+    entity: int
+    distance: float
+    point: Vec2
+    normal: Vec2
+
+
+class Scene:
+    """An isolated world of entities and the systems that step it.
+
+    ``gravity``: acceleration of dynamic bodies (world units per second squared, y up).
+    ``cell_size``: the spatial hash's cell; ``None`` chooses it from the hitbox sizes.
+    ``response_iterations``: passes of the response over bodies in several contacts (accuracy
+    knob: more passes settle stacks and corners better).
+    """
+
+    def __init__(
+        self,
+        *,
+        gravity: tuple[float, float] = (0.0, 0.0),
+        cell_size: float | None = None,
+        response_iterations: int = 4,
+    ) -> None:
+        self.gravity = vector2("Scene gravity", gravity)
+        if cell_size is not None:
+            cell_size = positive("Scene cell_size", cell_size)
+        if isinstance(response_iterations, bool) or not isinstance(response_iterations, int) \
+                or response_iterations < 1:
+            raise InvalidValue(f"Scene response_iterations must be an int >= 1, got {response_iterations!r}")
+        self.response_iterations = response_iterations
+        self.world = f"framework.scene.{next(_scene_ids)}"
+        self.store = BodyStore()
+        self.geometry = Geometry()
+        self.hash = SpatialHash(cell_size)
+        self.tracker = PairTracker()
+        self.renderer: Any = None
+        self.closed = False
+        self.frame = 0
+        self.time = 0.0
+        self.counters: dict[str, Any] = {}
+        self.stage_ms: dict[str, float] = {}
+        self._systems: dict[tuple[str, str], list[System]] = {}
+        self._handlers: list[tuple[type, type, Callable[..., Any], frozenset[str]]] = []
+        self._stepping = False
+        self._pending_despawn: list[int] = []
+        self._ghosts: dict[int, set[type]] = {}
+        self._contacts = StepContacts.empty()
+        self._started = np.zeros(0, dtype=bool)
+        self._ended = StepContacts.empty()
+        self._events: list[CollisionEvent] | None = []
+        self._support = _NO_SUPPORT
+        self._row_lookup = np.zeros(1, dtype=np.int64)
+        self._lookup_version = -1
+        esper.switch_world(self.world)
+
+    # --- entities ----------------------------------------------------------------------------
+
+    def _activate(self) -> None:
+        if self.closed:
+            raise SceneClosed(f"scene {self.world!r} is closed")
+        if esper.current_world != self.world:
+            esper.switch_world(self.world)
+
+    def spawn(self, *components: Any) -> int:
+        """Create an entity with ``components``; return its id.
+
+        A Hitbox needs a Transform; a static body has no Velocity. Nothing changes on error."""
+        self._activate()
+        kinds: dict[type, Any] = {}
+        for comp in components:
+            if type(comp) in kinds:
+                raise InvalidValue(f"spawn got two {type(comp).__name__} components: {components!r}")
+            kinds[type(comp)] = comp
+        t, v, h = kinds.get(Transform), kinds.get(Velocity), kinds.get(Hitbox)
+        for comp in (t, v, h):
+            if comp is not None and comp._store is not None:
+                raise InvalidValue(f"{comp!r} already belongs to an entity; give each entity its own")
+        if h is not None and t is None:
+            raise InvalidValue("an entity with a Hitbox needs a Transform")
+        if h is not None and h.body is Body.STATIC and v is not None:
+            raise InvalidValue("a static body never moves: give it no Velocity (or make it kinematic)")
+        if v is not None and t is None:
+            raise InvalidValue("an entity with a Velocity needs a Transform")
+        entity = esper.create_entity(*components)
+        if t is not None:
+            self.store.add(entity, t, v, h)
+        return entity
+
+    def despawn(self, entity: int) -> None:
+        """Remove ``entity``; its pairs end (``ended`` events) in the next step's events.
+
+        During a step (from a system or a handler) the removal waits until the step ends."""
+        self._activate()
+        if not esper.entity_exists(entity) or entity in self._pending_despawn:
+            raise InvalidValue(f"entity {entity!r} does not exist (despawned already?)")
+        if self._stepping:
+            self._pending_despawn.append(entity)
+        else:
+            self._remove(entity)
+
+    def _remove(self, entity: int) -> None:
+        comps = esper.components_for_entity(entity)
+        self._ghosts[entity] = {type(c) for c in comps}
+        if entity in self.store.row_of:
+            self.store.remove(entity, comps)
+        esper.delete_entity(entity, immediate=True)
+
+    def exists(self, entity: int) -> bool:
+        self._activate()
+        return esper.entity_exists(entity) and entity not in self._pending_despawn
+
+    def add_component(self, entity: int, component: Any) -> None:
+        """Add (or replace) a component of ``entity``, keeping the pipeline's view in step."""
+        self._activate()
+        if not esper.entity_exists(entity):
+            raise InvalidValue(f"entity {entity!r} does not exist")
+        store = self.store
+        has_t = entity in store.row_of
+        if isinstance(component, Transform):
+            raise InvalidValue("a Transform is given at spawn and edited in place; it cannot be replaced")
+        if isinstance(component, (Velocity, Hitbox)):
+            if not has_t:
+                raise InvalidValue(f"entity {entity} has no Transform")
+            if component._store is not None:
+                raise InvalidValue(f"{component!r} already belongs to an entity")
+            hb = component if isinstance(component, Hitbox) else esper.try_component(entity, Hitbox)
+            has_v = isinstance(component, Velocity) or esper.has_component(entity, Velocity)
+            if hb is not None and hb.body is Body.STATIC and has_v:
+                raise InvalidValue("a static body never moves: give it no Velocity")
+        esper.add_component(entity, component)
+        if isinstance(component, Velocity):
+            store.set_velocity(entity, component)
+        elif isinstance(component, Hitbox):
+            store.set_hitbox(entity, component)
+
+    def remove_component(self, entity: int, component_type: type) -> Any:
+        self._activate()
+        if component_type is Transform:
+            raise InvalidValue("remove the entity instead of its Transform")
+        comp = esper.remove_component(entity, component_type)
+        if component_type is Velocity and entity in self.store.row_of:
+            self.store.set_velocity(entity, None)
+            comp._own = [comp._get(i) for i in range(3)] if comp._store else comp._own
+        elif component_type is Hitbox and entity in self.store.row_of:
+            self.store.set_hitbox(entity, None)
+            object.__setattr__(comp, "_store", None)
+        return comp
+
+    def get(self, entity: int, component_type: type) -> Any:
+        """The ``component_type`` component of ``entity`` (KeyError if it has none)."""
+        self._activate()
+        return esper.component_for_entity(entity, component_type)
+
+    def try_get(self, entity: int, component_type: type) -> Any:
+        self._activate()
+        return esper.try_component(entity, component_type)
+
+    def query(self, *component_types: type) -> list[tuple[int, Any]]:
+        """``esper.get_components`` in this scene's world, sorted by entity id."""
+        self._activate()
+        if len(component_types) == 1:
+            return sorted(esper.get_component(component_types[0]), key=lambda ec: ec[0])
+        return sorted(esper.get_components(*component_types), key=lambda ec: ec[0])
+
+    @property
+    def entities(self) -> list[int]:
+        self._activate()
+        return sorted(esper.get_entities())
+
+    # --- systems and handlers ----------------------------------------------------------------
+
+    def add_system(self, system: System, *, before: str | None = None, after: str | None = None) -> None:
+        """Run ``system(scene, dt)`` every step, before or after a stage (default: after response)."""
+        if before is not None and after is not None:
+            raise InvalidValue("give either before= or after=, not both")
+        where = ("after", "response") if before is None and after is None else (
+            ("before", before) if before is not None else ("after", after))
+        if where[1] not in STAGES:
+            raise InvalidValue(f"unknown stage {where[1]!r}; stages are {STAGES}")
+        if not callable(system):
+            raise InvalidValue(f"system must be callable as system(scene, dt), got {system!r}")
+        self._systems.setdefault(where, []).append(system)
+
+    def remove_system(self, system: System) -> None:
+        for lst in self._systems.values():
+            if system in lst:
+                lst.remove(system)
+                return
+        raise InvalidValue(f"system {system!r} is not in this scene")
+
+    def on_collision(
+        self, type_a: type, type_b: type, handler: Callable[[Scene, CollisionEvent], Any],
+        kinds: Iterable[str] = ("started",),
+    ) -> None:
+        """Call ``handler(scene, event)`` for collision events between an entity with a ``type_a``
+        component and one with a ``type_b`` component. The event is turned so that ``event.a``
+        is the ``type_a`` entity (its normal then points from it toward the ``type_b`` one)."""
+        ks = frozenset(kinds)
+        if not ks <= {"started", "ongoing", "ended"}:
+            raise InvalidValue(f"kinds must be among 'started', 'ongoing', 'ended', got {sorted(ks)!r}")
+        self._handlers.append((type_a, type_b, handler, ks))
+
+    # --- stepping ----------------------------------------------------------------------------
+
+    def step(self, dt: float) -> None:
+        """Advance the scene by ``dt`` seconds (finite, > 0).
+
+        A component holding NaN, inf or a non-number makes this raise ``ValueError`` naming the
+        entity and the field, before anything changes."""
+        self._activate()
+        dt = positive("dt", dt)
+        self.store.check()
+        store = self.store
+        self._stepping = True
+        self.counters = counters = {"systems": [], "integrated": 0, "rehashed": 0, "candidate_pairs": 0,
+                                    "narrow_tests": {}, "contacts": 0, "events": 0, "resolved": 0,
+                                    "ccd_stopped": 0}
+        self.stage_ms = {}
+        try:
+            store.apply_hitbox_changes()
+            for stage in STAGES:
+                self._run_hooks("before", stage, dt)
+                t0 = time.perf_counter()
+                ran = getattr(self, "_stage_" + stage)(dt)
+                if ran:
+                    counters["systems"].append(stage)
+                    self.stage_ms[stage] = (time.perf_counter() - t0) * 1e3
+                self._run_hooks("after", stage, dt)
+            self._dispatch()
+        finally:
+            self._stepping = False
+            pending, self._pending_despawn = self._pending_despawn, []
+            for e in pending:
+                if esper.entity_exists(e):
+                    self._remove(e)
+        self.frame += 1
+        self.time += dt
+
+    def _run_hooks(self, when: str, stage: str, dt: float) -> None:
+        for system in self._systems.get((when, stage), ()):
+            system(self, dt)
+
+    def _stage_movement(self, dt: float) -> bool:
+        store = self.store
+        ccd = np.flatnonzero(store.ccd & store.has_vel & (store.body != STATIC))
+        self._ccd_rows = ccd
+        self._ccd_start = (store.x[ccd].copy(), store.y[ccd].copy())
+        rows = integrate(store, dt, self.gravity)
+        self.counters["integrated"] = int(rows.size)
+        return True
+
+    def _stage_ccd(self, dt: float) -> bool:
+        store, geom = self.store, self.geometry
+        geom.update(store)
+        rows = self._ccd_rows
+        if rows.size == 0 or rows.max() >= store.n:
+            return False
+        self._sync_static()
+        stopped = sweep_ccd_bodies(
+            store, geom, rows, *self._ccd_start, self._static_entities_in_box, self.counters
+        )
+        self.counters["ccd_stopped"] = stopped
+        if stopped:
+            geom.update(store)
+        return True
+
+    def _static_entities_in_box(self, minx: float, miny: float, maxx: float, maxy: float) -> list[int]:
+        ids = self.hash.query_box(minx, miny, maxx, maxy)
+        rows = self._rows_of(ids)
+        rows = rows[rows >= 0]
+        return rows[self.store.body[rows] == STATIC].tolist()
+
+    def _rows_of(self, entities: np.ndarray) -> np.ndarray:
+        store = self.store
+        if self._lookup_version != store.version or self._row_lookup.size <= (
+                int(store.entity.max()) if store.n else 0):
+            size = (int(store.entity.max()) + 1) if store.n else 1
+            lut = np.full(size, -1, dtype=np.int64)
+            lut[store.entity] = np.arange(store.n)
+            self._row_lookup, self._lookup_version = lut, store.version
+        entities = np.asarray(entities, dtype=np.int64)
+        out = np.full(entities.size, -1, dtype=np.int64)
+        ok = entities < self._row_lookup.size
+        out[ok] = self._row_lookup[entities[ok]]
+        return out
+
+    def _sync_static(self) -> None:
+        store, geom = self.store, self.geometry
+        if not store.static_dirty:
+            return
+        rows = np.flatnonzero((store.kind >= 0) & (store.body == STATIC))
+        self.hash.set_static(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
+                             store.entity[rows])
+        self.counters["rehashed"] = self.counters.get("rehashed", 0) + int(rows.size)
+        store.static_dirty = False
+        store.moved_static.clear()
+
+    def _stage_broad_phase(self, dt: float) -> bool:
+        store, geom = self.store, self.geometry
+        if geom.version != store.version or not hasattr(geom, "minx") or geom.minx.size != store.n:
+            geom.update(store)
+        self._sync_static()
+        moving = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
+        ea, eb = self.hash.pairs(geom.minx[moving], geom.miny[moving], geom.maxx[moving],
+                                 geom.maxy[moving], store.entity[moving])
+        self.counters["rehashed"] += int(moving.size)
+        ra, rb = self._rows_of(ea), self._rows_of(eb)
+        keep = filter_layers(store, ra, rb)
+        self._pairs = (ea[keep], eb[keep], ra[keep], rb[keep])
+        self.counters["candidate_pairs"] = int(keep.sum())
+        return True
+
+    def _stage_narrow_phase(self, dt: float) -> bool:
+        ea, eb, ra, rb = self._pairs
+        res = pair_contacts(self.store, self.geometry, ra, rb, self.counters["narrow_tests"])
+        h = np.flatnonzero(res.hit)
+        self._contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
+        self._contact_rows = (ra[h], rb[h])
+        self._started, _ongoing, self._ended = self.tracker.update(self._contacts)
+
+        self._events = None
+        self.counters["contacts"] = int(h.size)
+        self.counters["events"] = int(h.size + self._ended.a.size)
+        return True
+
+    def _stage_response(self, dt: float) -> bool:
+        store = self.store
+        c = self._contacts
+        # This step's contacts, plus the pairs the response resolved last step that no longer
+        # overlap: bodies resting on each other fall by the same amount and merely touch, and
+        # overlap again once the body below is pushed up (see response.resolve).
+        sa, sb, snx, sny = self._support
+        old = ~np.isin(pair_keys(sa, sb), pair_keys(c.a, c.b))
+        sra, srb = self._rows_of(sa[old]), self._rows_of(sb[old])
+        live = (sra >= 0) & (srb >= 0)
+        ra = np.concatenate([self._contact_rows[0], sra[live]])
+        rb = np.concatenate([self._contact_rows[1], srb[live]])
+        ents_a = np.concatenate([c.a, sa[old][live]])
+        ents_b = np.concatenate([c.b, sb[old][live]])
+        nx, ny = np.concatenate([c.nx, snx[old][live]]), np.concatenate([c.ny, sny[old][live]])
+        depth = np.concatenate([c.depth, np.zeros(int(live.sum()))])
+        alive0 = np.arange(ra.size) < c.a.size
+        self._support = _NO_SUPPORT
+        if ra.size and ra.max() >= store.n:  # rows spawned mid-step are not in this step
+            return False
+        solid = ~(store.sensor[ra] | store.sensor[rb]) & ((store.inv_mass[ra] > 0) | (store.inv_mass[rb] > 0))
+        idx = np.flatnonzero(solid)
+        if idx.size == 0:
+            return True
+        geom = self.geometry
+
+        def recompute(a: np.ndarray, b: np.ndarray):
+            if not (store.ox.any() or store.oy.any()):
+                geom.hx, geom.hy = store.x, store.y
+            else:
+                geom.update(store)
+            r = pair_contacts(store, geom, a, b)
+            return r.hit, r.nx, r.ny, r.depth
+
+        done = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self.gravity,
+                       self.response_iterations, recompute, alive0[idx])
+        keep = idx[done]
+        self._support = (ents_a[keep], ents_b[keep], nx[keep], ny[keep])
+        self.counters["resolved"] = int(done.sum())
+        return True
+
+    def _stage_render(self, dt: float) -> bool:
+        if self.renderer is None:
+            return False
+        self.renderer.draw(self)
+        return True
+
+    # --- events ------------------------------------------------------------------------------
+
+    @property
+    def events(self) -> list[CollisionEvent]:
+        """This step's collision events, sorted by pair (a, b): ended, then started or ongoing."""
+        if self._events is None:
+            self._events = to_events(self._contacts, self._started, ~self._started, self._ended)
+        return self._events
+
+    @property
+    def contacts(self) -> StepContacts:
+        """This step's overlapping pairs as arrays (entity ids a < b, normal from a to b)."""
+        return self._contacts
+
+    def _dispatch(self) -> None:
+        if not self._handlers:
+            self._ghosts.clear()
+            return
+        events = self.events
+        if not events:
+            self._ghosts.clear()
+            return
+        ghosts = self._ghosts
+
+        def has(e: int, t: type) -> bool:
+            if e in ghosts:
+                return t in ghosts[e]
+            return esper.has_component(e, t)
+
+        for ev in events:
+            for ta, tb, handler, ks in self._handlers:
+                if ev.kind not in ks:
+                    continue
+                if has(ev.a, ta) and has(ev.b, tb):
+                    handler(self, ev)
+                elif has(ev.b, ta) and has(ev.a, tb):
+                    handler(self, ev.flipped())
+        self._ghosts = {}
+
+    # --- queries -----------------------------------------------------------------------------
+
+    def _candidate_rows(self, minx: float, miny: float, maxx: float, maxy: float) -> np.ndarray:
+        """Rows whose current bounds strictly meet the box: statics via the hash, moving bodies by
+        one vectorised test over their current bounds."""
+        store, geom = self.store, self.geometry
+        geom.update(store)
+        self._sync_static()
+        st = self._rows_of(self.hash.query_box(minx, miny, maxx, maxy))
+        st = st[(st >= 0)]
+        st = st[store.body[st] == STATIC]
+        mv = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
+        hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)
+        return np.concatenate([st, mv[hit]])
+
+    def _mask_ok(self, rows: np.ndarray, mask: int) -> np.ndarray:
+        return rows[(self.store.layer[rows] & mask) != 0]
+
+    def raycast_all(
+        self, origin: tuple[float, float], direction: tuple[float, float], max_distance: float = math.inf,
+        mask: int = _ALL_BITS,
+    ) -> list[SceneHit]:
+        """Every hitbox the ray enters within ``max_distance``, nearest first (ties by entity)."""
+        self._activate()
+        ox, oy = vector2("origin", origin)
+        dx, dy = vector2("direction", direction)
+        if dx == 0.0 and dy == 0.0:
+            raise InvalidValue(f"direction must not be zero, got {direction!r}")
+        md = float(max_distance) if not isinstance(max_distance, bool) else math.nan
+        if not md >= 0.0:
+            raise InvalidValue(f"max_distance must be >= 0, got {max_distance!r}")
+        ln = math.hypot(dx, dy)
+        reach = md if math.isfinite(md) else self._world_extent(ox, oy)
+        ex, ey = ox + dx / ln * reach, oy + dy / ln * reach
+        rows = self._candidate_rows(min(ox, ex) - 1e-9, min(oy, ey) - 1e-9, max(ox, ex) + 1e-9,
+                                    max(oy, ey) + 1e-9)
+        rows = self._mask_ok(rows, mask)
+        hits = []
+        geom, store = self.geometry, self.store
+        for r in rows.tolist():
+            hb = store.hitboxes[r]
+            hit = _raycast(hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
+                           (ox, oy), (dx, dy), md)
+            if hit is not None:
+                hits.append(SceneHit(int(store.entity[r]), *hit))
+        hits.sort(key=lambda h: (h.distance, h.entity))
+        return hits
+
+    def raycast(self, origin: tuple[float, float], direction: tuple[float, float],
+                max_distance: float = math.inf, mask: int = _ALL_BITS) -> SceneHit | None:
+        """The first hitbox the ray enters within ``max_distance``, or ``None``."""
+        hits = self.raycast_all(origin, direction, max_distance, mask)
+        return hits[0] if hits else None
+
+    def _world_extent(self, ox: float, oy: float) -> float:
+        g = self.geometry
+        g.update(self.store)
+        if self.store.n == 0:
+            return 1.0
+        far = max(abs(float(g.minx.min()) - ox), abs(float(g.maxx.max()) - ox),
+                  abs(float(g.miny.min()) - oy), abs(float(g.maxy.max()) - oy))
+        return 2.0 * far + 1.0
+
+    def query_box(self, minx: float, miny: float, maxx: float, maxy: float, mask: int = _ALL_BITS) -> list[int]:
+        """Entities whose hitbox interiors overlap the box's interior, sorted."""
+        self._activate()
+        x0, y0, x1, y1 = (finite(n, v) for n, v in zip(("minx", "miny", "maxx", "maxy"), (minx, miny, maxx, maxy)))
+        if not (x1 > x0 and y1 > y0):
+            raise InvalidValue(f"query_box needs maxx > minx and maxy > miny, got {(minx, miny, maxx, maxy)!r}")
+        box = AABB(x1 - x0, y1 - y0)
+        return self._overlapping(box, ((x0 + x1) * 0.5, (y0 + y1) * 0.5), mask, (x0, y0, x1, y1))
+
+    def query_point(self, x: float, y: float, mask: int = _ALL_BITS) -> list[int]:
+        """Entities whose hitbox contains the point (closed: a point on the boundary counts)."""
+        self._activate()
+        px, py = finite("x", x), finite("y", y)
+        rows = self._mask_ok(self._candidate_rows(px - 1e-9, py - 1e-9, px + 1e-9, py + 1e-9), mask)
+        out = []
+        for r in rows.tolist():
+            if self._contains(r, px, py):
+                out.append(int(self.store.entity[r]))
+        return sorted(out)
+
+    def _contains(self, r: int, px: float, py: float) -> bool:
+        store, geom = self.store, self.geometry
+        hb = store.hitboxes[r]
+        dx, dy = px - float(geom.hx[r]), py - float(geom.hy[r])
+        shape = hb.shape
+        if isinstance(shape, Circle):
+            return dx * dx + dy * dy <= shape.radius * shape.radius
+        verts, count = geom.outlines(store, np.array([r]))
+        pts = verts[0, : int(count[0])]
+        for i in range(len(pts)):
+            x0, y0 = pts[i]
+            x1, y1 = pts[(i + 1) % len(pts)]
+            if (x1 - x0) * (dy - y0) - (y1 - y0) * (dx - x0) < 0.0:
+                return False
+        return True
+
+    def _overlapping(self, shape: Any, center: tuple[float, float], mask: int, box: tuple) -> list[int]:
+        rows = self._mask_ok(self._candidate_rows(*box), mask)
+        store, geom = self.store, self.geometry
+        check_shape("shape", shape)
+        if rows.size == 0:
+            return []
+        shapes_b = [store.hitboxes[r].shape for r in rows.tolist()]
+        poses_b = list(zip(geom.hx[rows].tolist(), geom.hy[rows].tolist(), store.rot[rows].tolist()))
+        res = batch.collide_many([shape] * rows.size, [center] * rows.size, shapes_b, poses_b)
+        return sorted(int(e) for e in store.entity[rows[res.hit]])
+
+    # --- lifetime ----------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Delete the scene's world. Further calls raise :class:`SceneClosed`."""
+        if self.closed:
+            return
+        if esper.current_world == self.world:
+            esper.switch_world("default")
+        if self.world in esper.list_worlds():
+            esper.delete_world(self.world)
+        self.closed = True
+
+    def __enter__(self) -> Scene:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:  # pragma: no cover - best effort
+        try:
+            if not self.closed and self.world in esper.list_worlds() and esper.current_world != self.world:
+                esper.delete_world(self.world)
+        except Exception:
+            pass

@@ -1,0 +1,251 @@
+"""The columnar store: one row per entity with a Transform, hot fields in numpy columns.
+
+The pipeline reads and writes whole columns; :class:`~framework.components.Transform` and
+:class:`~framework.components.Velocity` objects are views of a row, so game code's ``t.x += 1``
+and the systems see the same number without any gathering or writing back.
+
+Rows are packed: despawning moves the last row into the hole. Components find their row through
+their entity id, so nothing needs rebinding. A value that is not a real number (``None``, a
+string) cannot live in a float column: it is kept aside, the column holds NaN, and the next step
+reports it (with its repr) before changing anything.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+from typing import Any
+
+import numpy as np
+
+from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field
+from .shapes import AABB, Circle
+from .validation import InvalidValue
+
+__all__ = ["BodyStore", "KIND_AABB", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE"]
+
+KIND_NONE, KIND_AABB, KIND_CIRCLE, KIND_POLYGON = -1, 0, 1, 2
+BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
+DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
+
+_FLOATS = (
+    "x", "y", "rot", "vx", "vy", "w",  # transform and velocity (component views)
+    "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
+)
+_INTS = {"kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64}
+_BOOLS = ("has_vel", "sensor", "ccd")
+_FIELD_NAMES = {
+    "x": "Transform.x", "y": "Transform.y", "rot": "Transform.rotation",
+    "vx": "Velocity.x", "vy": "Velocity.y", "w": "Velocity.angular",
+}
+
+
+class BodyStore:
+    """Columns of every entity that has a Transform (and optionally Velocity and Hitbox)."""
+
+    def __init__(self, capacity: int = 64) -> None:
+        self.n = 0
+        self.cap = capacity
+        self.cols: dict[str, np.ndarray] = {}
+        for name in _FLOATS:
+            self.cols[name] = np.zeros(capacity)
+        for name, dt in _INTS.items():
+            self.cols[name] = np.zeros(capacity, dtype=dt)
+        for name in _BOOLS:
+            self.cols[name] = np.zeros(capacity, dtype=bool)
+        self.row_of: dict[int, int] = {}
+        self.hitboxes: list[Hitbox | None] = []
+        self.bad: dict[tuple[int, str], object] = {}
+        self.dirty_hitboxes: set[int] = set()
+        self.moved_static: set[int] = set()  # static entities whose transform game code changed
+        self.static_dirty = True  # the static set or a static body changed: re-hash the statics
+        self.version = 0  # bumped on every structural change (rows, kinds, body types)
+
+    # --- columns ---------------------------------------------------------------------------
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        cols = self.__dict__.get("cols")
+        if cols is not None and name in cols:
+            return cols[name][: self.__dict__["n"]]
+        raise AttributeError(name)
+
+    def _grow(self) -> None:
+        self.cap *= 2
+        for name, col in self.cols.items():
+            new = np.zeros(self.cap, dtype=col.dtype)
+            new[: self.n] = col[: self.n]
+            self.cols[name] = new
+
+    # --- rows ------------------------------------------------------------------------------
+
+    def add(self, entity: int, transform: Transform, velocity: Velocity | None, hitbox: Hitbox | None) -> None:
+        if self.n == self.cap:
+            self._grow()
+        row = self.n
+        c = self.cols
+        c["entity"][row] = entity
+        c["x"][row], c["y"][row], c["rot"][row] = transform._own
+        if velocity is not None:
+            c["vx"][row], c["vy"][row], c["w"][row] = velocity._own
+            c["has_vel"][row] = True
+        else:
+            c["vx"][row] = c["vy"][row] = c["w"][row] = 0.0
+            c["has_vel"][row] = False
+        self.n += 1
+        self.row_of[entity] = row
+        self.hitboxes.append(None)
+        self._set_hitbox_row(row, hitbox)
+        if hitbox is not None and hitbox._body is Body.STATIC:
+            self.static_dirty = True
+        for comp in (transform, velocity, hitbox):
+            if comp is not None:
+                object.__setattr__(comp, "_store", self)
+                object.__setattr__(comp, "_entity", entity)
+        self.version += 1
+
+    def remove(self, entity: int, components: tuple[Any, ...]) -> None:
+        row = self.row_of[entity]
+        last = self.n - 1
+        if self.cols["body"][row] == STATIC and self.cols["kind"][row] >= 0:
+            self.static_dirty = True
+        # Unbind: the components keep the values they had, as their own.
+        for comp in components:
+            if isinstance(comp, (Transform, Velocity)):
+                comp._own = [self.read(entity, col) for col in comp._columns]
+                comp._store = None
+            elif isinstance(comp, Hitbox):
+                object.__setattr__(comp, "_store", None)
+        del self.row_of[entity]
+        for key in [k for k in self.bad if k[0] == entity]:
+            del self.bad[key]
+        self.dirty_hitboxes.discard(entity)
+        self.moved_static.discard(entity)
+        if row != last:
+            for col in self.cols.values():
+                col[row] = col[last]
+            self.hitboxes[row] = self.hitboxes[last]
+            self.row_of[int(self.cols["entity"][row])] = row
+        self.hitboxes.pop()
+        self.n -= 1
+        self.version += 1
+
+    def set_velocity(self, entity: int, velocity: Velocity | None) -> None:
+        row = self.row_of[entity]
+        c = self.cols
+        if velocity is None:
+            c["has_vel"][row] = False
+            c["vx"][row] = c["vy"][row] = c["w"][row] = 0.0
+        else:
+            c["vx"][row], c["vy"][row], c["w"][row] = velocity._own
+            c["has_vel"][row] = True
+            velocity._store, velocity._entity = self, entity
+        self.version += 1
+
+    def set_hitbox(self, entity: int, hitbox: Hitbox | None) -> None:
+        row = self.row_of[entity]
+        self.static_dirty = True
+        self._set_hitbox_row(row, hitbox)
+        if hitbox is not None:
+            object.__setattr__(hitbox, "_store", self)
+            object.__setattr__(hitbox, "_entity", entity)
+        self.version += 1
+
+    def _set_hitbox_row(self, row: int, hb: Hitbox | None) -> None:
+        c = self.cols
+        self.hitboxes[row] = hb
+        if hb is None:
+            c["kind"][row] = KIND_NONE
+            c["body"][row] = DYNAMIC
+            c["sensor"][row] = c["ccd"][row] = False
+            c["layer"][row] = c["mask"][row] = 0
+            for name in ("ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution"):
+                c[name][row] = 0.0
+            return
+        shape = hb._shape
+        if isinstance(shape, AABB):
+            c["kind"][row] = KIND_AABB
+            c["hw"][row], c["hh"][row] = shape.width * 0.5, shape.height * 0.5
+            c["radius"][row] = 0.0
+        elif isinstance(shape, Circle):
+            c["kind"][row] = KIND_CIRCLE
+            c["hw"][row] = c["hh"][row] = c["radius"][row] = shape.radius
+        else:
+            c["kind"][row] = KIND_POLYGON
+            c["hw"][row] = c["hh"][row] = c["radius"][row] = 0.0
+        c["bound"][row] = shape.bounding_radius
+        c["ox"][row], c["oy"][row] = hb._offset
+        c["layer"][row], c["mask"][row] = hb._layer, hb._mask
+        c["sensor"][row], c["ccd"][row] = hb._sensor, hb._ccd
+        c["body"][row] = BODY_CODES[hb._body]
+        c["inv_mass"][row] = hb.inverse_mass
+        c["restitution"][row] = hb._restitution
+
+    # --- component views -------------------------------------------------------------------
+
+    def read(self, entity: int, col: str) -> Any:
+        bad = self.bad.get((entity, col), _MISSING) if self.bad else _MISSING
+        if bad is not _MISSING:
+            return bad
+        return float(self.cols[col][self.row_of[entity]])
+
+    def write(self, entity: int, col: str, value: object) -> None:
+        row = self.row_of[entity]
+        if isinstance(value, Real) and not isinstance(value, bool):
+            self.cols[col][row] = float(value)
+            if self.bad:
+                self.bad.pop((entity, col), None)
+        else:
+            self.bad[(entity, col)] = value
+            self.cols[col][row] = math.nan
+        if col in ("x", "y", "rot") and self.cols["body"][row] == STATIC and self.cols["kind"][row] >= 0:
+            self.moved_static.add(entity)
+            self.static_dirty = True
+
+    def hitbox_changed(self, entity: int) -> None:
+        self.dirty_hitboxes.add(entity)
+
+    # --- checks at the start of a step -----------------------------------------------------
+
+    def check(self) -> None:
+        """Raise :class:`InvalidValue` naming the entity and field of the first bad value.
+
+        Changes nothing, so a failed step leaves the scene exactly as it was."""
+        problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
+        n = self.n
+        for col in ("x", "y", "rot", "vx", "vy", "w"):
+            values = self.cols[col][:n]
+            ok = np.isfinite(values)
+            if not ok.all():
+                for row in np.flatnonzero(~ok):
+                    e = int(self.cols["entity"][row])
+                    if (e, col) not in self.bad:
+                        problems.append((e, col, float(values[row])))
+        for e in sorted(self.dirty_hitboxes):
+            hb = self.hitboxes[self.row_of[e]]
+            assert hb is not None
+            for name in ("shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd"):
+                try:
+                    check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
+                except InvalidValue as exc:
+                    raise InvalidValue(f"entity {e}: {exc}") from None
+        if problems:
+            e, col, v = min(problems, key=lambda p: (p[0], p[1]))
+            raise InvalidValue(f"entity {e}: {_FIELD_NAMES[col]} must be a finite number, got {v!r}")
+
+    def apply_hitbox_changes(self) -> set[int]:
+        """Re-derive the rows of hitboxes that game code edited; return those entities."""
+        changed = self.dirty_hitboxes
+        for e in changed:
+            row = self.row_of[e]
+            hb = self.hitboxes[row]
+            for name in ("offset", "layer", "mask", "body", "mass", "restitution"):
+                object.__setattr__(hb, "_" + name, check_hitbox_field(name, object.__getattribute__(hb, "_" + name)))
+            self._set_hitbox_row(row, hb)
+        self.dirty_hitboxes = set()
+        if changed:
+            self.version += 1
+            self.static_dirty = True
+        return changed
+
+
+_MISSING = object()

@@ -1,0 +1,235 @@
+"""Response: push overlapping bodies apart and remove (or reflect) their approaching velocity.
+
+Vectorised over contacts, in a few passes:
+
+- **Position.** A dynamic body touching immovable ones (static, kinematic, infinite mass) is
+  pushed out of its *deepest* such contact only; its other contacts are measured again and
+  resolved in the next pass only if they still overlap. That is what keeps a box sliding over a
+  floor of tiles from snagging on a seam (the sliver of the next tile stops overlapping once the
+  box stands on the floor) and a body pushed into a stacked wall from hanging on a seam. Two
+  dynamic bodies share the push-out by inverse mass; a body in several such contacts takes the
+  mean of their pushes (Jacobi), and further passes settle stacks.
+- **Velocity.** Only the contacts actually resolved change velocities: the approaching normal
+  velocity is removed (restitution 0, slide) or reflected (restitution e, bounce; a pair uses the
+  larger e). A bounce off an immovable body first takes away the potential energy the push-out
+  added against gravity, so an elastic ball never climbs higher than it started.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..store import BodyStore
+
+__all__ = ["resolve"]
+
+Recompute = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+
+
+def _first_per_group(groups: np.ndarray, keys: np.ndarray) -> np.ndarray:
+    """Indices of the smallest key within each group (ties: the lowest index)."""
+    order = np.lexsort((np.arange(groups.size), keys, groups))
+    g = groups[order]
+    first = np.ones(g.size, dtype=bool)
+    first[1:] = g[1:] != g[:-1]
+    return order[first]
+
+
+def resolve(
+    store: BodyStore,
+    ra: np.ndarray,
+    rb: np.ndarray,
+    nx: np.ndarray,
+    ny: np.ndarray,
+    depth: np.ndarray,
+    gravity: tuple[float, float],
+    iterations: int,
+    recompute: Recompute,
+    alive0: np.ndarray | None = None,
+) -> np.ndarray:
+    """Resolve the contacts ``(ra, rb)`` (normal from a to b); return the mask of those resolved.
+
+    ``alive0`` marks the contacts overlapping now; the others are last step's contacts that no
+    longer overlap (a resting stack's bodies fall by the same amount and merely touch). They keep
+    the support chain whole and are resolved if a push below makes them overlap again.
+    """
+    C = ra.size
+    resolved = np.zeros(C, dtype=bool)
+    if C == 0:
+        return resolved
+    c = store.cols
+    inv = c["inv_mass"]
+    ia, ib = inv[ra].copy(), inv[rb].copy()
+    level = _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity)
+    solid = (ia == 0.0) != (ib == 0.0)
+    mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
+    sgn = np.where(ib > 0.0, 1.0, -1.0)  # it moves along +n if it is b, along -n if it is a
+    both = (ia > 0.0) & (ib > 0.0)
+    applied_nx, applied_ny = nx.copy(), ny.copy()
+    pushed = np.zeros(C)  # total push-out along the applied normal (for the energy correction)
+    alive = np.ones(C, dtype=bool) if alive0 is None else alive0.copy()
+    cur_nx, cur_ny, cur_depth = nx.copy(), ny.copy(), depth.copy()
+    # Support level of each solid contact's mobile body: a stack is resolved from the ground up,
+    # each level measured again after the one below it moved (inf: not resting on anything).
+    mob_level = level[mobile]
+    levels = np.unique(mob_level[solid & np.isfinite(mob_level)])
+
+    moved = np.zeros(store.n, dtype=bool)  # rows moved since their contacts were last measured
+
+    def remeasure(sel: np.ndarray) -> None:
+        idx = np.flatnonzero(sel)
+        if idx.size:
+            hit, rnx, rny, rdepth = recompute(ra[idx], rb[idx])
+            alive[idx] = hit
+            cur_nx[idx], cur_ny[idx], cur_depth[idx] = rnx, rny, rdepth
+
+    def push_out_deepest(s_idx: np.ndarray) -> None:
+        """Push each mobile body fully out of its deepest immovable contact among ``s_idx``."""
+        pick = s_idx[_first_per_group(mobile[s_idx], -cur_depth[s_idx])]
+        m = mobile[pick]
+        d = cur_depth[pick] * sgn[pick]
+        c["x"][m] += cur_nx[pick] * d
+        c["y"][m] += cur_ny[pick] * d
+        moved[m] = True
+        applied_nx[pick], applied_ny[pick] = cur_nx[pick], cur_ny[pick]
+        pushed[pick] += cur_depth[pick]
+        resolved[pick] = True
+        alive[pick] = False  # touching now
+
+    for it in range(max(1, iterations)):
+        # Dynamic pairs: split by inverse mass, mean over each body's contacts.
+        d_idx = np.flatnonzero(alive & both)
+        if d_idx.size:
+            a, b = ra[d_idx], rb[d_idx]
+            w = 1.0 / (ia[d_idx] + ib[d_idx])
+            ddx = cur_nx[d_idx] * cur_depth[d_idx] * w
+            ddy = cur_ny[d_idx] * cur_depth[d_idx] * w
+            n = store.n
+            n_rows = np.bincount(np.concatenate([a, b]), minlength=n).astype(float)
+            sx = np.bincount(a, -ddx * ia[d_idx], n) + np.bincount(b, ddx * ib[d_idx], n)
+            sy = np.bincount(a, -ddy * ia[d_idx], n) + np.bincount(b, ddy * ib[d_idx], n)
+            touched = np.flatnonzero(n_rows)
+            c["x"][touched] += sx[touched] / n_rows[touched]
+            c["y"][touched] += sy[touched] / n_rows[touched]
+            moved[touched] = True
+            applied_nx[d_idx], applied_ny[d_idx] = cur_nx[d_idx], cur_ny[d_idx]
+            pushed[d_idx] += cur_depth[d_idx]
+            resolved[d_idx] = True
+        # Immovable contacts: deepest one per dynamic body, level by level from the ground up,
+        # each level measured again where the bodies under it moved.
+        for lv in [*levels.tolist(), np.inf]:
+            at_level = solid & (mob_level == lv)
+            remeasure(at_level & (moved[ra] | moved[rb]))
+            s_idx = np.flatnonzero(at_level & alive)
+            if s_idx.size == 0:
+                continue
+            push_out_deepest(s_idx)
+        if it + 1 >= iterations:
+            break
+        stale = moved[ra] | moved[rb]
+        if not stale.any():
+            break
+        remeasure(stale)
+        moved[:] = False
+        if not alive.any():
+            break
+
+    # Clean-up: immovable contacts only, so no dynamic body is left inside static geometry by a
+    # push from another dynamic body in the last pass.
+    for _ in range(max(1, iterations)):
+        remeasure(solid & (moved[ra] | moved[rb]))
+        moved[:] = False
+        s_idx = np.flatnonzero(solid & alive)
+        if s_idx.size == 0:
+            break
+        push_out_deepest(s_idx)
+
+    _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
+                resolved, gravity, iterations, mob_level)
+    return resolved
+
+
+def _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity) -> None:
+    """Make a stack solid from the ground up (in place on ``ia``/``ib``).
+
+    A dynamic body resting on something immovable has support level 1; one resting on a level-k
+    body has level k + 1 ("resting on" = the contact normal within 60 degrees of straight up,
+    against gravity). In a contact between two dynamic bodies at different levels, the lower one
+    counts as immovable, so a pass pushes the upper one fully out instead of pressing the lower one
+    into the floor: a stack settles in a few passes instead of sinking.
+    """
+    level = np.full(store.n, np.inf)
+    gx, gy = gravity
+    g = (gx * gx + gy * gy) ** 0.5
+    if g == 0.0:
+        return level
+    ux, uy = -gx / g, -gy / g
+    up = nx * ux + ny * uy  # > 0: b sits on a
+    solid = (ia == 0.0) != (ib == 0.0)
+    on_ground = solid & (((ib > 0.0) & (up > 0.5)) | ((ia > 0.0) & (up < -0.5)))
+    level[np.where(ib > 0.0, rb, ra)[on_ground]] = 1.0
+    both = (ia > 0.0) & (ib > 0.0)
+    b_on_a = both & (up > 0.5)
+    a_on_b = both & (up < -0.5)
+    lower = np.concatenate([ra[b_on_a], rb[a_on_b]])
+    upper = np.concatenate([rb[b_on_a], ra[a_on_b]])
+    if lower.size == 0:
+        return level
+    for _ in range(64):
+        cand = level[lower] + 1.0
+        new = level.copy()
+        np.minimum.at(new, upper, cand)
+        if np.array_equal(new, level):
+            break
+        level = new
+    la, lb = level[ra], level[rb]
+    ia[b_on_a & (la < lb)] = 0.0
+    ib[a_on_b & (lb < la)] = 0.0
+    return level
+
+
+def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed, resolved, gravity,
+                iterations, mob_level) -> None:
+    c = store.cols
+    rest = np.maximum(c["restitution"][ra], c["restitution"][rb])
+    gx, gy = gravity
+    # Potential energy (per unit mass) the push-out added to the mobile body of a solid contact.
+    dpe = -(gx * nx + gy * ny) * sgn * pushed
+    done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
+    for _ in range(max(1, iterations)):
+        vx, vy = c["vx"], c["vy"]
+        vn = (vx[rb] - vx[ra]) * nx + (vy[rb] - vy[ra]) * ny
+        approaching = resolved & (vn < 0.0) & ~done
+        if not approaching.any():
+            return
+        levels = np.unique(mob_level[approaching & solid])
+        for lv in levels.tolist():  # ground up: each level sees the velocities below it settled
+            s_idx = np.flatnonzero(approaching & solid & (mob_level == lv))
+            if lv != levels[0]:
+                vx, vy = c["vx"], c["vy"]
+                vn_l = (vx[rb[s_idx]] - vx[ra[s_idx]]) * nx[s_idx] + (vy[rb[s_idx]] - vy[ra[s_idx]]) * ny[s_idx]
+                vn[s_idx] = vn_l
+                s_idx = s_idx[vn_l < 0.0]
+            if s_idx.size == 0:
+                continue
+            pick = s_idx[_first_per_group(mobile[s_idx], vn[s_idx])]
+            v = vn[pick]
+            e = rest[pick]
+            target = e * np.sqrt(np.maximum(v * v - 2.0 * np.maximum(dpe[pick], 0.0), 0.0))
+            dv = (target - v) * sgn[pick]
+            m = mobile[pick]
+            c["vx"][m] += dv * nx[pick]
+            c["vy"][m] += dv * ny[pick]
+            done[pick] = e > 0.0
+        d_idx = np.flatnonzero(approaching & both)
+        if d_idx.size:
+            a, b = ra[d_idx], rb[d_idx]
+            v = vn[d_idx]
+            j = -(1.0 + rest[d_idx]) * v / (ia[d_idx] + ib[d_idx])
+            n = store.n
+            jx, jy = j * nx[d_idx], j * ny[d_idx]
+            c["vx"][:n] += np.bincount(b, jx * ib[d_idx], n) - np.bincount(a, jx * ia[d_idx], n)
+            c["vy"][:n] += np.bincount(b, jy * ib[d_idx], n) - np.bincount(a, jy * ia[d_idx], n)
+            done[d_idx] = rest[d_idx] > 0.0
