@@ -22,7 +22,7 @@ from .validation import InvalidValue, finite, vector2
 if TYPE_CHECKING:
     from .store import BodyStore
 
-__all__ = ["Body", "Hitbox", "Transform", "Velocity"]
+__all__ = ["Body", "Hitbox", "Transform", "Velocity", "Visual"]
 
 
 class _Columns:
@@ -115,7 +115,9 @@ class Body(Enum):
     STATIC = "static"
 
 
-_HITBOX_FIELDS = ("shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd")
+_HITBOX_FIELDS = (
+    "shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd", "one_way",
+)
 _ALL_BITS = 0xFFFFFFFF
 
 
@@ -135,6 +137,9 @@ class Hitbox:
     - ``restitution``: 0 (slide) to 1 (elastic bounce); a pair uses the larger of the two.
     - ``ccd``: continuous detection. The body is swept along its motion each step so it cannot
       pass through thin walls; bodies without it pay nothing for it.
+    - ``one_way``: a platform that is solid only from above (its local +y, turning with its
+      transform): a body that comes down onto it this step lands; one moving up through it, or
+      sideways into it, passes. Events are reported either way (they are about overlap).
     """
 
     __slots__ = ("_store", "_entity") + tuple("_" + f for f in _HITBOX_FIELDS)
@@ -151,11 +156,12 @@ class Hitbox:
         mass: float = 1.0,
         restitution: float = 0.0,
         ccd: bool = False,
+        one_way: bool = False,
     ) -> None:
         object.__setattr__(self, "_store", None)
         object.__setattr__(self, "_entity", -1)
         for name, value in zip(
-            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd)
+            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd, one_way)
         ):
             object.__setattr__(self, "_" + name, check_hitbox_field(name, value))
 
@@ -195,7 +201,7 @@ def check_hitbox_field(name: str, value: object) -> Any:
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= int(value) <= _ALL_BITS:
             raise InvalidValue(f"Hitbox {name} must be an int in [0, 2**32), got {value!r}")
         return int(value)
-    if name in ("sensor", "ccd"):
+    if name in ("sensor", "ccd", "one_way"):
         if not isinstance(value, bool):
             raise InvalidValue(f"Hitbox {name} must be True or False, got {value!r}")
         return value
@@ -220,3 +226,31 @@ def check_hitbox_field(name: str, value: object) -> Any:
         return r
     raise AttributeError(name)
 
+
+
+class Visual:
+    """How the render system draws an entity: a filled shape matching its hitbox in ``color``
+    (RGB or RGBA, 0-255), or an ``image`` (a file path) centred on the entity; higher ``z`` draws
+    on top. Entities without a Visual are not drawn (the debug overlay still outlines hitboxes)."""
+
+    __slots__ = ("color", "z", "image", "visible")
+
+    def __init__(
+        self, color: tuple[int, ...] = (255, 255, 255), z: int = 0, image: str | None = None,
+        visible: bool = True,
+    ) -> None:
+        if not isinstance(color, tuple) or len(color) not in (3, 4) or not all(
+            isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in color
+        ):
+            raise InvalidValue(f"Visual color must be an (r, g, b[, a]) tuple of ints 0-255, got {color!r}")
+        if isinstance(z, bool) or not isinstance(z, int):
+            raise InvalidValue(f"Visual z must be an int, got {z!r}")
+        if image is not None and not isinstance(image, str):
+            raise InvalidValue(f"Visual image must be a file path or None, got {image!r}")
+        self.color = color if len(color) == 4 else (*color, 255)
+        self.z = z
+        self.image = image
+        self.visible = bool(visible)
+
+    def __repr__(self) -> str:
+        return f"Visual(color={self.color!r}, z={self.z!r}, image={self.image!r}, visible={self.visible!r})"

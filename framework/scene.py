@@ -21,9 +21,10 @@ from .collision import batch
 from .collision.broad_phase import SpatialHash
 from .collision.placement import check_shape
 from .collision.ray import raycast as _raycast
-from .collision.results import RayHit, Vec2
+from .collision.results import Vec2
 from .components import Body, Hitbox, Transform, Velocity
 from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, to_events
+from .input import Input
 from .shapes import AABB, Circle
 from .store import STATIC, BodyStore
 from .systems.ccd import sweep_ccd_bodies
@@ -33,9 +34,41 @@ from .systems.narrow_phase import filter_layers, pair_contacts
 from .systems.response import resolve
 from .validation import InvalidValue, finite, positive, vector2
 
-__all__ = ["Scene", "SceneClosed", "SceneHit", "STAGES"]
+__all__ = ["DEFAULT_EFFECTS", "EFFECTS", "Scene", "SceneClosed", "SceneHit", "STAGES", "resolve_effects"]
 
 STAGES = ("movement", "ccd", "broad_phase", "narrow_phase", "response", "render")
+
+# Effects a scene can declare, each with the effects it needs. A scene assembles only the stages
+# its effects call for (see docs/effects.md).
+EFFECTS: dict[str, tuple[str, ...]] = {
+    "movement": (),                          # integrate Velocity
+    "gravity": ("movement",),                # accelerate dynamic bodies by Scene.gravity
+    "detection": (),                         # broad + narrow phase: which hitboxes overlap
+    "events": ("detection",),                # every pair's started / ongoing / ended events
+    "response": ("detection",),              # push bodies apart, slide, bounce
+    "continuous": ("movement", "detection"),  # sweep Hitbox(ccd=True) bodies
+    "rendering": (),                         # the render stage (a renderer must be attached)
+    "debug_overlay": ("rendering",),         # hitboxes, contacts, cells, rays on screen
+}
+DEFAULT_EFFECTS = frozenset({"movement", "gravity", "detection", "events", "response", "continuous"})
+
+
+def resolve_effects(effects: Iterable[str] | None) -> frozenset[str]:
+    """The declared effects plus everything they need; ``ValueError`` for an unknown one."""
+    if effects is None:
+        return DEFAULT_EFFECTS
+    if isinstance(effects, str):
+        raise InvalidValue(f"effects must be a collection of names, got the string {effects!r}")
+    wanted = list(effects)
+    out: set[str] = set()
+    while wanted:
+        name = wanted.pop()
+        if name not in EFFECTS:
+            raise InvalidValue(f"unknown effect {name!r}; known effects are {sorted(EFFECTS)}")
+        if name not in out:
+            out.add(name)
+            wanted.extend(EFFECTS[name])
+    return frozenset(out)
 _ALL_BITS = 0xFFFFFFFF
 _scene_ids = itertools.count(1)
 _NO_SUPPORT = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0))
@@ -63,6 +96,9 @@ class Scene:
     ``cell_size``: the spatial hash's cell; ``None`` chooses it from the hitbox sizes.
     ``response_iterations``: passes of the response over bodies in several contacts (accuracy
     knob: more passes settle stacks and corners better).
+    ``effects``: what the scene simulates (see :data:`EFFECTS`); the default,
+    :data:`DEFAULT_EFFECTS`, is a typical game's: movement, gravity, detection, events, response
+    and continuous detection. Rendering is added when a renderer is attached.
     """
 
     def __init__(
@@ -71,7 +107,9 @@ class Scene:
         gravity: tuple[float, float] = (0.0, 0.0),
         cell_size: float | None = None,
         response_iterations: int = 4,
+        effects: Iterable[str] | None = None,
     ) -> None:
+        self.effects = resolve_effects(effects)
         self.gravity = vector2("Scene gravity", gravity)
         if cell_size is not None:
             cell_size = positive("Scene cell_size", cell_size)
@@ -84,7 +122,12 @@ class Scene:
         self.geometry = Geometry()
         self.hash = SpatialHash(cell_size)
         self.tracker = PairTracker()
-        self.renderer: Any = None
+        self._renderer: Any = None
+        self.resources: dict[type, Any] = {Input: Input()}
+        # For the debug overlay: this step's rays (origin, end, first hit or None) and the swept
+        # paths of continuous-detection bodies ((x0, y0), (x1, y1)).
+        self.ray_log: list[tuple[tuple[float, float], tuple[float, float], SceneHit | None]] = []
+        self.swept_paths: list[tuple[tuple[float, float], tuple[float, float]]] = []
         self.closed = False
         self.frame = 0
         self.time = 0.0
@@ -267,6 +310,8 @@ class Scene:
                                     "narrow_tests": {}, "contacts": 0, "events": 0, "resolved": 0,
                                     "ccd_stopped": 0}
         self.stage_ms = {}
+        self.ray_log = []
+        self.swept_paths = []
         try:
             store.apply_hitbox_changes()
             for stage in STAGES:
@@ -286,31 +331,58 @@ class Scene:
                     self._remove(e)
         self.frame += 1
         self.time += dt
+        inp = self.resources.get(Input)
+        if inp is not None:
+            inp.end_step()
 
     def _run_hooks(self, when: str, stage: str, dt: float) -> None:
         for system in self._systems.get((when, stage), ()):
             system(self, dt)
 
+    @property
+    def renderer(self) -> Any:
+        """The object whose ``draw(scene)`` is the render stage; attaching one declares rendering."""
+        return self._renderer
+
+    @renderer.setter
+    def renderer(self, renderer: Any) -> None:
+        self._renderer = renderer
+        if renderer is not None:
+            self.effects = resolve_effects(self.effects | {"rendering"})
+        if renderer is not None and "debug_overlay" in self.effects and hasattr(renderer, "debug"):
+            renderer.debug = True
+
+    def _gravity(self) -> tuple[float, float]:
+        return self.gravity if "gravity" in self.effects else (0.0, 0.0)
+
     def _stage_movement(self, dt: float) -> bool:
+        if "movement" not in self.effects:
+            return False
         store = self.store
+        self._start_x, self._start_y = store.x.copy(), store.y.copy()
         ccd = np.flatnonzero(store.ccd & store.has_vel & (store.body != STATIC))
         self._ccd_rows = ccd
         self._ccd_start = (store.x[ccd].copy(), store.y[ccd].copy())
-        rows = integrate(store, dt, self.gravity)
+        rows = integrate(store, dt, self._gravity())
         self.counters["integrated"] = int(rows.size)
         return True
 
     def _stage_ccd(self, dt: float) -> bool:
-        store, geom = self.store, self.geometry
-        geom.update(store)
+        if "continuous" not in self.effects or "movement" not in self.effects:
+            return False
         rows = self._ccd_rows
+        store, geom = self.store, self.geometry
         if rows.size == 0 or rows.max() >= store.n:
             return False
+        geom.update(store)
         self._sync_static()
         stopped = sweep_ccd_bodies(
             store, geom, rows, *self._ccd_start, self._static_entities_in_box, self.counters
         )
         self.counters["ccd_stopped"] = stopped
+        x0, y0 = self._ccd_start
+        self.swept_paths = list(zip(zip(x0.tolist(), y0.tolist()),
+                                    zip(store.x[rows].tolist(), store.y[rows].tolist())))
         if stopped:
             geom.update(store)
         return True
@@ -347,9 +419,10 @@ class Scene:
         store.moved_static.clear()
 
     def _stage_broad_phase(self, dt: float) -> bool:
+        if "detection" not in self.effects:
+            return False
         store, geom = self.store, self.geometry
-        if geom.version != store.version or not hasattr(geom, "minx") or geom.minx.size != store.n:
-            geom.update(store)
+        geom.update(store)
         self._sync_static()
         moving = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
         ea, eb = self.hash.pairs(geom.minx[moving], geom.miny[moving], geom.maxx[moving],
@@ -357,11 +430,35 @@ class Scene:
         self.counters["rehashed"] += int(moving.size)
         ra, rb = self._rows_of(ea), self._rows_of(eb)
         keep = filter_layers(store, ra, rb)
+        if "events" not in self.effects:
+            keep &= self._someone_reads(ra, rb)
         self._pairs = (ea[keep], eb[keep], ra[keep], rb[keep])
         self.counters["candidate_pairs"] = int(keep.sum())
         return True
 
+    def _someone_reads(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+        """Without the events effect, only pairs the response or a handler reads are tested."""
+        store = self.store
+        need = np.zeros(ra.size, dtype=bool)
+        if "response" in self.effects:
+            need |= ~(store.sensor[ra] | store.sensor[rb]) & ((store.inv_mass[ra] > 0) | (store.inv_mass[rb] > 0))
+        for ta, tb, _handler, _kinds in self._handlers:
+            has_a, has_b = self._has_type(ta), self._has_type(tb)
+            need |= (has_a[ra] & has_b[rb]) | (has_a[rb] & has_b[ra])
+        return need
+
+    def _has_type(self, component_type: type) -> np.ndarray:
+        """Per row: whether the entity has a ``component_type`` component."""
+        mask = np.zeros(self.store.n, dtype=bool)
+        ents = [e for e, _ in esper.get_component(component_type)]
+        if ents:
+            rows = self._rows_of(np.array(ents, dtype=np.int64))
+            mask[rows[rows >= 0]] = True
+        return mask
+
     def _stage_narrow_phase(self, dt: float) -> bool:
+        if "detection" not in self.effects:
+            return False
         ea, eb, ra, rb = self._pairs
         res = pair_contacts(self.store, self.geometry, ra, rb, self.counters["narrow_tests"])
         h = np.flatnonzero(res.hit)
@@ -375,6 +472,8 @@ class Scene:
         return True
 
     def _stage_response(self, dt: float) -> bool:
+        if "response" not in self.effects:
+            return False
         store = self.store
         c = self._contacts
         # This step's contacts, plus the pairs the response resolved last step that no longer
@@ -395,6 +494,9 @@ class Scene:
         if ra.size and ra.max() >= store.n:  # rows spawned mid-step are not in this step
             return False
         solid = ~(store.sensor[ra] | store.sensor[rb]) & ((store.inv_mass[ra] > 0) | (store.inv_mass[rb] > 0))
+        one_way = store.one_way[ra] | store.one_way[rb]
+        if one_way.any():
+            solid &= ~one_way | self._lands_on_one_way(ra, rb, nx, ny, depth, alive0)
         idx = np.flatnonzero(solid)
         if idx.size == 0:
             return True
@@ -408,15 +510,36 @@ class Scene:
             r = pair_contacts(store, geom, a, b)
             return r.hit, r.nx, r.ny, r.depth
 
-        done = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self.gravity,
+        done = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
                        self.response_iterations, recompute, alive0[idx])
         keep = idx[done]
         self._support = (ents_a[keep], ents_b[keep], nx[keep], ny[keep])
         self.counters["resolved"] = int(done.sum())
         return True
 
+    def _lands_on_one_way(self, ra, rb, nx, ny, depth, alive0) -> np.ndarray:
+        """Mask of contacts a one-way platform takes: the other body comes from above (the
+        normal within 45 degrees of the platform's up) and sank in only by this step's motion."""
+        store = self.store
+        plat_is_a = store.one_way[ra]
+        plat = np.where(plat_is_a, ra, rb)
+        other = np.where(plat_is_a, rb, ra)
+        rot = store.rot[plat]
+        ux, uy = -np.sin(rot), np.cos(rot)
+        toward_other = np.where(plat_is_a, 1.0, -1.0)
+        from_above = (nx * ux + ny * uy) * toward_other > 0.7071
+        n0 = self._start_x.size
+        sx = np.where(other < n0, self._start_x[np.minimum(other, n0 - 1)], store.x[other])
+        sy = np.where(other < n0, self._start_y[np.minimum(other, n0 - 1)], store.y[other])
+        px = np.where(plat < n0, self._start_x[np.minimum(plat, n0 - 1)], store.x[plat])
+        py = np.where(plat < n0, self._start_y[np.minimum(plat, n0 - 1)], store.y[plat])
+        sank = -(((store.x[other] - sx) - (store.x[plat] - px)) * ux + ((store.y[other] - sy) - (store.y[plat] - py)) * uy)
+        tol = 1e-9 * (1.0 + store.bound[other])
+        came_down = depth <= np.maximum(sank, 0.0) + tol
+        return from_above & (came_down | ~alive0)
+
     def _stage_render(self, dt: float) -> bool:
-        if self.renderer is None:
+        if self._renderer is None or "rendering" not in self.effects:
             return False
         self.renderer.draw(self)
         return True
@@ -506,6 +629,7 @@ class Scene:
             if hit is not None:
                 hits.append(SceneHit(int(store.entity[r]), *hit))
         hits.sort(key=lambda h: (h.distance, h.entity))
+        self.ray_log.append(((ox, oy), (ex, ey), hits[0] if hits else None))
         return hits
 
     def raycast(self, origin: tuple[float, float], direction: tuple[float, float],

@@ -21,10 +21,11 @@ from .validation import InvalidValue, finite, positive
 
 __all__ = ["AABB", "Circle", "Polygon", "Shape"]
 
-# Tolerance of the "collinear" test: a vertex within this fraction of the polygon's extent (plus a
-# few units of rounding of its coordinates) of the line through its neighbours is on that line.
-# It is a distance, not an angle: rounding moves points by a distance, whatever the edge lengths.
-_COLLINEAR_REL = 1e-12
+# Tolerance of the "collinear" test: a vertex within this fraction of the polygon's extent (plus 16
+# units of rounding of its coordinates) of the line through its neighbours is on that line. It is a
+# distance, not an angle: rounding moves points by a distance, whatever the edge lengths. Small
+# enough for a 1 x 1e13 sliver to be a polygon, large enough to absorb computed collinear points.
+_COLLINEAR_REL = 1e-14
 _ROUNDING = 16.0 * 2.0**-52
 
 

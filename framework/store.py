@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field
 from .shapes import AABB, Circle
 from .validation import InvalidValue
@@ -33,7 +34,7 @@ _FLOATS = (
     "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
 )
 _INTS = {"kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64}
-_BOOLS = ("has_vel", "sensor", "ccd")
+_BOOLS = ("has_vel", "sensor", "ccd", "one_way")
 _FIELD_NAMES = {
     "x": "Transform.x", "y": "Transform.y", "rot": "Transform.rotation",
     "vx": "Velocity.x", "vy": "Velocity.y", "w": "Velocity.angular",
@@ -156,7 +157,7 @@ class BodyStore:
         if hb is None:
             c["kind"][row] = KIND_NONE
             c["body"][row] = DYNAMIC
-            c["sensor"][row] = c["ccd"][row] = False
+            c["sensor"][row] = c["ccd"][row] = c["one_way"][row] = False
             c["layer"][row] = c["mask"][row] = 0
             for name in ("ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution"):
                 c[name][row] = 0.0
@@ -175,7 +176,7 @@ class BodyStore:
         c["bound"][row] = shape.bounding_radius
         c["ox"][row], c["oy"][row] = hb._offset
         c["layer"][row], c["mask"][row] = hb._layer, hb._mask
-        c["sensor"][row], c["ccd"][row] = hb._sensor, hb._ccd
+        c["sensor"][row], c["ccd"][row], c["one_way"][row] = hb._sensor, hb._ccd, hb._one_way
         c["body"][row] = BODY_CODES[hb._body]
         c["inv_mass"][row] = hb.inverse_mass
         c["restitution"][row] = hb._restitution
@@ -223,7 +224,7 @@ class BodyStore:
         for e in sorted(self.dirty_hitboxes):
             hb = self.hitboxes[self.row_of[e]]
             assert hb is not None
-            for name in ("shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd"):
+            for name in _HITBOX_FIELD_NAMES:
                 try:
                     check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
                 except InvalidValue as exc:

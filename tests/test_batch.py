@@ -84,7 +84,8 @@ def random_pairs(rng: np.random.Generator, ka: str, kb: str, n: int) -> list[Pai
         ax, ay = dyadic(rng, -64, 64), dyadic(rng, -64, 64)
         reach = sa.bounding_radius + sb.bounding_radius
         ang = rng.uniform(0.0, 2.0 * math.pi)
-        dist = reach * rng.uniform(0.0, 1.0) ** 0.7
+        spread = {0: 1.0, 1: 1.2, 2: 1.5}[(ka, kb).count("circle")]  # about half overlap
+        dist = reach * spread * rng.uniform(0.0, 1.0) ** 0.7
         bx, by = ax + dist * math.cos(ang), ay + dist * math.sin(ang)
         if rng.random() < 0.5:  # dyadic positions: exact arithmetic, exact touching possible
             bx, by = round(bx * 64) / 64, round(by * 64) / 64
@@ -112,9 +113,8 @@ def touching_pairs(ka: str, kb: str) -> list[Pair]:
                 out.append((a, (ax, ay, 0.0), b, (ax + dx, ay + dy, 0.0)))
         elif ka == "circle" and kb == "circle":
             s = dyadic(rng, 0.125, 2, 8)
-            a, b = Circle(5 * s * w1 / 4), Circle(5 * s - 5 * s * w1 / 4)
-            if 5 * s * w1 / 4 >= 5 * s:
-                continue
+            ra = 5 * s * float(rng.integers(1, 8)) / 8
+            a, b = Circle(ra), Circle(5 * s - ra)
             sx, sy = rng.choice([-1, 1], 2)
             out.append((a, (ax, ay, 0.0), b, (ax + sx * 3 * s, ay + sy * 4 * s, 0.0)))
         elif "circle" in (ka, kb) and {ka, kb} <= {"aabb", "box", "circle"}:
@@ -151,6 +151,12 @@ def touching_pairs(ka: str, kb: str) -> list[Pair]:
     return out + closer
 
 
+SMALL = {"aabb": AABB(0.25, 0.125), "circle": Circle(0.0625), "box": Polygon.box(0.25, 0.125),
+         "polygon": Polygon([(0, 0), (0.25, 0), (0, 0.125)])}
+BIG = {"aabb": AABB(20, 16), "circle": Circle(10), "box": Polygon.box(20, 16),
+       "polygon": Polygon([(-10, -9), (11, -8), (9, 10), (-8, 9)])}
+
+
 def special_pairs(rng: np.random.Generator, ka: str, kb: str) -> list[Pair]:
     """Identical and concentric shapes, containment."""
     out: list[Pair] = []
@@ -160,14 +166,10 @@ def special_pairs(rng: np.random.Generator, ka: str, kb: str) -> list[Pair]:
         ax, ay = dyadic(rng, -10, 10), dyadic(rng, -10, 10)
         rot = random_rotation(rng, ka)
         out.append((sa, (ax, ay, rot), sb, (ax, ay, rot if ka == kb else random_rotation(rng, kb))))
-        # B much smaller, inside A (and the other way round).
-        small = {"aabb": AABB(0.25, 0.125), "circle": Circle(0.0625), "box": Polygon.box(0.25, 0.125),
-                 "polygon": Polygon([(0, 0), (0.25, 0), (0, 0.125)])}[kb]
-        big = {"aabb": AABB(20, 16), "circle": Circle(10), "box": Polygon.box(20, 16),
-               "polygon": Polygon([(-10, -9), (11, -8), (9, 10), (-8, 9)])}[ka]
+        # B much smaller, inside A, and A much smaller, inside B.
         off = (dyadic(rng, -3, 3), dyadic(rng, -3, 3))
-        out.append((big, (ax, ay, rot), small, (ax + off[0], ay + off[1], random_rotation(rng, kb))))
-        out.append((small, (ax + off[0], ay + off[1], 0.0), big, (ax, ay, rot)))
+        out.append((BIG[ka], (ax, ay, rot), SMALL[kb], (ax + off[0], ay + off[1], random_rotation(rng, kb))))
+        out.append((SMALL[ka], (ax + off[0], ay + off[1], random_rotation(rng, ka)), BIG[kb], (ax, ay, rot)))
     return out
 
 
@@ -259,7 +261,8 @@ def assert_matches(pairs: list[Pair], res: ContactArrays, label: str) -> None:
         got_n = (res.nx[i], res.ny[i])
         assert abs(got_n[0] - c.normal.x) <= 1e-12 and abs(got_n[1] - c.normal.y) <= 1e-12, \
             f"{where}: normal {got_n} vs {c}"
-        assert abs(res.depth[i] - c.depth) <= 1e-12 * max(c.depth, size), f"{where}: depth {res.depth[i]} vs {c}"
+        assert abs(res.depth[i] - c.depth) <= 1e-12 * max(c.depth, size), \
+            f"{where}: depth {res.depth[i]} vs {c}"
         assert res.depth[i] > 0.0
         tol = 1e-9 * (1.0 + size) + 4 * float(np.spacing(abs(ta[0]) + abs(ta[1]) + size))
         px, py = float(res.px[i]), float(res.py[i])

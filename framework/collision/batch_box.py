@@ -1,94 +1,179 @@
 """Batch kernel for axis-aligned box pairs.
 
-The scalar code treats two AABBs as two 4-vertex polygons. Their 8 separating axes collapse to
-4 distinct tests, and their 16 push-out candidates to 4 directions with 2 depths each, so this
-kernel evaluates exactly the scalar code's products on ``[P]`` arrays, with no ``[P, C, K]``
-projections:
+The overlap decision is exact and fully vectorised: the boxes' interiors overlap iff
+``|qx - ox| < hwa + hwb`` and the same in y, on the exact reals. Each side is a float plus an exact
+rounding error (Knuth's TwoSum), and two such double-doubles compare exactly: rounding is
+monotonic, so unequal leading parts decide, and equal ones leave it to the tails. This is the
+scalar code's decision, which is exact too (floats where clear, integers near touching), without
+its per-pair integer fallback: exactly touching boxes, common in tile worlds, cost nothing extra.
 
-A's outline (at the origin) is ``(±hwa, ±hha)`` and B's is ``(dx ± hwb, dy ± hhb)``. A's bottom
-and top edges give the axes ``(0, ∓Wa)`` with ``Wa = 2 hwa``; projecting on them multiplies the
-y coordinates by ``Wa`` (the ``0 * x`` term adds a signed zero only), and rounding is monotonic,
-so the scalar code's ``max(A.n) <= min(B.n)`` is ``Wa * hha <= -(Wa * yb1)`` and so on. B's edges
-give the same with ``Wb = (dx + hwb) - (dx - hwb)`` (which rounding may make differ from
-``2 hwb``, and may even make 0 far from the origin: then the scalar code calls the pair
-separated, and so does this kernel).
+Depths and normals follow the scalar code, which treats two AABBs as two 4-vertex polygons. Their
+8 separating axes collapse to two scales per direction, and their 16 push-out candidates to 4
+directions with 2 depths each. In the scaled frame, A's outline is ``(±hwa, ±hha)`` and B's
+``(±hwb, ±hhb)`` about its own origin, at offset d. A's bottom and top edges give the axes
+``(0, ∓c)`` with ``c = 2 hwa`` (the ``0 * x`` terms add signed zeros only), along which B must move
+up by ``(c hha + c hhb) - c dy`` or down by ``(c hha + c hhb) + c dy``, times ``|u| = c``; B's edges
+give the same with ``c = 2 hwb``; the side edges the same in x. Within the band around touching,
+where the scalar code takes its depths from exact overlaps, so does this kernel (double-double).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .batch_common import ContactArrays, columns, edges, scatter
-from .batch_polygon import overlap_point
+from .batch_common import F64, ContactArrays, columns, finish, frame
+from .batch_exact import BAND, TINY
+from .batch_polygon import POINT_TOL, overlap_point
 from .tiebreak import DEPTH_TOL
 
 __all__ = ["aabb_aabb", "overlap_aabb_aabb"]
 
 
-def _box_frame(ax, ay, ahw, ahh, bx, by, bhw, bhh):
-    ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
-    dx, dy = bx - ax, by - ay
-    # B's outline in A's frame, as the scalar code places it.
-    xb0, xb1, yb0, yb1 = dx - bhw, dx + bhw, dy - bhh, dy + bhh
-    return ax, ay, ahw, ahh, bhw, bhh, xb0, xb1, yb0, yb1
+def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(s, e)``: ``s = fl(a + b)`` and ``s + e == a + b`` exactly (Knuth; no overflow)."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
 
 
-def _scales(ahw, ahh, xb0, xb1, yb0, yb1):
-    """Lengths of the unnormalised axes: (A's y axis, B's y axis), (A's x axis, B's x axis)."""
-    return (ahw + ahw, xb1 - xb0), (ahh + ahh, yb1 - yb0)
+def _reach(o, q, ha, hb):
+    """Offset ``q - o`` and reach ``ha + hb`` on one axis, each as an exact double-double."""
+    return (*_two_sum(q, -o), *_two_sum(ha, hb))
 
 
-def _boxes_overlap(ahw, ahh, xb0, xb1, yb0, yb1) -> np.ndarray:
-    (wa, wb), (ha, hb) = _scales(ahw, ahh, xb0, xb1, yb0, yb1)
-    hit = np.ones(xb0.shape, dtype=bool)
-    for c in (wa, wb):  # axes (0, ±c): B above A, or below it
-        top = c * ahh
-        hit &= (top > c * yb0) & (c * yb1 > -top)
-    for c in (ha, hb):  # axes (±c, 0): B right of A, or left of it
-        right = c * ahw
-        hit &= (right > c * xb0) & (c * xb1 > -right)
-    return hit
+def _less(dh, dl, rh, rl) -> np.ndarray:
+    """``|dh + dl| < rh + rl`` exactly (``dh``, ``rh`` the rounded leading parts, ``rh >= 0``)."""
+    adh = np.abs(dh)
+    return (adh < rh) | ((adh == rh) & (np.sign(dh) * dl < rl))
 
 
 def overlap_aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh) -> np.ndarray:
     """``hit`` of :func:`aabb_aabb` only."""
-    _, _, ahw, ahh, _, _, xb0, xb1, yb0, yb1 = _box_frame(ax, ay, ahw, ahh, bx, by, bhw, bhh)
-    return _boxes_overlap(ahw, ahh, xb0, xb1, yb0, yb1)
+    ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
+    return _less(*_reach(ax, bx, ahw, bhw)) & _less(*_reach(ay, by, ahh, bhh))
+
+
+def _overlaps(hwa, hha, hwb, hhb, dx, dy):
+    """Per axis scale (A's, B's): B's move up, down, right and left, times the scale."""
+    up, down, right, left = [], [], [], []
+    for c in (hwa + hwa, hwb + hwb):
+        both = c * hha + c * hhb
+        up.append(both - c * dy)
+        down.append(both + c * dy)
+    for c in (hha + hha, hhb + hhb):
+        both = c * hwa + c * hwb
+        right.append(both - c * dx)
+        left.append(both + c * dx)
+    return up, down, right, left
 
 
 def aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh) -> ContactArrays:
     """Axis-aligned boxes: centres (ax, ay), (bx, by) and half extents (``ahw``, ``ahh``),
     (``bhw``, ``bhh``), all ``[P]``; the contacts of ``collide(AABB, .., AABB, ..)``."""
-    ax, ay, ahw, ahh, bhw, bhh, xb0, xb1, yb0, yb1 = _box_frame(ax, ay, ahw, ahh, bx, by, bhw, bhh)
-    hit = _boxes_overlap(ahw, ahh, xb0, xb1, yb0, yb1)
-    if not hit.any():
-        return scatter(hit, 0.0, 0.0, 0.0, 0.0, 0.0)
-    ax, ay, ahw, ahh, bhw, bhh = ax[hit], ay[hit], ahw[hit], ahh[hit], bhw[hit], bhh[hit]
-    xb0, xb1, yb0, yb1 = xb0[hit], xb1[hit], yb0[hit], yb1[hit]
-    (wa, wb), (ha, hb) = _scales(ahw, ahh, xb0, xb1, yb0, yb1)
-    # The 16 candidates of the scalar code, as 4 directions with 2 depths each (one per axis
-    # scale); the duplicates (A's bottom edge backward = its top edge forward, ...) are equal.
-    up = np.minimum(*(((c * ahh) - c * yb0) / c for c in (wa, wb)))
-    down = np.minimum(*(((c * ahh) + c * yb1) / c for c in (wa, wb)))
-    right = np.minimum(*(((c * ahw) - c * xb0) / c for c in (ha, hb)))
-    left = np.minimum(*(((c * ahw) + c * xb1) / c for c in (ha, hb)))
+    ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
+    rx, ry = _reach(ax, bx, ahw, bhw), _reach(ay, by, ahh, bhh)
+    hit = _less(*rx) & _less(*ry)
+    h = np.flatnonzero(hit)
+    ax, ay, ahw, ahh, bx, by, bhw, bhh = (v[h] for v in (ax, ay, ahw, ahh, bx, by, bhw, bhh))
+    rx, ry = (tuple(v[h] for v in r) for r in (rx, ry))
+    ra, rb = np.hypot(ahw, ahh), np.hypot(bhw, bhh)
+    dx, dy, k = frame(ax, ay, bx, by, np.maximum(ra, rb))
+    hwa, hha, hwb, hhb = (np.ldexp(v, -k) for v in (ahw, ahh, bhw, bhh))
+    size = np.ldexp(ra + rb, -k)
+    scales = (hwa + hwa, hwb + hwb, hha + hha, hhb + hhb)
+    up, down, right, left = _overlaps(hwa, hha, hwb, hhb, dx, dy)
+    # Depths: the 16 candidates of the scalar code are 4 directions with 2 depths each (one per
+    # axis scale); the duplicates (A's bottom edge backward = its top edge forward, ...) are equal.
+    wa, wb, ha, hb = scales
+    up = np.minimum(np.maximum(up[0] / wa, TINY), np.maximum(up[1] / wb, TINY))
+    down = np.minimum(np.maximum(down[0] / wa, TINY), np.maximum(down[1] / wb, TINY))
+    right = np.minimum(np.maximum(right[0] / ha, TINY), np.maximum(right[1] / hb, TINY))
+    left = np.minimum(np.maximum(left[0] / ha, TINY), np.maximum(left[1] / hb, TINY))
+    # Within the band around touching, depths from the exact overlaps: reach -/+ offset.
+    mag = size + np.abs(dx) + np.abs(dy)
+    near = (np.minimum(np.minimum(up, down), np.minimum(right, left)) <= 2.0 * BAND * mag)
+    if near.any():
+        for (dh, dl, rh, rl), plus, minus in ((rx, right, left), (ry, up, down)):
+            fwd = np.ldexp((rh - dh) + (rl - dl), -k)
+            bwd = np.ldexp((rh + dh) + (rl + dl), -k)
+            plus[near] = np.maximum(fwd, TINY)[near]
+            minus[near] = np.maximum(bwd, TINY)[near]
     # The tie-break rule: keep the near-shortest; prefer vertical; then up (or right).
-    size = np.hypot(ahw, ahh) + np.hypot(bhw, bhh)
     lim = np.minimum(np.minimum(up, down), np.minimum(right, left)) + DEPTH_TOL * size
     vertical = (up <= lim) | (down <= lim)
     use_up, use_right = up <= lim, right <= lim
     depth = np.where(vertical, np.where(use_up, up, down), np.where(use_right, right, left))
     nx = np.where(vertical, 0.0, np.where(use_right, 1.0, -1.0))
     ny = np.where(vertical, np.where(use_up, 1.0, -1.0), 0.0)
-    # Contact point: the scalar code's construction on the two 4-vertex outlines.
-    n = ahw.shape[0]
-    avx = np.stack((-ahw, ahw, ahw, -ahw), axis=1)
-    avy = np.stack((-ahh, -ahh, ahh, ahh), axis=1)
-    bvx = np.stack((xb0, xb1, xb1, xb0), axis=1)
-    bvy = np.stack((yb0, yb0, yb1, yb1), axis=1)
-    four = np.full(n, 4)
-    px, py = overlap_point(
-        avx, avy, edges(avx), edges(avy), four, bvx, bvy, edges(bvx), edges(bvy), four,
-        nx, ny, depth, size,
-    )
-    return scatter(hit, nx, ny, depth, px + ax, py + ay)
+    px, py = _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size)
+    return finish(hit, nx, ny, depth, px, py, k, ax, ay)
+
+
+def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
+    """``collide.overlap_point`` of two boxes, with B at its offset: the mean of A's corners in B,
+    B's corners in A and the crossings of their edges, each counted by the scalar code's tests.
+
+    For boxes those tests separate: an edge's cross product ``ex (y - y0) - ey (x - x0)`` has one
+    term ``0 * (...)``, a signed zero that changes no comparison, so a corner is inside when its x
+    passes the two side edges and its y the bottom and top edges; and only the 8 perpendicular
+    edge pairs can cross (parallel ones have ``den == 0`` exactly and are skipped).
+    """
+    tol = POINT_TOL * size
+    xb0, xb1, yb0, yb1 = -hwb + dx, hwb + dx, -hhb + dy, hhb + dy
+    wa, ha = hwa + hwa, hha + hha  # A's edge lengths; B's as the scalar code gets them:
+    wb, hb = xb1 - xb0, yb1 - yb0
+
+    def a_in_b_x(x):  # B's right edge (origin (xb1, yb0)) and left edge (origin (xb0, yb1))
+        return ~((-(hb * (x - xb1)) < -tol * hb) | ((hb * (x - xb0)) < -tol * hb))
+
+    def a_in_b_y(y):  # B's bottom edge (origin (xb0, yb0)) and top edge (origin (xb1, yb1))
+        return ~((wb * (y - yb0) < -tol * wb) | ((-wb) * (y - yb1) < -tol * wb))
+
+    def b_in_a_x(x):
+        return ~((-(ha * (x - hwa)) < -tol * ha) | ((ha * (x - (-hwa))) < -tol * ha))
+
+    def b_in_a_y(y):
+        return ~((wa * (y - (-hha)) < -tol * wa) | ((-wa) * (y - hha) < -tol * wa))
+
+    sx = np.zeros(hwa.shape, dtype=F64)
+    sy = np.zeros(hwa.shape, dtype=F64)
+    count = np.zeros(hwa.shape, dtype=F64)
+    for xs, ys, in_x, in_y in (((-hwa, hwa), (-hha, hha), a_in_b_x, a_in_b_y),
+                               ((xb0, xb1), (yb0, yb1), b_in_a_x, b_in_a_y)):
+        mx = [in_x(x).astype(F64) for x in xs]
+        my = [in_y(y).astype(F64) for y in ys]
+        nxin, nyin = mx[0] + mx[1], my[0] + my[1]
+        sx += (xs[0] * mx[0] + xs[1] * mx[1]) * nyin
+        sy += (ys[0] * my[0] + ys[1] * my[1]) * nxin
+        count += nxin * nyin
+    # Edges as (origin x, origin y, ex, ey): A's bottom, right, top, left; then B's.
+    z = np.zeros(hwa.shape, dtype=F64)
+    ea = ((-hwa, -hha, wa, z), (hwa, -hha, z, ha), (hwa, hha, -wa, z), (-hwa, hha, z, -ha))
+    eb = ((xb0, yb0, wb, z), (xb1, yb0, z, hb), (xb1, yb1, -wb, z), (xb0, yb1, z, -hb))
+    combos = [(0, 1), (0, 3), (2, 1), (2, 3), (1, 0), (1, 2), (3, 0), (3, 2)]
+    px_, py_, rx, ry = (np.stack([ea[i][c] for i, _ in combos]) for c in range(4))
+    qx, qy, sx_, sy_ = (np.stack([eb[j][c] for _, j in combos]) for c in range(4))
+    den = rx * sy_ - ry * sx_
+    wx, wy = qx - px_, qy - py_
+    parallel = den == 0.0  # only where a box edge has vanished
+    den += parallel
+    t = (wx * sy_ - wy * sx_) / den
+    u = (wx * ry - wy * rx) / den
+    crossing = ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~parallel).astype(F64)
+    t = np.minimum(np.maximum(t, 0.0), 1.0)  # unchanged where crossing; finite elsewhere
+    sx += ((px_ + t * rx) * crossing).sum(axis=0)
+    sy += ((py_ + t * ry) * crossing).sum(axis=0)
+    count += crossing.sum(axis=0)
+    found = count > 0
+    c = np.maximum(count, 1.0)
+    px, py = sx / c, sy / c
+    if not found.all():
+        # Rounding hid every vertex (near-degenerate only): the generic fallback.
+        m = np.flatnonzero(~found)
+        four = np.full(m.size, 4)
+        avx = np.stack((-hwa[m], hwa[m], hwa[m], -hwa[m]))
+        avy = np.stack((-hha[m], -hha[m], hha[m], hha[m]))
+        bvx = np.stack((xb0[m], xb1[m], xb1[m], xb0[m]))
+        bvy = np.stack((yb0[m], yb0[m], yb1[m], yb1[m]))
+        px[m], py[m] = overlap_point(avx, avy, four, bvx, bvy, four, nx[m], ny[m], depth[m], size[m])
+    return px, py

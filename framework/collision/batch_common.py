@@ -8,7 +8,12 @@ Padded outlines: a batch of convex counter-clockwise outlines is an array ``[P, 
 count per row; slots at and past the count repeat the last real vertex. Edge ``i`` runs from slot
 ``i`` to slot ``i + 1``, and the last slot's edge closes the outline back to slot 0, so the real
 edges are ``i < count - 1`` and ``i == K - 1`` (in the scalar code's order) and the padding edges
-between them have length exactly zero.
+between them have length exactly zero: every test that skips zero edges skips them.
+
+Frames: like the scalar code, every kernel works in a local frame (A's hitbox origin; the
+polygon's for polygon / circle pairs) scaled by a power of two per row (:func:`frame`), with each
+shape in its own local coordinates and B's offset kept apart: a projection is
+``u . local + u . offset``.
 """
 
 from __future__ import annotations
@@ -68,9 +73,28 @@ def columns_of(n: int, *values: object) -> list[np.ndarray]:
     return out
 
 
-def scatter(hit: np.ndarray, nx, ny, depth, px, py) -> ContactArrays:
-    """Contacts computed for the rows where ``hit`` (compressed) spread back to all rows."""
+def frame(ox: np.ndarray, oy: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach: np.ndarray):
+    """The scaled local frame of the scalar code: ``(dx, dy, k)`` with the offset of q from o
+    scaled by ``2**-k`` so that it and ``reach`` (the larger bounding radius) are about 1.
+
+    Scaling by a power of two is exact, so ordinary scenes get the unscaled answers bit for bit,
+    while radii of 1e-200 or 1e300 neither underflow nor overflow.
+    """
+    # Halves first: 0.5 * q - 0.5 * o never overflows, and halving is exact above the subnormals.
+    hx, hy = 0.5 * qx - 0.5 * ox, 0.5 * qy - 0.5 * oy
+    k = np.frexp(np.maximum(np.maximum(np.abs(hx), np.abs(hy)), 0.5 * reach))[1]
+    return np.ldexp(hx, 1 - k), np.ldexp(hy, 1 - k), k
+
+
+def finish(hit: np.ndarray, nx, ny, depth, px, py, k, ox, oy) -> ContactArrays:
+    """Contacts of the ``hit`` rows (compressed, in the scaled local frame of origin (ox, oy),
+    all ``[H]``) unscaled, moved to the world and spread back to all rows (zeros elsewhere)."""
     n = hit.shape[0]
+    depth = np.ldexp(depth, k)
+    px = ox + np.ldexp(px, k)
+    py = oy + np.ldexp(py, k)
+    if not (np.isfinite(depth).all() and np.isfinite(px).all() and np.isfinite(py).all()):
+        raise InvalidValue("batch collide: a contact is beyond float64's range")
     outs = []
     for v in (nx, ny, depth, px, py):
         o = np.zeros(n, dtype=F64)
@@ -82,10 +106,14 @@ def scatter(hit: np.ndarray, nx, ny, depth, px, py) -> ContactArrays:
     return ContactArrays(hit, *outs)
 
 
-# --- padded outlines ---------------------------------------------------------------------------
+# --- padded outlines, vertex-major -------------------------------------------------------------
+# Inside the kernels a batch of outlines is ``vx, vy [K, P]`` (slot-major): every reduction over
+# the few slots is then a reduction over axis 0, which numpy vectorises along the P pairs (a
+# reduction over a short last axis costs some 30 times more).
 
 def outline_rows(verts: object, count: object, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(vx, vy, count)`` of a padded outline batch; padding is rewritten to repeat the last vertex."""
+    """``(vx [K, P], vy [K, P], count [P])`` of an outline batch ``[P, K, 2]``; the padding is
+    rewritten to repeat each outline's last vertex, whatever the caller put there."""
     v = np.asarray(verts, dtype=F64)
     if v.ndim != 3 or v.shape[2] != 2:
         raise InvalidValue(f"{name} must have shape [P, K, 2], got {v.shape}")
@@ -96,58 +124,87 @@ def outline_rows(verts: object, count: object, name: str) -> tuple[np.ndarray, n
     c = c.astype(np.intp, copy=False)
     if p and (c.min() < 3 or c.max() > k):
         raise InvalidValue(f"{name} counts must lie in [3, {k}], got {c.min()}..{c.max()}")
+    vx = np.ascontiguousarray(v[:, :, 0].T)
+    vy = np.ascontiguousarray(v[:, :, 1].T)
     if p and c.min() < k:
-        idx = np.minimum(np.arange(k), c[:, None] - 1)
-        v = np.take_along_axis(v, idx[:, :, None], axis=1)
-    return v[:, :, 0], v[:, :, 1], c
+        idx = np.minimum(np.arange(k)[:, None], c - 1)
+        vx = np.take_along_axis(vx, idx, axis=0)
+        vy = np.take_along_axis(vy, idx, axis=0)
+    return vx, vy, c
 
 
 def edges(v: np.ndarray) -> np.ndarray:
-    """One coordinate of the edge vectors of padded outlines (see the module docstring)."""
+    """One coordinate of the edge vectors of padded outlines ``[K, P]`` (module docstring)."""
     e = np.empty_like(v)
-    np.subtract(v[:, 1:], v[:, :-1], out=e[:, :-1])
-    np.subtract(v[:, 0], v[:, -1], out=e[:, -1])
+    np.subtract(v[1:], v[:-1], out=e[:-1])
+    np.subtract(v[0], v[-1], out=e[-1])
     return e
 
 
-def edge_mask(count: np.ndarray, k: int) -> np.ndarray:
-    """``[P, K]``: which edge slots are real edges of the outline."""
-    i = np.arange(k)
-    return (i < count[:, None] - 1) | (i == k - 1)
+def edge_mask(ex: np.ndarray, ey: np.ndarray) -> np.ndarray:
+    """The edges that give an axis; padding edges (and, as in the scalar code, an edge scaled
+    away to nothing) have length exactly zero."""
+    return (ex != 0.0) | (ey != 0.0)
 
 
 def vertex_mask(count: np.ndarray, k: int) -> np.ndarray:
-    return np.arange(k) < count[:, None]
+    """``[K, P]``: the real (not padding) vertex slots."""
+    return np.arange(k)[:, None] < count
 
 
-def radii(vx: np.ndarray, vy: np.ndarray) -> np.ndarray:
-    """Bounding radius of each outline about its own hitbox origin."""
-    return np.hypot(vx, vy).max(axis=1)
+# In the scaled frames every value is of order 1, so ``BIG`` can stand for "absent" in a min.
+# Selections are written as arithmetic (``x * m + (1 - m) * BIG``, exact where ``m`` is 1) rather
+# than ``np.where``, which is several times slower on unpredictable masks.
+BIG = 1e300
+
+
+def first(mask: np.ndarray) -> np.ndarray:
+    """Per column of ``mask [C, P]``, the first row that is True (0 where none is)."""
+    c = mask.shape[0]
+    m = mask.astype(F64)
+    i = (np.arange(c, dtype=F64)[:, None] * m + (1.0 - m) * c).min(axis=0).astype(np.intp)
+    return i % c
+
+
+def first_min(v: np.ndarray) -> np.ndarray:
+    """Per column of ``v [C, P]``, the first row holding the column's minimum (as ``argmin``)."""
+    return first(v == v.min(axis=0))
+
+
+def cols(v: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """The pairs ``rows`` (integer indices) of a slot-major array ``[C, P]``, C-contiguous (plain
+    ``v[:, mask]`` can come out column-major, which makes every later axis-0 reduction slow)."""
+    return np.take(v, rows, axis=1)
+
+
+def take(v: np.ndarray, i: np.ndarray) -> np.ndarray:
+    """``v[i[p], p]`` for every column p."""
+    return np.take_along_axis(v, i[None, :], axis=0)[0]
 
 
 # --- the tie-break rule on arrays ------------------------------------------------------------
 
 def pick(depth: np.ndarray, nx: np.ndarray, ny: np.ndarray, size: np.ndarray):
-    """Per row, the winning ``(depth, nx, ny)`` among candidates ``[P, C]`` (``depth`` +inf for
-    absent ones), by the steps of :func:`framework.collision.tiebreak.pick`."""
-    p = depth.shape[0]
-    best = depth.min(axis=1)
-    near = depth <= (best + DEPTH_TOL * size)[:, None]
-    # 2. closest to vertical
+    """Per column, the winning ``(depth, nx, ny)`` among candidates ``[C, P]`` (``depth`` >= BIG
+    for absent ones), by the steps of :func:`framework.collision.tiebreak.pick`."""
+    best = depth.min(axis=0)
+    near = depth <= best + DEPTH_TOL * size
+    # 2. closest to vertical (x * 1 + 0 is x exactly; a candidate not near scores -4)
     any_ = np.abs(ny)
-    top = np.where(near, any_, -np.inf).max(axis=1)
-    near &= any_ >= (top - DIR_TOL)[:, None]
+    m = near.astype(F64)
+    top = (any_ * m + (m - 1.0) * 4.0).max(axis=0)
+    near &= any_ >= top - DIR_TOL
     # 3. fixed angular order of the directions folded into the upper half-plane
     fold = (ny < -DIR_TOL) | ((any_ <= DIR_TOL) & (nx < 0.0))
-    fx = np.where(fold, -nx, nx)
-    top = np.where(near, fx, -np.inf).max(axis=1)
-    near &= fx >= (top - DIR_TOL)[:, None]
+    fx = nx * (1.0 - 2.0 * fold.astype(F64))
+    m = near.astype(F64)
+    top = (fx * m + (m - 1.0) * 4.0).max(axis=0)
+    near &= fx >= top - DIR_TOL
     # 4. max over key (ny > tol, nx > tol, -depth), the first of equals winning
     for key in (ny > DIR_TOL, nx > DIR_TOL):
         keep = near & key
-        near = np.where(keep.any(axis=1)[:, None], keep, near)
-    low = np.where(near, depth, np.inf).min(axis=1)
-    near &= depth == low[:, None]
-    i = near.argmax(axis=1)
-    rows = np.arange(p)
-    return depth[rows, i], nx[rows, i], ny[rows, i]
+        near = keep | (near & ~keep.any(axis=0))
+    m = near.astype(F64)
+    low = (np.minimum(depth, BIG) * m + (1.0 - m) * BIG).min(axis=0)
+    i = first(near & (depth == low))
+    return take(depth, i), take(nx, i), take(ny, i)

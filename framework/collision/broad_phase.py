@@ -6,18 +6,20 @@ are not a pair, as touching shapes are not a collision), never two static bodies
 two int64 arrays ``(a, b)`` with ``a < b``, sorted lexicographically, so the output depends only on
 the input values (no hash seeds, no set order).
 
-How (see :mod:`framework.collision.grid` for the invariants):
+How (the invariants and their proofs are in :mod:`framework.collision.grid`):
 
-- a uniform grid; a body is entered in every cell its closed bounds touch, computed with one
-  monotone ``floor(v / cell)``, so two overlapping bodies always share a cell whatever the rounding;
-- the cell entries of one set are a single sorted int64 array; pairs come from runs of equal cells,
-  each pair only from its *reference cell* (no duplicates, no dedup pass), and are then tested
-  exactly on the float bounds;
-- the static bodies are entered once by :meth:`SpatialHash.set_static`; each :meth:`SpatialHash.pairs`
-  call enters only the moving bodies and looks their occupied cells up in the static array with one
-  ``searchsorted``, so a 100,000-tile level adds only the cost of the tiles next to movers;
-- bodies covering more than ``grid.LARGE_CELLS`` cells, and non-finite bounds, skip the grid and are
-  compared with everything directly.
+- one uniform grid of square cells. A body is entered in the cells its bounds need for strict
+  overlaps, computed with one monotone ``floor(v / cell)``, so two overlapping bodies always share
+  a cell whatever the rounding (``1.0 // 0.1 == 9.0`` cannot lose a pair), and a pair sharing
+  several cells is reported from one of them only (its *reference cell*; no dedup pass);
+- static bodies: :meth:`SpatialHash.set_static` enters them once in a sorted cell array. Each
+  :meth:`SpatialHash.pairs` call looks up only the cells the moving bodies cover, so a
+  100,000-tile level adds the cost of the tiles next to movers, not of the level;
+- moving bodies: entered in horizontal strips (rows of cells), sorted by (row, minx), and swept:
+  each entry meets the following entries of its row whose minx is below its maxx;
+- candidates are tested exactly on the float bounds; no Python loop runs over bodies;
+- bodies covering more than ``grid.LARGE_CELLS`` cells (one huge body among small ones), and bodies
+  with NaN or infinite bounds, are kept aside and compared with every other body directly.
 """
 
 from __future__ import annotations
@@ -105,8 +107,8 @@ class SpatialHash:
     extent at the first non-empty :meth:`set_static` or :meth:`pairs` call, then keeps it.
 
     Ids are the caller's integers (e.g. row numbers in its tables); they must be unique over the
-    static and the moving bodies together. Every call copies the bounds it keeps, so the caller may
-    reuse its arrays.
+    static and the moving bodies together. Nothing keeps a reference to the caller's arrays, so it
+    may reuse and overwrite them between calls.
     """
 
     def __init__(self, cell_size: float | None = None) -> None:
@@ -167,14 +169,14 @@ class SpatialHash:
         if mov.large.shape[0]:
             # large movers against every mover (each large-large pair once) and every static
             lg = mov.large
-            i, j = overlap_pairs(subset(mov.bounds, lg), mov.bounds)
+            i, j = overlap_pairs(subset(b, lg), b)
             i = lg[i]
             is_large = np.zeros(mov.n, dtype=bool)
             is_large[lg] = True
             keep = ~is_large[j] | (i < j)
             out_a.append(ids[i[keep]])
             out_b.append(ids[j[keep]])
-            i, s = overlap_pairs(subset(mov.bounds, lg), stat.bounds)
+            i, s = overlap_pairs(subset(b, lg), stat.bounds)
             out_a.append(ids[lg[i]])
             out_b.append(sids[s])
         if stat.large.shape[0] and mov.n:
@@ -182,7 +184,7 @@ class SpatialHash:
             small = np.ones(mov.n, dtype=bool)
             small[mov.large] = False
             sm = np.flatnonzero(small)
-            s, m = overlap_pairs(subset(stat.bounds, stat.large), subset(mov.bounds, sm))
+            s, m = overlap_pairs(subset(stat.bounds, stat.large), subset(b, sm))
             out_a.append(sids[stat.large[s]])
             out_b.append(ids[sm[m]])
         if not out_a:
@@ -261,7 +263,8 @@ class SpatialHash:
         for index, bounds, ids in self._sets():
             if bounds[0].shape[0] == 0:
                 continue
-            c = None if index is None else self._ray_candidates(index, *ray)
+            with np.errstate(over="ignore", invalid="ignore"):
+                c = None if index is None else self._ray_candidates(index, *ray)
             if c is None:
                 found.append(ids[_segment_touches(bounds, *ray)])
             else:
@@ -271,6 +274,9 @@ class SpatialHash:
     def _ray_candidates(self, index: CellIndex, ox, oy, ux, uy, length) -> np.ndarray | None:
         """Sorted numbers of the bodies in the cells near the segment (found column by column,
         padded by a cell each way) and of the large bodies; ``None``: test every body."""
+        lim = grid.CELL_LIMIT
+        if min(index.x0, index.y0) <= -lim or max(index.x0 + index.wx, index.y0 + index.wy) > lim:
+            return None  # clipped cell indices: the grid's cells are not where the geometry says
         cand = [index.large]
         cell = self._cell
         # clip the segment to the grid's box, padded by a cell, so that an endless ray ends
@@ -289,17 +295,22 @@ class SpatialHash:
             xs, xe = sorted((ox + ux * t0, ox + ux * t1))
             ys, ye = oy + uy * t0, oy + uy * t1
             c0, c1 = (int(v) for v in grid.cell_index(np.array([xs, xe]), cell))
-            cols = np.arange(max(c0 - 1, index.x0), min(c1 + 1, index.x0 + index.wx - 1) + 1)
+            k0, k1 = max(c0 - 1, index.x0), min(c1 + 1, index.x0 + index.wx - 1)
+            if k1 - k0 >= index.entries:
+                return None  # a ray across more columns than there are entries
+            cols = np.arange(k0, k1 + 1)
             # the segment's y range over each column's x range
             xa = np.maximum(cols * cell, xs)
             xb = np.minimum((cols + 1) * cell, xe)
-            if ux == 0.0:
+            if abs(ux) < 1e-9:  # (nearly) vertical: the whole y range in each of the few columns
                 ya = np.full(cols.shape[0], min(ys, ye))
                 yb = np.full(cols.shape[0], max(ys, ye))
             else:
                 ya = oy + (xa - ox) * (uy / ux)
                 yb = oy + (xb - ox) * (uy / ux)
                 ya, yb = np.minimum(ya, yb), np.maximum(ya, yb)
+            if not (np.isfinite(ya).all() and np.isfinite(yb).all()):
+                return None  # coordinates near the float limit
             r0 = np.maximum(grid.cell_index(ya, cell) - 1, index.y0)
             r1 = np.minimum(grid.cell_index(yb, cell) + 1, index.y0 + index.wy - 1)
             cnt = np.maximum(r1 - r0 + 1, 0)

@@ -72,7 +72,9 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
         return None
     (nx, ny, depth, px, py), k = found
     try:
-        depth = math.ldexp(depth, k)
+        # An overlap below the smallest float (only between shapes 1e300 times smaller than the
+        # scene) is still an overlap: depth > 0.
+        depth = max(math.ldexp(depth, k), _TINY)
         px, py = ox + math.ldexp(px, k), oy + math.ldexp(py, k)
     except OverflowError:
         px = math.inf
@@ -181,18 +183,14 @@ def polygon_circle(
     With ``flip`` the normal points from the circle to the polygon (the circle is the caller's A).
     """
     f = -1.0 if flip else 1.0
-    n = len(poly)
     rp = max(math.hypot(x, y) for x, y in poly)
     tol = _BAND * (abs(cx) + abs(cy) + rp + r)  # on distances
-    seps = []  # unnormalised signed distances of the centre outside each face
-    for i in range(n):
-        x0, y0 = poly[i]
-        x1, y1 = poly[(i + 1) % n]
-        ex, ey = x1 - x0, y1 - y0
-        seps.append(ey * (cx - x0) - ex * (cy - y0))  # outward normal (ey, -ex) of a CCW outline
-    if all(s <= 0.0 for s in seps):
+    faces = _faces(poly)
+    # Unnormalised signed distances of the centre outside each face (outward normal (ey, -ex)).
+    seps = [ey * (cx - x0) - ex * (cy - y0) for x0, y0, ex, ey, _, _ in faces]
+    if faces and all(s <= 0.0 for s in seps):
         # Centre inside (or on the boundary): push out through the nearest face, plus the radius.
-        cands = _inside_candidates(poly, seps, r, f)
+        cands = _inside_candidates(faces, seps, r, f)
         if min(c[0] for c in cands) > tol:
             depth, nx, ny = pick(cands, size)
             return nx, ny, depth, cx, cy
@@ -200,30 +198,21 @@ def polygon_circle(
     # Centre outside: the closest point of the polygon is on a face whose region holds the centre
     # (s > 0 and the projection falls within the edge), or else it is the nearest vertex.
     dist = None
-    for i in range(n):
-        s = seps[i]
-        if s <= 0.0:
-            continue
-        x0, y0 = poly[i]
-        x1, y1 = poly[(i + 1) % n]
-        ex, ey = x1 - x0, y1 - y0
-        e2 = ex * ex + ey * ey
-        t = (cx - x0) * ex + (cy - y0) * ey
-        if 0.0 <= t <= e2:
-            ln = math.sqrt(e2)
+    for (x0, y0, ex, ey, ln, _), s in zip(faces, seps, strict=True):
+        if s > 0.0 and 0.0 <= ((cx - x0) * ex + (cy - y0) * ey) / ln <= ln:
             nx, ny = ey / ln, -ex / ln
             dist = s / ln
             px, py = cx - nx * dist, cy - ny * dist  # closest point on the face
             break
     if dist is None:
-        # Squared distances in one frame (no per-vertex rescaling), so the nearest vertex wins.
-        vx, vy = min(poly, key=lambda v: (cx - v[0]) ** 2 + (cy - v[1]) ** 2)
+        # Distances in one frame (no per-vertex rescaling), so the nearest vertex wins.
+        vx, vy = min(poly, key=lambda v: math.hypot(cx - v[0], cy - v[1]))
         ddx, ddy = cx - vx, cy - vy
         dist = math.hypot(ddx, ddy)
-        nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, 1.0)
+        if dist == 0.0:
+            return _polygon_circle_exact(poly, cx, cy, r, off, size, f)
+        nx, ny = ddx / dist, ddy / dist
         px, py = vx, vy
-    if dist == 0.0:
-        return _polygon_circle_exact(poly, cx, cy, r, off, size, f)
     if dist >= r + tol:
         return None
     if dist > r - tol:
@@ -231,16 +220,39 @@ def polygon_circle(
     return f * nx, f * ny, r - dist, px, py
 
 
-def _inside_candidates(poly: Pts, seps: list[float], r: float, f: float) -> list[tuple[float, float, float]]:
+Face = tuple[float, float, float, float, float, int]
+
+
+def _faces(poly: Pts) -> list[Face]:
+    """``(x0, y0, ex, ey, |e|, k)`` of each edge of an outline, but those scaled away to nothing.
+
+    ``(ex, ey)`` is the edge times ``2**-k`` (exact), which keeps products from underflowing.
+    """
     n = len(poly)
-    cands = []
+    faces = []
     for i in range(n):
         x0, y0 = poly[i]
         x1, y1 = poly[(i + 1) % n]
-        ex, ey = x1 - x0, y1 - y0
-        ln = math.hypot(ex, ey)
-        cands.append((r - seps[i] / ln, f * ey / ln, -f * ex / ln))
-    return cands
+        if (x0, y0) != (x1, y1):
+            k = math.frexp(max(abs(x1 - x0), abs(y1 - y0)))[1]
+            ex, ey = math.ldexp(x1 - x0, -k), math.ldexp(y1 - y0, -k)
+            faces.append((x0, y0, ex, ey, math.hypot(ex, ey), k))
+    return faces
+
+
+def _inside_candidates(faces: list[Face], seps: list[float], r: float, f: float) -> list[tuple[float, float, float]]:
+    """Push-outs through each face of a centre inside; ``seps`` are in the faces' edge units."""
+    cands = [
+        (r - s / ln, f * ey / ln, -f * ex / ln) for (_, _, ex, ey, ln, _), s in zip(faces, seps, strict=True)
+    ]
+    return cands or [(r, 0.0, 1.0)]  # a polygon shrunk to a point at the centre: undefined, up
+
+
+def _ratio(num: int, den: int, e: int) -> float:
+    """``num / den * 2**e`` (``den > 0``) as a float, to within 2**-60 relative."""
+    shift = 64 - (num.bit_length() - den.bit_length())
+    q = (num << shift) // den if shift >= 0 else num // (den << -shift)
+    return _to_float(q, e - shift)
 
 
 def _polygon_circle_exact(
@@ -250,49 +262,46 @@ def _polygon_circle_exact(
     n = len(poly)
     ecx, ecy, rest, e = _exact_offset(off, (r, 0), *((c, 0) for p in poly for c in p))
     er, pts = rest[0], [(rest[1 + 2 * i], rest[2 + 2 * i]) for i in range(n)]
-    seps = []
+    edges = []  # (index, ex, ey, s) of the edges of nonzero length
     for i in range(n):
-        x0, y0 = pts[i]
-        x1, y1 = pts[(i + 1) % n]
-        seps.append((y1 - y0) * (ecx - x0) - (x1 - x0) * (ecy - y0))
-    if all(s <= 0 for s in seps):
-        # Inside or on the boundary: always an overlap (r > 0), depth r + distance to the face.
-        cands = _inside_candidates(poly, [_to_float(s, 2 * e) for s in seps], r, f)
-        depth, nx, ny = pick(cands, size)
-        return nx, ny, max(depth, _TINY), cx, cy
-    for i in range(n):
-        s = seps[i]
-        if s <= 0:
-            continue
         x0, y0 = pts[i]
         x1, y1 = pts[(i + 1) % n]
         ex, ey = x1 - x0, y1 - y0
+        if ex or ey:
+            edges.append((i, ex, ey, ey * (ecx - x0) - ex * (ecy - y0)))
+    if edges and all(s <= 0 for *_, s in edges):
+        # Inside or on the boundary: always an overlap (r > 0), depth r + distance to the face.
+        faces = _faces(poly)  # the same edges: a float edge is zero exactly when the exact one is
+        seps = [_to_float(s, 2 * e - face[5]) for (*_, s), face in zip(edges, faces, strict=True)]
+        cands = _inside_candidates(faces, seps, r, f)
+        depth, nx, ny = pick(cands, size)
+        return nx, ny, max(depth, _TINY), cx, cy
+    for i, ex, ey, s in edges:
+        x0, y0 = pts[i]
         e2 = ex * ex + ey * ey
-        t = (ecx - x0) * ex + (ecy - y0) * ey
-        if 0 <= t <= e2:
-            # distance s / |e| < r  <=>  s^2 < r^2 |e|^2; depth = (r^2 |e|^2 - s^2) / (|e| (r |e| + s)).
+        if s > 0 and 0 <= (ecx - x0) * ex + (ecy - y0) * ey <= e2:
+            # distance s / |e| < r  <=>  s^2 < r^2 |e|^2; then depth = r - dist, computed as
+            # (r^2 - dist^2) / (r + dist) with r^2 - dist^2 = (r^2 |e|^2 - s^2) / |e|^2 exact.
             num = er * er * e2 - s * s
             if num <= 0:
                 return None
-            fx0, fy0 = poly[i]
-            fx1, fy1 = poly[(i + 1) % n]
-            fex, fey = fx1 - fx0, fy1 - fy0
+            (fx0, fy0), (fx1, fy1) = poly[i], poly[(i + 1) % n]
+            k = math.frexp(max(abs(fx1 - fx0), abs(fy1 - fy0)))[1]
+            fex, fey = math.ldexp(fx1 - fx0, -k), math.ldexp(fy1 - fy0, -k)
             ln = math.hypot(fex, fey)
-            fs = _to_float(s, 2 * e)
-            depth = max(_to_float(num, 4 * e) / (ln * (r * ln + fs)), _TINY)
+            dist = _to_float(s, 2 * e - k) / ln
+            depth = max(_ratio(num, e2, 2 * e) / (r + dist), _TINY)
             nx, ny = fey / ln, -fex / ln
-            dist = fs / ln
             return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
     j = min(range(n), key=lambda i: (ecx - pts[i][0]) ** 2 + (ecy - pts[i][1]) ** 2)
-    d2 = (ecx - pts[j][0]) ** 2 + (ecy - pts[j][1]) ** 2
-    num = er * er - d2
+    num = er * er - (ecx - pts[j][0]) ** 2 - (ecy - pts[j][1]) ** 2
     if num <= 0:
         return None
-    vx, vy = poly[j]
     ddx, ddy = _to_float(ecx - pts[j][0], e), _to_float(ecy - pts[j][1], e)
     dist = math.hypot(ddx, ddy)
     depth = max(_to_float(num, 2 * e) / (r + dist), _TINY)
-    return f * ddx / dist, f * ddy / dist, depth, vx, vy
+    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
+    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
 
 # --- polygon / polygon (AABBs are polygons here) ----------------------------------------------
@@ -302,6 +311,16 @@ def _edge(poly: Pts, i: int) -> tuple[float, float]:
     x0, y0 = poly[i]
     x1, y1 = poly[(i + 1) % len(poly)]
     return y1 - y0, x0 - x1
+
+
+def _unit_scale(ux: float, uy: float) -> tuple[float, float]:
+    """``(ux, uy)`` times the power of two that brings its larger component into [0.5, 1).
+
+    Exact, so it changes no decision and no result bit; it only keeps a very short edge's products
+    with small coordinates from underflowing.
+    """
+    k = math.frexp(max(abs(ux), abs(uy)))[1]
+    return math.ldexp(ux, -k), math.ldexp(uy, -k)
 
 
 def _axes(pa: Pts, pb: Pts) -> list[tuple[int, int]]:
@@ -338,7 +357,7 @@ def polygon_polygon(
 ) -> Res | None:
     """Convex CCW outline A at the origin and B (outline ``lb`` about its own origin) at (dx, dy)."""
     edges = _axes(pa, lb)
-    axes = [_edge(lb if which else pa, i) for which, i in edges]
+    axes = [_unit_scale(*_edge(lb if which else pa, i)) for which, i in edges]
     mag = size + abs(dx) + abs(dy)
     overlaps = []  # per axis: how far B must move forward (+u) and backward (-u), times |u|
     borderline = False
@@ -376,21 +395,26 @@ def polygon_polygon(
 def _polygon_polygon_exact(
     pa: Pts, lb: Pts, off: Terms, edges: list[tuple[int, int]]
 ) -> list[tuple[float, float]] | None:
-    """The SAT on exact integers: ``None`` if separated or touching, else the per-axis overlaps."""
+    """The SAT on exact integers: ``None`` if separated or touching, else the overlaps along the
+    axes of ``edges``. Every edge is tested, also those whose float axis was dropped as a repeat
+    (rounding can make nearly parallel edges look exactly parallel)."""
     ex, ey, rest, e = _exact_offset(off, *((c, 0) for p in pa + lb for c in p))
     pts = [(rest[2 * i], rest[2 * i + 1]) for i in range(len(rest) // 2)]
     ia, ib = pts[: len(pa)], pts[len(pa):]
-    out = []
-    for which, i in edges:
-        ux, uy = _edge(ib if which else ia, i)  # type: ignore[arg-type]
-        amin, amax = _extent(ia, ux, uy)  # type: ignore[arg-type]
-        bmin, bmax = _extent(ib, ux, uy)  # type: ignore[arg-type]
-        ud = ux * ex + uy * ey
-        fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
-        if fwd <= 0 or bwd <= 0:
-            return None
-        out.append((_to_float(fwd, 2 * e), _to_float(bwd, 2 * e)))
-    return out
+    found = {}
+    for which, poly in enumerate((ia, ib)):
+        for i in range(len(poly)):
+            ux, uy = _edge(poly, i)  # type: ignore[arg-type]
+            if not (ux or uy):
+                continue
+            amin, amax = _extent(ia, ux, uy)  # type: ignore[arg-type]
+            bmin, bmax = _extent(ib, ux, uy)  # type: ignore[arg-type]
+            ud = ux * ex + uy * ey
+            fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
+            if fwd <= 0 or bwd <= 0:
+                return None
+            found[which, i] = (fwd, bwd)
+    return [(_to_float(found[k][0], 2 * e), _to_float(found[k][1], 2 * e)) for k in edges]
 
 
 def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:

@@ -1,26 +1,28 @@
 """Numpy kernels of the broad phase: a uniform grid of cells and horizontal strips, no Python loop
 over bodies.
 
-Cells. A body with bounds ``[minx, maxx] x [miny, maxy]`` covers the closed range of columns
-``cell_index(minx) .. cell_index(maxx)`` and of rows ``cell_index(miny) .. cell_index(maxy)``, where
-``cell_index(v) = floor(v / cell)`` clipped to ``+-CELL_LIMIT``. That one function is used for every
-coordinate, and it is monotone (division by a positive float is correctly rounded, hence monotone,
-and so are ``floor`` and clipping). So two bodies that overlap, even only by touching, always share
-a cell: ``minx_b <= maxx_a`` gives ``cell_index(minx_b) <= cell_index(maxx_a)``, and the same for
-the other bounds. Whether ``1.0 / 0.1`` rounds to 9.999... or to 10.0 does not matter, only that
-every caller sees the same answer.
+Cells. ``cell_index(v) = floor(v / cell)``, clipped to ``+-CELL_LIMIT``, is the one function that
+turns every coordinate into a cell, and it is monotone (division by a positive float is correctly
+rounded, hence monotone, and so are ``floor`` and clipping). An interval ``[lo, hi]`` is entered in
+cells ``cell_index(lo) .. max(cell_index(lo), cell_index(p))`` with ``p`` in ``[prev(hi), hi]``
+(see :func:`cell_range`): a body ending exactly on a cell border does not enter the cell it only
+touches. Two intervals that overlap strictly share a cell: ``lo_b < hi_a`` gives
+``lo_b <= prev(hi_a) <= p_a``, so ``cell_index(lo_b) <= last_a`` by monotonicity, and the same the
+other way round. Whether ``1.0 / 0.1`` rounds to 9.999... or to 10.0 never matters, only that every
+caller sees the same answer (``1.0 // 0.1 == 9.0`` is a different function and is never used).
 
-Reference cell. A pair covering several common cells is reported from one of them only: the cell
-``(max(cx0_a, cx0_b), max(cy0_a, cy0_b))`` (``cx0``: first column of a body, ``cy0``: first row),
-which holds the lower-left corner of the intersection of the two bounds, so both bodies cover it.
-A common cell is that one exactly when it is in the first column of one of the two bodies and in
-the first row of one of them: every cell entry carries two flag bits (bit 1: first column of its
-body, bit 0: first row) and a pair is kept iff ``flags_a | flags_b == 0b11``. No set of pairs, no
-``np.unique`` over pairs. Strips (rows alone) use the row bit alone.
+Reference cell. A pair sharing several cells is reported from one of them only: the cell
+``(max(cx0_a, cx0_b), max(cy0_a, cy0_b))`` (``cx0``: first column of a body, ``cy0``: first row).
+By the inequalities above it lies in both bodies' ranges. A shared cell is that one exactly when it
+is in the first column of one of the two bodies and in the first row of one of them, so every cell
+entry carries two flag bits (bit 1: first column of its body, bit 0: first row) and a pair is kept
+iff ``flags_a | flags_b == 0b11``: no set of pairs, no ``np.unique`` over pairs. Strips (rows
+alone) use the row bit alone.
 
 Static bodies are entered in a :class:`CellIndex`: one int64 array of the packed
-``(cell key, flags, body)`` sorted by ``np.sort`` (2-3x faster than ``argsort``), cell keys row-major
-so that looking up cells in row order means sorted ``searchsorted`` queries.
+``(cell key, flag code, body)`` sorted by ``np.sort`` (2-3x faster than ``argsort``). Within a cell
+the flag codes are ordered so that the partners of any query entry form one contiguous range, and
+cells are found through a dense table (or ``searchsorted`` on a sparse grid).
 
 Moving bodies are swept in strips (:class:`StripSweep`): entered in every row of cells they cover,
 sorted by (row, minx), and each entry is paired with the following entries of its row whose minx is
@@ -102,23 +104,34 @@ def cell_index(v: np.ndarray, cell: float, clip: bool = True) -> np.ndarray:
 
     ``clip=False`` skips the clipping when the caller knows every ``|v| / cell`` is below the limit.
     """
-    c = np.floor(v / cell)
+    return _floor_cells(v / cell, clip)
+
+
+def _floor_cells(q: np.ndarray, clip: bool) -> np.ndarray:
+    np.floor(q, out=q)
     if clip:
-        np.clip(c, -CELL_LIMIT, CELL_LIMIT, out=c)
-    return c.astype(_I64)
+        np.clip(q, -CELL_LIMIT, CELL_LIMIT, out=q)
+    return q.astype(_I64)
 
 
 def cell_range(lo: np.ndarray, hi: np.ndarray, cell: float, clip: bool = True):
     """First and last cell index that interval ``[lo, hi]`` needs, for strict overlaps.
 
-    The last is ``cell_index`` of the float just below ``hi``, so a body ending exactly on a cell
-    border (a tile on a grid) is not entered in the cell beyond, which it only touches; but never
-    below the first, so a zero-width interval keeps its one cell. Two intervals that overlap strictly
-    still share a cell: ``lo_b < hi_a`` gives ``lo_b <= prev(hi_a)``, so by monotonicity
-    ``first_b <= last_a``.
+    The last is ``cell_index(p)`` for a ``p`` between the float just below ``hi`` and ``hi``, so a
+    body ending exactly on a cell border (a tile on a grid) is not entered in the cell beyond, which
+    it only touches; and never below the first, so a zero-width interval keeps its one cell. Two
+    intervals that overlap strictly still share a cell: ``lo_b < hi_a`` gives ``lo_b <= p_a``, so by
+    monotonicity ``first_b <= last_a`` (and the reference cell lies in both ranges).
+
+    ``p = hi - |hi| * 2**-53``: ``|hi| * 2**-53`` is below one ulp of ``hi`` (at most one ulp of the
+    binade below for a power of two), so ``p`` rounds to ``hi`` or the float just below it.
     """
     first = cell_index(lo, cell, clip)
-    last = cell_index(np.nextafter(hi, -np.inf), cell, clip)
+    p = np.abs(hi)
+    p *= -(2.0**-53)
+    p += hi
+    p /= cell
+    last = _floor_cells(p, clip)
     np.maximum(last, first, out=last)
     return first, last
 
@@ -130,12 +143,17 @@ def auto_cell_size(minx, miny, maxx, maxy) -> float | None:
     small that a coordinate is more than 2**28 cells from the origin (a scene at 1e9 with tiny bodies
     gets cells of a few units, and cell indices stay unclipped).
     """
-    fin = np.isfinite(minx + miny + maxx + maxy)
-    if not fin.all():
-        minx, miny, maxx, maxy = minx[fin], miny[fin], maxx[fin], maxy[fin]
+    with np.errstate(over="ignore", invalid="ignore"):
+        fin = np.isfinite(minx + miny + maxx + maxy)
+        if not fin.all():
+            minx, miny, maxx, maxy = minx[fin], miny[fin], maxx[fin], maxy[fin]
+        if minx.shape[0] == 0:
+            return None
+        return _auto_cell_size(minx, miny, maxx, maxy)
+
+
+def _auto_cell_size(minx, miny, maxx, maxy) -> float:
     n = minx.shape[0]
-    if n == 0:
-        return None
     cell = 2.0 * float(np.median(np.maximum(maxx - minx, maxy - miny)))
     if not (np.isfinite(cell) and cell > 0.0):
         spread = max(float(maxx.max() - minx.min()), float(maxy.max() - miny.min()))
@@ -188,6 +206,10 @@ class _Ranges:
     ``lo_x, hi_x``: the least minx and greatest maxx of the small bodies."""
 
     def __init__(self, bounds: tuple, cell: float) -> None:
+        with np.errstate(over="ignore"):  # huge coordinates over a tiny cell: clipped below
+            self._compute(bounds, cell)
+
+    def _compute(self, bounds: tuple, cell: float) -> None:
         minx, miny, maxx, maxy = bounds
         n = minx.shape[0]
         if n == 0:
@@ -261,6 +283,7 @@ class CellIndex:
             self.x0 = self.y0 = self.wx = self.wy = 0
             self.key = self.flags = self.body = self.ukey = _EMPTY_I
             self.bound = np.zeros((0, 5), dtype=_I64)
+            self._dense = None
             self.ebounds = (np.zeros(0),) * 4
             return
         cx0, cy0, nx, ny = r.cx0[sb], r.cy0[sb], r.nx[sb], r.ny[sb]
@@ -302,6 +325,11 @@ class CellIndex:
         for c in (1, 2, 3, 4):
             bound[:, c] = np.searchsorted(kc, ukc + c)
         self.bound = bound
+        # a dense table cell key -> cell number when the grid is not much bigger than its entries
+        self._dense = None
+        if wx * wy <= max(1 << 16, 4 * self.key.shape[0]):
+            self._dense = np.full(wx * wy + 1, -1, dtype=_I64)  # the extra last slot: "outside"
+            self._dense[self.ukey] = np.arange(starts.shape[0], dtype=_I64)
         # the bounds in entry order, so the pair tests read neighbouring memory
         self.ebounds = subset(self.bounds, self.body)
 
@@ -321,10 +349,14 @@ class CellIndex:
             z = np.zeros(cx.shape[0], dtype=_I64)
             return z, z
         valid = (cx >= self.x0) & (cx < self.x0 + self.wx) & (cy >= self.y0) & (cy < self.y0 + self.wy)
-        key = np.where(valid, (cy - self.y0) * self.wx + (cx - self.x0), -1)
-        u = np.searchsorted(self.ukey, key)
-        np.minimum(u, self.ukey.shape[0] - 1, out=u)
-        hit = self.ukey[u] == key
+        if self._dense is not None:
+            u = self._dense[np.where(valid, (cy - self.y0) * self.wx + (cx - self.x0), -1)]
+            hit = u >= 0
+        else:
+            key = np.where(valid, (cy - self.y0) * self.wx + (cx - self.x0), -1)
+            u = np.searchsorted(self.ukey, key)
+            np.minimum(u, self.ukey.shape[0] - 1, out=u)
+            hit = self.ukey[u] == key
         if f is None:
             lo, hi = self.bound[u, 0], self.bound[u, 4]
         else:
@@ -360,19 +392,19 @@ class StripSweep:
     that still ends the sweep at the first entry past it, and pairs are then tested exactly. The
     sweep key ``row << qbits | q`` also ends every sweep at the end of its row.
 
-    Attributes (read-only by convention): ``n``, ``bounds``, ``large`` as in :class:`CellIndex`;
-    per entry, in sorted order: ``row`` (relative to the lowest), ``first`` (1 in the body's first
-    row), ``body``, the body's bounds ``ex0, ey0, ex1, ey1``, the sweep key ``skey`` and its limit
-    ``slim``.
+    Attributes (read-only by convention): ``n``, ``large`` as in :class:`CellIndex`; per entry, in
+    sorted order: ``row`` (relative to the lowest), ``first`` (1 in the body's first row), ``body``,
+    the body's bounds ``ex0, ey0, ex1, ey1``, the sweep key ``skey`` and its limit ``slim``.
     """
 
     def __init__(self, bounds: tuple, cell: float) -> None:
-        self.bounds = tuple(np.array(v) for v in bounds)
-        minx, miny, maxx, maxy = self.bounds
+        minx, miny, maxx, maxy = bounds  # not kept: the caller may reuse its arrays
         self.n = minx.shape[0]
         self.cell = cell
-        r = self._ranges = _Ranges(self.bounds, cell)
+        r = self._ranges = _Ranges(bounds, cell)
         self.large = r.large
+        self._large_bounds = subset(bounds, r.large)
+        self._bounds = None
         sb = r.small
         k = sb.shape[0]
         if k == 0:
@@ -403,9 +435,25 @@ class StripSweep:
         # a sentinel past the last entry ends every sweep there
         self.skey = np.append(skey, np.iinfo(_I64).max)
 
+    @property
+    def bounds(self) -> tuple:
+        """The bodies' (minx, miny, maxx, maxy), rebuilt on demand from the entries (each small body
+        once, from its first row) and the large bodies."""
+        if self._bounds is None:
+            out = tuple(np.empty(self.n) for _ in range(4))
+            once = np.flatnonzero(self.first)
+            entry = (self.ex0, self.ey0, self.ex1, self.ey1)
+            for v, e, lg in zip(out, entry, self._large_bounds, strict=True):
+                v[self.body[once]] = e[once]
+                v[self.large] = lg
+            self._bounds = out
+        return self._bounds
+
     def quantise(self, x: np.ndarray) -> np.ndarray:
         """The monotone quantiser ``q`` of the sort order (see the class notes)."""
         lo, scale, top = self._q
+        if scale == 0.0:  # one x for all, or a span that overflows: no order within rows at all
+            return np.zeros(x.shape[0], dtype=_I64)
         q = np.floor((x - lo) * scale)
         np.clip(q, 0.0, top, out=q)
         return q.astype(_I64)
@@ -419,7 +467,8 @@ class StripSweep:
         e = self.entries
         if e < 2:
             return _EMPTY_I, _EMPTY_I
-        x0, y0, x1, y1, first, skey, slim = self.ex0, self.ey0, self.ex1, self.ey1, self.first, self.skey, self.slim
+        x0, y0, x1, y1 = self.ex0, self.ey0, self.ex1, self.ey1
+        first, skey, slim = self.first, self.skey, self.slim
         out_a, out_b = [], []
         # entry p meets p+1, p+2, ... while their sweep key is within its limit: step all entries
         # forward together while many are active, then finish the few long sweeps by binary search
@@ -459,6 +508,6 @@ class StripSweep:
         lo, hi = stat.lookup(r.cx0[body[q]] + dx, self.row[q] + self._y0, f)
         own, ps = expand_runs(hi - lo, lo)
         q = q[own]
-        bx0, by0, bx1, by1 = stat.ebounds
-        ok = strict_overlap(self.ex0[q], self.ey0[q], self.ex1[q], self.ey1[q], bx0[ps], by0[ps], bx1[ps], by1[ps])
+        ok = strict_overlap(*(v[q] for v in (self.ex0, self.ey0, self.ex1, self.ey1)),
+                            *(v[ps] for v in stat.ebounds))
         return body[q[ok]], stat.body[ps[ok]]

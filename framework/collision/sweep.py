@@ -13,14 +13,16 @@ a sweep is a ray cast of B's offset against ``M``, with the same grazing rules:
   the first entry into ``M`` is the first entry into any of those pieces.
 
 Positions are scaled by one power of two and the motion by another (both exact); times are kept
-in the scaled frame (``tau = t * 2**(j - k)``) and turned into a step fraction at the end.
+in the scaled frame (``tau = t * 2**(j - k)``) and turned into a step fraction at the end. Swapping
+A and B repeats the same arithmetic, so it gives the same fraction and the negated normal bit for
+bit (except at fraction 0, where the normal is ``collide``'s).
 """
 
 from __future__ import annotations
 
 import math
 
-from ..shapes import Circle, Shape
+from ..shapes import AABB, Circle, Shape
 from ..validation import vector2
 from .collide import collide
 from .placement import check_shape, pose
@@ -82,10 +84,18 @@ def time_of_impact(
         res = _polygon_circle(scaled_outline(shape_a, 0.0, 0.0, ar, k), dx, dy,
                               math.ldexp(shape_b.radius, -k), vx, vy)
     elif a_circle:
-        # A circle against B: cast A's centre (at the origin, moving by -v) at B's rounded
-        # outline, then turn the normals round to point from A toward B.
-        res = _polygon_circle(scaled_outline(shape_b, dx, dy, br, k), 0.0, 0.0,
+        # A circle against B: in B's frame (as when B comes first, so that both orders do the same
+        # arithmetic), cast A's centre at -delta, moving by -v; then turn the normals round.
+        res = _polygon_circle(scaled_outline(shape_b, 0.0, 0.0, br, k), -dx, -dy,
                               math.ldexp(shape_a.radius, -k), -vx, -vy)
+        if res is not None:
+            res = res[0], res[1], [(t, -nx, -ny) for t, nx, ny in res[2]]
+    elif _order_key(shape_b, bx, by, br) < _order_key(shape_a, ax, ay, ar):
+        # Work in the frame of whichever shape sorts first, so that swapping A and B repeats the
+        # very same arithmetic: the same fraction and the exactly negated normal. (Two circles'
+        # numbers only change sign when swapped; a circle and a polygon work in the polygon's frame.)
+        res = _polygon_polygon(scaled_outline(shape_b, 0.0, 0.0, br, k),
+                               scaled_outline(shape_a, -dx, -dy, ar, k), -vx, -vy)
         if res is not None:
             res = res[0], res[1], [(t, -nx, -ny) for t, nx, ny in res[2]]
     else:
@@ -103,6 +113,12 @@ def time_of_impact(
     # in (or an overlap that collide's rounding missed): contact from the start.
     fraction = math.ldexp(t_in, k - j) if t_in > 0.0 else 0.0
     return Impact(fraction + 0.0, Vec2(nx + 0.0, ny + 0.0))
+
+
+def _order_key(shape: Shape, x: float, y: float, rotation: float) -> tuple:
+    """A total order on placed boxes and polygons (equal keys: the same outline at the same place)."""
+    params = (shape.width, shape.height) if isinstance(shape, AABB) else shape.points  # type: ignore[union-attr]
+    return (x, y, rotation, shape.kind, params)
 
 
 # --- pairs of kinds, in the scaled local frame --------------------------------------------------

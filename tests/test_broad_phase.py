@@ -1,0 +1,641 @@
+"""The broad phase (``framework.collision.broad_phase``) against the O(N^2) brute-force reference.
+
+The pair set must be exactly the brute-force one: bounds overlapping strictly on both axes (touching
+is not a pair), never two static bodies, each pair once as ``(i, j)`` with ``i < j``, sorted. Hand
+cases cover each known pitfall of grid hashing (negative coordinates, bounds on cell borders,
+bodies spanning many cells, one huge body, float floor division with a 0.1 cell, duplicates,
+N = 0 and 1, all static, coordinates near 1e9, points, NaN and inf); property tests compare random
+scenes snapped to a coarse dyadic grid, so that many bounds touch exactly or sit on cell borders.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from framework.collision import grid
+from framework.collision.broad_phase import SpatialHash, brute_force_pairs, find_pairs
+
+
+def as_set(pairs) -> set[tuple[int, int]]:
+    a, b = pairs
+    return set(zip(a.tolist(), b.tolist(), strict=True))
+
+
+def assert_exact(minx, miny, maxx, maxy, static=None, cell_size=None):
+    """find_pairs equals brute force, as arrays (so also in order and dtype kind)."""
+    got = find_pairs(minx, miny, maxx, maxy, static, cell_size)
+    exp = brute_force_pairs(minx, miny, maxx, maxy, static)
+    assert got[0].dtype.kind == "i" and got[1].dtype.kind == "i"
+    assert np.array_equal(got[0], exp[0]) and np.array_equal(got[1], exp[1]), (
+        f"missing {as_set(exp) - as_set(got)}, extra {as_set(got) - as_set(exp)}"
+    )
+    return got
+
+
+def boxes(*rows):
+    """Bounds arrays from (minx, miny, maxx, maxy) rows."""
+    a = np.array(rows, dtype=np.float64).reshape(-1, 4)
+    return a[:, 0], a[:, 1], a[:, 2], a[:, 3]
+
+
+def hashed_pairs(minx, miny, maxx, maxy, static, ids, cell_size=None):
+    """Pairs through the SpatialHash API with caller ids: statics first, then the movers."""
+    h = SpatialHash(cell_size)
+    b = (np.asarray(minx), np.asarray(miny), np.asarray(maxx), np.asarray(maxy))
+    h.set_static(*(v[static] for v in b), ids[static])
+    return h, h.pairs(*(v[~static] for v in b), ids[~static])
+
+
+# --- the reference itself ---------------------------------------------------------------------
+
+
+def test_brute_force_semantics():
+    b = boxes(
+        (0, 0, 2, 2),  # 0
+        (1, 1, 3, 3),  # 1 overlaps 0
+        (2, 0, 4, 2),  # 2 touches 0 along an edge, overlaps 1
+        (3, 3, 5, 5),  # 3 touches 1 at a corner only
+        (0.5, 0.5, 0.5, 0.5),  # 4 a point inside 0
+        (2, 1.5, 2, 1.5),  # 5 a point on the edges of 0 and 2 (touching), inside 1
+    )
+    static = np.array([False, False, False, False, False, True])
+    assert as_set(brute_force_pairs(*b, static)) == {(0, 1), (1, 2), (0, 4), (1, 5)}
+    assert as_set(brute_force_pairs(*b, np.array([True, True, False, False, False, False]))) == {
+        (1, 2), (0, 4), (1, 5)
+    }
+
+
+# --- sizes of N and trivial inputs --------------------------------------------------------------
+
+
+@pytest.mark.parametrize("static", [None, [True], [False]])
+def test_no_bodies_and_one_body(static):
+    e = np.zeros(0)
+    a, b = find_pairs(e, e, e, e)
+    assert a.shape == (0,) and b.shape == (0,) and a.dtype == np.int64
+    assert as_set(find_pairs([0.0], [0.0], [1.0], [1.0], static)) == set()
+
+
+def test_empty_hash_queries():
+    h = SpatialHash()
+    assert h.cell_size is None
+    assert h.query_box(0, 0, 1, 1).shape == (0,)
+    assert h.query_ray(0, 0, 1, 0, 10).shape == (0,)
+    assert h.cells_in_use().shape == (0, 2)
+    e = np.zeros(0)
+    a, b = h.pairs(e, e, e, e, np.zeros(0, dtype=np.int64))
+    assert a.shape == (0,) and h.rehashed_last == 0
+
+
+def test_all_static_gives_no_pairs():
+    b = boxes((0, 0, 2, 2), (1, 1, 3, 3), (0, 0, 2, 2))
+    assert as_set(find_pairs(*b, np.ones(3, dtype=bool))) == set()
+
+
+# --- touching, borders, negative coordinates ------------------------------------------------------
+
+
+def test_touching_is_not_a_pair_but_one_ulp_is():
+    up = np.nextafter(2.0, 3.0)
+    b = boxes(
+        (0, 0, 2, 2),
+        (2, 0, 4, 2),  # touches 0 on x = 2
+        (0, 2, 2, 4),  # touches 0 on y = 2
+        (2, 2, 4, 4),  # corner
+        (np.nextafter(2.0, 1.0), 5, 3, 6),  # far in y
+    )
+    assert_exact(*b, cell_size=1.0)
+    assert as_set(find_pairs(*b, cell_size=1.0)) == set()
+    b2 = boxes((0, 0, up, 2), (2, 0, 4, 2))
+    assert as_set(assert_exact(*b2, cell_size=1.0)) == {(0, 1)}
+    assert as_set(assert_exact(*b2, cell_size=2.0)) == {(0, 1)}
+
+
+@pytest.mark.parametrize("cell", [1.0, 2.0, 0.5, 4.0, None])
+def test_bounds_exactly_on_cell_borders(cell):
+    # unit tiles on integer coordinates, some overlapping by half, some touching, all on borders
+    rows = []
+    for i in range(-3, 4):
+        for j in range(-3, 4):
+            rows.append((i, j, i + 1, j + 1))
+    rows += [(-0.5, -0.5, 0.5, 0.5), (0, 0, 2, 2), (1, -3, 1, 4), (-4, 0, 4, 0), (0, 0, 0, 0)]
+    b = boxes(*rows)
+    static = np.zeros(len(rows), dtype=bool)
+    static[: 49] = True
+    got = assert_exact(*b, static, cell_size=cell)
+    assert len(got[0]) > 0
+    assert_exact(*b, None, cell_size=cell)
+
+
+def test_negative_coordinates_mirror_positive():
+    rng = np.random.default_rng(3)
+    x = np.round(rng.uniform(0, 40, 300) * 4) / 4
+    y = np.round(rng.uniform(0, 40, 300) * 4) / 4
+    w = np.round(rng.uniform(0, 4, 300) * 4) / 4
+    h = np.round(rng.uniform(0, 4, 300) * 4) / 4
+    pos = assert_exact(x, y, x + w, y + h, cell_size=2.0)
+    # mirrored through the origin, every interval flips: the same pairs
+    neg = assert_exact(-(x + w), -(y + h), -x, -y, cell_size=2.0)
+    assert as_set(pos) == as_set(neg)
+    # and straddling the origin
+    assert_exact(x - 20, y - 20, x + w - 20, y + h - 20, cell_size=2.0)
+
+
+# --- sizes relative to the cell -------------------------------------------------------------------
+
+
+def test_bodies_larger_than_a_cell_pair_once():
+    # two big boxes sharing a 10 x 10 block of cells, and small ones inside and around them
+    b = boxes((0, 0, 12, 12), (2, 2, 14, 14), (5, 5, 6, 6), (13, 13, 20, 20), (-3, 5, 0, 6))
+    got = assert_exact(*b, cell_size=1.0)
+    assert as_set(got) == {(0, 1), (0, 2), (1, 2), (1, 3)}
+    assert len(got[0]) == len(set(zip(*got, strict=True)))
+
+
+def test_one_huge_body_does_not_blow_up_the_cells():
+    rng = np.random.default_rng(7)
+    n = 400
+    x, y = rng.uniform(-100, 100, n), rng.uniform(-100, 100, n)
+    b = [x, y, x + rng.uniform(0.5, 2, n), y + rng.uniform(0.5, 2, n)]
+    b = [np.append(v, e) for v, e in zip(b, (-1e12, -1e12, 1e12, 1e12), strict=True)]
+    static = np.zeros(n + 1, dtype=bool)
+    static[:: 3] = True
+    got = assert_exact(*b, static)
+    assert (n, n) not in as_set(got) and len(got[0]) >= n - static[:n].sum()  # huge one meets all
+    h = SpatialHash(1.0)
+    h.set_static(*(v[static] for v in b), np.flatnonzero(static))
+    h.pairs(*(v[~static] for v in b), np.flatnonzero(~static))
+    # the huge body is kept aside: a few hundred cells in use, not 10**24
+    assert len(h.cells_in_use()) < 10 * n
+    # also as a static body
+    static[n] = True
+    assert_exact(*b, static)
+
+
+def test_huge_and_tall_bodies_against_each_other():
+    b = boxes(
+        (-1e6, 0, 1e6, 1), (0, -1e6, 1, 1e6),  # a huge horizontal and a huge vertical bar
+        (-1e6, 0.5, 1e6, 0.75), (0.25, 0.25, 0.5, 0.5), (3, 3, 4, 4), (0, 10, 1, 11),
+    )
+    for static in (None, np.array([1, 0, 0, 0, 0, 0], bool), np.array([1, 1, 0, 0, 0, 1], bool)):
+        assert_exact(*b, static, cell_size=1.0)
+
+
+# --- float pitfalls -----------------------------------------------------------------------------
+
+
+def test_floor_division_with_a_tenth_cell():
+    assert 1.0 // 0.1 == 9.0  # the pitfall: floor division and floor(x / cell) disagree
+    # bounds near multiples of 0.1 built every which way, plus one ulp either side
+    ks = np.arange(-30, 31)
+    vals = np.concatenate([ks / 10, ks * 0.1, ks * 0.1 + 0.0, np.cumsum(np.full(61, 0.1)) - 3.1])
+    vals = np.concatenate([vals, np.nextafter(vals, np.inf), np.nextafter(vals, -np.inf)])
+    rng = np.random.default_rng(11)
+    lo_x, lo_y = rng.choice(vals, 800), rng.choice(vals, 800)
+    span = rng.choice([0.0, 0.1, 0.2, 0.3, 1.0], 800)
+    hi_x = np.maximum(lo_x, rng.choice(vals, 800) * 0 + lo_x + span)
+    hi_y = np.maximum(lo_y, lo_y + rng.choice([0.0, 0.1, 0.3], 800))
+    static = rng.random(800) < 0.5
+    for cell in (0.1, 0.3, 0.7, 1.0):
+        assert_exact(lo_x, lo_y, hi_x, hi_y, static, cell)
+
+
+@pytest.mark.parametrize("cell", [0.1, 0.7, 1.7, 1 / 3])
+def test_pairs_whose_quotients_round_together(cell):
+    # minx_b < maxx_a by one ulp, yet minx_b / cell and maxx_a / cell round to the same integer
+    # (1.7 / 0.1 == 17.0 and so is the float below 1.7 divided by 0.1)
+    found = 0
+    for k in range(1, 400):
+        for hi in (k * cell, np.nextafter(k * cell, np.inf), np.nextafter(k * cell, 0.0)):
+            lo = np.nextafter(hi, 0.0)
+            q = hi / cell
+            if lo / cell == q and q == math.floor(q):
+                b = boxes((hi - 1, 0, hi, 1), (lo, 0, lo + 1, 1),  # in x; and the same in y, far away
+                          (1e3, hi - 1, 1e3 + 1, hi), (1e3, lo, 1e3 + 1, lo + 1))
+                assert as_set(assert_exact(*b, cell_size=cell)) == {(0, 1), (2, 3)}
+                found += 1
+    assert found > 10
+
+
+def test_coordinates_near_1e9():
+    rng = np.random.default_rng(5)
+    x = np.round(rng.uniform(0, 64, 500) * 4) / 4
+    y = np.round(rng.uniform(0, 64, 500) * 4) / 4
+    w = np.round(rng.uniform(0, 3, 500) * 4) / 4
+    static = rng.random(500) < 0.3
+    near = assert_exact(x, y, x + w, y + w, static)
+    off = 2.0**30  # ~1.07e9, and the sums stay exact at quarter units
+    far = assert_exact(x + off, y - off, x + w + off, y + w - off, static)
+    assert as_set(near) == as_set(far)
+    assert_exact(x + 1e9, y + 1e9, x + w + 1e9, y + w + 1e9, static)
+    assert_exact(x + 1e9, y + 1e9, x + w + 1e9, y + w + 1e9, static, cell_size=0.1)
+
+
+def test_scene_spread_over_an_astronomical_span():
+    # cell 1 with bodies at +-1e9 and +-1e12: cell indices are clipped and the cell keys need a
+    # sparse lookup; nothing may be lost
+    corners = [(-1e12, -1e12), (-1e9, 1e9), (1e9, -1e9), (1e12, 1e12), (0.0, 0.0), (1e9, 1e9)]
+    rows = []
+    for cx, cy in corners:
+        for dx, dy, s in ((0, 0, 2), (1, 1, 2), (2, 0, 1), (2.5, 0.5, 0.25)):
+            rows.append((cx + dx, cy + dy, cx + dx + s, cy + dy + s))
+    b = boxes(*rows)
+    static = np.arange(len(rows)) % 2 == 0
+    for cell in (1.0, 1e-3, None):
+        got = assert_exact(*b, static, cell)
+        assert len(got[0]) >= 6
+    # rays and boxes over that span
+    ids = np.arange(len(rows))
+    for cell in (1.0, None):
+        h, _ = hashed_pairs(*b, static, ids, cell)
+        for k, (cx, cy) in enumerate(corners):
+            at = ids[4 * k: 4 * k + 4]
+            got = set(h.query_ray(cx - 10, cy + 1.5, 1, 0).tolist())  # endless, along +x
+            assert {int(at[0]), int(at[1])} <= got
+            got = set(h.query_ray(cx + 1.5, cy + 100, 0, -1, 1000).tolist())
+            assert {int(at[0]), int(at[1])} <= got
+            assert h.query_box(cx + 0.5, cy + 0.5, cx + 1.5, cy + 1.5).tolist() == at[:2].tolist()
+    # the extremes of float64: spans overflow to inf
+    big = boxes((-1.7e308, 0, -1.6e308, 1), (-1.65e308, 0.5, -1e308, 2), (1e308, 0, 1.7e308, 1),
+                (1.6e308, 0, 1.7e308, 3), (0, 0, 1, 1), (0.5, 0.5, 1e308, 0.75))
+    for cell in (1.0, None, 1e300, 1e307):
+        assert len(assert_exact(*big, None, cell)[0]) == 3
+        h, _ = hashed_pairs(*big, np.array([1, 0, 1, 0, 1, 0], bool), np.arange(6), cell)
+        assert {0, 1} <= set(h.query_ray(-1.69e308, 0.75, 1, 0).tolist())
+        assert {2, 3} <= set(h.query_ray(1.65e308, -1e300, 0, 1, math.inf).tolist())
+
+
+def test_points_and_zero_width_bounds():
+    b = boxes(
+        (0, 0, 4, 4),  # 0
+        (2, 2, 2, 2),  # 1 point inside 0: a pair by the strict-overlap formula
+        (4, 1, 4, 1),  # 2 point on 0's edge: touching
+        (2, 2, 2, 2),  # 3 the same point as 1: two points never overlap
+        (1, -1, 1, 5),  # 4 vertical segment through 0 and through point 1's column
+        (-1, 2, 5, 2),  # 5 horizontal segment crossing 4 and through point 1
+    )
+    for cell in (None, 1.0, 2.0, 0.5):
+        assert as_set(assert_exact(*b, cell_size=cell)) == {(0, 1), (0, 3), (0, 4), (0, 5), (4, 5)}
+    # all points: the automatic cell size still works
+    p = np.arange(10.0)
+    assert_exact(p, p, p, p)
+    h = SpatialHash()
+    h.pairs(p, p, p, p, np.arange(10))
+    assert h.cell_size is not None and h.cell_size > 0
+
+
+def test_duplicates_and_identical_boxes_pair_once():
+    b = boxes(*[(0.5, 0.5, 3.5, 3.5)] * 5, (1, 1, 2, 2))
+    got = assert_exact(*b, cell_size=1.0)
+    assert len(got[0]) == 15
+
+
+def test_nan_and_inf_bounds():
+    b = boxes(
+        (0, 0, 2, 2),
+        (np.nan, 0, 1, 1),
+        (1, 1, np.inf, np.inf),  # overlaps everything up and to the right
+        (-np.inf, -np.inf, 0.5, 0.5),
+        (1, np.nan, 2, np.nan),
+        (5, 5, 6, 6),
+    )
+    for static in (None, np.array([0, 0, 1, 0, 0, 1], bool), np.array([1, 1, 0, 1, 0, 0], bool)):
+        assert_exact(*b, static)
+
+
+def test_inverted_and_mismatched_bounds_raise():
+    with pytest.raises(ValueError, match="maxx"):
+        find_pairs([0.0, 1.0], [0.0, 0.0], [1.0, 0.5], [1.0, 1.0])
+    with pytest.raises(ValueError, match="maxy"):
+        SpatialHash().set_static([0.0], [1.0], [1.0], [0.0], [0])
+    with pytest.raises(ValueError, match="length"):
+        SpatialHash().pairs([0.0], [0.0], [1.0, 2.0], [1.0], [0])
+    with pytest.raises(ValueError, match="ids"):
+        SpatialHash().pairs([0.0], [0.0], [1.0], [1.0], [0, 1])
+    with pytest.raises(ValueError, match="cell_size"):
+        SpatialHash(0.0)
+    h = SpatialHash(1.0)
+    h.set_static([0.0], [0.0], [2.0], [2.0], [7])
+    with pytest.raises(ValueError, match="unique"):
+        h.pairs([1.0], [1.0], [3.0], [3.0], [7])
+
+
+# --- the SpatialHash API ------------------------------------------------------------------------
+
+
+def test_pairs_are_reported_in_ids_sorted():
+    b = boxes((0, 0, 2, 2), (1, 1, 3, 3), (1.5, 0, 2.5, 1.2), (10, 10, 11, 11))
+    static = np.array([True, False, False, True])
+    ids = np.array([900, 40, 7, 3])
+    _, (a, c) = hashed_pairs(*b, static, ids)
+    assert a.tolist() == [7, 7, 40] and c.tolist() == [40, 900, 900]
+    # ids far apart take the general sort path
+    ids = np.array([2**45, 5, 2**40, -3])
+    _, (a, c) = hashed_pairs(*b, static, ids)
+    assert list(zip(a.tolist(), c.tolist(), strict=True)) == sorted(
+        [(5, 2**45), (5, 2**40), (2**40, 2**45)]
+    )
+
+
+def test_statics_are_hashed_once():
+    k = 40  # 1,600 unit tiles and 120 movers
+    gx, gy = np.meshgrid(np.arange(k, dtype=float), np.arange(k, dtype=float))
+    sx, sy = gx.ravel(), gy.ravel()
+    h = SpatialHash()
+    h.set_static(sx, sy, sx + 1, sy + 1, np.arange(k * k))
+    assert h.rehashed_last == k * k
+    index = h._static
+    cell = h.cell_size
+    assert cell == pytest.approx(2.0)
+    rng = np.random.default_rng(2)
+    for step in range(20):
+        m = 120
+        x, y = rng.uniform(-2, k + 2, m), rng.uniform(-2, k + 2, m)
+        w = rng.uniform(0.2, 1.5, m)
+        ids = np.arange(10_000, 10_000 + m)
+        a, b = h.pairs(x, y, x + w, y + w, ids)
+        assert h.rehashed_last == m
+        assert h._static is index and h.cell_size == cell
+        if step % 5 == 0:
+            allb = [np.concatenate([s, v]) for s, v in zip((sx, sy, sx + 1, sy + 1), (x, y, x + w, y + w),
+                                                            strict=True)]
+            static = np.arange(k * k + m) < k * k
+            ea, eb = brute_force_pairs(*allb, static)
+            all_ids = np.concatenate([np.arange(k * k), ids])
+            assert np.array_equal(a, all_ids[ea]) and np.array_equal(b, all_ids[eb])
+
+
+def test_cell_size_is_chosen_once_from_the_first_build():
+    h = SpatialHash()
+    h.set_static([0.0, 10.0], [0.0, 0.0], [3.0, 13.0], [3.0, 2.0], [0, 1])
+    assert h.cell_size == pytest.approx(6.0)  # twice the median extent (3)
+    h.pairs([0.0], [0.0], [100.0], [100.0], [5])
+    assert h.cell_size == pytest.approx(6.0)
+    assert SpatialHash(0.25).cell_size == 0.25
+
+
+def test_auto_cell_size_guards():
+    med = grid.auto_cell_size(*boxes((0, 0, 1, 1), (0, 0, 2, 1), (0, 0, 4, 4), (0, 0, 1e9, 1)))
+    assert 2 <= med <= 8  # the median ignores one huge body
+    pts = np.array([0.0, 100.0])
+    assert grid.auto_cell_size(pts, pts, pts, pts) > 0
+    far = np.array([1e15, 1e15 + 0.125])
+    assert grid.auto_cell_size(far, far, far + 1e-3, far + 1e-3) >= 1e15 * 2.0**-28
+    nan = np.array([np.nan])
+    assert grid.auto_cell_size(nan, nan, nan, nan) is None
+
+
+def test_order_of_bodies_does_not_matter_and_runs_repeat_exactly():
+    rng = np.random.default_rng(9)
+    n = 600
+    x, y = rng.uniform(-30, 30, n), rng.uniform(-30, 30, n)
+    w, h = rng.uniform(0, 3, n), rng.uniform(0, 3, n)
+    static = rng.random(n) < 0.4
+    ids = rng.permutation(10 * n)[:n]
+    _, first = hashed_pairs(x, y, x + w, y + h, static, ids)
+    _, again = hashed_pairs(x, y, x + w, y + h, static, ids)
+    assert first[0].tobytes() == again[0].tobytes() and first[1].tobytes() == again[1].tobytes()
+    p = rng.permutation(n)
+    _, shuffled = hashed_pairs(x[p], y[p], (x + w)[p], (y + h)[p], static[p], ids[p])
+    assert np.array_equal(first[0], shuffled[0]) and np.array_equal(first[1], shuffled[1])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_larger_random_scenes(seed):
+    # enough bodies for the vectorised sweep (not only its tail), with some long and tall bodies
+    rng = np.random.default_rng(seed)
+    n = 2500
+    side = math.sqrt(n) * 14
+    x, y = rng.uniform(-side / 2, side / 2, n), rng.uniform(-side / 2, side / 2, n)
+    w, h = rng.uniform(4, 16, n), rng.uniform(4, 16, n)
+    w[:10] *= rng.uniform(5, 20, 10)  # long bodies, many cells but not "large"
+    h[10:20] *= rng.uniform(5, 20, 10)
+    x, y, w, h = (np.round(v * 2) / 2 for v in (x, y, w, h))
+    static = rng.random(n) < [0.0, 0.3, 0.7, 1.0][seed]
+    got = assert_exact(x, y, x + w, y + h, static)
+    assert len(got[0]) > n / 4 or static.all()
+    assert_exact(x, y, x + w, y + h, static, cell_size=8.0)
+
+
+def test_a_crowd_in_one_cell():
+    rng = np.random.default_rng(4)
+    x, y = rng.uniform(0, 1, 500), rng.uniform(0, 1, 500)
+    got = assert_exact(x, y, x + 0.5, y + 0.5, cell_size=10.0)
+    assert len(got[0]) > 20_000
+
+
+# --- queries ------------------------------------------------------------------------------------
+
+
+def brute_box(b, box):
+    minx, miny, maxx, maxy = b
+    return np.flatnonzero((maxx > box[0]) & (box[2] > minx) & (maxy > box[1]) & (box[3] > miny))
+
+
+def test_query_box_hand_cases():
+    b = boxes((0, 0, 1, 1), (1, 0, 2, 1), (-5, -5, -4, -4), (0, 0, 10, 10), (3, 3, 3, 3))
+    static = np.array([True, True, True, False, False])
+    ids = np.array([10, 11, 12, 13, 14])
+    h, _ = hashed_pairs(*b, static, ids, cell_size=1.0)
+    assert h.query_box(0.25, 0.25, 0.75, 0.75).tolist() == [10, 13]
+    assert h.query_box(1, 0, 1, 1).tolist() == [13]  # a zero-width box on the border of 10 and 11
+    assert h.query_box(1, 0.5, 1, 0.5).tolist() == [13]
+    assert h.query_box(-4, -4, -3, -3).tolist() == []  # touches 12 only
+    assert h.query_box(-100, -100, 100, 100).tolist() == [10, 11, 12, 13, 14]  # 14: point inside
+    assert h.query_box(2.5, 2.5, 3.5, 3.5).tolist() == [13, 14]
+    with pytest.raises(ValueError):
+        h.query_box(1, 1, 0, 0)
+    with pytest.raises(ValueError):
+        h.query_box(0, 0, math.nan, 1)
+
+
+def segment_samples_hit(b, o, u, length, samples=4001):
+    """Bodies whose closed bounds contain one of many points sampled along the segment."""
+    t = np.linspace(0.0, length, samples)
+    px, py = o[0] + u[0] * t, o[1] + u[1] * t
+    minx, miny, maxx, maxy = (v[:, None] for v in b)
+    inside = (minx <= px) & (px <= maxx) & (miny <= py) & (py <= maxy)
+    return set(np.flatnonzero(inside.any(axis=1)).tolist())
+
+
+def segment_near(b, o, u, length, tol):
+    """Bodies whose bounds, grown by ``tol``, the segment meets (a loose float slab test)."""
+    out = set()
+    for i, (x0, y0, x1, y1) in enumerate(zip(*b, strict=True)):
+        t0, t1 = 0.0, length
+        ok = True
+        for oo, uu, lo, hi in ((o[0], u[0], x0 - tol, x1 + tol), (o[1], u[1], y0 - tol, y1 + tol)):
+            if uu == 0.0:
+                ok &= lo <= oo <= hi
+            else:
+                a, c = (lo - oo) / uu, (hi - oo) / uu
+                t0, t1 = max(t0, min(a, c)), min(t1, max(a, c))
+        if ok and t0 <= t1:
+            out.add(i)
+    return out
+
+
+def test_query_ray_hand_cases():
+    b = boxes((0, 0, 1, 1), (1, 0, 2, 1), (2, 0, 3, 1), (0, 2, 1, 3), (5, 5, 6, 6), (-3, -3, -2, -2))
+    static = np.array([True, True, True, True, False, False])
+    ids = np.arange(6)
+    h, _ = hashed_pairs(*b, static, ids, cell_size=1.0)
+    # along the top edge of the row of tiles (grazing: a superset may include them)
+    r = set(h.query_ray(-1, 1, 1, 0, 10).tolist())
+    assert {0, 1, 2} <= r and 4 not in r and 5 not in r
+    # through a corner, diagonal: (1, 1) is the corner of 0 and 1, the ray goes on to (5, 5)
+    r = set(h.query_ray(0.5, 0.5, 2, 2).tolist())  # endless
+    assert {0, 4} <= r and 5 not in r
+    # the direction need not be unit length: max_distance is in world units
+    assert 4 not in set(h.query_ray(0.5, 0.5, 2, 2, 1.0).tolist())
+    assert 5 in set(h.query_ray(0.5, 0.5, -7, -7, 3.6).tolist())
+    # vertical, down a column border
+    r = set(h.query_ray(1, 4, 0, -1, 10).tolist())
+    assert {0, 1, 3} <= r and 4 not in r
+    # zero length
+    assert 0 in set(h.query_ray(0.5, 0.5, 1, 0, 0.0).tolist())
+    with pytest.raises(ValueError):
+        h.query_ray(0, 0, 0, 0, 1)
+    with pytest.raises(ValueError):
+        h.query_ray(0, 0, 1, 0, -1)
+    with pytest.raises(ValueError):
+        h.query_ray(0, 0, 1, 0, math.nan)
+
+
+def test_query_ray_does_not_visit_everything():
+    k = 200
+    gx, gy = np.meshgrid(np.arange(k, dtype=float), np.arange(k, dtype=float))
+    sx, sy = gx.ravel(), gy.ravel()
+    h = SpatialHash(1.0)
+    h.set_static(sx, sy, sx + 0.5, sy + 0.5, np.arange(k * k))
+    r = h.query_ray(0.25, 0.25, 1, 1, 10)  # to (7.32, 7.32): meets the tiles (k, k), k = 0..7
+    assert r.tolist() == [201 * k for k in range(8)]
+    r = h.query_ray(-5, 100.25, 1, 0)  # endless, along one row
+    assert k <= len(r) < 4 * k
+
+
+def test_queries_over_many_moving_bodies():
+    # after a few queries the moving bodies get cells of their own; answers must not change
+    rng = np.random.default_rng(12)
+    n = 3000
+    x, y = np.round(rng.uniform(-200, 200, n)), np.round(rng.uniform(-200, 200, n))
+    w = np.round(rng.uniform(0, 8, n) * 2) / 2
+    static = np.arange(n) < 800
+    h, _ = hashed_pairs(x, y, x + w, y + w, static, np.arange(n))
+    b = (x, y, x + w, y + w)
+    for q in range(12):
+        bx, by = rng.uniform(-220, 200, 2).round()
+        bw = [0.0, 3.0, 40.0, 500.0][q % 4]
+        assert np.array_equal(h.query_box(bx, by, bx + bw, by + bw), brute_box(b, (bx, by, bx + bw, by + bw)))
+        ang = rng.uniform(0, 2 * math.pi)
+        u = (math.cos(ang), math.sin(ang))
+        got = set(h.query_ray(bx, by, *u, 150.0).tolist())
+        assert segment_samples_hit(b, (bx, by), u, 150.0) <= got <= segment_near(b, (bx, by), u, 150.0, 1e-6)
+    assert h._moving_cells is not None
+    # a new step drops them
+    m = ~static
+    h.pairs(x[m] + 1, y[m], x[m] + w[m] + 1, y[m] + w[m], np.arange(800, n))
+    assert h._moving_cells is None
+
+
+def test_the_caller_may_overwrite_its_arrays():
+    b = [np.array(v) for v in boxes((0, 0, 1, 1), (5, 5, 6, 6), (-1e9, 3, 1e9, 4))]
+    h = SpatialHash(1.0)
+    h.pairs(*b, np.array([1, 2, 3]))
+    for v in b:
+        v[:] = 100.0  # the caller reuses its columns for the next step
+    assert h.query_box(0.5, 0.5, 0.75, 0.75).tolist() == [1]
+    assert h.query_box(5.5, 5.5, 7, 7).tolist() == [2]
+    assert h.query_box(0, 3.5, 0, 3.5).tolist() == [3]
+    assert set(h.query_ray(-1, 0.5, 1, 0, 2).tolist()) == {1}
+
+
+def test_argument_checks():
+    with pytest.raises(ValueError, match="static"):
+        find_pairs([0.0], [0.0], [1.0], [1.0], [True, False])
+    with pytest.raises(ValueError, match="static"):
+        brute_force_pairs([0.0], [0.0], [1.0], [1.0], [True, False])
+    with pytest.raises(ValueError, match="integers"):
+        SpatialHash().pairs([0.0], [0.0], [1.0], [1.0], [0.5])
+    SpatialHash().pairs([], [], [], [], [])  # an empty list of ids is fine
+
+
+def test_cells_in_use():
+    b = boxes((0, 0, 1, 1), (2.5, -1.5, 3.5, -0.5), (-1e9, -1e9, 1e9, 1e9))
+    static = np.array([True, False, False])
+    h, _ = hashed_pairs(*b, static, np.arange(3), cell_size=1.0)
+    cells = h.cells_in_use()
+    assert cells.dtype.kind == "i" and cells.shape[1] == 2
+    # tile (0,0)-(1,1) is in cell (0, 0) only (it merely touches the next ones); the mover spans
+    # 2 x 2 cells; the huge one occupies none
+    assert cells.tolist() == [[0, 0], [2, -2], [2, -1], [3, -2], [3, -1]]
+
+
+# --- property tests -----------------------------------------------------------------------------
+
+quarter = st.integers(-64, 64).map(lambda i: i / 4)
+size = st.one_of(st.just(0.0), st.integers(0, 12).map(lambda i: i / 4), st.integers(0, 40).map(float))
+body = st.tuples(quarter, quarter, size, size, st.booleans())
+cells = st.sampled_from([None, 0.1, 0.25, 0.3, 0.5, 1.0, 1.5, 2.0, 3.0, 8.0])
+
+
+@st.composite
+def scenes(draw):
+    bodies = draw(st.lists(body, max_size=40))
+    if bodies and draw(st.booleans()):  # copies: identical and touching bodies
+        bodies += draw(st.lists(st.sampled_from(bodies), max_size=8))
+    a = np.array([bb[:4] for bb in bodies], dtype=np.float64).reshape(-1, 4)
+    static = np.array([bb[4] for bb in bodies], dtype=bool)
+    b = (a[:, 0], a[:, 1], a[:, 0] + a[:, 2], a[:, 1] + a[:, 3])
+    return b, static
+
+
+@settings(max_examples=300, deadline=None)
+@given(scenes(), cells, st.integers(0, 2**40))
+def test_random_scenes_match_brute_force(scene, cell, id_base):
+    b, static = scene
+    assert_exact(*b, static, cell)
+    ids = id_base + 3 * np.arange(len(static))[::-1]
+    h, (a, c) = hashed_pairs(*b, static, ids, cell)
+    ea, ec = brute_force_pairs(*b, static)
+    lo, hi = np.minimum(ids[ea], ids[ec]), np.maximum(ids[ea], ids[ec])
+    order = np.lexsort((hi, lo))
+    assert np.array_equal(a, lo[order]) and np.array_equal(c, hi[order])
+    assert h.rehashed_last == int((~static).sum())
+
+
+@settings(max_examples=200, deadline=None)
+@given(scenes(), cells, quarter, quarter, size, size, st.integers(1, 6))
+def test_random_query_box_matches_brute_force(scene, cell, x, y, w, hh, repeat):
+    b, static = scene
+    ids = np.arange(len(static)) + 100
+    h, _ = hashed_pairs(*b, static, ids, cell)
+    box = (x, y, x + w, y + hh)
+    exp = ids[brute_box(b, box)]
+    for _ in range(repeat):  # later queries may use the moving bodies' cells
+        assert np.array_equal(h.query_box(*box), exp)
+
+
+@settings(max_examples=150, deadline=None)
+@given(scenes(), cells, quarter, quarter, st.integers(-8, 8), st.integers(-8, 8),
+       st.one_of(st.just(math.inf), st.integers(0, 60).map(lambda i: i / 2)), st.integers(1, 5))
+def test_random_query_ray_is_a_tight_superset(scene, cell, ox, oy, dx, dy, length, repeat):
+    if dx == 0 and dy == 0:
+        dx = 1
+    b, static = scene
+    n = len(static)
+    h, _ = hashed_pairs(*b, static, np.arange(n), cell)
+    norm = math.hypot(dx, dy)
+    u = (dx / norm, dy / norm)
+    finite_len = length if math.isfinite(length) else 400.0  # beyond every body
+    must = segment_samples_hit(b, (ox, oy), u, finite_len) if n else set()
+    may = segment_near(b, (ox, oy), u, finite_len, 1e-6)
+    for _ in range(repeat):
+        got = h.query_ray(ox, oy, dx, dy, length)
+        assert np.array_equal(got, np.unique(got))
+        assert must <= set(got.tolist()) <= may
