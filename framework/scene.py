@@ -49,8 +49,16 @@ EFFECTS: dict[str, tuple[str, ...]] = {
     "continuous": ("movement", "detection"),  # sweep Hitbox(ccd=True) bodies
     "rendering": (),                         # the render stage (a renderer must be attached)
     "debug_overlay": ("rendering",),         # hitboxes, contacts, cells, rays on screen
+    "sleeping": (),                          # bodies at rest sleep: no work until woken
 }
-DEFAULT_EFFECTS = frozenset({"movement", "gravity", "detection", "events", "response", "continuous"})
+DEFAULT_EFFECTS = frozenset(
+    {"movement", "gravity", "detection", "events", "response", "continuous", "sleeping"}
+)
+# A dynamic body sleeps after this many steps at rest: moving less than SLEEP_SPEED (relative to
+# 1 + its size, per second) with a speed below that. Game code writing its Transform or Velocity,
+# a contact with an awake body, a change to the static level or a despawn nearby wake it.
+SLEEP_STEPS = 30
+SLEEP_SPEED = 1e-3
 
 
 def resolve_effects(effects: Iterable[str] | None) -> frozenset[str]:
@@ -121,6 +129,7 @@ class Scene:
         self.store = BodyStore()
         self.geometry = Geometry()
         self.hash = SpatialHash(cell_size)
+        self.sleep_hash = SpatialHash(cell_size)  # the sleeping bodies, entered when they change
         self.tracker = PairTracker()
         self._renderer: Any = None
         self.resources: dict[type, Any] = {Input: Input()}
@@ -195,8 +204,18 @@ class Scene:
     def _remove(self, entity: int) -> None:
         comps = esper.components_for_entity(entity)
         self._ghosts[entity] = {type(c) for c in comps}
-        if entity in self.store.row_of:
-            self.store.remove(entity, comps)
+        store = self.store
+        if entity in store.row_of:
+            row = store.row_of[entity]
+            if store.asleep.any() and store.kind[row] >= 0:
+                # Whatever slept on or against it wakes.
+                r = 1.1 * float(store.bound[row])
+                x, y = float(store.x[row]), float(store.y[row])
+                self.geometry.update(store)
+                g = self.geometry
+                near = (g.minx < x + r) & (g.maxx > x - r) & (g.miny < y + r) & (g.maxy > y - r)
+                store.wake(np.flatnonzero(near & store.asleep))
+            store.remove(entity, comps)
         esper.delete_entity(entity, immediate=True)
 
     def exists(self, entity: int) -> bool:
@@ -312,6 +331,7 @@ class Scene:
         self.stage_ms = {}
         self.ray_log = []
         self.swept_paths = []
+        self._start_x = self._start_y = np.zeros(0)  # set by movement
         try:
             store.apply_hitbox_changes()
             for stage in STAGES:
@@ -322,6 +342,8 @@ class Scene:
                     counters["systems"].append(stage)
                     self.stage_ms[stage] = (time.perf_counter() - t0) * 1e3
                 self._run_hooks("after", stage, dt)
+            if "sleeping" in self.effects:
+                self._update_sleep(dt)
             self._dispatch()
         finally:
             self._stepping = False
@@ -411,6 +433,8 @@ class Scene:
         store, geom = self.store, self.geometry
         if not store.static_dirty:
             return
+        if store.asleep.any():  # the level changed under the sleepers
+            store.wake(np.flatnonzero(store.asleep))
         rows = np.flatnonzero((store.kind >= 0) & (store.body == STATIC))
         self.hash.set_static(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
                              store.entity[rows])
@@ -424,10 +448,24 @@ class Scene:
         store, geom = self.store, self.geometry
         geom.update(store)
         self._sync_static()
-        moving = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
-        ea, eb = self.hash.pairs(geom.minx[moving], geom.miny[moving], geom.maxx[moving],
-                                 geom.maxy[moving], store.entity[moving])
+        awake = (store.kind >= 0) & (store.body != STATIC) & ~store.asleep
+        moving = np.flatnonzero(awake)
+        bounds = (geom.minx[moving], geom.miny[moving], geom.maxx[moving], geom.maxy[moving])
+        ea, eb = self.hash.pairs(*bounds, store.entity[moving])
         self.counters["rehashed"] += int(moving.size)
+        if store.sleep_dirty:
+            sleepers = np.flatnonzero(store.asleep)
+            self.sleep_hash.set_static(geom.minx[sleepers], geom.miny[sleepers], geom.maxx[sleepers],
+                                       geom.maxy[sleepers], store.entity[sleepers])
+            self.counters["rehashed"] += int(sleepers.size)
+            store.sleep_dirty = False
+        self.counters["asleep"] = int(store.asleep.sum())
+        if self.counters["asleep"]:
+            sa, sb = self.sleep_hash.pairs(*bounds, store.entity[moving], moving_pairs=False)
+            if sa.size:
+                keys = np.concatenate([pair_keys(ea, eb), pair_keys(sa, sb)])
+                keys.sort()
+                ea, eb = keys >> 32, keys & 0xFFFFFFFF
         ra, rb = self._rows_of(ea), self._rows_of(eb)
         keep = filter_layers(store, ra, rb)
         if "events" not in self.effects:
@@ -462,12 +500,35 @@ class Scene:
         ea, eb, ra, rb = self._pairs
         res = pair_contacts(self.store, self.geometry, ra, rb, self.counters["narrow_tests"])
         h = np.flatnonzero(res.hit)
-        self._contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
-        self._contact_rows = (ra[h], rb[h])
+        contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
+        crows = (ra[h], rb[h])
+        store = self.store
+        if store.asleep.any():
+            # Pairs of sleeping (or sleeping and static) bodies are not tested: they keep the
+            # contact they had, so their events stay "ongoing" while they sleep.
+            prev = self.tracker.active
+            pa, pb = self._rows_of(prev.a), self._rows_of(prev.b)
+            ok = (pa >= 0) & (pb >= 0)
+            idle = store.asleep | (store.body == STATIC)
+            frozen = np.flatnonzero(ok & idle[np.maximum(pa, 0)] & idle[np.maximum(pb, 0)])
+            if frozen.size:
+                merged = [np.concatenate([x, y[frozen]]) for x, y in zip(contacts, prev)]
+                order = np.lexsort((merged[1], merged[0]))
+                contacts = StepContacts(*(m[order] for m in merged))
+                crows = (np.concatenate([crows[0], pa[frozen]])[order],
+                         np.concatenate([crows[1], pb[frozen]])[order])
+            # A touch by an awake, solid body wakes a sleeper.
+            a_, b_ = crows
+            solid = ~(store.sensor[a_] | store.sensor[b_])
+            wake_b = solid & store.asleep[b_] & ~store.asleep[a_] & (store.body[a_] != STATIC)
+            wake_a = solid & store.asleep[a_] & ~store.asleep[b_] & (store.body[b_] != STATIC)
+            store.wake(np.concatenate([b_[wake_b], a_[wake_a]]))
+        self._contacts = contacts
+        self._contact_rows = crows
         self._started, _ongoing, self._ended = self.tracker.update(self._contacts)
 
         self._events = None
-        self.counters["contacts"] = int(h.size)
+        self.counters["contacts"] = int(self._contacts.a.size)
         self.counters["events"] = int(h.size + self._ended.a.size)
         return True
 
@@ -493,7 +554,8 @@ class Scene:
         self._support = _NO_SUPPORT
         if ra.size and ra.max() >= store.n:  # rows spawned mid-step are not in this step
             return False
-        solid = ~(store.sensor[ra] | store.sensor[rb]) & ((store.inv_mass[ra] > 0) | (store.inv_mass[rb] > 0))
+        movable = (store.inv_mass > 0) & ~store.asleep  # sleeping bodies keep still
+        solid = ~(store.sensor[ra] | store.sensor[rb]) & (movable[ra] | movable[rb])
         one_way = store.one_way[ra] | store.one_way[rb]
         if one_way.any():
             solid &= ~one_way | self._lands_on_one_way(ra, rb, nx, ny, depth, alive0)
@@ -517,6 +579,28 @@ class Scene:
         self.counters["resolved"] = int(done.sum())
         return True
 
+    def _update_sleep(self, dt: float) -> None:
+        """Count the steps each awake dynamic body has been at rest; put the restful to sleep."""
+        store = self.store
+        n0 = self._start_x.size
+        if n0 == 0:
+            return
+        c = store.cols
+        rows = np.flatnonzero((store.body[:n0] == 0) & (store.kind[:n0] >= 0) & ~store.asleep[:n0])
+        if rows.size == 0:
+            return
+        tol = SLEEP_SPEED * (1.0 + store.bound[rows])
+        moved = np.abs(store.x[rows] - self._start_x[rows]) + np.abs(store.y[rows] - self._start_y[rows])
+        speed = np.abs(store.vx[rows]) + np.abs(store.vy[rows]) + np.abs(store.w[rows]) * store.bound[rows]
+        rest = (moved <= tol * dt) & (speed <= tol)
+        still = c["still"]
+        still[rows] = np.where(rest, still[rows] + 1, 0)
+        sleepy = rows[still[rows] >= SLEEP_STEPS]
+        if sleepy.size:
+            c["asleep"][sleepy] = True
+            c["vx"][sleepy] = c["vy"][sleepy] = c["w"][sleepy] = 0.0
+            store.sleep_dirty = True
+
     def _lands_on_one_way(self, ra, rb, nx, ny, depth, alive0) -> np.ndarray:
         """Mask of contacts a one-way platform takes: the other body comes from above (the
         normal within 45 degrees of the platform's up) and sank in only by this step's motion."""
@@ -528,12 +612,13 @@ class Scene:
         ux, uy = -np.sin(rot), np.cos(rot)
         toward_other = np.where(plat_is_a, 1.0, -1.0)
         from_above = (nx * ux + ny * uy) * toward_other > 0.7071
+        # Where each body started the step (rows spawned during the step: where they are).
+        x0, y0 = store.x.copy(), store.y.copy()
         n0 = self._start_x.size
-        sx = np.where(other < n0, self._start_x[np.minimum(other, n0 - 1)], store.x[other])
-        sy = np.where(other < n0, self._start_y[np.minimum(other, n0 - 1)], store.y[other])
-        px = np.where(plat < n0, self._start_x[np.minimum(plat, n0 - 1)], store.x[plat])
-        py = np.where(plat < n0, self._start_y[np.minimum(plat, n0 - 1)], store.y[plat])
-        sank = -(((store.x[other] - sx) - (store.x[plat] - px)) * ux + ((store.y[other] - sy) - (store.y[plat] - py)) * uy)
+        x0[:n0], y0[:n0] = self._start_x, self._start_y
+        dx = (store.x[other] - x0[other]) - (store.x[plat] - x0[plat])
+        dy = (store.y[other] - y0[other]) - (store.y[plat] - y0[plat])
+        sank = -(dx * ux + dy * uy)
         tol = 1e-9 * (1.0 + store.bound[other])
         came_down = depth <= np.maximum(sank, 0.0) + tol
         return from_above & (came_down | ~alive0)

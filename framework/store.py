@@ -33,8 +33,11 @@ _FLOATS = (
     "x", "y", "rot", "vx", "vy", "w",  # transform and velocity (component views)
     "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
 )
-_INTS = {"kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64}
-_BOOLS = ("has_vel", "sensor", "ccd", "one_way")
+_INTS = {
+    "kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64,
+    "still": np.int32,  # consecutive steps the body has been at rest (sleeping)
+}
+_BOOLS = ("has_vel", "sensor", "ccd", "one_way", "asleep")
 _FIELD_NAMES = {
     "x": "Transform.x", "y": "Transform.y", "rot": "Transform.rotation",
     "vx": "Velocity.x", "vy": "Velocity.y", "w": "Velocity.angular",
@@ -60,6 +63,7 @@ class BodyStore:
         self.dirty_hitboxes: set[int] = set()
         self.moved_static: set[int] = set()  # static entities whose transform game code changed
         self.static_dirty = True  # the static set or a static body changed: re-hash the statics
+        self.sleep_dirty = False  # a body fell asleep or woke: re-hash the sleepers
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
 
     # --- columns ---------------------------------------------------------------------------
@@ -85,6 +89,8 @@ class BodyStore:
         row = self.n
         c = self.cols
         c["entity"][row] = entity
+        c["asleep"][row] = False
+        c["still"][row] = 0
         c["x"][row], c["y"][row], c["rot"][row] = transform._own
         if velocity is not None:
             c["vx"][row], c["vy"][row], c["w"][row] = velocity._own
@@ -109,6 +115,8 @@ class BodyStore:
         last = self.n - 1
         if self.cols["body"][row] == STATIC and self.cols["kind"][row] >= 0:
             self.static_dirty = True
+        if self.cols["asleep"][row]:
+            self.sleep_dirty = True
         # Unbind: the components keep the values they had, as their own.
         for comp in components:
             if isinstance(comp, (Transform, Velocity)):
@@ -140,11 +148,13 @@ class BodyStore:
             c["vx"][row], c["vy"][row], c["w"][row] = velocity._own
             c["has_vel"][row] = True
             velocity._store, velocity._entity = self, entity
+        self.wake(row)
         self.version += 1
 
     def set_hitbox(self, entity: int, hitbox: Hitbox | None) -> None:
         row = self.row_of[entity]
         self.static_dirty = True
+        self.wake(row)
         self._set_hitbox_row(row, hitbox)
         if hitbox is not None:
             object.__setattr__(hitbox, "_store", self)
@@ -189,8 +199,19 @@ class BodyStore:
             return bad
         return float(self.cols[col][self.row_of[entity]])
 
+    def wake(self, rows: np.ndarray | int) -> None:
+        """Wake sleeping rows (game code moved them, or something touched them)."""
+        asleep = self.cols["asleep"]
+        rows = np.atleast_1d(rows)
+        if asleep[rows].any():
+            asleep[rows] = False
+            self.sleep_dirty = True
+        self.cols["still"][rows] = 0
+
     def write(self, entity: int, col: str, value: object) -> None:
         row = self.row_of[entity]
+        if self.cols["asleep"][row] or self.cols["still"][row]:
+            self.wake(row)
         if isinstance(value, Real) and not isinstance(value, bool):
             self.cols[col][row] = float(value)
             if self.bad:
@@ -244,6 +265,7 @@ class BodyStore:
             self._set_hitbox_row(row, hb)
         self.dirty_hitboxes = set()
         if changed:
+            self.wake(np.array([self.row_of[e] for e in changed], dtype=np.int64))
             self.version += 1
             self.static_dirty = True
         return changed

@@ -365,3 +365,61 @@ def test_bad_inputs_raise() -> None:
         collide_many([AABB(1, 1)], [(0, math.inf)], [AABB(1, 1)], [(0, 0)])
     with pytest.raises(ValueError):
         collide_many([AABB(1, 1)], [(0, 0)], [], [])
+
+
+def test_vectorised_tie_break_matches_scalar_rule() -> None:
+    """The array form of ``tiebreak.pick`` on candidate sets full of ties: equal and near-equal
+    depths, directions and their negations, vertical / horizontal / diagonal, signed zeros."""
+    from framework.collision.batch_common import BIG, pick
+    from framework.collision.tiebreak import pick as scalar_pick
+
+    rng = np.random.default_rng(3)
+    dirs = [(0.0, 1.0), (-0.0, 1.0), (0.0, -1.0), (1.0, 0.0), (-1.0, 0.0), (1.0, -0.0), (-1.0, -0.0),
+            (math.sqrt(0.5), math.sqrt(0.5)), (-math.sqrt(0.5), math.sqrt(0.5)),
+            (math.sqrt(0.5), -math.sqrt(0.5)), (0.6, 0.8), (-0.6, 0.8), (0.8, -0.6), (1e-13, 1.0)]
+    p, c_max = 3000, 12
+    depth = np.full((c_max, p), BIG)
+    nx = np.zeros((c_max, p))
+    ny = np.zeros((c_max, p))
+    size = rng.choice([1.0, 3.0, 1e-6, 1e6], p)
+    cands_all = []
+    for j in range(p):
+        n = int(rng.integers(1, c_max + 1))
+        base = float(rng.choice([0.5, 1.0, 2.0]))
+        cands = []
+        for _ in range(n):
+            if rng.random() < 0.6:
+                d, (x, y) = base, dirs[int(rng.integers(len(dirs)))]
+            else:
+                a = rng.uniform(0, 2 * math.pi)
+                d, (x, y) = base * rng.uniform(1.0, 1.5), (math.cos(a), math.sin(a))
+            d += float(rng.choice([0.0, 0.0, 0.3e-12, 2e-12, 1e-16])) * size[j] * base
+            cands.append((d * size[j], x, y))
+        cands_all.append(cands)
+        for i, (d, x, y) in enumerate(cands):
+            depth[i, j], nx[i, j], ny[i, j] = d, x, y
+    got = pick(depth, nx, ny, size)
+    for j, cands in enumerate(cands_all):
+        want = scalar_pick(cands, float(size[j]))
+        assert (got[0][j], got[1][j], got[2][j]) == want, (cands, size[j], want)
+
+
+@pytest.mark.parametrize("scale", [2.0**-600, 1e-200, 1e200, 2.0**600])
+def test_tiny_and_huge_scenes(scale: float) -> None:
+    """Radii of 1e-200 or 1e200 neither underflow nor overflow: the kernels work in the scalar
+    code's power-of-two-scaled frame and agree with it."""
+    def scaled(shape):
+        if isinstance(shape, AABB):
+            return AABB(shape.width * scale, shape.height * scale)
+        if isinstance(shape, Circle):
+            return Circle(shape.radius * scale)
+        return Polygon([(x * scale, y * scale) for x, y in shape.points])
+
+    pairs: list[Pair] = []
+    for ka, kb in COMBOS:
+        rng = np.random.default_rng(21)
+        pairs += random_pairs(rng, ka, kb, 25) + touching_pairs(ka, kb)[:6]
+    pairs = [(scaled(sa), (ta[0] * scale, ta[1] * scale, ta[2]), scaled(sb), (tb[0] * scale, tb[1] * scale, tb[2]))
+             for sa, ta, sb, tb in pairs]
+    res = collide_many([p[0] for p in pairs], [p[1] for p in pairs], [p[2] for p in pairs], [p[3] for p in pairs])
+    assert_matches(pairs, res, f"scale {scale}")

@@ -639,3 +639,21 @@ def test_random_query_ray_is_a_tight_superset(scene, cell, ox, oy, dx, dy, lengt
         got = h.query_ray(ox, oy, dx, dy, length)
         assert np.array_equal(got, np.unique(got))
         assert must <= set(got.tolist()) <= may
+
+
+def test_moving_pairs_false_gives_only_moving_static_pairs():
+    rng = np.random.default_rng(11)
+    n_s, n_m = 300, 200
+    sx, sy = rng.uniform(0, 100, n_s), rng.uniform(0, 100, n_s)
+    mx, my = rng.uniform(0, 100, n_m), rng.uniform(0, 100, n_m)
+    sw, mw = rng.uniform(1, 6, n_s), rng.uniform(1, 6, n_m)
+    sw[0] = 400.0  # a large static among small ones
+    mw[0] = 300.0  # and a large mover
+    h = SpatialHash(4.0)
+    h.set_static(sx, sy, sx + sw, sy + sw, np.arange(n_s))
+    ids = np.arange(n_s, n_s + n_m)
+    a, b = h.pairs(mx, my, mx + mw, my + mw, ids, moving_pairs=False)
+    ra, rb = h.pairs(mx, my, mx + mw, my + mw, ids)
+    cross = (ra < n_s) != (rb < n_s)
+    assert np.array_equal(a, ra[cross]) and np.array_equal(b, rb[cross])
+    assert a.size > 0 and (ra.size - a.size) > 0

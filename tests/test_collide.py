@@ -295,6 +295,13 @@ def test_extreme_magnitudes_never_give_nan_or_inf():
         for c in (collide(sa, ta, sb, tb), collide(sb, tb, sa, ta)):
             if c is not None:
                 assert all(math.isfinite(v) for v in (*c.normal, c.depth, *c.point)) and c.depth > 0
+    # Edges 1e-250 long: their products with coordinates of 1e-295 would underflow unless each
+    # axis is rescaled; the depth is the sum of the half-heights, not the smallest float.
+    thin, speck = AABB(1.0, 2.0**-830), AABB(2.0**-830, 2.0**-980)
+    for c in (collide(thin, (0, 0), speck, (0, 0, 0.5)), collide(speck, (0, 0), thin, (0, 0))):
+        assert c is not None and c.normal == (0.0, 1.0) and c.depth == 2.0**-831 + 2.0**-981
+    c = collide(thin, (0, 0), Circle(2.0**-980), (0.25, 2.0**-831))  # centre on the top face
+    assert c is not None and c.normal == (0.0, 1.0) and c.depth == pytest.approx(2.0**-980, rel=1e-9)
     # A contact whose depth is beyond float64 itself is refused, not returned as inf.
     with pytest.raises(ValueError, match="beyond float64"):
         collide(Circle(1.5e308), (0, 0), Circle(1.5e308), (0, 0))

@@ -109,6 +109,11 @@ def aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh) -> ContactArrays:
     return finish(hit, nx, ny, depth, px, py, k, ax, ay)
 
 
+def _crossing(t: np.ndarray, u: np.ndarray, gone: np.ndarray) -> np.ndarray:
+    """1.0 where two edges cross (``t`` and ``u`` in [0, 1]; a vanished edge never crosses)."""
+    return ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~gone).astype(F64)
+
+
 def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
     """``collide.overlap_point`` of two boxes, with B at its offset: the mean of A's corners in B,
     B's corners in A and the crossings of their edges, each counted by the scalar code's tests.
@@ -146,24 +151,34 @@ def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
         sx += (xs[0] * mx[0] + xs[1] * mx[1]) * nyin
         sy += (ys[0] * my[0] + ys[1] * my[1]) * nxin
         count += nxin * nyin
-    # Edges as (origin x, origin y, ex, ey): A's bottom, right, top, left; then B's.
-    z = np.zeros(hwa.shape, dtype=F64)
-    ea = ((-hwa, -hha, wa, z), (hwa, -hha, z, ha), (hwa, hha, -wa, z), (-hwa, hha, z, -ha))
-    eb = ((xb0, yb0, wb, z), (xb1, yb0, z, hb), (xb1, yb1, -wb, z), (xb0, yb1, z, -hb))
-    combos = [(0, 1), (0, 3), (2, 1), (2, 3), (1, 0), (1, 2), (3, 0), (3, 2)]
-    px_, py_, rx, ry = (np.stack([ea[i][c] for i, _ in combos]) for c in range(4))
-    qx, qy, sx_, sy_ = (np.stack([eb[j][c] for _, j in combos]) for c in range(4))
-    den = rx * sy_ - ry * sx_
-    wx, wy = qx - px_, qy - py_
-    parallel = den == 0.0  # only where a box edge has vanished
-    den += parallel
-    t = (wx * sy_ - wy * sx_) / den
-    u = (wx * ry - wy * rx) / den
-    crossing = ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~parallel).astype(F64)
-    t = np.minimum(np.maximum(t, 0.0), 1.0)  # unchanged where crossing; finite elsewhere
-    sx += ((px_ + t * rx) * crossing).sum(axis=0)
-    sy += ((py_ + t * ry) * crossing).sum(axis=0)
-    count += crossing.sum(axis=0)
+    # Crossings: A's bottom / top edges with B's right / left ones, and A's right / left edges
+    # with B's bottom / top ones. With the zero components of the edge vectors written out, the
+    # scalar code's den = rx sy - ry sx, t = (wx sy - wy sx) / den and u = (wx ry - wy rx) / den
+    # lose terms that are signed zeros (changing no comparison and no sum).
+    def stack(*v):
+        return np.stack(v)
+
+    # A horizontal (origin p, vector (r, 0)) x B vertical (origin q, vector (0, s)).
+    p_x, p_y, r = stack(-hwa, -hwa, hwa, hwa), stack(-hha, -hha, hha, hha), stack(wa, wa, -wa, -wa)
+    q_x, q_y, s_ = stack(xb1, xb0, xb1, xb0), stack(yb0, yb1, yb0, yb1), stack(hb, -hb, hb, -hb)
+    den = r * s_
+    gone = den == 0.0  # a box edge has vanished (extreme size ratios): no crossing
+    den += gone
+    t = ((q_x - p_x) * s_) / den
+    u = (-((q_y - p_y) * r)) / den
+    hx, hy, hcross = p_x + np.minimum(np.maximum(t, 0.0), 1.0) * r, p_y, _crossing(t, u, gone)
+    # A vertical (origin p, vector (0, r)) x B horizontal (origin q, vector (s, 0)).
+    p_x, p_y, r = stack(hwa, hwa, -hwa, -hwa), stack(-hha, -hha, hha, hha), stack(ha, ha, -ha, -ha)
+    q_x, q_y, s_ = stack(xb0, xb1, xb0, xb1), stack(yb0, yb1, yb0, yb1), stack(wb, -wb, wb, -wb)
+    den = -(r * s_)
+    gone = den == 0.0
+    den += gone
+    t = (-((q_y - p_y) * s_)) / den
+    u = ((q_x - p_x) * r) / den
+    vx, vy, vcross = p_x, p_y + np.minimum(np.maximum(t, 0.0), 1.0) * r, _crossing(t, u, gone)
+    sx += (hx * hcross).sum(axis=0) + (vx * vcross).sum(axis=0)
+    sy += (hy * hcross).sum(axis=0) + (vy * vcross).sum(axis=0)
+    count += hcross.sum(axis=0) + vcross.sum(axis=0)
     found = count > 0
     c = np.maximum(count, 1.0)
     px, py = sx / c, sy / c

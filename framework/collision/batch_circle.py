@@ -18,10 +18,12 @@ from .batch_common import (
     columns_of,
     edge_mask,
     edges,
+    extent,
     finish,
     first,
     first_min,
     frame,
+    norm,
     outline_rows,
     pick,
     take,
@@ -91,11 +93,10 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
             np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
     f = -1.0 if flip else 1.0
     # The polygon's frame, whichever shape of the pair it is.
-    rp = np.hypot(vx, vy).max(axis=0)
-    cx, cy, k = frame(ax, ay, bx, by, np.maximum(rp, r))
-    vx, vy = np.ldexp(vx, -k), np.ldexp(vy, -k)
-    size = np.ldexp(rp + r if size is None else columns_of(p, size)[0], -k)
-    rp, r = np.ldexp(rp, -k), np.ldexp(r, -k)
+    cx, cy, k = frame(ax, ay, bx, by, np.maximum(extent(vx, vy), r))
+    vx, vy, r = np.ldexp(vx, -k), np.ldexp(vy, -k), np.ldexp(r, -k)
+    rp = np.sqrt((vx * vx + vy * vy).max(axis=0))  # the polygon's radius (fine for tolerances)
+    size = rp + r if size is None else np.ldexp(columns_of(p, size)[0], -k)
     tol = BAND * (np.abs(cx) + np.abs(cy) + rp + r)  # on distances
     ex, ey = edges(vx), edges(vy)
     valid = edge_mask(ex, ey)
@@ -105,7 +106,7 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
     inside = ~out.any(axis=0)
     # Inside (or on the boundary): out through the nearest face, plus the radius.
     absent = (~valid).astype(F64)
-    ln = np.hypot(ex, ey) + absent  # 1 on padding edges
+    ln = norm(ex, ey) + absent  # 1 on padding edges
     cdepth = (r - s / ln) + absent * BIG
     inside_clear = inside & (cdepth.min(axis=0) > tol)
     # Outside: the closest point is on the first face whose region holds the centre, or else it
@@ -117,9 +118,9 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
     fi = first(face)
     vi = first_min(wx * wx + wy * wy)
     fex, fey = take(ex, fi), take(ey, fi)
-    fln = np.where(has_face, np.sqrt(fex * fex + fey * fey), 1.0)
+    fln = np.sqrt(fex * fex + fey * fey) + ~has_face  # 1 where there is no such face
     ddx, ddy = take(wx, vi), take(wy, vi)
-    dist = np.where(has_face, take(s, fi) / fln, np.hypot(ddx, ddy))
+    dist = np.where(has_face, take(s, fi) / fln, norm(ddx, ddy))
     out_hit = ~inside & (dist > 0.0) & (dist <= r - tol)
     exact = (inside & ~inside_clear) | (~inside & ((dist == 0.0) | ((dist > r - tol) & (dist < r + tol))))
     hit = inside_clear | out_hit
@@ -142,18 +143,20 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
         mex, mey, mln = cols(ex, m), cols(ey, m), cols(ln, m)
         depth[m], nx[m], ny[m] = pick(cols(cdepth, m), f * mey / mln, -f * mex / mln, size[m])
         px[m], py[m] = cx[m], cy[m]
-    m = out_hit & has_face
-    if m.any():
-        unx, uny = fey[m] / fln[m], -fex[m] / fln[m]
+    m = np.flatnonzero(out_hit & has_face)
+    if m.size:
+        d, ln_ = dist[m], fln[m]
+        unx, uny = fey[m] / ln_, -fex[m] / ln_
         nx[m], ny[m] = f * unx, f * uny
-        depth[m] = r[m] - dist[m]
-        px[m], py[m] = cx[m] - unx * dist[m], cy[m] - uny * dist[m]
-    m = out_hit & ~has_face
-    if m.any():
+        depth[m] = r[m] - d
+        px[m], py[m] = cx[m] - unx * d, cy[m] - uny * d
+    m = np.flatnonzero(out_hit & ~has_face)
+    if m.size:
         d = dist[m]  # > 0 on these rows
         nx[m], ny[m] = f * ddx[m] / d, f * ddy[m] / d
         depth[m] = r[m] - d
-        px[m], py[m] = take(vx, vi)[m], take(vy, vi)[m]
+        j = vi[m]
+        px[m], py[m] = vx[j, m], vy[j, m]
     for i, res in results.items():
         nx[i], ny[i], depth[i], px[i], py[i] = res
     return finish(hit, nx[hit], ny[hit], depth[hit], px[hit], py[hit], k[hit], ax[hit], ay[hit])

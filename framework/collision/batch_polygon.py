@@ -26,9 +26,11 @@ from .batch_common import (
     columns_of,
     edge_mask,
     edges,
+    extent,
     finish,
     first_min,
     frame,
+    norm,
     outline_rows,
     pick,
     take,
@@ -54,10 +56,10 @@ def _frame(ax, ay, averts, acount, bx, by, bverts, bcount):
     if p == 0:
         z = np.zeros(0)
         return avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, z, z, np.zeros(0, dtype=np.intp), z
-    ra, rb = np.hypot(avx, avy).max(axis=0), np.hypot(bvx, bvy).max(axis=0)
-    dx, dy, k = frame(ax, ay, bx, by, np.maximum(ra, rb))
+    dx, dy, k = frame(ax, ay, bx, by, np.maximum(extent(avx, avy), extent(bvx, bvy)))
     avx, avy, bvx, bvy = (np.ldexp(v, -k) for v in (avx, avy, bvx, bvy))
-    size = np.ldexp(ra + rb, -k)
+    # The bounding radii summed (fine for tolerances), in the scaled frame.
+    size = np.sqrt((avx * avx + avy * avy).max(axis=0)) + np.sqrt((bvx * bvx + bvy * bvy).max(axis=0))
     return avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size
 
 
@@ -137,15 +139,21 @@ def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None) -
     acount, bcount = acount[h], bcount[h]
     dx, dy, sz = dx[h], dy[h], sz[h]
     absent = (~valid).astype(F64)
-    ln = np.hypot(ux, uy) + absent  # 1 on padding axes
-    nx, ny = ux / ln, uy / ln
-    fwd = np.maximum(fwd / ln, TINY) + absent * BIG
-    bwd = np.maximum(bwd / ln, TINY) + absent * BIG
-    # Candidates in the scalar code's order: per axis, forward then backward.
-    cdepth = np.stack((fwd, bwd), axis=1).reshape(-1, fwd.shape[1])
-    cnx = np.stack((nx, -nx), axis=1).reshape(cdepth.shape)
-    cny = np.stack((ny, -ny), axis=1).reshape(cdepth.shape)
-    depth, nx, ny = pick(cdepth, cnx, cny, sz)
+    ln = norm(ux, uy) + absent  # 1 on padding axes
+    # Candidates in the scalar code's order: per axis, forward then backward ([C, 2, H]).
+    c, n = ux.shape
+    cdepth, cnx, cny = np.empty((c, 2, n)), np.empty((c, 2, n)), np.empty((c, 2, n))
+    np.divide(ux, ln, out=cnx[:, 0])
+    np.divide(uy, ln, out=cny[:, 0])
+    np.negative(cnx[:, 0], out=cnx[:, 1])
+    np.negative(cny[:, 0], out=cny[:, 1])
+    absent *= BIG
+    for j, over in enumerate((fwd, bwd)):
+        d = cdepth[:, j]
+        np.divide(over, ln, out=d)
+        np.maximum(d, TINY, out=d)
+        d += absent
+    depth, nx, ny = pick(*(a.reshape(2 * c, n) for a in (cdepth, cnx, cny)), sz)
     # The point is found with B at its offset.
     bvx, bvy = bvx + dx, bvy + dy
     px, py = overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, sz)
@@ -157,7 +165,7 @@ def _inside(x, y, ox, oy, ex, ey, tol):
     ``tol`` (absolute, ``[P]``) of rounding, as ``collide._inside``. Padding edges never exclude."""
     cross = ex[None] * (y[:, None] - oy[None])
     cross -= ey[None] * (x[:, None] - ox[None])
-    return ~(cross < -tol * np.hypot(ex, ey)[None]).any(axis=1)
+    return ~(cross < -tol * norm(ex, ey)[None]).any(axis=1)
 
 
 def overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, size):

@@ -142,11 +142,13 @@ class SpatialHash:
         self._static_ids = ids.copy()
         self.rehashed_last = b[0].shape[0]
 
-    def pairs(self, minx, miny, maxx, maxy, ids) -> tuple[np.ndarray, np.ndarray]:
+    def pairs(self, minx, miny, maxx, maxy, ids, *, moving_pairs: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """All moving-moving and moving-static pairs of strictly overlapping bounds.
 
         The arguments are this step's moving bodies. Returns ``(id_a, id_b)`` int64 arrays with
         ``id_a < id_b``, sorted lexicographically. The static bodies are not re-entered.
+        ``moving_pairs=False`` gives only the moving-static pairs (e.g. awake bodies against a
+        second hash holding the sleeping ones).
         """
         b = as_bounds(minx, miny, maxx, maxy)
         ids = _as_ids(ids, b[0].shape[0])
@@ -159,9 +161,10 @@ class SpatialHash:
 
         out_a, out_b = [], []
         if mov.entries:
-            a, c = mov.self_pairs()
-            out_a.append(ids[a])
-            out_b.append(ids[c])
+            if moving_pairs:
+                a, c = mov.self_pairs()
+                out_a.append(ids[a])
+                out_b.append(ids[c])
             if stat.entries:
                 m, s = mov.cross_pairs(stat)
                 out_a.append(ids[m])
@@ -169,13 +172,14 @@ class SpatialHash:
         if mov.large.shape[0]:
             # large movers against every mover (each large-large pair once) and every static
             lg = mov.large
-            i, j = overlap_pairs(subset(b, lg), b)
-            i = lg[i]
-            is_large = np.zeros(mov.n, dtype=bool)
-            is_large[lg] = True
-            keep = ~is_large[j] | (i < j)
-            out_a.append(ids[i[keep]])
-            out_b.append(ids[j[keep]])
+            if moving_pairs:
+                i, j = overlap_pairs(subset(b, lg), b)
+                i = lg[i]
+                is_large = np.zeros(mov.n, dtype=bool)
+                is_large[lg] = True
+                keep = ~is_large[j] | (i < j)
+                out_a.append(ids[i[keep]])
+                out_b.append(ids[j[keep]])
             i, s = overlap_pairs(subset(b, lg), stat.bounds)
             out_a.append(ids[lg[i]])
             out_b.append(sids[s])

@@ -198,8 +198,9 @@ def polygon_circle(
     # Centre outside: the closest point of the polygon is on a face whose region holds the centre
     # (s > 0 and the projection falls within the edge), or else it is the nearest vertex.
     dist = None
-    for (x0, y0, ex, ey, ln, _), s in zip(faces, seps, strict=True):
-        if s > 0.0 and 0.0 <= ((cx - x0) * ex + (cy - y0) * ey) / ln <= ln:
+    for (x0, y0, ex, ey, ln, k), s in zip(faces, seps, strict=True):
+        # The centre's projection on the edge line lies within the edge (of length ln * 2**k).
+        if s > 0.0 and 0.0 <= ((cx - x0) * ex + (cy - y0) * ey) / ln <= math.ldexp(ln, k):
             nx, ny = ey / ln, -ex / ln
             dist = s / ln
             px, py = cx - nx * dist, cy - ny * dist  # closest point on the face
@@ -313,16 +314,6 @@ def _edge(poly: Pts, i: int) -> tuple[float, float]:
     return y1 - y0, x0 - x1
 
 
-def _unit_scale(ux: float, uy: float) -> tuple[float, float]:
-    """``(ux, uy)`` times the power of two that brings its larger component into [0.5, 1).
-
-    Exact, so it changes no decision and no result bit; it only keeps a very short edge's products
-    with small coordinates from underflowing.
-    """
-    k = math.frexp(max(abs(ux), abs(uy)))[1]
-    return math.ldexp(ux, -k), math.ldexp(uy, -k)
-
-
 def _axes(pa: Pts, pb: Pts) -> list[tuple[int, int]]:
     """The edges ``(0 for A / 1 for B, index)`` whose normals are the SAT axes.
 
@@ -357,7 +348,11 @@ def polygon_polygon(
 ) -> Res | None:
     """Convex CCW outline A at the origin and B (outline ``lb`` about its own origin) at (dx, dy)."""
     edges = _axes(pa, lb)
-    axes = [_unit_scale(*_edge(lb if which else pa, i)) for which, i in edges]
+    # Each axis times 2**-k (exact): its larger component in [0.5, 1), so that a very short edge's
+    # products with small coordinates do not underflow. No decision or result bit changes.
+    raw = [_edge(lb if which else pa, i) for which, i in edges]
+    ks = [math.frexp(max(abs(ux), abs(uy)))[1] for ux, uy in raw]
+    axes = [(math.ldexp(ux, -k), math.ldexp(uy, -k)) for (ux, uy), k in zip(raw, ks, strict=True)]
     mag = size + abs(dx) + abs(dy)
     overlaps = []  # per axis: how far B must move forward (+u) and backward (-u), times |u|
     borderline = False
@@ -376,7 +371,7 @@ def polygon_polygon(
     if not axes:
         return None  # both shapes vanish at this scale: two points apart
     if borderline:
-        exact = _polygon_polygon_exact(pa, lb, off, edges)
+        exact = _polygon_polygon_exact(pa, lb, off, edges, ks)
         if exact is None:
             return None  # a separating axis (touching counts as separated)
         overlaps = exact
@@ -393,11 +388,12 @@ def polygon_polygon(
 
 
 def _polygon_polygon_exact(
-    pa: Pts, lb: Pts, off: Terms, edges: list[tuple[int, int]]
+    pa: Pts, lb: Pts, off: Terms, edges: list[tuple[int, int]], ks: list[int]
 ) -> list[tuple[float, float]] | None:
     """The SAT on exact integers: ``None`` if separated or touching, else the overlaps along the
-    axes of ``edges``. Every edge is tested, also those whose float axis was dropped as a repeat
-    (rounding can make nearly parallel edges look exactly parallel)."""
+    axes of ``edges``, in the units of those axes scaled by ``2**-ks``. Every edge is tested, also
+    those whose float axis was dropped as a repeat (rounding can make nearly parallel edges look
+    exactly parallel)."""
     ex, ey, rest, e = _exact_offset(off, *((c, 0) for p in pa + lb for c in p))
     pts = [(rest[2 * i], rest[2 * i + 1]) for i in range(len(rest) // 2)]
     ia, ib = pts[: len(pa)], pts[len(pa):]
@@ -414,7 +410,8 @@ def _polygon_polygon_exact(
             if fwd <= 0 or bwd <= 0:
                 return None
             found[which, i] = (fwd, bwd)
-    return [(_to_float(found[k][0], 2 * e), _to_float(found[k][1], 2 * e)) for k in edges]
+    return [(_to_float(found[edge][0], 2 * e - k), _to_float(found[edge][1], 2 * e - k))
+            for edge, k in zip(edges, ks, strict=True)]
 
 
 def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:

@@ -11,7 +11,9 @@ boxes at one place), where the upward (then rightward) one wins whichever shape 
 3. Then the fixed angular order: fold each direction into the upper half-plane (negate it if
    ``ny < 0``, or ``ny == 0`` and ``nx < 0``) and prefer the largest folded ``nx``. Folding commutes
    with negation, so this step is symmetric too.
-4. A direction and its negation still tie: prefer ``ny > 0``, then ``nx > 0``.
+4. A direction and its negation still tie (the direction is undefined): prefer ``ny > 0``, then
+   ``nx > 0``, and return the shortest of the tied depths, so that both argument orders give the
+   same depth (the winner's own depth exceeds it by less than the tolerance of step 1).
 
 The batch kernels implement the same steps on arrays; keep the two in step.
 """
@@ -50,4 +52,5 @@ def pick(cands: list[tuple[float, float, float]], size: float) -> tuple[float, f
     if len(near) == 1:
         return near[0]
     # Only a direction and (near-)copies of it or its negation remain.
-    return max(near, key=lambda c: (c[2] > DIR_TOL, c[1] > DIR_TOL, -c[0]))
+    _, nx, ny = max(near, key=lambda c: (c[2] > DIR_TOL, c[1] > DIR_TOL, -c[0]))
+    return min(c[0] for c in near), nx, ny

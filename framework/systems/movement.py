@@ -1,6 +1,6 @@
 """Movement: integrate velocities (semi-implicit Euler), with optional gravity.
 
-Only rows with a Velocity are touched; static bodies never move. Gravity accelerates dynamic
+Only rows with a Velocity are touched; static and sleeping bodies never move. Gravity accelerates dynamic
 bodies only (kinematic ones move exactly as game code tells them).
 """
 
@@ -15,7 +15,7 @@ __all__ = ["integrate"]
 
 def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> np.ndarray:
     """Advance every moving row by ``dt``; return the rows integrated."""
-    rows = np.flatnonzero(store.has_vel & (store.body != STATIC))
+    rows = np.flatnonzero(store.has_vel & (store.body != STATIC) & ~store.asleep)
     if rows.size == 0:
         return rows
     c = store.cols

@@ -1,0 +1,154 @@
+"""A scene pays only for the effects it declares: the per-step counters prove work not called for
+is not done, and that declaring an effect turns the work on."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from framework import AABB, Circle, Hitbox, Scene, Transform, Velocity
+from framework.scene import DEFAULT_EFFECTS, SLEEP_STEPS, resolve_effects
+
+DT = 1.0 / 64.0
+
+
+def test_effects_pull_in_what_they_need_and_unknown_ones_are_refused():
+    assert resolve_effects(["response"]) == {"response", "detection"}
+    assert resolve_effects(["continuous"]) == {"continuous", "movement", "detection"}
+    assert resolve_effects(["debug_overlay"]) == {"debug_overlay", "rendering"}
+    assert resolve_effects(None) == DEFAULT_EFFECTS
+    with pytest.raises(ValueError, match="'teleport'"):
+        Scene(effects=["movement", "teleport"])
+    with pytest.raises(ValueError, match="collection"):
+        Scene(effects="movement")
+
+
+def test_a_scene_without_response_runs_no_response_system():
+    with Scene(effects=["movement", "detection", "events"]) as s:
+        s.spawn(Transform(0, 0), Hitbox(AABB(2, 2), body="static"))
+        d = s.spawn(Transform(0, 1.5), Velocity(0, -1), Hitbox(AABB(1, 1)))
+        s.step(DT)
+        assert s.counters["systems"] == ["movement", "broad_phase", "narrow_phase"]
+        assert [e.kind for e in s.events] == ["started"]
+        assert s.get(d, Transform).y == 1.5 - DT  # nobody pushed it out
+
+
+def test_a_puzzle_scene_without_physics_does_no_collision_work():
+    with Scene(effects=["movement"]) as s:
+        for i in range(50):
+            s.spawn(Transform(i * 0.5, 0), Velocity(1, 0), Hitbox(AABB(1, 1)))
+        s.step(DT)
+        c = s.counters
+        assert c["systems"] == ["movement"] and c["integrated"] == 50
+        assert c["candidate_pairs"] == 0 and c["narrow_tests"] == {} and c["rehashed"] == 0
+        assert s.events == []
+
+
+def test_enabling_an_effect_turns_the_work_on():
+    def run(effects):
+        with Scene(effects=effects, gravity=(0, -10)) as s:
+            s.spawn(Transform(0, 0), Hitbox(AABB(4, 1), body="static"))
+            b = s.spawn(Transform(0, 1.0), Velocity(), Hitbox(AABB(1, 1)))
+            for _ in range(10):
+                s.step(DT)
+            return s.counters, s.get(b, Transform).y
+
+    c, y = run(["movement"])
+    assert c["systems"] == ["movement"] and y == 1.0  # no gravity declared: it floats
+    c, y = run(["gravity"])
+    assert y < 1.0 and c["candidate_pairs"] == 0  # falls into the floor: no detection
+    c, y = run(["gravity", "response"])
+    assert "response" in c["systems"] and c["resolved"] == 1 and y == pytest.approx(1.0, abs=1e-9)
+
+
+def test_100k_static_tiles_add_no_per_step_rehashing():
+    with Scene(cell_size=4.0) as s:
+        side = 317
+        xs, ys = np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float))
+        for x, y in zip(xs.ravel()[:100_000].tolist(), ys.ravel()[:100_000].tolist()):
+            s.spawn(Transform(x, -y - 10.0), Hitbox(AABB(1, 1), body="static"))
+        rng = np.random.default_rng(1)
+        for _ in range(100):
+            s.spawn(Transform(float(rng.uniform(0, 300)), float(rng.uniform(0, 20))),
+                    Velocity(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))), Hitbox(Circle(0.5)))
+        s.step(DT)
+        assert s.counters["rehashed"] == 100_000 + 100  # the level is hashed once, at the first step
+        for _ in range(5):
+            s.step(DT)
+            assert s.counters["rehashed"] == 100  # then only the moving bodies
+            assert s.counters["integrated"] == 100
+
+
+def test_sleeping_bodies_cost_nothing_until_woken():
+    with Scene(gravity=(0.0, -10.0)) as s:
+        s.spawn(Transform(0, 0), Hitbox(AABB(40, 1), body="static"))
+        boxes = [s.spawn(Transform(-15.0 + 3 * i, 1.0), Velocity(), Hitbox(AABB(1, 1))) for i in range(10)]
+        for _ in range(SLEEP_STEPS + 5):
+            s.step(1 / 60)
+        c = s.counters
+        assert c["asleep"] == 10
+        assert c["integrated"] == 0 and c["candidate_pairs"] == 0 and c["narrow_tests"] == {}
+        assert c["rehashed"] == 0
+        # They still rest on the floor: the resting contacts stay "ongoing".
+        assert [e.kind for e in s.events] == ["ongoing"] * 10
+        y_rest = s.get(boxes[0], Transform).y
+        assert y_rest == pytest.approx(1.0, abs=1e-9)
+        # Game code moving one wakes it (and only it).
+        s.get(boxes[0], Velocity).y = 3.0
+        s.step(1 / 60)
+        assert s.counters["asleep"] == 9 and s.counters["integrated"] == 1
+        assert s.get(boxes[0], Transform).y > y_rest
+
+
+def test_an_awake_body_landing_on_a_sleeper_wakes_it():
+    with Scene(gravity=(0.0, -10.0)) as s:
+        s.spawn(Transform(0, 0), Hitbox(AABB(10, 1), body="static"))
+        low = s.spawn(Transform(0, 1.0), Velocity(), Hitbox(AABB(1, 1)))
+        for _ in range(SLEEP_STEPS + 2):
+            s.step(1 / 60)
+        assert s.store.asleep[s.store.row_of[low]]
+        top = s.spawn(Transform(0, 3.0), Velocity(), Hitbox(AABB(1, 1)))
+        for _ in range(60):
+            s.step(1 / 60)
+        # The dropped box ends resting on the (woken) lower one, both in place.
+        assert s.get(top, Transform).y == pytest.approx(2.0, abs=1e-6)
+        assert s.get(low, Transform).y == pytest.approx(1.0, abs=1e-6)
+
+
+def test_without_the_events_effect_only_listened_pairs_are_tested():
+    class Coin:
+        pass
+
+    class Player:
+        pass
+
+    got = []
+    with Scene(effects=["movement", "response"]) as s:
+        s.on_collision(Player, Coin, lambda sc, ev: got.append(ev.kind))
+        s.spawn(Transform(0, 0), Hitbox(Circle(0.5), sensor=True, body="static"), Coin())
+        s.spawn(Transform(5, 0), Hitbox(Circle(0.5), sensor=True, body="static"))  # nobody listens
+        s.spawn(Transform(0.5, 0), Velocity(), Hitbox(AABB(1, 1)), Player())
+        s.spawn(Transform(5.5, 0), Velocity(), Hitbox(AABB(1, 1)))
+        s.step(DT)
+        assert got == ["started"]
+        assert s.counters["candidate_pairs"] == 1 and s.counters["contacts"] == 1
+
+
+def test_headless_scene_never_imports_pyglet_gl():
+    code = textwrap.dedent("""
+        import sys
+        from framework import AABB, Hitbox, Scene, Transform, Velocity
+        s = Scene(gravity=(0, -10))
+        s.spawn(Transform(0, 0), Hitbox(AABB(4, 1), body="static"))
+        s.spawn(Transform(0, 2), Velocity(), Hitbox(AABB(1, 1)))
+        for _ in range(10):
+            s.step(1 / 60)
+        bad = [m for m in sys.modules if m.startswith(("pyglet.gl", "pyglet.window", "pyglet.graphics"))]
+        print(bad)
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
