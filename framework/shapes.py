@@ -105,7 +105,13 @@ class Polygon(Shape):
         """A ``width`` x ``height`` box centred on the origin that rotates with its transform."""
         hw = _halvable("Polygon.box width", width) * 0.5
         hh = _halvable("Polygon.box height", height) * 0.5
-        return cls([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
+        try:
+            return cls([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
+        except InvalidValue:
+            raise InvalidValue(
+                f"Polygon.box({width!r}, {height!r}) is too thin to be a polygon in float64 (width and "
+                "height more than ~1e13 apart); an AABB has no such limit"
+            ) from None
 
     @property
     def bounding_radius(self) -> float:

@@ -419,7 +419,7 @@ def test_tiny_and_huge_scenes(scale: float) -> None:
     for ka, kb in COMBOS:
         rng = np.random.default_rng(21)
         pairs += random_pairs(rng, ka, kb, 25) + touching_pairs(ka, kb)[:6]
-    pairs = [(scaled(sa), (ta[0] * scale, ta[1] * scale, ta[2]), scaled(sb), (tb[0] * scale, tb[1] * scale, tb[2]))
-             for sa, ta, sb, tb in pairs]
-    res = collide_many([p[0] for p in pairs], [p[1] for p in pairs], [p[2] for p in pairs], [p[3] for p in pairs])
+    pairs = [(scaled(sa), (ta[0] * scale, ta[1] * scale, ta[2]),
+              scaled(sb), (tb[0] * scale, tb[1] * scale, tb[2])) for sa, ta, sb, tb in pairs]
+    res = collide_many(*zip(*pairs, strict=True))
     assert_matches(pairs, res, f"scale {scale}")

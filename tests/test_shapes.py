@@ -285,3 +285,9 @@ def test_bow_tie_and_star_say_self_intersecting_not_collinear():
 )
 def test_bad_points_raise_naming_the_value(pts, bad):
     raises_naming(bad, Polygon, pts)
+
+
+def test_too_thin_polygon_box_names_its_sizes():
+    err = raises_naming(1e15, Polygon.box, 1, 1e15)
+    assert f"Polygon.box(1, {1e15!r})" in str(err) and "AABB" in str(err)
+    assert len(Polygon.box(1, 1e12)) == 4  # a 1e12 aspect ratio is still a polygon

@@ -3,9 +3,10 @@ arrays of pairs at once, one kernel per pair of shape kinds.
 
 Every kernel takes ``[P]`` arrays (scalars broadcast) and returns a :class:`ContactArrays` whose
 row ``i`` is what ``collide`` gives for pair ``i``: the same overlap decision on every input
-(touching is not a collision, exactly, on dyadic coordinates), the same normal and depth up to
-rounding (the same tie-break rule), and the same point up to rounding. Each has a cheaper
-``overlap_*`` twin that returns only ``hit``.
+(touching is never a collision and an overlap of one ulp always is), the same normal and depth up
+to rounding (the same tie-break rule) and the same point up to rounding. Each has a cheaper
+``overlap_*`` twin that returns only ``hit``. No Python loop runs over the pairs, except over the
+rare ones within rounding of touching that need exact integer arithmetic (none for AABB pairs).
 
 =============================  ===============================================================
 ``circle_circle``              circles A and B
@@ -17,9 +18,14 @@ rounding (the same tie-break rule), and the same point up to rounding. Each has 
 
 Polygon kernels take each shape's hitbox origin in world coordinates and its outline relative
 to that origin, already rotated: ``verts [P, K, 2]`` and ``counts [P]`` as :func:`outlines` gives
-them, gathered per pair. Like the scalar code, every kernel works relative to shape A's position
-(B's offset from A is the one large-magnitude subtraction), so a scene at x = 1e9 gives the
-answers of the same scene at the origin.
+them, gathered per pair. They accept an optional ``size`` ``[P]`` (the two bounding radii summed,
+the scale of the tie-break tolerance) and otherwise measure it from the outlines.
+
+Numerics, as in the scalar code (whose module docstring explains them): each pair is worked in a
+local frame (A's hitbox origin; the polygon's for a polygon / circle pair) scaled by a power of two,
+so a scene at x = 1e9 gives the answers of the scene at the origin and radii of 1e-200 or 1e300
+neither underflow nor overflow; floats decide wherever the answer is clear of rounding, exact
+arithmetic inside a thin band around touching (:mod:`~framework.collision.batch_exact`).
 
 Inputs must be finite (the systems check components); kernels never return NaN or inf.
 :func:`collide_many` groups arbitrary shape pairs by kind and is the convenient (validated) entry.
@@ -71,7 +77,8 @@ def outlines(shapes: Sequence[AABB | Polygon], rotations: object) -> tuple[np.nd
     Returns ``(verts, counts)``: ``verts [N, K, 2]`` float64, counter-clockwise, ``K`` the largest
     vertex count, the slots past a shape's count repeating its last vertex; ``counts [N]``.
     ``rotations`` (``[N]`` or a scalar, radians) turns polygons and ``Polygon.box``; AABBs never
-    turn. The vertices are those of the scalar code's outline, bit for bit, before the offset.
+    turn. The vertices are those of the scalar code's outlines bit for bit (``math.cos`` and
+    ``math.sin``, the same products), up to its power-of-two scaling.
     """
     n = len(shapes)
     rot = np.asarray(rotations, dtype=F64)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .batch_common import F64, ContactArrays, columns, finish, frame
 from .batch_exact import BAND, TINY
-from .batch_polygon import POINT_TOL, overlap_point
+from .batch_point import POINT_TOL, overlap_point
 from .tiebreak import DEPTH_TOL
 
 __all__ = ["aabb_aabb", "overlap_aabb_aabb"]

@@ -103,7 +103,7 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
     wx, wy = cx - vx, cy - vy  # centre relative to each vertex / edge start
     s = ey * wx - ex * wy  # unnormalised distance outside each face; 0 on padding edges
     out = s > 0.0
-    inside = ~out.any(axis=0)
+    inside = ~out.any(axis=0) & valid.any(axis=0)  # (a polygon shrunk to a point has no faces)
     # Inside (or on the boundary): out through the nearest face, plus the radius.
     absent = (~valid).astype(F64)
     ln = norm(ex, ey) + absent  # 1 on padding edges

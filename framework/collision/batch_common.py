@@ -1,8 +1,9 @@
 """Shared pieces of the batch (numpy) collision kernels.
 
-The result record, input coercion, padded-outline helpers and the tie-break rule of
-:mod:`framework.collision.tiebreak` on arrays. The kernels themselves live in ``batch_circle``,
-``batch_box`` and ``batch_polygon``; :mod:`framework.collision.batch` is the public face.
+The result record, input coercion, frames, padded-outline helpers and the tie-break rule of
+:mod:`framework.collision.tiebreak` on arrays. The kernels live in ``batch_circle``, ``batch_box``
+and ``batch_polygon``, the contact point of polygons in ``batch_point``, the exact fallback near
+touching in ``batch_exact``; :mod:`framework.collision.batch` is the public face.
 
 Padded outlines: a batch of convex counter-clockwise outlines is an array ``[P, K, 2]`` plus a
 count per row; slots at and past the count repeat the last real vertex. Edge ``i`` runs from slot
@@ -24,6 +25,9 @@ import numpy as np
 
 from ..validation import InvalidValue
 from .tiebreak import DEPTH_TOL, DIR_TOL
+
+# Smallest positive float: the floor of every depth, so "depth > 0" holds even where it underflows.
+TINY = 5e-324
 
 __all__ = ["ContactArrays"]
 
@@ -90,7 +94,9 @@ def finish(hit: np.ndarray, nx, ny, depth, px, py, k, ox, oy) -> ContactArrays:
     """Contacts of the ``hit`` rows (compressed, in the scaled local frame of origin (ox, oy),
     all ``[H]``) unscaled, moved to the world and spread back to all rows (zeros elsewhere)."""
     n = hit.shape[0]
-    depth = np.ldexp(depth, k)
+    # An overlap below the smallest float (shapes 1e300 times smaller than the scene) is still an
+    # overlap: depth > 0.
+    depth = np.maximum(np.ldexp(depth, k), TINY)
     px = ox + np.ldexp(px, k)
     py = oy + np.ldexp(py, k)
     if not (np.isfinite(depth).all() and np.isfinite(px).all() and np.isfinite(py).all()):
@@ -216,10 +222,13 @@ def pick(depth: np.ndarray, nx: np.ndarray, ny: np.ndarray, size: np.ndarray):
     fx = nx * (1.0 - 2.0 * fold.astype(F64))
     top = (fx + (near.astype(F64) - 1.0) * 4.0).max(axis=0)
     near &= fx >= top - DIR_TOL
-    # 4. max over key (ny > tol, nx > tol, -depth), the first of equals winning
+    # 4. Only a direction and (near-)copies of it or its negation remain: the direction of the max
+    # over key (ny > tol, nx > tol, -depth), the first of equals winning, with the shortest depth
+    # of them all.
+    shortest = (depth + (1.0 - near.astype(F64)) * BIG).min(axis=0)
     for key in (ny > DIR_TOL, nx > DIR_TOL):
         keep = near & key
         near = keep | (near & ~keep.any(axis=0))
     low = (depth + (1.0 - near.astype(F64)) * BIG).min(axis=0)
     i = first(near & (depth == low))
-    return take(depth, i), take(nx, i), take(ny, i)
+    return shortest, take(nx, i), take(ny, i)

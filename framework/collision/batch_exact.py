@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from .batch_common import TINY
 from .tiebreak import pick
 
 __all__ = ["BAND", "TINY", "circle_circle_exact", "polygon_circle_exact", "polygon_polygon_exact"]
@@ -22,8 +23,6 @@ __all__ = ["BAND", "TINY", "circle_circle_exact", "polygon_circle_exact", "polyg
 # Half-width of the band, relative to the magnitudes involved, inside which a float decision is
 # not trusted (float rounding is below 1e-15 of them). The scalar code uses the same band.
 BAND = 1e-13
-# Smallest positive float: the floor of a depth, so "depth > 0" holds even when it underflows.
-TINY = 5e-324
 
 Pts = Sequence[tuple[float, float]]
 Offset = tuple[float, float, float, float, int]  # ox, oy, qx, qy, k: the offset is (q - o) * 2**-k
@@ -65,7 +64,7 @@ def polygon_circle_exact(
     for i in range(n):
         (x0, y0), (x1, y1) = pts[i], pts[(i + 1) % n]
         seps.append((y1 - y0) * (ecx - x0) - (x1 - x0) * (ecy - y0))
-    if all(s <= 0 for s in seps):
+    if any(pts[i] != pts[(i + 1) % n] for i in range(n)) and all(s <= 0 for s in seps):
         # Inside or on the boundary: an overlap (r > 0), depth r + distance to the nearest face.
         cands = []
         for i in range(n):
@@ -104,7 +103,8 @@ def polygon_circle_exact(
     ddx, ddy = _float(ecx - pts[j][0], e), _float(ecy - pts[j][1], e)
     dist = math.hypot(ddx, ddy)
     depth = max(_float(num, 2 * e) / (r + dist), TINY)
-    return f * ddx / dist, f * ddy / dist, depth, poly[j][0], poly[j][1]
+    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
+    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
 
 def _extent(pts: list[tuple[int, int]], ux: int, uy: int) -> tuple[int, int]:

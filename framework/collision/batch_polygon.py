@@ -2,15 +2,17 @@
 
 Separating axes, vectorised over pairs: the axes are the unnormalised outward edge normals of A
 and of B, ``[C, P]`` with ``C = Ka + Kb``; every vertex of both outlines is projected on every
-axis at once (``[C, K, P]``), with B about its own origin and ``u . d`` added, exactly the scalar
-code's products and comparisons. Rows within the band of touching on some axis are decided
-exactly (:mod:`framework.collision.batch_exact`). Only the overlapping rows go on to normalise
-their axes, build the ``2 C`` push-out candidates and apply the tie-break rule.
+axis (a loop over the few vertices, each step on ``[C, P]``), with B about its own origin and
+``u . d`` added, exactly the scalar code's products and comparisons. Rows within the band of
+touching on some axis are decided exactly (:mod:`framework.collision.batch_exact`). Only the
+overlapping rows go on to normalise their axes, build the ``2 C`` push-out candidates and apply
+the tie-break rule.
 
-Contact point: the mean of the vertices of A ∩ B, built as the scalar code builds it: A's vertices
-inside B and B's vertices inside A (``[Ka, Kb, P]`` edge tests) and the crossings of every edge
-of A with every edge of B (``[Ka, Kb, P]``), each included by the same closed tests. The mean
-is a convex combination of points of A ∩ B, so it lies in the overlap.
+Contact point: :func:`framework.collision.batch_point.overlap_point`, the scalar code's mean of
+the vertices of A ∩ B.
+
+Rows where both outlines are centred axis-aligned rectangles (``Polygon.box`` unturned, or an
+AABB's outline) are, to the scalar code, two AABBs: they go to the exact box kernel instead.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..validation import InvalidValue
+from .batch_box import aabb_aabb, overlap_aabb_aabb
 from .batch_common import (
     BIG,
     F64,
@@ -28,39 +31,51 @@ from .batch_common import (
     edges,
     extent,
     finish,
-    first_min,
     frame,
+    no_contacts,
     norm,
     outline_rows,
     pick,
-    take,
-    vertex_mask,
 )
 from .batch_exact import BAND, TINY, polygon_polygon_exact
+from .batch_point import overlap_point
 
 __all__ = ["overlap_polygon_polygon", "polygon_polygon"]
 
-# Relative tolerance of the inside test of the contact point (times the pair's size), as in
-# ``collide.overlap_point``.
-POINT_TOL = 1e-12
 
-
-def _frame(ax, ay, averts, acount, bx, by, bverts, bcount):
+def _frame(avx, avy, bvx, bvy, ax, ay, bx, by):
     """Both outlines ``[K, P]`` about their own origins and B's offset, in A's scaled frame."""
+    dx, dy, k = frame(ax, ay, bx, by, np.maximum(extent(avx, avy), extent(bvx, bvy)))
+    avx, avy, bvx, bvy = (np.ldexp(v, -k) for v in (avx, avy, bvx, bvy))
+    # The bounding radii summed (fine for tolerances), in the scaled frame.
+    size = np.sqrt((avx * avx + avy * avy).max(axis=0)) + np.sqrt((bvx * bvx + bvy * bvy).max(axis=0))
+    return avx, avy, bvx, bvy, dx, dy, k, size
+
+
+def _centred_boxes(vx: np.ndarray, vy: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """The outlines that are ``(±hw, ±hh)`` exactly, as an AABB's (``Polygon.box`` unturned)."""
+    if vx.shape[0] < 4:
+        return np.zeros(count.shape, dtype=bool)
+    x0, x1, x2, x3 = vx[:4]
+    y0, y1, y2, y3 = vy[:4]
+    return ((count == 4) & (x1 > 0.0) & (y2 > 0.0) & (x0 == -x1) & (x2 == x1) & (x3 == x0)
+            & (y1 == y0) & (y0 == -y2) & (y3 == y2))
+
+
+def _rows(ax, ay, averts, acount, bx, by, bverts, bcount):
     avx, avy, acount = outline_rows(averts, acount, "averts")
     bvx, bvy, bcount = outline_rows(bverts, bcount, "bverts")
     p = avx.shape[1]
     if bvx.shape[1] != p:
         raise InvalidValue(f"averts has {p} rows but bverts has {bvx.shape[1]}")
     ax, ay, bx, by = columns_of(p, ax, ay, bx, by)
-    if p == 0:
-        z = np.zeros(0)
-        return avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, z, z, np.zeros(0, dtype=np.intp), z
-    dx, dy, k = frame(ax, ay, bx, by, np.maximum(extent(avx, avy), extent(bvx, bvy)))
-    avx, avy, bvx, bvy = (np.ldexp(v, -k) for v in (avx, avy, bvx, bvy))
-    # The bounding radii summed (fine for tolerances), in the scaled frame.
-    size = np.sqrt((avx * avx + avy * avy).max(axis=0)) + np.sqrt((bvx * bvx + bvy * bvy).max(axis=0))
-    return avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size
+    is_box = _centred_boxes(avx, avy, acount) & _centred_boxes(bvx, bvy, bcount)
+    boxes, rest = np.flatnonzero(is_box), np.flatnonzero(~is_box)
+    # Two centred axis-aligned boxes are, to the scalar code, the outlines of two AABBs: the box
+    # kernel gives their contacts exactly and far more cheaply (no integer fallback when touching).
+    box_args = (ax[boxes], ay[boxes], avx[1, boxes], avy[2, boxes],
+                bx[boxes], by[boxes], bvx[1, boxes], bvy[2, boxes])
+    return avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, boxes, rest, box_args
 
 
 def _extent(ux: np.ndarray, uy: np.ndarray, vx: np.ndarray, vy: np.ndarray):
@@ -112,10 +127,18 @@ def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size):
 
 def overlap_polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount) -> np.ndarray:
     """``hit`` of :func:`polygon_polygon` only."""
-    fr = _frame(ax, ay, averts, acount, bx, by, bverts, bcount)
-    if fr[6].shape[0] == 0:
-        return np.zeros(0, dtype=bool)
-    return _sat(*fr)[0]
+    avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, boxes, rest, box_args = _rows(
+        ax, ay, averts, acount, bx, by, bverts, bcount
+    )
+    hit = np.zeros(ax.shape, dtype=bool)
+    if boxes.size:
+        hit[boxes] = overlap_aabb_aabb(*box_args)
+    if rest.size:
+        avx, avy, bvx, bvy = (cols(v, rest) for v in (avx, avy, bvx, bvy))
+        ax, ay, bx, by, acount, bcount = (v[rest] for v in (ax, ay, bx, by, acount, bcount))
+        avx, avy, bvx, bvy, dx, dy, k, size = _frame(avx, avy, bvx, bvy, ax, ay, bx, by)
+        hit[rest] = _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size)[0]
+    return hit
 
 
 def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None) -> ContactArrays:
@@ -126,14 +149,37 @@ def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None) -
     ``size`` (optional ``[P]``): the pair's bounding radii summed (the scale of the tie-break and
     contact-point tolerances); by default it is measured from the outlines.
     """
-    fr = _frame(ax, ay, averts, acount, bx, by, bverts, bcount)
-    avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, sz = fr
+    avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, boxes, rest, box_args = _rows(
+        ax, ay, averts, acount, bx, by, bverts, bcount
+    )
+    p = ax.shape[0]
+    if size is not None:
+        size = columns_of(p, size)[0]
+    if not boxes.size:
+        return _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size)
+    out = no_contacts(p)
+    res = aabb_aabb(*box_args)
+    for dst, src in zip(out, res, strict=True):
+        dst[boxes] = src
+    if rest.size:
+        res = _polygon_polygon(
+            *(cols(v, rest) if v.ndim == 2 else v[rest] for v in (avx, avy, acount, bvx, bvy, bcount)),
+            *(v[rest] for v in (ax, ay, bx, by)), None if size is None else size[rest],
+        )
+        for dst, src in zip(out, res, strict=True):
+            dst[rest] = src
+    return out
+
+
+def _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size) -> ContactArrays:
+    """:func:`polygon_polygon` on slot-major rows, by separating axes."""
     p = ax.shape[0]
     if p == 0:
-        return finish(np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), k, ax, ay)
+        return no_contacts(0)
+    avx, avy, bvx, bvy, dx, dy, k, sz = _frame(avx, avy, bvx, bvy, ax, ay, bx, by)
     if size is not None:
-        sz = np.ldexp(columns_of(p, size)[0], -k)
-    hit, axes = _sat(*fr[:-1], sz)
+        sz = np.ldexp(size, -k)
+    hit, axes = _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, sz)
     h = np.flatnonzero(hit)
     ux, uy, valid, fwd, bwd, avx, avy, bvx, bvy = (cols(a, h) for a in (*axes, avx, avy, bvx, bvy))
     acount, bcount = acount[h], bcount[h]
@@ -158,52 +204,3 @@ def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None) -
     bvx, bvy = bvx + dx, bvy + dy
     px, py = overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, sz)
     return finish(hit, nx, ny, depth, px, py, k[h], ax[h], ay[h])
-
-
-def _inside(x, y, ox, oy, ex, ey, tol):
-    """``[Kp, P]``: points (x, y) in the closed outlines (vertices ox, oy, edges ex, ey), with
-    ``tol`` (absolute, ``[P]``) of rounding, as ``collide._inside``. Padding edges never exclude."""
-    cross = ex[None] * (y[:, None] - oy[None])
-    cross -= ey[None] * (x[:, None] - ox[None])
-    return ~(cross < -tol * norm(ex, ey)[None]).any(axis=1)
-
-
-def overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, size):
-    """Mean of the vertices of A ∩ B for overlapping outlines ``[K, P]`` (B at its offset)."""
-    tol = POINT_TOL * size
-    exa, eya, exb, eyb = edges(avx), edges(avy), edges(bvx), edges(bvy)
-    ina = _inside(avx, avy, bvx, bvy, exb, eyb, tol) & vertex_mask(acount, avx.shape[0])
-    inb = _inside(bvx, bvy, avx, avy, exa, eya, tol) & vertex_mask(bcount, bvx.shape[0])
-    ina, inb = ina.astype(F64), inb.astype(F64)
-    sx = (avx * ina).sum(axis=0) + (bvx * inb).sum(axis=0)
-    sy = (avy * ina).sum(axis=0) + (bvy * inb).sum(axis=0)
-    count = ina.sum(axis=0) + inb.sum(axis=0)
-    # Crossings of A's edge i (p + t r) with B's edge j (q + u s), t and u in [0, 1]: [Ka, Kb, P].
-    # Parallel and padding (zero) edges have den == 0 exactly and are skipped, as in the scalar code.
-    rx, ry = exa[:, None], eya[:, None]
-    sx_, sy_ = exb[None], eyb[None]
-    den = rx * sy_ - ry * sx_
-    wx = bvx[None] - avx[:, None]
-    wy = bvy[None] - avy[:, None]
-    parallel = den == 0.0
-    den += parallel  # 1 where 0: those are skipped
-    t = (wx * sy_ - wy * sx_) / den
-    u = (wx * ry - wy * rx) / den
-    crossing = ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~parallel).astype(F64)
-    t = np.minimum(np.maximum(t, 0.0), 1.0)  # unchanged where crossing; finite elsewhere
-    sx += ((avx[:, None] + t * rx) * crossing).sum(axis=(0, 1))
-    sy += ((avy[:, None] + t * ry) * crossing).sum(axis=(0, 1))
-    count += crossing.sum(axis=(0, 1))
-    found = count > 0
-    c = np.maximum(count, 1.0)
-    px, py = sx / c, sy / c
-    if not found.all():
-        # Rounding hid every vertex (near-degenerate only): the middle of the penetration segment
-        # from B's deepest vertex.
-        m = np.flatnonzero(~found)
-        mx, my = cols(bvx, m), cols(bvy, m)
-        j = first_min(mx * nx[m] + my * ny[m])
-        half = depth[m] * 0.5
-        px[m] = take(mx, j) + nx[m] * half
-        py[m] = take(my, j) + ny[m] * half
-    return px, py

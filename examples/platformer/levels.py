@@ -1,0 +1,522 @@
+"""Level files: Tiled JSON maps (``.tmj``) and a plain-text format for tests and quick sketches.
+
+Both load into the same :class:`Level`: a grid of tile kinds (rows top to bottom, as drawn) and a
+list of :class:`LevelObject` in world coordinates (y up, units of the map's pixels). The game
+(:mod:`.game`) turns a Level into entities; nothing here knows about the scene.
+
+**Text maps**, one character per tile, rows top to bottom::
+
+    #  solid tile          -  one-way platform     ^  spikes
+    P  player start        C  coin                 E  enemy
+    K  checkpoint          G  goal                 .  empty (so is a space)
+    M  moving platform (a run of M is one platform, half a tile thick, one-way)
+    ~  the cells a moving platform sweeps: to its right, left, above or below (one side)
+
+Lines starting with ``;`` are comments; short rows are padded with empty cells.
+
+**Tiled maps** (orthogonal, finite, Tiled's JSON export): tile layers give tile kinds, either
+for the whole layer (a ``kind`` property, or the layer named ``solid``, ``oneway`` or ``spikes``)
+or per tile from the tileset (each tile's ``type``/``class`` or ``kind`` property). Layers named
+``background`` or ``decoration`` (or ``kind`` = ``decoration``) are ignored. Layer ``data`` may
+be a plain array or base64 (uncompressed, zlib or gzip). One object layer (or more) holds
+objects whose ``type``/``class`` (or ``name``) is ``player``, ``coin``, ``enemy``, ``goal``,
+``checkpoint``, ``platform`` or ``spikes``; points and rectangles both work. Properties:
+``platform``: ``dx``, ``dy`` (travel in tiles, y up), ``speed`` (tiles/s), ``one_way`` (bool);
+``enemy``: ``speed`` (tiles/s), ``direction`` (-1 left, 1 right).
+
+A malformed file raises :class:`LevelError`, a ``ValueError`` whose message starts with the
+file's name and says what is wrong.
+"""
+
+from __future__ import annotations
+
+import base64
+import gzip
+import json
+import math
+import sys
+import zlib
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "LEVEL_DIR", "Level", "LevelError", "LevelObject", "builtin_levels", "load_level", "parse_text",
+    "parse_tmj", "to_tmj",
+]
+
+LEVEL_DIR = Path(__file__).with_name("levels")
+TILE_KINDS = ("solid", "oneway", "spikes")
+OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes")
+DECORATION = ("background", "decoration")
+DEFAULT_TILE = 32.0
+
+_TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes"}
+_TEXT_OBJECTS = {"P": "player", "C": "coin", "E": "enemy", "G": "goal", "K": "checkpoint"}
+_TEXT_EMPTY = ". "
+_FLIP_BITS = 0xF0000000  # Tiled's flip / rotate flags in the high bits of a gid
+
+
+class LevelError(ValueError):
+    """A level file that cannot be loaded; the message names the file and the problem."""
+
+
+@dataclass(frozen=True)
+class LevelObject:
+    """A thing placed in a level: ``kind``, its rectangle in world coordinates (centre ``x, y``,
+    y up; ``width`` and ``height`` are 0 for a point) and its properties."""
+
+    kind: str
+    x: float
+    y: float
+    width: float = 0.0
+    height: float = 0.0
+    props: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def bottom(self) -> float:
+        return self.y - self.height * 0.5
+
+
+@dataclass
+class Level:
+    """A loaded level: ``tiles[row][col]`` is a kind from ``TILE_KINDS`` or ``None``, row 0 at the
+    top; the world's origin is the map's bottom-left corner, one tile is ``tile`` units."""
+
+    name: str
+    source: str
+    tile: float
+    width: int
+    height: int
+    tiles: list[list[str | None]]
+    objects: list[LevelObject]
+
+    @property
+    def size(self) -> tuple[float, float]:
+        """World width and height of the map."""
+        return self.width * self.tile, self.height * self.tile
+
+    def cell_center(self, col: int, row: int) -> tuple[float, float]:
+        return (col + 0.5) * self.tile, (self.height - row - 0.5) * self.tile
+
+    def of_kind(self, kind: str) -> list[LevelObject]:
+        return [o for o in self.objects if o.kind == kind]
+
+    @property
+    def player(self) -> LevelObject:
+        return self.of_kind("player")[0]
+
+    def validate(self) -> Level:
+        """Check what every level needs; raise :class:`LevelError` naming the source."""
+        def fail(msg: str) -> None:
+            raise LevelError(f"{self.source}: {msg}")
+
+        if not (math.isfinite(self.tile) and self.tile > 0):
+            fail(f"tile size must be a positive number, got {self.tile!r}")
+        if self.width < 1 or self.height < 1:
+            fail(f"the map is empty ({self.width} x {self.height} tiles)")
+        players = self.of_kind("player")
+        if len(players) != 1:
+            fail(f"needs exactly one player start, found {len(players)}")
+        if not self.of_kind("goal"):
+            fail("has no goal")
+        w, h = self.size
+        for o in self.objects:
+            if o.kind not in OBJECT_KINDS:
+                fail(f"unknown object kind {o.kind!r} (known: {', '.join(OBJECT_KINDS)})")
+            if not all(math.isfinite(v) for v in (o.x, o.y, o.width, o.height)):
+                fail(f"{o.kind} at ({o.x}, {o.y}) has a non-finite position or size")
+            if not (0 <= o.x <= w and 0 <= o.y <= h):
+                fail(f"{o.kind} at ({o.x:g}, {o.y:g}) lies outside the map (0..{w:g}, 0..{h:g})")
+            if o.kind == "platform":
+                if o.width <= 0 or o.height <= 0:
+                    fail(f"platform at ({o.x:g}, {o.y:g}) needs a rectangle (width and height > 0)")
+                for key in ("dx", "dy", "speed"):
+                    if not _is_number(o.props.get(key, 0.0)):
+                        fail(f"platform at ({o.x:g}, {o.y:g}): {key} must be a number, "
+                             f"got {o.props[key]!r}")
+                if o.props.get("dx", 0) == 0 and o.props.get("dy", 0) == 0:
+                    fail(f"platform at ({o.x:g}, {o.y:g}) does not move: give it dx or dy")
+                if not float(o.props.get("speed", 2.0)) > 0:
+                    fail(f"platform at ({o.x:g}, {o.y:g}): speed must be > 0")
+            if o.kind == "enemy":
+                if not _is_number(o.props.get("speed", 2.0)) or not float(o.props.get("speed", 2.0)) >= 0:
+                    fail(f"enemy at ({o.x:g}, {o.y:g}): speed must be a number >= 0")
+                if o.props.get("direction", -1) not in (-1, 1):
+                    fail(f"enemy at ({o.x:g}, {o.y:g}): direction must be -1 or 1, "
+                         f"got {o.props.get('direction')!r}")
+        return self
+
+
+def _is_number(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+# --- text maps -------------------------------------------------------------------------------------
+
+
+def parse_text(text: str, source: str = "<text>", *, tile: float = DEFAULT_TILE, name: str | None = None) -> Level:
+    """A :class:`Level` from a text map (see the module docstring for the characters)."""
+    def fail(msg: str) -> None:
+        raise LevelError(f"{source}: {msg}")
+
+    lines = [ln.rstrip("\r\n").rstrip() for ln in text.splitlines()]
+    lines = [ln for ln in lines if not ln.lstrip().startswith(";")]
+    while lines and not lines[0].strip():
+        lines.pop(0)
+    while lines and not lines[-1].strip():
+        lines.pop()
+    if not lines:
+        fail("the map is empty")
+    width = max(len(ln) for ln in lines)
+    grid = [ln.ljust(width, ".") for ln in lines]
+    height = len(grid)
+    tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
+    objects: list[LevelObject] = []
+    known = set(_TEXT_TILES) | set(_TEXT_OBJECTS) | set(_TEXT_EMPTY) | {"M", "~"}
+
+    def center(col: int, row: int) -> tuple[float, float]:
+        return (col + 0.5) * tile, (height - row - 0.5) * tile
+
+    for row, line in enumerate(grid):
+        for col, ch in enumerate(line):
+            if ch not in known:
+                fail(f"unknown character {ch!r} at line {row + 1}, column {col + 1} "
+                     f"(known: {''.join(sorted(known - {' '}))})")
+            if ch in _TEXT_TILES:
+                tiles[row][col] = _TEXT_TILES[ch]
+            elif ch in _TEXT_OBJECTS:
+                x, y = center(col, row)
+                objects.append(LevelObject(_TEXT_OBJECTS[ch], x, y, tile, tile))
+    objects.extend(_text_platforms(grid, tile, fail))
+    return Level(name or Path(source).stem, source, float(tile), width, height, tiles, objects).validate()
+
+
+def _text_platforms(grid: list[str], tile: float, fail) -> list[LevelObject]:
+    height, width = len(grid), len(grid[0])
+    out = []
+    used = set()
+    for row, line in enumerate(grid):
+        col = 0
+        while col < width:
+            if line[col] != "M":
+                col += 1
+                continue
+            start = col
+            while col < width and line[col] == "M":
+                col += 1
+            run = col - start
+
+            def count(cells: Iterable[tuple[int, int]]) -> int:
+                n = 0
+                for r, c in cells:
+                    if not (0 <= r < height and 0 <= c < width) or grid[r][c] != "~":
+                        break
+                    used.add((r, c))
+                    n += 1
+                return n
+
+            right = count((row, c) for c in range(col, width))
+            left = count((row, c) for c in range(start - 1, -1, -1))
+            up = count((r, start) for r in range(row - 1, -1, -1))
+            down = count((r, start) for r in range(row + 1, height))
+            sides = [(d, n) for d, n in (("right", right), ("left", left), ("up", up), ("down", down)) if n]
+            where = f"moving platform at line {row + 1}, column {start + 1}"
+            if not sides:
+                fail(f"{where} has no path: mark the cells it sweeps with '~' on one side")
+            if len(sides) > 1:
+                fail(f"{where} has '~' paths on several sides ({', '.join(d for d, _ in sides)}); use one")
+            side, n = sides[0]
+            dx = {"right": n, "left": -n}.get(side, 0)
+            dy = {"up": n, "down": -n}.get(side, 0)
+            x = (start + run * 0.5) * tile
+            y = (height - row) * tile - tile * 0.25
+            out.append(LevelObject("platform", x, y, run * tile, tile * 0.5,
+                                   {"dx": float(dx), "dy": float(dy), "speed": 2.0, "one_way": True}))
+    for row, line in enumerate(grid):
+        for col, ch in enumerate(line):
+            if ch == "~" and (row, col) not in used:
+                fail(f"'~' at line {row + 1}, column {col + 1} is not next to a moving platform's path")
+    return out
+
+
+# --- Tiled maps ------------------------------------------------------------------------------------
+
+
+def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None) -> Level:
+    """A :class:`Level` from a decoded Tiled JSON map."""
+    def fail(msg: str) -> None:
+        raise LevelError(f"{source}: {msg}")
+
+    if not isinstance(data, dict):
+        fail(f"a Tiled map must be a JSON object, got {type(data).__name__}")
+    if data.get("type", "map") != "map":
+        fail(f"not a Tiled map (type is {data.get('type')!r})")
+    if data.get("orientation", "orthogonal") != "orthogonal":
+        fail(f"only orthogonal maps are supported, got {data.get('orientation')!r}")
+    if data.get("infinite"):
+        fail("infinite maps are not supported; save the map as finite (Map > Map Properties)")
+    for key in ("width", "height", "tilewidth", "tileheight", "layers"):
+        if key not in data:
+            fail(f"missing {key!r}")
+    width, height, tw, th = data["width"], data["height"], data["tilewidth"], data["tileheight"]
+    for key, v in (("width", width), ("height", height), ("tilewidth", tw), ("tileheight", th)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            fail(f"{key!r} must be a positive integer, got {v!r}")
+    if tw != th:
+        fail(f"tiles must be square, got tilewidth {tw} and tileheight {th}")
+    if not isinstance(data["layers"], list):
+        fail("'layers' must be a list")
+    gid_kinds = _tileset_kinds(data.get("tilesets", []), fail)
+    tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
+    objects: list[LevelObject] = []
+    map_h = float(height * th)
+    for layer in _flat_layers(data["layers"], fail):
+        lname = str(layer.get("name", ""))
+        ltype = layer.get("type")
+        where = f"layer {lname!r}"
+        if ltype == "tilelayer":
+            kind = _props(layer, fail, where).get("kind", lname.lower())
+            if kind in DECORATION or lname.lower() in DECORATION:
+                continue
+            if kind not in TILE_KINDS:
+                kind = None  # per-tile kinds from the tileset
+            gids = _layer_data(layer, width, height, fail, where)
+            for i, raw in enumerate(gids):
+                gid = raw & ~_FLIP_BITS
+                if gid == 0:
+                    continue
+                row, col = divmod(i, width)
+                k = kind or gid_kinds.get(gid)
+                if k is None:
+                    fail(f"{where}: tile {gid} at column {col}, row {row} has no kind: name the layer "
+                         f"{'/'.join(TILE_KINDS)}, give it a 'kind' property, or give the tile a type")
+                tiles[row][col] = k
+        elif ltype == "objectgroup":
+            objs = layer.get("objects", [])
+            if not isinstance(objs, list):
+                fail(f"{where}: 'objects' must be a list")
+            for obj in objs:
+                objects.append(_tmj_object(obj, map_h, fail, where))
+        elif ltype in ("imagelayer",):
+            continue
+        else:
+            fail(f"{where}: unknown layer type {ltype!r}")
+    title = _props(data, fail, "map").get("title") or name or Path(source).stem
+    return Level(str(title), source, float(tw), width, height, tiles, objects).validate()
+
+
+def _flat_layers(layers: list, fail) -> list[dict]:
+    out = []
+    for layer in layers:
+        if not isinstance(layer, dict):
+            fail(f"a layer must be a JSON object, got {layer!r:.60}")
+        if layer.get("type") == "group":
+            out.extend(_flat_layers(layer.get("layers", []), fail))
+        else:
+            out.append(layer)
+    return out
+
+
+def _props(thing: dict, fail, where: str) -> dict[str, Any]:
+    """Tiled's ``properties`` (a list of ``{name, type, value}``; an old-style dict also works)."""
+    raw = thing.get("properties", [])
+    if isinstance(raw, dict):
+        return dict(raw)
+    if not isinstance(raw, list):
+        fail(f"{where}: 'properties' must be a list")
+    out = {}
+    for p in raw:
+        if not isinstance(p, dict) or "name" not in p or "value" not in p:
+            fail(f"{where}: a property needs 'name' and 'value', got {p!r:.80}")
+        out[p["name"]] = p["value"]
+    return out
+
+
+def _tileset_kinds(tilesets: Any, fail) -> dict[int, str]:
+    if not isinstance(tilesets, list):
+        fail("'tilesets' must be a list")
+    kinds: dict[int, str] = {}
+    for ts in tilesets:
+        if not isinstance(ts, dict) or "firstgid" not in ts:
+            fail(f"a tileset needs 'firstgid', got {ts!r:.80}")
+        if "source" in ts:
+            fail(f"external tileset {ts['source']!r} is not supported: embed the tileset in the map")
+        first = ts["firstgid"]
+        for tile in ts.get("tiles", []):
+            kind = _props(tile, fail, f"tileset {ts.get('name')!r}").get(
+                "kind", tile.get("type") or tile.get("class"))
+            if kind in DECORATION:
+                continue
+            if kind is not None:
+                if kind not in TILE_KINDS:
+                    fail(f"tileset {ts.get('name')!r}: tile {tile.get('id')} has unknown kind {kind!r} "
+                         f"(known: {', '.join(TILE_KINDS)})")
+                kinds[first + int(tile["id"])] = kind
+    return kinds
+
+
+def _layer_data(layer: dict, width: int, height: int, fail, where: str) -> list[int]:
+    if layer.get("width", width) != width or layer.get("height", height) != height:
+        fail(f"{where} is {layer.get('width')} x {layer.get('height')} tiles, the map {width} x {height}")
+    data = layer.get("data")
+    if data is None:
+        fail(f"{where} has no 'data' (chunks of infinite maps are not supported)")
+    if layer.get("encoding") == "base64":
+        try:
+            raw = base64.b64decode(data)
+            comp = layer.get("compression", "")
+            if comp == "zlib":
+                raw = zlib.decompress(raw)
+            elif comp == "gzip":
+                raw = gzip.decompress(raw)
+            elif comp:
+                fail(f"{where}: unsupported compression {comp!r} (use none, zlib or gzip)")
+        except (ValueError, zlib.error, OSError) as exc:
+            fail(f"{where}: bad base64 tile data ({exc})")
+        if len(raw) % 4:
+            fail(f"{where}: base64 tile data is not a whole number of 32-bit gids")
+        gids = [int.from_bytes(raw[i:i + 4], "little") for i in range(0, len(raw), 4)]
+    else:
+        if not isinstance(data, list) or not all(
+                isinstance(g, int) and not isinstance(g, bool) and g >= 0 for g in data):
+            fail(f"{where}: 'data' must be a list of tile ids (non-negative integers)")
+        gids = data
+    if len(gids) != width * height:
+        fail(f"{where} has {len(gids)} tiles, expected width x height = {width} x {height} = {width * height}")
+    return gids
+
+
+def _tmj_object(obj: Any, map_h: float, fail, where: str) -> LevelObject:
+    if not isinstance(obj, dict):
+        fail(f"{where}: an object must be a JSON object, got {obj!r:.60}")
+    kind = str(obj.get("type") or obj.get("class") or obj.get("name") or "").lower()
+    label = f"{where}: object {obj.get('id', '?')} ({kind or 'no type'})"
+    if kind not in OBJECT_KINDS:
+        fail(f"{label}: unknown object type {kind!r} (known: {', '.join(OBJECT_KINDS)})")
+    vals = []
+    for key in ("x", "y", "width", "height"):
+        v = obj.get(key, 0.0)
+        if not _is_number(v):
+            fail(f"{label}: {key!r} must be a finite number, got {v!r}")
+        vals.append(float(v))
+    x, y, w, h = vals
+    if w < 0 or h < 0:
+        fail(f"{label}: negative size {w} x {h}")
+    if obj.get("rotation", 0):
+        fail(f"{label}: rotated objects are not supported")
+    cx = x + w * 0.5
+    # Tiled is y down from the map's top; rectangles hang from (x, y), tile objects stand on it.
+    cy = map_h - (y - h * 0.5 if obj.get("gid") else y + h * 0.5)
+    return LevelObject(kind, cx, cy, w, h, _props(obj, fail, label))
+
+
+# --- loading and writing ---------------------------------------------------------------------------
+
+
+def load_level(path: str | Path) -> Level:
+    """Load a ``.tmj`` (or ``.json``) Tiled map or a ``.txt`` text map; :class:`LevelError` if bad."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise LevelError(f"{p}: no such level file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise LevelError(f"{p}: cannot read the level file ({exc})") from None
+    suffix = p.suffix.lower()
+    if suffix in (".tmj", ".json"):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise LevelError(f"{p}: not valid JSON ({exc})") from None
+        return parse_tmj(data, str(p))
+    if suffix == ".txt":
+        return parse_text(text, str(p))
+    raise LevelError(f"{p}: unknown level format {suffix!r} (use .tmj or .txt)")
+
+
+def builtin_levels() -> list[Path]:
+    """The shipped levels, in play order."""
+    return sorted(LEVEL_DIR.glob("*.tmj"))
+
+
+_TILESET = {
+    "firstgid": 1, "name": "platformer", "tilewidth": 32, "tileheight": 32, "tilecount": 3,
+    "columns": 3, "margin": 0, "spacing": 0, "image": "tiles.png", "imagewidth": 96, "imageheight": 32,
+    "tiles": [{"id": 0, "type": "solid"}, {"id": 1, "type": "oneway"}, {"id": 2, "type": "spikes"}],
+}
+
+
+def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
+    """The Tiled JSON map of ``level`` (what the shipped ``.tmj`` files were written from)."""
+    t = level.tile
+    gid = {k: i + 1 for i, k in enumerate(TILE_KINDS)}
+    data = [gid[k] if k else 0 for row in level.tiles for k in row]
+    map_h = level.height * t
+    objs = []
+    for i, o in enumerate(level.objects, start=1):
+        entry: dict[str, Any] = {"id": i, "name": "", "type": o.kind, "rotation": 0, "visible": True}
+        if o.kind in ("player", "enemy"):
+            # A point at the feet: bottom-centre of the cell it was drawn in.
+            entry.update(x=o.x, y=map_h - o.bottom, width=0, height=0, point=True)
+        elif o.kind == "coin":
+            entry.update(x=o.x, y=map_h - o.y, width=0, height=0, point=True)
+        else:
+            entry.update(x=o.x - o.width * 0.5, y=map_h - (o.y + o.height * 0.5), width=o.width, height=o.height)
+        if o.props:
+            entry["properties"] = [
+                {"name": k, "type": "bool" if isinstance(v, bool) else "float" if isinstance(v, float)
+                 else "int" if isinstance(v, int) else "string", "value": v}
+                for k, v in sorted(o.props.items())
+            ]
+        objs.append(entry)
+    tileset = dict(_TILESET, tilewidth=int(t), tileheight=int(t), imagewidth=int(3 * t), imageheight=int(t))
+    return {
+        "type": "map", "version": "1.10", "tiledversion": "1.10.2", "orientation": "orthogonal",
+        "renderorder": "right-down", "infinite": False, "compressionlevel": -1,
+        "width": level.width, "height": level.height, "tilewidth": int(t), "tileheight": int(t),
+        "nextlayerid": 3, "nextobjectid": len(objs) + 1,
+        "properties": [{"name": "title", "type": "string", "value": title or level.name}],
+        "tilesets": [tileset],
+        "layers": [
+            {"type": "tilelayer", "id": 1, "name": "tiles", "x": 0, "y": 0, "width": level.width,
+             "height": level.height, "opacity": 1, "visible": True, "data": data},
+            {"type": "objectgroup", "id": 2, "name": "objects", "x": 0, "y": 0, "opacity": 1,
+             "visible": True, "draworder": "topdown", "objects": objs},
+        ],
+    }
+
+
+def dump_tmj(tmj: dict[str, Any]) -> str:
+    """JSON text of a map with one tile row per line (readable diffs)."""
+    layers = []
+    for layer in tmj["layers"]:
+        if layer["type"] == "tilelayer":
+            w = layer["width"]
+            rows = [", ".join(str(g) for g in layer["data"][i:i + w]) for i in range(0, len(layer["data"]), w)]
+            body = {k: v for k, v in layer.items() if k != "data"}
+            text = json.dumps(body)[:-1] + ', "data": [\n        ' + ",\n        ".join(rows) + "\n      ]}"
+        else:
+            objs = ",\n        ".join(json.dumps(o) for o in layer["objects"])
+            body = {k: v for k, v in layer.items() if k != "objects"}
+            text = json.dumps(body)[:-1] + ', "objects": [\n        ' + objs + "\n      ]}"
+        layers.append(text)
+    head = {k: v for k, v in tmj.items() if k != "layers"}
+    return json.dumps(head, indent=2)[:-2] + ',\n  "layers": [\n      ' + ",\n      ".join(layers) + "\n  ]\n}\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m examples.platformer.levels IN.txt OUT.tmj [TITLE]``: convert a text map."""
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) not in (2, 3):
+        print(main.__doc__, file=sys.stderr)
+        return 2
+    level = load_level(args[0])
+    Path(args[1]).write_text(dump_tmj(to_tmj(level, args[2] if len(args) == 3 else None)), encoding="utf-8")
+    parse_tmj(json.loads(Path(args[1]).read_text(encoding="utf-8")), args[1])  # it loads back
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,360 @@
+"""The platformer's systems and collision handlers: plain ``fn(scene, dt)`` / ``fn(scene, event)``.
+
+Where each runs in a step (see :func:`install`)::
+
+    before movement   level_flow -> move_platforms -> control_player -> walk_enemies
+    movement          (framework: integrate velocities, gravity)
+    after movement    carry_riders      the moving platform's displacement to whoever stands on it
+    ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide)
+    after response    sense_player -> sense_enemies -> fall_out -> follow_camera
+    end of step       collision handlers: coins, spikes, enemies, checkpoints, the goal
+
+Everything collision-related comes from the pipeline: the contacts it found this step
+(``scene.contacts``), its events (``scene.on_collision``) and ``scene.query_box``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from framework import Hitbox, Transform, Velocity
+from framework.components import Visual
+from framework.events import CollisionEvent
+from framework.input import Input
+
+from .components import (
+    HAZARD, ONE_WAY, SOLID, Checkpoint, Coin, Enemy, GameState, Goal, Hazard, MovingPlatform, Player, Tuning,
+)
+
+if TYPE_CHECKING:
+    from framework import Scene
+
+__all__ = ["install", "kill_player"]
+
+LEFT, RIGHT, JUMP, DOWN = ("left", "a"), ("right", "d"), ("space", "up", "w"), ("down", "s")
+GROUND_NORMAL = 0.7  # a contact whose normal (toward the body) has y above this is ground
+CHECKPOINT_ON = (120, 230, 255)
+
+
+def _state(scene: Scene) -> GameState:
+    return scene.resources[GameState]
+
+
+def _tile(scene: Scene) -> float:
+    return scene.resources["tile"]
+
+
+# --- before movement ----------------------------------------------------------------------------
+
+
+def level_flow(scene: Scene, dt: float) -> None:
+    """Game keys (R restart, F1 debug, Esc quit) and level changes.
+
+    A level change takes two steps: this step despawns the old level (despawns wait for the end
+    of the step), the next one spawns the new level before anything moves."""
+    from .game import Game  # the Game object is a scene resource
+
+    state, keys = _state(scene), scene.resources[Input]
+    game: Game = scene.resources[Game]
+    if keys.was_pressed("escape"):
+        state.quit = True
+    if keys.was_pressed("f1"):
+        state.debug = not state.debug
+        renderer = scene.renderer
+        if renderer is not None and hasattr(renderer, "debug"):
+            renderer.debug = state.debug
+    if keys.was_pressed("r") and state.pending is None:
+        state.pending, state.pending_stage = "restart", 0
+    if state.reached_goal and state.goal_timer > 0.0:
+        state.goal_timer -= dt
+        if state.goal_timer <= 0.0 and state.pending is None:
+            if state.level_index + 1 < len(game.levels):
+                state.pending, state.pending_stage = "next", 0
+            else:
+                state.finished = True
+    if state.pending is None:
+        return
+    if state.pending_stage == 0:
+        game.clear_level()
+        state.pending_stage = 1
+    else:
+        index = state.level_index + (1 if state.pending == "next" else 0)
+        state.pending = None
+        game.spawn_level(index)
+
+
+def move_platforms(scene: Scene, dt: float) -> None:
+    """Steer each moving platform toward its current end; turn around on arrival."""
+    for _e, (plat, t, v) in scene.query(MovingPlatform, Transform, Velocity):
+        tx, ty = plat.end if plat.toward_end else plat.start
+        dx, dy = tx - t.x, ty - t.y
+        dist = (dx * dx + dy * dy) ** 0.5
+        if dist <= plat.speed * dt:
+            v.x, v.y = dx / dt, dy / dt  # arrive exactly this step, then head back
+            plat.toward_end = not plat.toward_end
+        else:
+            v.x, v.y = dx / dist * plat.speed, dy / dist * plat.speed
+        plat.moved = (t.x, t.y)  # where it starts the step; carry_riders takes the difference
+
+
+def control_player(scene: Scene, dt: float) -> None:
+    """Run, jump (coyote time, buffering, variable height), drop through one-way platforms."""
+    tu: Tuning = scene.resources[Tuning]
+    tile = _tile(scene)
+    keys = scene.resources[Input]
+    for e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
+        p.prev_bottom = t.y - hb.shape.height * 0.5
+        p.since_ground = 0.0 if p.grounded else p.since_ground + dt
+        p.since_jump_press = 0.0 if keys.was_pressed(*JUMP) else p.since_jump_press + dt
+        vx, vy = v.x, v.y
+
+        # Drop through a one-way platform: down + jump while standing on one.
+        if p.drop_timer > 0.0:
+            p.drop_timer -= dt
+            if p.drop_timer <= 0.0:
+                hb.mask |= ONE_WAY
+        on_one_way = p.grounded and p.ground is not None and scene.exists(p.ground) and \
+            scene.get(p.ground, Hitbox).one_way
+        if keys.is_held(*DOWN) and p.since_jump_press == 0.0 and on_one_way:
+            hb.mask &= ~ONE_WAY
+            p.drop_timer = tu.drop_time
+            p.since_jump_press = 1e9
+            p.grounded, p.ground, p.since_ground = False, None, 1e9
+
+        # Jump: a press remembered for jump_buffer, from the ground or up to coyote_time after it.
+        if p.since_jump_press <= tu.jump_buffer and p.since_ground <= tu.coyote_time:
+            vy = tu.jump_speed * tile
+            p.jumping = True
+            p.since_jump_press = p.since_ground = 1e9
+            p.grounded, p.ground = False, None
+        if p.jumping and (vy <= 0.0 or not keys.is_held(*JUMP)):
+            if vy > 0.0:
+                vy *= tu.jump_cut  # released early: a lower jump
+            p.jumping = False
+
+        # Run: accelerate toward the target speed (quicker on the ground).
+        want = (keys.is_held(*RIGHT) - keys.is_held(*LEFT)) * tu.run_speed * tile
+        accel = (tu.ground_accel if p.grounded else tu.air_accel) * tile * dt
+        vx = min(want, vx + accel) if want > vx else max(want, vx - accel)
+        if want:
+            p.facing = 1 if want > 0 else -1
+        vy = max(vy, -tu.fall_speed * tile)
+        if vx != v.x:
+            v.x = vx
+        if vy != v.y:
+            v.y = vy
+
+
+def walk_enemies(scene: Scene, dt: float) -> None:
+    for _e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
+        en.prev_top = t.y + hb.shape.height * 0.5
+        v.x = en.direction * en.speed
+
+
+# --- after movement -----------------------------------------------------------------------------
+
+
+def carry_riders(scene: Scene, dt: float) -> None:
+    """Move whoever stood on a moving platform last step by the platform's displacement."""
+    for _e, (p, t) in scene.query(Player, Transform):
+        if p.ground is None or not scene.exists(p.ground):
+            continue
+        plat = scene.try_get(p.ground, MovingPlatform)
+        if plat is None:
+            continue
+        pt = scene.get(p.ground, Transform)
+        x0, y0 = plat.moved
+        t.x += pt.x - x0
+        t.y += pt.y - y0
+
+
+# --- after response -----------------------------------------------------------------------------
+
+
+def _touching(scene: Scene, entity: int) -> list[tuple[int, float, float, float]]:
+    """This step's contacts of ``entity``: (other, normal x, normal y toward ``entity``, depth)."""
+    c = scene.contacts
+    out = []
+    for i in np.flatnonzero((c.a == entity) | (c.b == entity)).tolist():
+        a, b = int(c.a[i]), int(c.b[i])
+        sign = -1.0 if a == entity else 1.0  # contact normals point from a to b
+        out.append((b if a == entity else a, sign * float(c.nx[i]), sign * float(c.ny[i]), float(c.depth[i])))
+    return out
+
+
+def sense_player(scene: Scene, dt: float) -> None:
+    """Grounded: a solid contact below the player, from the pipeline's contacts of this step.
+
+    A one-way platform counts only when the player came down onto it this step (the pipeline's
+    own rule), so rising through one or standing inside it is not standing on it."""
+    tu: Tuning = scene.resources[Tuning]
+    g = tu.gravity * _tile(scene)
+    for e, (p, v, t, hb) in scene.query(Player, Velocity, Transform, Hitbox):
+        ground, best = None, -1.0
+        if v.y <= 1e-9:
+            fell = max(p.prev_bottom - (t.y - hb.shape.height * 0.5), 0.0)  # how far the feet fell
+            for other, _nx, ny, depth in _touching(scene, e):
+                if ny < GROUND_NORMAL:
+                    continue
+                ohb = scene.try_get(other, Hitbox)
+                if ohb is None or ohb.sensor or scene.try_get(other, Enemy) is not None:
+                    continue
+                if ohb.one_way and depth > fell + g * dt * dt + 1e-6 * _tile(scene):
+                    continue
+                rank = depth + (1e9 if scene.try_get(other, MovingPlatform) is not None else 0.0)
+                if rank > best:
+                    ground, best = other, rank
+        p.grounded = ground is not None
+        p.ground = ground
+
+
+def sense_enemies(scene: Scene, dt: float) -> None:
+    """Walkers turn at walls (contacts against their heading) and before ledges and spikes."""
+    tile = _tile(scene)
+    for e, (en, t, hb) in scene.query(Enemy, Transform, Hitbox):
+        w, h = hb.shape.width, hb.shape.height
+        grounded = False
+        turn = False
+        for other, nx, ny, _depth in _touching(scene, e):
+            ohb = scene.try_get(other, Hitbox)
+            if ohb is None or ohb.sensor or scene.try_get(other, Player) is not None:
+                continue
+            if ny >= GROUND_NORMAL:
+                grounded = True
+            elif nx * en.direction < -0.7:
+                turn = True  # pushed back against its heading: a wall or another enemy
+        if grounded and not turn:
+            front = t.x + en.direction * (w * 0.5 + 0.1 * tile)
+            bottom = t.y - h * 0.5
+            probe = (front - 0.05 * tile, bottom - 0.25 * tile, front + 0.05 * tile, bottom - 0.05 * tile)
+            if not scene.query_box(*probe, mask=SOLID | ONE_WAY):
+                turn = True  # a ledge ahead
+            elif scene.query_box(front - 0.05 * tile, bottom + 0.05 * tile, front + 0.05 * tile,
+                                 bottom + 0.3 * tile, mask=HAZARD):
+                turn = True  # spikes ahead
+        if turn and en.turned_frame != scene.frame:
+            en.direction = -en.direction
+            en.turned_frame = scene.frame
+
+
+def fall_out(scene: Scene, dt: float) -> None:
+    """Falling below the level kills."""
+    state = _state(scene)
+    for e, (_p, t) in scene.query(Player, Transform):
+        if t.y < state.bounds[1] - 2.0 * _tile(scene):
+            kill_player(scene, e)
+
+
+def follow_camera(scene: Scene, dt: float) -> None:
+    """Keep the player in view, the view inside the level (centred where the level is smaller)."""
+    state = _state(scene)
+    if state.player is None or not scene.exists(state.player):
+        return
+    t = scene.get(state.player, Transform)
+    minx, miny, maxx, maxy = state.bounds
+    vw, vh = state.view
+
+    def clamp(c: float, lo: float, hi: float, span: float) -> float:
+        if hi - lo <= span:
+            return (lo + hi) * 0.5
+        return min(max(c, lo + span * 0.5), hi - span * 0.5)
+
+    state.camera = (clamp(t.x, minx, maxx, vw), clamp(t.y, miny, maxy, vh))
+
+
+# --- collision handlers -------------------------------------------------------------------------
+
+
+def kill_player(scene: Scene, player: int) -> None:
+    """Count a death and put the player back at the last checkpoint, at rest."""
+    p = scene.get(player, Player)
+    if p.dead_frame == scene.frame:
+        return
+    state = _state(scene)
+    state.deaths += 1
+    hb = scene.get(player, Hitbox)
+    t, v = scene.get(player, Transform), scene.get(player, Velocity)
+    x, feet = state.checkpoint
+    t.x, t.y = x, feet + hb.shape.height * 0.5
+    v.x = v.y = 0.0
+    hb.mask |= ONE_WAY
+    fresh = Player(dead_frame=scene.frame, facing=p.facing)
+    for name in fresh.__dataclass_fields__:
+        setattr(p, name, getattr(fresh, name))
+    p.prev_bottom = feet
+
+
+def on_coin(scene: Scene, ev: CollisionEvent) -> None:
+    if not scene.exists(ev.b):
+        return  # already taken this step
+    state = _state(scene)
+    value = scene.get(ev.b, Coin).value
+    state.coins += value
+    state.coins_in_level += value
+    scene.despawn(ev.b)
+
+
+def on_hazard(scene: Scene, ev: CollisionEvent) -> None:
+    kill_player(scene, ev.a)
+
+
+def on_enemy(scene: Scene, ev: CollisionEvent) -> None:
+    """Stomp (the player's feet were above the enemy's head when the step began) or die."""
+    player, enemy = ev.a, ev.b
+    if not (scene.exists(player) and scene.exists(enemy)):
+        return
+    p, en = scene.get(player, Player), scene.get(enemy, Enemy)
+    if p.dead_frame == scene.frame:
+        return
+    tu: Tuning = scene.resources[Tuning]
+    tile = _tile(scene)
+    if p.prev_bottom >= en.prev_top - 0.2 * tile:
+        scene.despawn(enemy)
+        held = scene.resources[Input].is_held(*JUMP)
+        scene.get(player, Velocity).y = (tu.jump_speed if held else tu.stomp_bounce) * tile
+        p.jumping = held
+        p.grounded, p.ground = False, None
+        _state(scene).messages.append("stomp")
+    else:
+        kill_player(scene, player)
+
+
+def on_checkpoint(scene: Scene, ev: CollisionEvent) -> None:
+    cp = scene.get(ev.b, Checkpoint)
+    if cp.active:
+        return
+    for _e, other in scene.query(Checkpoint):
+        other.active = False
+    cp.active = True
+    t, hb = scene.get(ev.b, Transform), scene.get(ev.b, Hitbox)
+    _state(scene).checkpoint = (t.x, t.y - hb.shape.height * 0.5)
+    for e, (c, vis) in scene.query(Checkpoint, Visual):
+        vis.color = (*CHECKPOINT_ON, 255) if c.active else (150, 150, 150, 255)
+
+
+def on_goal(scene: Scene, ev: CollisionEvent) -> None:
+    state = _state(scene)
+    if state.goal_timer > 0.0 or state.pending is not None:
+        return
+    if not state.reached_goal or state.levels_completed <= state.level_index:
+        state.reached_goal = True
+        state.levels_completed += 1
+        state.goal_timer = 1.0  # a moment to see it, then the next level
+
+
+def install(scene: Scene) -> None:
+    """Add the game's systems and handlers to ``scene`` (once)."""
+    from .components import Player as P
+
+    for system in (level_flow, move_platforms, control_player, walk_enemies):
+        scene.add_system(system, before="movement")
+    scene.add_system(carry_riders, after="movement")
+    for system in (sense_player, sense_enemies, fall_out, follow_camera):
+        scene.add_system(system, after="response")
+    scene.on_collision(P, Coin, on_coin)
+    scene.on_collision(P, Hazard, on_hazard, kinds=("started", "ongoing"))
+    scene.on_collision(P, Enemy, on_enemy, kinds=("started", "ongoing"))
+    scene.on_collision(P, Checkpoint, on_checkpoint)
+    scene.on_collision(P, Goal, on_goal)
