@@ -400,3 +400,28 @@ def test_hitbox_swapped_for_invalid_shape_raises_at_step(scene):
     scene.get(e, Hitbox).shape = Circle(1.0)
     scene.step(DT)
     assert scene.store.kind[0] == 1
+
+
+def test_substeps_split_the_step_and_report_every_substep():
+    with Scene(substeps=4) as s:
+        s.spawn(Transform(0.0, 0.0), Hitbox(AABB(2, 2), body="static"))
+        b = s.spawn(Transform(2.0, 0.0), Velocity(-1.0, 0.0), Hitbox(AABB(2, 2), sensor=True))
+        s.step(0.5)  # four sub-steps of 1/8: x = 1.875, 1.75, 1.625, 1.5
+        assert s.get(b, Transform).x == 1.5
+        assert [e.kind for e in s.events] == ["started", "ongoing", "ongoing", "ongoing"]
+        assert [e.depth for e in s.events] == [0.125, 0.25, 0.375, 0.5]
+        assert s.counters["integrated"] == 4 and s.frame == 1
+    with pytest.raises(ValueError, match="substeps"):
+        Scene(substeps=0)
+
+
+def test_substeps_stop_a_fast_body_tunnelling():
+    def crosses(substeps):
+        with Scene(substeps=substeps) as s:
+            s.spawn(Transform(10.0, 0.0), Hitbox(AABB(1.0, 8.0), body="static"))
+            bullet = s.spawn(Transform(0.0, 0.0), Velocity(120.0, 0.0), Hitbox(Circle(0.25)))
+            for _ in range(10):
+                s.step(1 / 60)  # 2 units per step: over the 1-wide wall
+            return s.get(bullet, Transform).x > 10.0
+
+    assert crosses(1) and not crosses(4)

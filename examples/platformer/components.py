@@ -55,6 +55,7 @@ class Player:
     drop_timer: float = 0.0          # > 0: falling through one-way platforms
     facing: int = 1
     prev_bottom: float = 0.0         # where the feet were when the step started (stomps)
+    vy_start: float = 0.0            # vertical velocity the step started with (after control)
     dead_frame: int = -1             # the frame the player last died (one death per frame)
 
 
@@ -76,7 +77,7 @@ class MovingPlatform:
     end: tuple[float, float]
     speed: float
     toward_end: bool = True
-    moved: tuple[float, float] = (0.0, 0.0)  # its displacement in the current step
+    start_pos: tuple[float, float] = (0.0, 0.0)  # where it began the current step
 
 
 @dataclass
@@ -112,6 +113,7 @@ class GameState:
 
     level_index: int = 0
     level_name: str = ""
+    tile: float = 32.0
     coins: int = 0                    # collected in the whole run
     coins_in_level: int = 0
     coin_total_in_level: int = 0

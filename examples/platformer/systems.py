@@ -43,7 +43,7 @@ def _state(scene: Scene) -> GameState:
 
 
 def _tile(scene: Scene) -> float:
-    return scene.resources["tile"]
+    return scene.resources[GameState].tile
 
 
 # --- before movement ----------------------------------------------------------------------------
@@ -96,7 +96,7 @@ def move_platforms(scene: Scene, dt: float) -> None:
             plat.toward_end = not plat.toward_end
         else:
             v.x, v.y = dx / dist * plat.speed, dy / dist * plat.speed
-        plat.moved = (t.x, t.y)  # where it starts the step; carry_riders takes the difference
+        plat.start_pos = (t.x, t.y)  # carry_riders and sense_player take the difference
 
 
 def control_player(scene: Scene, dt: float) -> None:
@@ -141,6 +141,7 @@ def control_player(scene: Scene, dt: float) -> None:
         if want:
             p.facing = 1 if want > 0 else -1
         vy = max(vy, -tu.fall_speed * tile)
+        p.vy_start = vy
         if vx != v.x:
             v.x = vx
         if vy != v.y:
@@ -165,7 +166,7 @@ def carry_riders(scene: Scene, dt: float) -> None:
         if plat is None:
             continue
         pt = scene.get(p.ground, Transform)
-        x0, y0 = plat.moved
+        x0, y0 = plat.start_pos
         t.x += pt.x - x0
         t.y += pt.y - y0
 
@@ -185,29 +186,40 @@ def _touching(scene: Scene, entity: int) -> list[tuple[int, float, float, float]
 
 
 def sense_player(scene: Scene, dt: float) -> None:
-    """Grounded: a solid contact below the player, from the pipeline's contacts of this step.
+    """Grounded: a solid contact below the player among the pipeline's contacts of this step.
 
-    A one-way platform counts only when the player came down onto it this step (the pipeline's
-    own rule), so rising through one or standing inside it is not standing on it."""
-    tu: Tuning = scene.resources[Tuning]
-    g = tu.gravity * _tile(scene)
-    for e, (p, v, t, hb) in scene.query(Player, Velocity, Transform, Hitbox):
+    A one-way platform counts only if the feet were on or above its top when the step began (the
+    pipeline's own landing rule), so rising through one or standing inside it is not standing on
+    it. On a moving platform the player's vertical velocity is kept relative to it (zero while
+    standing): carry_riders moves the player with it."""
+    tol = 1e-3 * _tile(scene)
+    for e, (p, v, hb) in scene.query(Player, Velocity, Hitbox):
         ground, best = None, -1.0
-        if v.y <= 1e-9:
-            fell = max(p.prev_bottom - (t.y - hb.shape.height * 0.5), 0.0)  # how far the feet fell
-            for other, _nx, ny, depth in _touching(scene, e):
-                if ny < GROUND_NORMAL:
+        for other, _nx, ny, depth in _touching(scene, e):
+            if ny < GROUND_NORMAL:
+                continue
+            ohb = scene.try_get(other, Hitbox)
+            if ohb is None or ohb.sensor or scene.try_get(other, Enemy) is not None:
+                continue
+            plat = scene.try_get(other, MovingPlatform)
+            ov = scene.try_get(other, Velocity)
+            # The velocity of a rider is relative to its platform; anyone else's is absolute.
+            rel = p.vy_start if other == p.ground or ov is None else v.y - ov.y
+            if rel > 1e-9:
+                continue  # moving up, away from it
+            if ohb.one_way:
+                ot = scene.get(other, Transform)
+                y0 = plat.start_pos[1] if plat is not None else ot.y
+                top = y0 + ohb.offset[1] + ohb.shape.height * 0.5
+                if p.prev_bottom < top - tol:
                     continue
-                ohb = scene.try_get(other, Hitbox)
-                if ohb is None or ohb.sensor or scene.try_get(other, Enemy) is not None:
-                    continue
-                if ohb.one_way and depth > fell + g * dt * dt + 1e-6 * _tile(scene):
-                    continue
-                rank = depth + (1e9 if scene.try_get(other, MovingPlatform) is not None else 0.0)
-                if rank > best:
-                    ground, best = other, rank
+            rank = depth + (1e9 if plat is not None else 0.0)
+            if rank > best:
+                ground, best = other, rank
         p.grounded = ground is not None
         p.ground = ground
+        if ground is not None and scene.try_get(ground, MovingPlatform) is not None:
+            v.y = 0.0
 
 
 def sense_enemies(scene: Scene, dt: float) -> None:

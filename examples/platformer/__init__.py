@@ -1,0 +1,14 @@
+"""The example platformer: run, jump, stomp, collect, reach the goal.
+
+``python -m examples.platformer`` plays it in a window; ``--headless --demo`` plays the first level
+by itself. See docs/platformer.md.
+"""
+
+from .components import GameState, Tuning
+from .game import DT, Game
+from .levels import Level, LevelError, builtin_levels, load_level, parse_text, parse_tmj
+
+__all__ = [
+    "DT", "Game", "GameState", "Level", "LevelError", "Tuning", "builtin_levels", "load_level", "parse_text",
+    "parse_tmj",
+]

@@ -1,0 +1,195 @@
+"""The game: turns levels into entities in one framework Scene and steps it at 60 Hz.
+
+::
+
+    game = Game()                      # the shipped levels; or Game([parse_text(...)])
+    game.step({"right", "space"})      # one fixed step with these keys held
+    game.state.coins, game.player_transform.x
+
+The scene stays the same object for the whole run (a window runner holds it); levels are swapped
+inside it by despawning one level's entities and spawning the next one's (see
+:func:`.systems.level_flow`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
+from framework.components import Visual
+from framework.input import Input
+
+from . import systems
+from .components import (
+    ALL, ENEMY, HAZARD, ONE_WAY, PICKUP, PLAYER, SOLID, Checkpoint, Coin, Enemy, GameState, Goal, Hazard,
+    LevelPiece, MovingPlatform, Player, Tuning,
+)
+from .levels import Level, builtin_levels, load_level
+
+__all__ = ["DT", "Game", "COLORS"]
+
+DT = 1.0 / 60.0
+COLORS = {
+    "solid": (86, 98, 128), "oneway": (176, 134, 82), "spikes": (226, 70, 70), "player": (84, 176, 255),
+    "enemy": (196, 84, 164), "coin": (255, 212, 64), "goal": (90, 224, 120), "checkpoint": (150, 150, 150),
+    "platform": (214, 170, 96),
+}
+PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
+
+
+class Game:
+    """A run of the platformer over ``levels`` (paths or :class:`Level` objects; default: the
+    shipped ones), in a new scene unless one is given."""
+
+    def __init__(
+        self, levels: Sequence[Level | str | Path] | None = None, *, tuning: Tuning | None = None,
+        scene: Scene | None = None, view: tuple[float, float] = (960.0, 540.0), start: int = 0,
+    ) -> None:
+        if levels is None:
+            levels = builtin_levels()
+        self.levels = [lvl if isinstance(lvl, Level) else load_level(lvl) for lvl in levels]
+        if not self.levels:
+            raise ValueError("Game needs at least one level")
+        self.tuning = tuning or Tuning()
+        self.scene = scene if scene is not None else Scene()
+        self.state = GameState(view=view)
+        self.scene.resources[GameState] = self.state
+        self.scene.resources[Tuning] = self.tuning
+        self.scene.resources[Game] = self
+        systems.install(self.scene)
+        self.spawn_level(start)
+
+    # --- levels ----------------------------------------------------------------------------------
+
+    @property
+    def level(self) -> Level:
+        return self.levels[self.state.level_index]
+
+    def clear_level(self) -> None:
+        """Despawn every entity the current level spawned (at the end of the step, if stepping)."""
+        scene = self.scene
+        for e, _piece in scene.query(LevelPiece):
+            if scene.exists(e):
+                scene.despawn(e)
+        self.state.player = None
+
+    def spawn_level(self, index: int) -> None:
+        """Spawn level ``index``: its tiles, objects and the player at its start."""
+        if not 0 <= index < len(self.levels):
+            raise ValueError(f"no level {index}: the game has {len(self.levels)}")
+        if self.state.player is not None:
+            self.clear_level()
+        level = self.levels[index]
+        scene, tu, st = self.scene, self.tuning, self.state
+        t = level.tile
+        scene.gravity = (0.0, -tu.gravity * t)
+        st.level_index, st.level_name, st.tile = index, level.name, t
+        st.coins_in_level, st.goal_timer, st.pending = 0, 0.0, None
+        st.bounds = (0.0, 0.0, *level.size)
+        start = level.player
+        st.checkpoint = (start.x, start.bottom)
+
+        def piece(kind: str, *components) -> int:
+            return scene.spawn(*components, LevelPiece(kind))
+
+        for row, cells in enumerate(level.tiles):
+            for col, kind in enumerate(cells):
+                if kind is None:
+                    continue
+                x, y = level.cell_center(col, row)
+                if kind == "solid":
+                    piece(kind, Transform(x, y), Hitbox(AABB(t, t), body="static", layer=SOLID),
+                          Visual(COLORS[kind], z=0))
+                elif kind == "oneway":
+                    # A slab on the top quarter of the cell, solid only from above.
+                    piece(kind, Transform(x, y + 0.375 * t), Hitbox(
+                        AABB(t, 0.25 * t), body="static", layer=ONE_WAY, one_way=True), Visual(COLORS[kind], z=0))
+                else:  # spikes
+                    self._spikes(x, y - 0.5 * t, t, piece)
+        for obj in level.objects:
+            if obj.kind == "coin":
+                piece("coin", Transform(obj.x, obj.y), Hitbox(
+                    Circle(tu.coin_radius * t), body="static", sensor=True, layer=PICKUP, mask=PLAYER),
+                    Coin(), Visual(COLORS["coin"], z=2))
+            elif obj.kind in ("goal", "checkpoint"):
+                w, h = (obj.width, obj.height) if obj.width > 0 and obj.height > 0 else (t, t)
+                bottom = obj.bottom if obj.height > 0 else obj.y
+                comp = Goal() if obj.kind == "goal" else Checkpoint()
+                w = min(w, 0.5 * t) if obj.kind == "checkpoint" else w
+                piece(obj.kind, Transform(obj.x, bottom + h * 0.5), Hitbox(
+                    AABB(w, h), body="static", sensor=True, layer=PICKUP, mask=PLAYER), comp,
+                    Visual(COLORS[obj.kind], z=1))
+            elif obj.kind == "spikes":
+                n = max(1, round(obj.width / t))
+                for i in range(n):
+                    self._spikes(obj.x - obj.width * 0.5 + (i + 0.5) * obj.width / n, obj.bottom, obj.width / n, piece)
+            elif obj.kind == "platform":
+                self._platform(obj, t, piece)
+            elif obj.kind == "enemy":
+                w, h = tu.enemy_size[0] * t, tu.enemy_size[1] * t
+                speed = float(obj.props.get("speed", 2.0)) * t
+                piece("enemy", Transform(obj.x, obj.bottom + h * 0.5), Velocity(), Hitbox(
+                    AABB(w, h), layer=ENEMY, mask=SOLID | ONE_WAY | PLAYER | ENEMY),
+                    Enemy(speed, int(obj.props.get("direction", -1))), Visual(COLORS["enemy"], z=3))
+        st.coin_total_in_level = len(level.of_kind("coin"))
+        w, h = tu.player_size[0] * t, tu.player_size[1] * t
+        st.player = piece("player", Transform(start.x, start.bottom + h * 0.5), Velocity(),
+                          Hitbox(AABB(w, h), layer=PLAYER, mask=PLAYER_MASK), Player(),
+                          Visual(COLORS["player"], z=4))
+        systems.follow_camera(scene, 0.0)
+
+    @staticmethod
+    def _spikes(x: float, bottom: float, width: float, piece) -> None:
+        # A triangle standing on the cell's floor, a bit narrower and lower than the cell.
+        h = 0.55 * width
+        tri = Polygon([(-0.42 * width, 0.0), (0.42 * width, 0.0), (0.0, h)])
+        piece("spikes", Transform(x, bottom), Hitbox(tri, body="static", sensor=True, layer=HAZARD, mask=PLAYER),
+              Hazard(), Visual(COLORS["spikes"], z=1))
+
+    def _platform(self, obj, t: float, piece) -> None:
+        one_way = bool(obj.props.get("one_way", True))
+        dx, dy = float(obj.props.get("dx", 0.0)) * t, float(obj.props.get("dy", 0.0)) * t
+        speed = float(obj.props.get("speed", 2.0)) * t
+        piece("platform", Transform(obj.x, obj.y), Velocity(), Hitbox(
+            AABB(obj.width, obj.height), body="kinematic", layer=ONE_WAY if one_way else SOLID, mask=ALL,
+            one_way=one_way), MovingPlatform((obj.x, obj.y), (obj.x + dx, obj.y + dy), speed),
+            Visual(COLORS["platform"], z=1))
+
+    # --- running ---------------------------------------------------------------------------------
+
+    def step(self, keys: Iterable[str] | None = None) -> None:
+        """One fixed step (1/60 s); ``keys``: exactly the keys held during it (None: unchanged)."""
+        if keys is not None:
+            self.scene.resources[Input].set_held(keys)
+        self.scene.step(DT)
+
+    @property
+    def player(self) -> int:
+        if self.state.player is None:
+            raise RuntimeError("no player: the level is being changed")
+        return self.state.player
+
+    @property
+    def player_transform(self) -> Transform:
+        return self.scene.get(self.player, Transform)
+
+    @property
+    def player_state(self) -> Player:
+        return self.scene.get(self.player, Player)
+
+    def summary(self) -> dict:
+        st = self.state
+        return {
+            "level": st.level_name, "level_index": st.level_index, "reached_goal": st.reached_goal,
+            "levels_completed": st.levels_completed, "coins": st.coins, "deaths": st.deaths,
+        }
+
+    def close(self) -> None:
+        self.scene.close()
+
+    def __enter__(self) -> Game:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
