@@ -604,7 +604,7 @@ class Scene:
                 geom.hx, geom.hy = store.x, store.y
             else:
                 geom.update(store)
-            r = pair_contacts(store, geom, a, b)
+            r = pair_contacts(store, geom, a, b, remeasure=True)
             return r.hit, r.nx, r.ny, r.depth
 
         done = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),

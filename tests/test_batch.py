@@ -423,3 +423,28 @@ def test_tiny_and_huge_scenes(scale: float) -> None:
               scaled(sb), (tb[0] * scale, tb[1] * scale, tb[2])) for sa, ta, sb, tb in pairs]
     res = collide_many(*zip(*pairs, strict=True))
     assert_matches(pairs, res, f"scale {scale}")
+
+
+def test_fast_box_kernel_matches_the_exact_one():
+    """The pipeline's box kernel: same decisions, normals and depths as aabb_aabb; its point is the
+    overlap rectangle's centre, inside the overlap."""
+    from framework.collision.batch import aabb_aabb, aabb_aabb_fast
+
+    rng = np.random.default_rng(5)
+    P = 20_000
+    ax, ay = rng.integers(-40, 40, P) / 4.0, rng.integers(-40, 40, P) / 4.0  # dyadic: many touch
+    bx, by = ax + rng.integers(-16, 16, P) / 4.0, ay + rng.integers(-16, 16, P) / 4.0
+    ahw, ahh, bhw, bhh = (rng.integers(1, 12, P) / 4.0 for _ in range(4))
+    ax[:1000] += 1e9  # far from the origin
+    bx[:1000] += 1e9
+    bx[1000:1100], by[1000:1100] = ax[1000:1100], ay[1000:1100]  # concentric
+    ref = aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh)
+    fast = aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh)
+    assert np.array_equal(ref.hit, fast.hit)
+    assert np.array_equal(ref.nx, fast.nx) and np.array_equal(ref.ny, fast.ny)
+    np.testing.assert_allclose(fast.depth, ref.depth, rtol=1e-12, atol=0)
+    h = ref.hit
+    assert np.all(np.abs(fast.px[h] - ax[h]) <= ahw[h] + 1e-6) and np.all(np.abs(fast.px[h] - bx[h]) <= bhw[h] + 1e-6)
+    assert np.all(np.abs(fast.py[h] - ay[h]) <= ahh[h] + 1e-6) and np.all(np.abs(fast.py[h] - by[h]) <= bhh[h] + 1e-6)
+    touching = (np.abs(bx - ax) == ahw + bhw) | (np.abs(by - ay) == ahh + bhh)
+    assert touching.sum() > 500 and not fast.hit[touching].any()

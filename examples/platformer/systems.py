@@ -223,20 +223,13 @@ def sense_player(scene: Scene, dt: float) -> None:
 
 
 def sense_enemies(scene: Scene, dt: float) -> None:
-    """Walkers turn at walls (contacts against their heading) and before ledges and spikes."""
+    """Walkers turn where the response stopped them (a wall, another enemy) and before ledges
+    and spikes (``scene.query_box`` just ahead of their feet)."""
     tile = _tile(scene)
-    for e, (en, t, hb) in scene.query(Enemy, Transform, Hitbox):
+    for e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
         w, h = hb.shape.width, hb.shape.height
-        grounded = False
-        turn = False
-        for other, nx, ny, _depth in _touching(scene, e):
-            ohb = scene.try_get(other, Hitbox)
-            if ohb is None or ohb.sensor or scene.try_get(other, Player) is not None:
-                continue
-            if ny >= GROUND_NORMAL:
-                grounded = True
-            elif nx * en.direction < -0.7:
-                turn = True  # pushed back against its heading: a wall or another enemy
+        turn = abs(v.x) < 0.5 * en.speed  # the response took away its walking speed
+        grounded = any(ny >= GROUND_NORMAL for _o, _nx, ny, _d in _touching(scene, e))
         if grounded and not turn:
             front = t.x + en.direction * (w * 0.5 + 0.1 * tile)
             bottom = t.y - h * 0.5

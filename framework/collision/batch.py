@@ -40,7 +40,7 @@ import numpy as np
 
 from ..shapes import AABB, Circle, Polygon, Shape
 from ..validation import InvalidValue
-from .batch_box import aabb_aabb, overlap_aabb_aabb
+from .batch_box import aabb_aabb, aabb_aabb_fast, overlap_aabb_aabb
 from .batch_circle import circle_circle, overlap_circle_circle, overlap_polygon_circle, polygon_circle
 from .batch_common import F64, ContactArrays, no_contacts
 from .batch_polygon import overlap_polygon_polygon, polygon_polygon
@@ -49,6 +49,7 @@ from .placement import check_shape, pose
 __all__ = [
     "ContactArrays",
     "aabb_aabb",
+    "aabb_aabb_fast",
     "circle_circle",
     "collide_many",
     "outlines",

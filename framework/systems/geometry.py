@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..shapes import Polygon
-from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, BodyStore
+from ..store import KIND_AABB, KIND_POLYGON, BodyStore
 
 __all__ = ["Geometry"]
 
@@ -47,15 +47,23 @@ class Geometry:
             self.rebuild_tables(store)
         x, y, rot = store.x, store.y, store.rot
         ox, oy = store.ox, store.oy
-        c, s = np.cos(rot), np.sin(rot)
-        if ox.any() or oy.any():
-            self.hx = x + (c * ox - s * oy)
-            self.hy = y + (s * ox + c * oy)
+        pr = self.poly_rows
+        offset = np.flatnonzero((ox != 0.0) | (oy != 0.0))
+        # Rotations matter only to polygons and to offset hitboxes (AABBs and circles ignore them).
+        turned = np.union1d(pr, offset) if offset.size else pr
+        c = np.ones(store.n)
+        s = np.zeros(store.n)
+        if turned.size:
+            c[turned], s[turned] = np.cos(rot[turned]), np.sin(rot[turned])
+        if offset.size:
+            self.hx, self.hy = x.copy(), y.copy()
+            co, so = c[offset], s[offset]
+            self.hx[offset] += co * ox[offset] - so * oy[offset]
+            self.hy[offset] += so * ox[offset] + co * oy[offset]
         else:
             self.hx, self.hy = x, y
         self.cos, self.sin = c, s
-        ex, ey = store.hw.copy(), store.hh.copy()
-        pr = self.poly_rows
+        ex, ey = store.hw, store.hh
         if pr.size:
             loc = self.local[pr]
             cc, ss = c[pr, None], s[pr, None]
@@ -100,6 +108,3 @@ class Geometry:
             count[poly] = self.count[rows[poly]]
         return out, count
 
-
-def is_circle(kind: np.ndarray) -> np.ndarray:
-    return kind == KIND_CIRCLE

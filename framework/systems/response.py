@@ -82,12 +82,24 @@ def resolve(
     per_row = np.bincount(np.concatenate([ra, rb]), minlength=store.n)
     lone = np.where(solid, per_row[mobile] == 1, (per_row[ra] == 1) & (per_row[rb] == 1))
 
+    # Where each row stood when the response began: contacts between two dynamic bodies are
+    # re-measured along their normal from how far the bodies moved since (SAT depth is linear in
+    # translation along a fixed axis, as in Box2D's solver); contacts with immovable bodies are
+    # measured again from the geometry, because there the axis matters (tile seams).
+    x0, y0 = c["x"][: store.n].copy(), c["y"][: store.n].copy()
+
     def remeasure(sel: np.ndarray) -> None:
-        idx = np.flatnonzero(sel)
+        idx = np.flatnonzero(sel & solid)
         if idx.size:
             hit, rnx, rny, rdepth = recompute(ra[idx], rb[idx])
             alive[idx] = hit
             cur_nx[idx], cur_ny[idx], cur_depth[idx] = rnx, rny, rdepth
+        idx = np.flatnonzero(sel & both)
+        if idx.size:
+            a, b = ra[idx], rb[idx]
+            rel = ((c["x"][b] - x0[b]) - (c["x"][a] - x0[a])) * nx[idx] + ((c["y"][b] - y0[b]) - (c["y"][a] - y0[a])) * ny[idx]
+            cur_depth[idx] = depth[idx] - rel
+            alive[idx] = cur_depth[idx] > 0.0
 
     def push_out_deepest(s_idx: np.ndarray) -> None:
         """Push each mobile body fully out of its deepest immovable contact among ``s_idx``."""
