@@ -66,6 +66,14 @@ def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return (a.astype(np.int64) << 32) | b.astype(np.int64)
 
 
+def sorted_member(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """``np.isin(keys, table)`` for a sorted ``table`` (one binary search per key)."""
+    if table.size == 0:
+        return np.zeros(keys.size, dtype=bool)
+    pos = np.minimum(np.searchsorted(table, keys), table.size - 1)
+    return table[pos] == keys
+
+
 class PairTracker:
     """Turns each step's overlapping pairs into started / ongoing / ended events."""
 
@@ -76,8 +84,8 @@ class PairTracker:
     def update(self, now: StepContacts) -> tuple[np.ndarray, np.ndarray, StepContacts]:
         """Record this step's pairs; return (started mask over ``now``, ongoing mask, ended pairs)."""
         keys = pair_keys(now.a, now.b)
-        was = np.isin(keys, self.keys, assume_unique=True)
-        gone = ~np.isin(self.keys, keys, assume_unique=True)
+        was = sorted_member(keys, self.keys)
+        gone = ~sorted_member(self.keys, keys)
         ended = self.active.take(np.flatnonzero(gone))
         self.active, self.keys = now, keys
         return ~was, was, ended

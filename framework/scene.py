@@ -23,7 +23,7 @@ from .collision.placement import check_shape
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
 from .components import Body, Hitbox, Transform, Velocity
-from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, to_events
+from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, sorted_member, to_events
 from .input import Input
 from .shapes import AABB, Circle
 from .store import STATIC, BodyStore
@@ -576,7 +576,7 @@ class Scene:
         # overlap: bodies resting on each other fall by the same amount and merely touch, and
         # overlap again once the body below is pushed up (see response.resolve).
         sa, sb, snx, sny = self._support
-        old = ~np.isin(pair_keys(sa, sb), pair_keys(c.a, c.b))
+        old = ~sorted_member(pair_keys(sa, sb), pair_keys(c.a, c.b))
         sra, srb = self._rows_of(sa[old]), self._rows_of(sb[old])
         live = (sra >= 0) & (srb >= 0)
         ra = np.concatenate([self._contact_rows[0], sra[live]])
@@ -610,6 +610,7 @@ class Scene:
         done = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
                        self.response_iterations, recompute, alive0[idx])
         keep = idx[done]
+        keep = keep[np.argsort(pair_keys(ents_a[keep], ents_b[keep]), kind="stable")]
         self._support = (ents_a[keep], ents_b[keep], nx[keep], ny[keep])
         self.counters["resolved"] = int(done.sum())
         return True

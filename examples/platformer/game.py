@@ -22,9 +22,25 @@ from framework.input import Input
 
 from . import systems
 from .components import (
-    ALL, ENEMY, HAZARD, ONE_WAY, PICKUP, PLAYER, SOLID, Checkpoint, Coin, Enemy, GameState, Goal, Hazard,
-    LevelPiece, MovingPlatform, Player, Tuning,
+    ALL,
+    ENEMY,
+    HAZARD,
+    ONE_WAY,
+    PICKUP,
+    PLAYER,
+    SOLID,
+    Checkpoint,
+    Coin,
+    Enemy,
+    GameState,
+    Goal,
+    Hazard,
+    LevelPiece,
+    MovingPlatform,
+    Player,
+    Tuning,
 )
+from .demo import Autoplay
 from .levels import Level, builtin_levels, load_level
 
 __all__ = ["DT", "Game", "COLORS"]
@@ -40,11 +56,13 @@ PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
 
 class Game:
     """A run of the platformer over ``levels`` (paths or :class:`Level` objects; default: the
-    shipped ones), in a new scene unless one is given."""
+    shipped ones), in a new scene unless one is given. ``autoplay``: scripted input (see
+    :mod:`.demo`) instead of the keyboard's."""
 
     def __init__(
         self, levels: Sequence[Level | str | Path] | None = None, *, tuning: Tuning | None = None,
         scene: Scene | None = None, view: tuple[float, float] = (960.0, 540.0), start: int = 0,
+        autoplay: Autoplay | None = None,
     ) -> None:
         if levels is None:
             levels = builtin_levels()
@@ -57,6 +75,9 @@ class Game:
         self.scene.resources[GameState] = self.state
         self.scene.resources[Tuning] = self.tuning
         self.scene.resources[Game] = self
+        self.autoplay = autoplay
+        if autoplay is not None:
+            self.scene.add_system(self._autoplay, before="movement")  # first: before anyone reads keys
         systems.install(self.scene)
         self.spawn_level(start)
 
@@ -155,6 +176,10 @@ class Game:
             AABB(obj.width, obj.height), body="kinematic", layer=ONE_WAY if one_way else SOLID, mask=ALL,
             one_way=one_way), MovingPlatform((obj.x, obj.y), (obj.x + dx, obj.y + dy), speed),
             Visual(COLORS["platform"], z=1))
+
+    def _autoplay(self, scene: Scene, dt: float) -> None:
+        keys = self.autoplay.keys(self) if self.state.player is not None and self.state.pending is None else ()
+        scene.resources[Input].set_held(keys)
 
     # --- running ---------------------------------------------------------------------------------
 

@@ -25,7 +25,18 @@ from framework.events import CollisionEvent
 from framework.input import Input
 
 from .components import (
-    HAZARD, ONE_WAY, SOLID, Checkpoint, Coin, Enemy, GameState, Goal, Hazard, MovingPlatform, Player, Tuning,
+    HAZARD,
+    ONE_WAY,
+    SOLID,
+    Checkpoint,
+    Coin,
+    Enemy,
+    GameState,
+    Goal,
+    Hazard,
+    MovingPlatform,
+    Player,
+    Tuning,
 )
 
 if TYPE_CHECKING:
@@ -104,7 +115,7 @@ def control_player(scene: Scene, dt: float) -> None:
     tu: Tuning = scene.resources[Tuning]
     tile = _tile(scene)
     keys = scene.resources[Input]
-    for e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
+    for _e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
         p.prev_bottom = t.y - hb.shape.height * 0.5
         p.since_ground = 0.0 if p.grounded else p.since_ground + dt
         p.since_jump_press = 0.0 if keys.was_pressed(*JUMP) else p.since_jump_press + dt
@@ -185,35 +196,46 @@ def _touching(scene: Scene, entity: int) -> list[tuple[int, float, float, float]
     return out
 
 
+def _below_feet(scene: Scene, t: Transform, hb: Hitbox, mask: int) -> list[int]:
+    """Entities in a thin box just under a body's feet, a hair narrower than the body.
+
+    Asked after the response, when a body on the ground merely touches it. The pipeline's raw
+    contacts are not enough: a body pushed against a wall of tiles also overlaps, by a sliver, the
+    top of the tile below the one it hits (a contact with an upward normal that the response
+    then discards), which would let it jump off walls."""
+    w, h = hb.shape.width, hb.shape.height
+    x, bottom = t.x + hb.offset[0], t.y + hb.offset[1] - h * 0.5
+    inset, depth = 1e-3 * w, 0.05 * h
+    return scene.query_box(x - w * 0.5 + inset, bottom - depth, x + w * 0.5 - inset, bottom, mask=mask)
+
+
 def sense_player(scene: Scene, dt: float) -> None:
-    """Grounded: a solid contact below the player among the pipeline's contacts of this step.
+    """Grounded: something solid right under the feet after the response (``scene.query_box``).
 
     A one-way platform counts only if the feet were on or above its top when the step began (the
     pipeline's own landing rule), so rising through one or standing inside it is not standing on
-    it. On a moving platform the player's vertical velocity is kept relative to it (zero while
-    standing): carry_riders moves the player with it."""
+    it; nothing counts while moving up, away from it. On a moving platform the player's vertical
+    velocity is kept relative to it (zero while standing): carry_riders moves the player with it."""
     tol = 1e-3 * _tile(scene)
-    for e, (p, v, hb) in scene.query(Player, Velocity, Hitbox):
-        ground, best = None, -1.0
-        for other, _nx, ny, depth in _touching(scene, e):
-            if ny < GROUND_NORMAL:
-                continue
-            ohb = scene.try_get(other, Hitbox)
-            if ohb is None or ohb.sensor or scene.try_get(other, Enemy) is not None:
+    for _e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
+        ground, best = None, -1
+        for other in _below_feet(scene, t, hb, hb.mask & (SOLID | ONE_WAY)):
+            ohb = scene.get(other, Hitbox)
+            if ohb.sensor:
                 continue
             plat = scene.try_get(other, MovingPlatform)
             ov = scene.try_get(other, Velocity)
-            # The velocity of a rider is relative to its platform; anyone else's is absolute.
+            # A rider's velocity is relative to its platform; anyone else's is absolute.
             rel = p.vy_start if other == p.ground or ov is None else v.y - ov.y
             if rel > 1e-9:
-                continue  # moving up, away from it
+                continue
             if ohb.one_way:
                 ot = scene.get(other, Transform)
                 y0 = plat.start_pos[1] if plat is not None else ot.y
                 top = y0 + ohb.offset[1] + ohb.shape.height * 0.5
                 if p.prev_bottom < top - tol:
                     continue
-            rank = depth + (1e9 if plat is not None else 0.0)
+            rank = 1 if plat is not None else 0  # on a platform and a tile at once: ride
             if rank > best:
                 ground, best = other, rank
         p.grounded = ground is not None
@@ -226,10 +248,10 @@ def sense_enemies(scene: Scene, dt: float) -> None:
     """Walkers turn where the response stopped them (a wall, another enemy) and before ledges
     and spikes (``scene.query_box`` just ahead of their feet)."""
     tile = _tile(scene)
-    for e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
+    for _e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
         w, h = hb.shape.width, hb.shape.height
         turn = abs(v.x) < 0.5 * en.speed  # the response took away its walking speed
-        grounded = any(ny >= GROUND_NORMAL for _o, _nx, ny, _d in _touching(scene, e))
+        grounded = bool(_below_feet(scene, t, hb, SOLID | ONE_WAY))
         if grounded and not turn:
             front = t.x + en.direction * (w * 0.5 + 0.1 * tile)
             bottom = t.y - h * 0.5
@@ -335,7 +357,7 @@ def on_checkpoint(scene: Scene, ev: CollisionEvent) -> None:
     cp.active = True
     t, hb = scene.get(ev.b, Transform), scene.get(ev.b, Hitbox)
     _state(scene).checkpoint = (t.x, t.y - hb.shape.height * 0.5)
-    for e, (c, vis) in scene.query(Checkpoint, Visual):
+    for _e, (c, vis) in scene.query(Checkpoint, Visual):
         vis.color = (*CHECKPOINT_ON, 255) if c.active else (150, 150, 150, 255)
 
 

@@ -208,41 +208,32 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
     """
     ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
     dx, dy = bx - ax, by - ay
+    adx, ady = np.abs(dx), np.abs(dy)
     sx, sy = ahw + bhw, ahh + bhh
-    ox, oy = sx - np.abs(dx), sy - np.abs(dy)
-    mag = sx + sy + np.abs(dx) + np.abs(dy)
-    band = 8.0 * BAND * mag
+    ox, oy = sx - adx, sy - ady  # the shortest push-out along x and along y
+    mag = sx + sy + adx + ady
+    band = (8.0 * BAND) * mag
     unclear = ((np.abs(ox) <= band) & (oy >= -band)) | ((np.abs(oy) <= band) & (ox >= -band))
-    unclear |= ~np.isfinite(mag) | (mag > 1e150) | (mag < 1e-150)
+    unclear |= ~(mag <= 1e150) | (mag < 1e-150)
     hit = (ox > 0.0) & (oy > 0.0) & ~unclear
-    n = ax.shape[0]
-    nx, ny, depth, px, py = (np.zeros(n, dtype=F64) for _ in range(5))
-    h = np.flatnonzero(hit)
-    if h.size:
-        dxh, dyh, sxh, syh = dx[h], dy[h], sx[h], sy[h]
-        up, down, right, left = syh - dyh, syh + dyh, sxh - dxh, sxh + dxh
-        size = np.hypot(ahw[h], ahh[h]) + np.hypot(bhw[h], bhh[h])
-        best = np.minimum(np.minimum(up, down), np.minimum(right, left))
-        lim = best + DEPTH_TOL * size
-        vertical = (up <= lim) | (down <= lim)
-        use_up, use_right = up <= lim, right <= lim
-        both_v, both_h = use_up & (down <= lim), use_right & (left <= lim)
-        # The tie rule: nearly shortest, most vertical, then up (or right); a direction tied with
-        # its negation reports the shorter depth (as tiebreak.pick does).
-        dv = np.where(both_v, np.minimum(up, down), np.where(use_up, up, down))
-        dh = np.where(both_h, np.minimum(right, left), np.where(use_right, right, left))
-        depth[h] = np.where(vertical, dv, dh)
-        nx[h] = np.where(vertical, 0.0, np.where(use_right, 1.0, -1.0))
-        ny[h] = np.where(vertical, np.where(use_up, 1.0, -1.0), 0.0)
-        if points:
-            lo_x = np.maximum(ax[h] - ahw[h], bx[h] - bhw[h])
-            hi_x = np.minimum(ax[h] + ahw[h], bx[h] + bhw[h])
-            lo_y = np.maximum(ay[h] - ahh[h], by[h] - bhh[h])
-            hi_y = np.minimum(ay[h] + ahh[h], by[h] + bhh[h])
-            px[h], py[h] = 0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)
+    # The tie rule on the 4 candidates (up sy - dy, down sy + dy, right sx - dx, left sx + dx):
+    # keep those within DEPTH_TOL * size of the shortest, prefer vertical, then up (or right). The
+    # depth is then the shortest of the kept direction's pair, i.e. oy (or ox).
+    size = np.sqrt(ahw * ahw + ahh * ahh) + np.sqrt(bhw * bhw + bhh * bhh)
+    lim = np.minimum(ox, oy) + DEPTH_TOL * size
+    vertical = oy <= lim
+    zero = np.zeros(ax.shape[0], dtype=F64)
+    depth = np.where(hit, np.where(vertical, oy, ox), zero)
+    ny = np.where(hit & vertical, np.where(sy - dy <= lim, 1.0, -1.0), zero)
+    nx = np.where(hit & ~vertical, np.where(sx - dx <= lim, 1.0, -1.0), zero)
+    if points:  # the centre of the overlap rectangle
+        px = np.where(hit, 0.5 * (np.maximum(ax - ahw, bx - bhw) + np.minimum(ax + ahw, bx + bhw)), zero)
+        py = np.where(hit, 0.5 * (np.maximum(ay - ahh, by - bhh) + np.minimum(ay + ahh, by + bhh)), zero)
+    else:
+        px, py = zero, zero.copy()
     u = np.flatnonzero(unclear) if exact else np.zeros(0, dtype=np.intp)
     if u.size:
-        exact = aabb_aabb(ax[u], ay[u], ahw[u], ahh[u], bx[u], by[u], bhw[u], bhh[u])
-        hit[u] = exact.hit
-        nx[u], ny[u], depth[u], px[u], py[u] = exact.nx, exact.ny, exact.depth, exact.px, exact.py
-    return ContactArrays(hit, nx + 0.0, ny + 0.0, depth, px, py)
+        ref = aabb_aabb(ax[u], ay[u], ahw[u], ahh[u], bx[u], by[u], bhw[u], bhh[u])
+        hit[u] = ref.hit
+        nx[u], ny[u], depth[u], px[u], py[u] = ref.nx, ref.ny, ref.depth, ref.px, ref.py
+    return ContactArrays(hit, nx, ny, depth, px, py)

@@ -30,7 +30,7 @@ _offscreen: Any = None
 def offscreen_window() -> Any:
     """The hidden window whose GL context offscreen rendering uses (made on first call)."""
     global _offscreen
-    if _offscreen is None or getattr(_offscreen, "_context", True) is None:
+    if _offscreen is None or _offscreen.context is None:
         _offscreen = pyglet.window.Window(16, 16, visible=False, caption="framework offscreen")
     return _offscreen
 

@@ -45,8 +45,9 @@ def pair_contacts(
     kb = store.kind[rb].astype(np.int64)
     code = ka * 3 + kb
     hx, hy = geom.hx, geom.hy
-    for c in np.unique(code).tolist():
-        idx = np.flatnonzero(code == c)
+    kinds = [int(code[0])] if (code == code[0]).all() else np.unique(code).tolist()
+    for c in kinds:
+        idx = np.flatnonzero(code == c) if len(kinds) > 1 else np.arange(P)
         a, b = ra[idx], rb[idx]
         kind_a, kind_b = divmod(c, 3)
         if counts is not None:

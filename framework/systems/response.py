@@ -97,7 +97,9 @@ def resolve(
         idx = np.flatnonzero(sel & both)
         if idx.size:
             a, b = ra[idx], rb[idx]
-            rel = ((c["x"][b] - x0[b]) - (c["x"][a] - x0[a])) * nx[idx] + ((c["y"][b] - y0[b]) - (c["y"][a] - y0[a])) * ny[idx]
+            mx = (c["x"][b] - x0[b]) - (c["x"][a] - x0[a])
+            my = (c["y"][b] - y0[b]) - (c["y"][a] - y0[a])
+            rel = mx * nx[idx] + my * ny[idx]
             cur_depth[idx] = depth[idx] - rel
             alive[idx] = cur_depth[idx] > 0.0
 
