@@ -227,6 +227,18 @@ def check_hitbox_field(name: str, value: object) -> Any:
     raise AttributeError(name)
 
 
+def check_component(comp: object) -> None:
+    """Raise :class:`InvalidValue` if ``comp``, about to join an entity, holds a bad value (one
+    written after it was made, or while it belonged to another entity). Normalises a Hitbox's
+    fields in place, as its constructor would; changes nothing on error."""
+    if isinstance(comp, _Columns):
+        for name, value in zip(comp._fields, comp._values()):
+            finite(f"{type(comp).__name__}.{name}", value)
+    elif isinstance(comp, Hitbox):
+        fields = [check_hitbox_field(f, object.__getattribute__(comp, "_" + f)) for f in _HITBOX_FIELDS]
+        for name, value in zip(_HITBOX_FIELDS, fields):
+            object.__setattr__(comp, "_" + name, value)
+
 
 class Visual:
     """How the render system draws an entity: a filled shape matching its hitbox in ``color``

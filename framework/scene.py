@@ -12,6 +12,7 @@ import itertools
 import math
 import time
 from collections.abc import Callable, Iterable
+from numbers import Integral
 from typing import Any, NamedTuple
 
 import esper
@@ -22,7 +23,7 @@ from .collision.broad_phase import SpatialHash
 from .collision.placement import check_shape
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
-from .components import Body, Hitbox, Transform, Velocity
+from .components import Body, Hitbox, Transform, Velocity, check_component
 from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, sorted_member, to_events
 from .input import Input
 from .shapes import AABB, Circle
@@ -189,6 +190,9 @@ class Scene:
         self._activate()
         kinds: dict[type, Any] = {}
         for comp in components:
+            if comp is None or isinstance(comp, type):
+                raise InvalidValue(f"spawn takes component instances, got {comp!r}")
+            check_component(comp)
             if type(comp) in kinds:
                 raise InvalidValue(f"spawn got two {type(comp).__name__} components: {components!r}")
             kinds[type(comp)] = comp
@@ -212,7 +216,7 @@ class Scene:
 
         During a step (from a system or a handler) the removal waits until the step ends."""
         self._activate()
-        if not esper.entity_exists(entity) or entity in self._pending_despawn:
+        if not self.exists(entity):
             raise InvalidValue(f"entity {entity!r} does not exist (despawned already?)")
         if self._stepping:
             self._pending_despawn.append(entity)
@@ -237,18 +241,27 @@ class Scene:
         esper.delete_entity(entity, immediate=True)
 
     def exists(self, entity: int) -> bool:
+        """Whether ``entity`` is an entity of this scene (not despawned, nor waiting to be)."""
         self._activate()
-        return esper.entity_exists(entity) and entity not in self._pending_despawn
+        if isinstance(entity, bool) or not isinstance(entity, Integral):  # True is not entity 1
+            return False
+        return esper.entity_exists(int(entity)) and entity not in self._pending_despawn
 
     def add_component(self, entity: int, component: Any) -> None:
         """Add (or replace) a component of ``entity``, keeping the pipeline's view in step."""
         self._activate()
-        if not esper.entity_exists(entity):
+        if not self.exists(entity):
             raise InvalidValue(f"entity {entity!r} does not exist")
+        if component is None or isinstance(component, type):
+            raise InvalidValue(f"add_component takes a component instance, got {component!r}")
         store = self.store
         has_t = entity in store.row_of
         if isinstance(component, Transform):
             raise InvalidValue("a Transform is given at spawn and edited in place; it cannot be replaced")
+        try:
+            check_component(component)
+        except InvalidValue as exc:
+            raise InvalidValue(f"entity {entity}: {exc}") from None
         if isinstance(component, (Velocity, Hitbox)):
             if not has_t:
                 raise InvalidValue(f"entity {entity} has no Transform")
@@ -258,23 +271,31 @@ class Scene:
             has_v = isinstance(component, Velocity) or esper.has_component(entity, Velocity)
             if hb is not None and hb.body is Body.STATIC and has_v:
                 raise InvalidValue("a static body never moves: give it no Velocity")
+        old = esper.try_component(entity, type(component))
         esper.add_component(entity, component)
         if isinstance(component, Velocity):
+            if old is not None:
+                store.unbind(entity, old)  # the replaced Velocity no longer writes to the row
             store.set_velocity(entity, component)
         elif isinstance(component, Hitbox):
             store.set_hitbox(entity, component)
 
     def remove_component(self, entity: int, component_type: type) -> Any:
+        """Remove and return ``entity``'s ``component_type`` component; it keeps its values."""
         self._activate()
         if component_type is Transform:
             raise InvalidValue("remove the entity instead of its Transform")
+        if not self.exists(entity):
+            raise InvalidValue(f"entity {entity!r} does not exist")
+        if not esper.has_component(entity, component_type):
+            name = getattr(component_type, "__name__", repr(component_type))
+            raise InvalidValue(f"entity {entity} has no {name} component")
         comp = esper.remove_component(entity, component_type)
         if component_type is Velocity and entity in self.store.row_of:
+            self.store.unbind(entity, comp)  # before the row forgets its values
             self.store.set_velocity(entity, None)
-            comp._own = [comp._get(i) for i in range(3)] if comp._store else comp._own
         elif component_type is Hitbox and entity in self.store.row_of:
             self.store.set_hitbox(entity, None)
-            object.__setattr__(comp, "_store", None)
         return comp
 
     def get(self, entity: int, component_type: type) -> Any:
@@ -337,10 +358,14 @@ class Scene:
         """Advance the scene by ``dt`` seconds (finite, > 0), in ``substeps`` equal sub-steps.
 
         A component holding NaN, inf or a non-number makes this raise ``ValueError`` naming the
-        entity and the field, before anything changes. With several sub-steps, each runs the whole
+        entity and the field, before anything changes. One that game code spoils during the step
+        (from a system or a handler), or that overflows, is reported at the end of the step (which
+        is then complete: frame, time and events included). With several sub-steps, each runs the whole
         pipeline (game systems and handlers included; rendering only after the last), the events
         of all sub-steps are reported in order, and the counters add up."""
         self._activate()
+        if self._stepping:
+            raise InvalidValue("step() was called from inside a step (a system or a collision handler)")
         dt = positive("dt", dt)
         self.store.check()
         n = self.substeps
@@ -360,6 +385,13 @@ class Scene:
         inp = self.resources.get(Input)
         if inp is not None:
             inp.end_step()
+        try:
+            # A bad value written by game code during the step (a system or a handler), or a
+            # motion that overflowed: reported now, by the step that made it.
+            self.store.check()
+        except InvalidValue as exc:
+            raise InvalidValue(f"{exc} (at the end of step {self.frame}: written by a system or a collision "
+                               "handler during the step, or an overflow)") from None
 
     def _substep(self, dt: float, render: bool) -> None:
         store = self.store

@@ -117,13 +117,8 @@ class BodyStore:
             self.static_dirty = True
         if self.cols["asleep"][row]:
             self.sleep_dirty = True
-        # Unbind: the components keep the values they had, as their own.
         for comp in components:
-            if isinstance(comp, (Transform, Velocity)):
-                comp._own = [self.read(entity, col) for col in comp._columns]
-                comp._store = None
-            elif isinstance(comp, Hitbox):
-                object.__setattr__(comp, "_store", None)
+            self.unbind(entity, comp)
         del self.row_of[entity]
         for key in [k for k in self.bad if k[0] == entity]:
             del self.bad[key]
@@ -138,9 +133,21 @@ class BodyStore:
         self.n -= 1
         self.version += 1
 
+    def unbind(self, entity: int, comp: object) -> None:
+        """Detach a component from its row: it keeps the values it had (bad ones included), as its
+        own, and no longer writes to the row (which may soon hold another entity or component)."""
+        if isinstance(comp, (Transform, Velocity)) and comp._store is self:
+            comp._own = [self.read(entity, col) for col in comp._columns]
+            comp._store = None
+        elif isinstance(comp, Hitbox) and comp._store is self:
+            object.__setattr__(comp, "_store", None)
+
     def set_velocity(self, entity: int, velocity: Velocity | None) -> None:
+        """Give the row ``velocity``'s values (or none); unbind the old Velocity first."""
         row = self.row_of[entity]
         c = self.cols
+        for col in ("vx", "vy", "w"):  # values the old Velocity held, reported no more
+            self.bad.pop((entity, col), None)
         if velocity is None:
             c["has_vel"][row] = False
             c["vx"][row] = c["vy"][row] = c["w"][row] = 0.0
@@ -153,6 +160,10 @@ class BodyStore:
 
     def set_hitbox(self, entity: int, hitbox: Hitbox | None) -> None:
         row = self.row_of[entity]
+        old = self.hitboxes[row]
+        if old is not None and old is not hitbox:
+            self.unbind(entity, old)
+        self.dirty_hitboxes.discard(entity)  # edits of the old hitbox no longer matter
         self.static_dirty = True
         self.wake(row)
         self._set_hitbox_row(row, hitbox)
@@ -212,8 +223,12 @@ class BodyStore:
         row = self.row_of[entity]
         if self.cols["asleep"][row] or self.cols["still"][row]:
             self.wake(row)
-        if isinstance(value, Real) and not isinstance(value, bool):
-            self.cols[col][row] = float(value)
+        try:
+            number = float(value) if isinstance(value, Real) and not isinstance(value, bool) else None
+        except (OverflowError, ValueError):  # an int beyond float64 (10**400): not a finite float
+            number = None
+        if number is not None:
+            self.cols[col][row] = number
             if self.bad:
                 self.bad.pop((entity, col), None)
         else:
@@ -247,9 +262,12 @@ class BodyStore:
             assert hb is not None
             for name in _HITBOX_FIELD_NAMES:
                 try:
-                    check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
+                    value = check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
                 except InvalidValue as exc:
                     raise InvalidValue(f"entity {e}: {exc}") from None
+                if name == "body" and value is Body.STATIC and self.cols["has_vel"][self.row_of[e]]:
+                    raise InvalidValue(f"entity {e}: Hitbox body is static, but a static body never moves: "
+                                       "remove its Velocity first (or make it kinematic)")
         if problems:
             e, col, v = min(problems, key=lambda p: (p[0], p[1]))
             raise InvalidValue(f"entity {e}: {_FIELD_NAMES[col]} must be a finite number, got {v!r}")

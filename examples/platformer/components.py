@@ -6,7 +6,7 @@ these only mark what an entity *is* to the game and hold its game state.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 __all__ = [
     "ALL", "Checkpoint", "Coin", "ENEMY", "Enemy", "GameState", "Goal", "Hazard", "LevelPiece",
@@ -39,7 +39,7 @@ class Tuning:
     stomp_bounce: float = 12.0     # tiles/s up after stomping an enemy (jump held: jump_speed)
     drop_time: float = 0.2         # s the one-way layer stays out of the mask after down+jump
     player_size: tuple[float, float] = (0.75, 0.875)  # tiles
-    enemy_size: tuple[float, float] = (0.8, 0.7)
+    enemy_size: tuple[float, float] = (0.75, 0.6875)
     coin_radius: float = 0.25
 
 
@@ -67,6 +67,8 @@ class Enemy:
     direction: int = -1
     prev_top: float = 0.0
     turned_frame: int = -1
+    probe_cell: tuple[int, int] | None = None  # where the ledge probe last looked ...
+    probe_ground: bool = True                  # ... and whether it found ground there
 
 
 @dataclass
@@ -76,7 +78,9 @@ class MovingPlatform:
     start: tuple[float, float]
     end: tuple[float, float]
     speed: float
+    pause: float = 0.5                       # s it waits at each end
     toward_end: bool = True
+    waiting: float = 0.0
     start_pos: tuple[float, float] = (0.0, 0.0)  # where it began the current step
 
 
@@ -114,11 +118,13 @@ class GameState:
     level_index: int = 0
     level_name: str = ""
     tile: float = 32.0
+    art: bool = False                 # the level is drawn with the tile images (see art.py)
     coins: int = 0                    # collected in the whole run
     coins_in_level: int = 0
     coin_total_in_level: int = 0
     deaths: int = 0
     reached_goal: bool = False        # a goal was reached in this run
+    level_done: bool = False          # the current level's goal was reached
     levels_completed: int = 0
     finished: bool = False            # the last level was completed
     checkpoint: tuple[float, float] = (0.0, 0.0)  # respawn point (feet)
@@ -129,6 +135,4 @@ class GameState:
     pending: str | None = None         # "restart" / "next": a level change asked for
     pending_stage: int = 0
     goal_timer: float = 0.0
-    quit: bool = False
-    debug: bool = False
-    messages: list[str] = field(default_factory=list)
+    stomps: int = 0

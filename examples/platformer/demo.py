@@ -13,7 +13,7 @@ from framework import Transform
 
 from .components import Enemy, MovingPlatform
 
-__all__ = ["Autoplay", "level1"]
+__all__ = ["Autoplay", "SCRIPTS", "level1", "level2", "play_all"]
 
 Keys = set[str]
 TIMEOUT = 600  # steps any one wait may take before the script gives up on it
@@ -59,7 +59,7 @@ def jump_from(game, x: float, frames: int = 30, keys: tuple[str, ...] = ("right"
 def hop_onto(game, x: float, frames: int = 30) -> Iterator[Keys]:
     """Jump from where the player stands, steering right until past ``x``, then drop straight down."""
     yield from land(game, ())
-    for i in range(frames):
+    for _ in range(frames):
         yield {"space", "right"} if _x(game) < x else {"space"}
     for _ in range(TIMEOUT):
         if game.player_state.grounded:
@@ -72,7 +72,8 @@ def stomp(game, near: float = 0.9, far: float = 1.6) -> Iterator[Keys]:
     jump straight up and come down on it."""
     tile = game.state.tile
     for _ in range(TIMEOUT):
-        enemies = [(t.x / tile - _x(game), en.direction) for _e, (en, t) in game.scene.query(Enemy, Transform)]
+        enemies = [(t.x / tile - _x(game), en.direction)
+                   for _e, (en, t) in game.scene.query(Enemy, Transform)]
         if not enemies:
             return
         d, heading = min(enemies, key=lambda e: abs(e[0]))
@@ -83,15 +84,14 @@ def stomp(game, near: float = 0.9, far: float = 1.6) -> Iterator[Keys]:
     yield from land(game, ())
 
 
-def ride(game, board_x: float, leave_x: float) -> Iterator[Keys]:
-    """Wait at the pit for the moving platform to come back, jump on, ride, jump off."""
+def ride(game, board_x: float) -> Iterator[Keys]:
+    """Wait at the pit for the moving platform to stop at its start, jump on, ride it to its end,
+    jump off."""
     tile = game.state.tile
     yield from run_to(game, board_x)
     (pe, plat), = game.scene.query(MovingPlatform)
-    start_x = plat.start[0] / tile
-    for _ in range(2 * TIMEOUT):  # wait until it is back at its start
-        t = game.scene.get(pe, Transform)
-        if plat.toward_end and abs(t.x / tile - start_x) < 0.3:
+    for _ in range(2 * TIMEOUT):
+        if plat.toward_end and plat.waiting > 0.0:
             break
         yield set()
     for i in range(40):  # jump on, steering over its middle
@@ -99,12 +99,42 @@ def ride(game, board_x: float, leave_x: float) -> Iterator[Keys]:
         if _x(game) < game.scene.get(pe, Transform).x / tile - 0.3:
             keys.add("right")
         yield keys
-    for _ in range(TIMEOUT):  # ride to the far end
-        if game.scene.get(pe, Transform).x / tile >= leave_x:
+    for _ in range(2 * TIMEOUT):  # ride to the far end
+        if not plat.toward_end:
             break
         yield set()
     yield from jump(40)
     yield from land(game)
+
+
+def lift(game, step_off_x: float) -> Iterator[Keys]:
+    """Wait for the lift (the level's moving platform) to stop at its start, walk on, ride it to
+    its end, walk off to ``step_off_x``."""
+    tile = game.state.tile
+    (pe, plat), = game.scene.query(MovingPlatform)
+    for _ in range(2 * TIMEOUT):
+        if plat.toward_end and plat.waiting > 0.0:
+            break
+        yield set()
+    for _ in range(TIMEOUT):  # on to its middle
+        if _x(game) >= plat.start[0] / tile:
+            break
+        yield {"right"}
+    for _ in range(2 * TIMEOUT):
+        if not plat.toward_end and plat.waiting > 0.0:  # arrived at the end
+            break
+        yield set()
+    yield from run_to(game, step_off_x)
+
+
+def drop(game) -> Iterator[Keys]:
+    """Down + jump: fall through the one-way platform underfoot, then land on whatever is below."""
+    yield from land(game, ())
+    yield {"down"}
+    yield {"down", "space"}
+    for _ in range(10):
+        yield {"down"}
+    yield from land(game, ())
 
 
 def level1(game) -> Iterator[Keys]:
@@ -119,13 +149,49 @@ def level1(game) -> Iterator[Keys]:
     yield from stomp(game)                      # the pen's enemy
     yield from jump_from(game, 42.3, 20)        # out of the pen; the checkpoint
     yield from jump_from(game, 49.6, 30)        # over the spikes
-    yield from ride(game, 55.6, 65.3)           # the moving platform over the big pit
+    yield from ride(game, 55.6)           # the moving platform over the big pit
     yield from stomp(game)                      # the second enemy
     yield from jump_from(game, 75.6, 20)        # the block, the tall block, the high ledge
     yield from hop_onto(game, 78.8)
     yield from hop_onto(game, 81.2)
     yield from jump_from(game, 82.3, 30)        # over to the plateau
     yield from run_to(game, 96.0)               # the goal
+
+
+def level2(game) -> Iterator[Keys]:
+    """Plays ``02-caverns.tmj``: spikes, a walker, the lift, two more walkers, the drop room."""
+    yield from jump_from(game, 7.3, 30)         # over the spikes
+    yield from stomp(game)
+    yield from jump_from(game, 18.5, 25)        # the one-way ledge, then the raised floor
+    yield from hop_onto(game, 24.5)
+    yield from run_to(game, 31.0)
+    yield from lift(game, 37.5)                 # up the shaft
+    yield from stomp(game)
+    yield from jump_from(game, 46.3, 25)        # over the bump
+    yield from stomp(game)
+    yield from run_to(game, 64.0)               # down through the drop room's one-way floors
+    for _ in range(4):
+        yield from drop(game)
+    yield from run_to(game, 75.5)               # out of the door, over the spikes
+    yield from jump_from(game, 75.6, 30)
+    yield from stomp(game)
+    yield from jump_from(game, 84.5, 25)        # onto the goal's block
+    yield from run_to(game, 87.0)
+
+
+SCRIPTS = (level1, level2)
+
+
+def play_all(game) -> Iterator[Keys]:
+    """The scripts of the shipped levels, one after the other (holding nothing in between)."""
+    for index, script in enumerate(SCRIPTS):
+        while game.state.level_index != index or game.state.player is None:
+            if game.state.finished:
+                return
+            yield set()
+        yield from script(game)
+        while not game.state.reached_goal or game.state.levels_completed <= index:
+            yield set()
 
 
 class Autoplay:

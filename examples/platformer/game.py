@@ -52,6 +52,10 @@ COLORS = {
     "platform": (214, 170, 96),
 }
 PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
+ART_TILE = 32.0  # the tile images (see art.py) are drawn for 32-unit tiles; other sizes get colours
+IMAGES = {name: Path(__file__).with_name("images") / f"{name}.png" for name in (
+    "ground", "ground_top", "plank", "player_right", "player_left", "enemy", "goal", "checkpoint",
+    "checkpoint_on")}
 
 
 class Game:
@@ -106,7 +110,7 @@ class Game:
         t = level.tile
         scene.gravity = (0.0, -tu.gravity * t)
         st.level_index, st.level_name, st.tile = index, level.name, t
-        st.coins_in_level, st.goal_timer, st.pending = 0, 0.0, None
+        st.coins_in_level, st.goal_timer, st.pending, st.level_done = 0, 0.0, None, False
         st.bounds = (0.0, 0.0, *level.size)
         start = level.player
         st.checkpoint = (start.x, start.bottom)
@@ -114,18 +118,25 @@ class Game:
         def piece(kind: str, *components) -> int:
             return scene.spawn(*components, LevelPiece(kind))
 
+        art = st.art = t == ART_TILE and all(p.exists() for p in IMAGES.values())
+
+        def look(image: str, color: str, z: int) -> Visual:
+            return Visual(image=str(IMAGES[image]), z=z) if art else Visual(COLORS[color], z=z)
+
         for row, cells in enumerate(level.tiles):
             for col, kind in enumerate(cells):
                 if kind is None:
                     continue
                 x, y = level.cell_center(col, row)
                 if kind == "solid":
+                    top = row == 0 or level.tiles[row - 1][col] != "solid"
                     piece(kind, Transform(x, y), Hitbox(AABB(t, t), body="static", layer=SOLID),
-                          Visual(COLORS[kind], z=0))
+                          look("ground_top" if top else "ground", kind, 0))
                 elif kind == "oneway":
                     # A slab on the top quarter of the cell, solid only from above.
                     piece(kind, Transform(x, y + 0.375 * t), Hitbox(
-                        AABB(t, 0.25 * t), body="static", layer=ONE_WAY, one_way=True), Visual(COLORS[kind], z=0))
+                        AABB(t, 0.25 * t), body="static", layer=ONE_WAY, one_way=True),
+                        look("plank", kind, 0))
                 else:  # spikes
                     self._spikes(x, y - 0.5 * t, t, piece)
         for obj in level.objects:
@@ -140,24 +151,25 @@ class Game:
                 w = min(w, 0.5 * t) if obj.kind == "checkpoint" else w
                 piece(obj.kind, Transform(obj.x, bottom + h * 0.5), Hitbox(
                     AABB(w, h), body="static", sensor=True, layer=PICKUP, mask=PLAYER), comp,
-                    Visual(COLORS[obj.kind], z=1))
+                    look(obj.kind, obj.kind, 1))
             elif obj.kind == "spikes":
                 n = max(1, round(obj.width / t))
                 for i in range(n):
-                    self._spikes(obj.x - obj.width * 0.5 + (i + 0.5) * obj.width / n, obj.bottom, obj.width / n, piece)
+                    x = obj.x - obj.width * 0.5 + (i + 0.5) * obj.width / n
+                    self._spikes(x, obj.bottom, obj.width / n, piece)
             elif obj.kind == "platform":
                 self._platform(obj, t, piece)
             elif obj.kind == "enemy":
                 w, h = tu.enemy_size[0] * t, tu.enemy_size[1] * t
                 speed = float(obj.props.get("speed", 2.0)) * t
                 piece("enemy", Transform(obj.x, obj.bottom + h * 0.5), Velocity(), Hitbox(
-                    AABB(w, h), layer=ENEMY, mask=SOLID | ONE_WAY | PLAYER | ENEMY),
-                    Enemy(speed, int(obj.props.get("direction", -1))), Visual(COLORS["enemy"], z=3))
+                    AABB(w, h), layer=ENEMY, mask=SOLID | ONE_WAY | PLAYER | ENEMY | HAZARD),
+                    Enemy(speed, int(obj.props.get("direction", -1))), look("enemy", "enemy", 3))
         st.coin_total_in_level = len(level.of_kind("coin"))
         w, h = tu.player_size[0] * t, tu.player_size[1] * t
         st.player = piece("player", Transform(start.x, start.bottom + h * 0.5), Velocity(),
                           Hitbox(AABB(w, h), layer=PLAYER, mask=PLAYER_MASK), Player(),
-                          Visual(COLORS["player"], z=4))
+                          look("player_right", "player", 4))
         systems.follow_camera(scene, 0.0)
 
     @staticmethod
@@ -165,21 +177,22 @@ class Game:
         # A triangle standing on the cell's floor, a bit narrower and lower than the cell.
         h = 0.55 * width
         tri = Polygon([(-0.42 * width, 0.0), (0.42 * width, 0.0), (0.0, h)])
-        piece("spikes", Transform(x, bottom), Hitbox(tri, body="static", sensor=True, layer=HAZARD, mask=PLAYER),
-              Hazard(), Visual(COLORS["spikes"], z=1))
+        hitbox = Hitbox(tri, body="static", sensor=True, layer=HAZARD, mask=PLAYER | ENEMY)
+        piece("spikes", Transform(x, bottom), hitbox, Hazard(), Visual(COLORS["spikes"], z=1))
 
     def _platform(self, obj, t: float, piece) -> None:
         one_way = bool(obj.props.get("one_way", True))
         dx, dy = float(obj.props.get("dx", 0.0)) * t, float(obj.props.get("dy", 0.0)) * t
         speed = float(obj.props.get("speed", 2.0)) * t
+        pause = float(obj.props.get("pause", 0.5))
         piece("platform", Transform(obj.x, obj.y), Velocity(), Hitbox(
             AABB(obj.width, obj.height), body="kinematic", layer=ONE_WAY if one_way else SOLID, mask=ALL,
-            one_way=one_way), MovingPlatform((obj.x, obj.y), (obj.x + dx, obj.y + dy), speed),
+            one_way=one_way), MovingPlatform((obj.x, obj.y), (obj.x + dx, obj.y + dy), speed, pause),
             Visual(COLORS["platform"], z=1))
 
     def _autoplay(self, scene: Scene, dt: float) -> None:
-        keys = self.autoplay.keys(self) if self.state.player is not None and self.state.pending is None else ()
-        scene.resources[Input].set_held(keys)
+        playing = self.state.player is not None and self.state.pending is None
+        scene.resources[Input].set_held(self.autoplay.keys(self) if playing else ())
 
     # --- running ---------------------------------------------------------------------------------
 
@@ -208,6 +221,7 @@ class Game:
         return {
             "level": st.level_name, "level_index": st.level_index, "reached_goal": st.reached_goal,
             "levels_completed": st.levels_completed, "coins": st.coins, "deaths": st.deaths,
+            "stomps": st.stomps,
         }
 
     def close(self) -> None:

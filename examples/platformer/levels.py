@@ -34,7 +34,6 @@ import base64
 import gzip
 import json
 import math
-import sys
 import zlib
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -43,7 +42,7 @@ from typing import Any
 
 __all__ = [
     "LEVEL_DIR", "Level", "LevelError", "LevelObject", "builtin_levels", "load_level", "parse_text",
-    "parse_tmj", "to_tmj",
+    "parse_tmj", "to_tmj", "dump_tmj",
 ]
 
 LEVEL_DIR = Path(__file__).with_name("levels")
@@ -119,8 +118,6 @@ class Level:
         players = self.of_kind("player")
         if len(players) != 1:
             fail(f"needs exactly one player start, found {len(players)}")
-        if not self.of_kind("goal"):
-            fail("has no goal")
         w, h = self.size
         for o in self.objects:
             if o.kind not in OBJECT_KINDS:
@@ -156,7 +153,9 @@ def _is_number(v: object) -> bool:
 # --- text maps -------------------------------------------------------------------------------------
 
 
-def parse_text(text: str, source: str = "<text>", *, tile: float = DEFAULT_TILE, name: str | None = None) -> Level:
+def parse_text(
+    text: str, source: str = "<text>", *, tile: float = DEFAULT_TILE, name: str | None = None,
+) -> Level:
     """A :class:`Level` from a text map (see the module docstring for the characters)."""
     def fail(msg: str) -> None:
         raise LevelError(f"{source}: {msg}")
@@ -384,7 +383,8 @@ def _layer_data(layer: dict, width: int, height: int, fail, where: str) -> list[
             fail(f"{where}: 'data' must be a list of tile ids (non-negative integers)")
         gids = data
     if len(gids) != width * height:
-        fail(f"{where} has {len(gids)} tiles, expected width x height = {width} x {height} = {width * height}")
+        fail(f"{where} has {len(gids)} tiles, expected width x height = "
+             f"{width} x {height} = {width * height}")
     return gids
 
 
@@ -463,7 +463,8 @@ def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
         elif o.kind == "coin":
             entry.update(x=o.x, y=map_h - o.y, width=0, height=0, point=True)
         else:
-            entry.update(x=o.x - o.width * 0.5, y=map_h - (o.y + o.height * 0.5), width=o.width, height=o.height)
+            entry.update(x=o.x - o.width * 0.5, y=map_h - (o.y + o.height * 0.5),
+                         width=o.width, height=o.height)
         if o.props:
             entry["properties"] = [
                 {"name": k, "type": "bool" if isinstance(v, bool) else "float" if isinstance(v, float)
@@ -494,7 +495,8 @@ def dump_tmj(tmj: dict[str, Any]) -> str:
     for layer in tmj["layers"]:
         if layer["type"] == "tilelayer":
             w = layer["width"]
-            rows = [", ".join(str(g) for g in layer["data"][i:i + w]) for i in range(0, len(layer["data"]), w)]
+            data = layer["data"]
+            rows = [", ".join(str(g) for g in data[i:i + w]) for i in range(0, len(data), w)]
             body = {k: v for k, v in layer.items() if k != "data"}
             text = json.dumps(body)[:-1] + ', "data": [\n        ' + ",\n        ".join(rows) + "\n      ]}"
         else:
@@ -503,20 +505,5 @@ def dump_tmj(tmj: dict[str, Any]) -> str:
             text = json.dumps(body)[:-1] + ', "objects": [\n        ' + objs + "\n      ]}"
         layers.append(text)
     head = {k: v for k, v in tmj.items() if k != "layers"}
-    return json.dumps(head, indent=2)[:-2] + ',\n  "layers": [\n      ' + ",\n      ".join(layers) + "\n  ]\n}\n"
-
-
-def main(argv: list[str] | None = None) -> int:
-    """``python -m examples.platformer.levels IN.txt OUT.tmj [TITLE]``: convert a text map."""
-    args = sys.argv[1:] if argv is None else argv
-    if len(args) not in (2, 3):
-        print(main.__doc__, file=sys.stderr)
-        return 2
-    level = load_level(args[0])
-    Path(args[1]).write_text(dump_tmj(to_tmj(level, args[2] if len(args) == 3 else None)), encoding="utf-8")
-    parse_tmj(json.loads(Path(args[1]).read_text(encoding="utf-8")), args[1])  # it loads back
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    body = ",\n      ".join(layers)
+    return json.dumps(head, indent=2)[:-2] + ',\n  "layers": [\n      ' + body + "\n  ]\n}\n"

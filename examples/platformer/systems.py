@@ -6,26 +6,27 @@ Where each runs in a step (see :func:`install`)::
     movement          (framework: integrate velocities, gravity)
     after movement    carry_riders      the moving platform's displacement to whoever stands on it
     ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide)
-    after response    sense_player -> sense_enemies -> fall_out -> follow_camera
+    after response    sense_player -> sense_enemies -> fall_out -> face -> follow_camera
     end of step       collision handlers: coins, spikes, enemies, checkpoints, the goal
 
 Everything collision-related comes from the pipeline: the contacts it found this step
-(``scene.contacts``), its events (``scene.on_collision``) and ``scene.query_box``.
+(``scene.contacts``), its events (``scene.on_collision``), its queries (``scene.query_point``) and
+``framework.collide`` to check a reported contact after the response.
 """
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from framework import Hitbox, Transform, Velocity
+from framework import AABB, Hitbox, Transform, Velocity, collide
 from framework.components import Visual
 from framework.events import CollisionEvent
 from framework.input import Input
 
 from .components import (
-    HAZARD,
     ONE_WAY,
     SOLID,
     Checkpoint,
@@ -61,7 +62,7 @@ def _tile(scene: Scene) -> float:
 
 
 def level_flow(scene: Scene, dt: float) -> None:
-    """Game keys (R restart, F1 debug, Esc quit) and level changes.
+    """R restarts the level; level changes (F1 and Esc are the window runner's).
 
     A level change takes two steps: this step despawns the old level (despawns wait for the end
     of the step), the next one spawns the new level before anything moves."""
@@ -69,16 +70,9 @@ def level_flow(scene: Scene, dt: float) -> None:
 
     state, keys = _state(scene), scene.resources[Input]
     game: Game = scene.resources[Game]
-    if keys.was_pressed("escape"):
-        state.quit = True
-    if keys.was_pressed("f1"):
-        state.debug = not state.debug
-        renderer = scene.renderer
-        if renderer is not None and hasattr(renderer, "debug"):
-            renderer.debug = state.debug
     if keys.was_pressed("r") and state.pending is None:
         state.pending, state.pending_stage = "restart", 0
-    if state.reached_goal and state.goal_timer > 0.0:
+    if state.level_done and state.goal_timer > 0.0:
         state.goal_timer -= dt
         if state.goal_timer <= 0.0 and state.pending is None:
             if state.level_index + 1 < len(game.levels):
@@ -97,17 +91,22 @@ def level_flow(scene: Scene, dt: float) -> None:
 
 
 def move_platforms(scene: Scene, dt: float) -> None:
-    """Steer each moving platform toward its current end; turn around on arrival."""
+    """Steer each moving platform toward its current end; wait there a moment, then turn back."""
     for _e, (plat, t, v) in scene.query(MovingPlatform, Transform, Velocity):
+        plat.start_pos = (t.x, t.y)  # carry_riders and sense_player take the difference
+        if plat.waiting > 0.0:
+            plat.waiting -= dt
+            v.x = v.y = 0.0
+            continue
         tx, ty = plat.end if plat.toward_end else plat.start
         dx, dy = tx - t.x, ty - t.y
         dist = (dx * dx + dy * dy) ** 0.5
         if dist <= plat.speed * dt:
-            v.x, v.y = dx / dt, dy / dt  # arrive exactly this step, then head back
+            v.x, v.y = dx / dt, dy / dt  # arrive exactly this step, then wait and head back
             plat.toward_end = not plat.toward_end
+            plat.waiting = plat.pause
         else:
             v.x, v.y = dx / dist * plat.speed, dy / dist * plat.speed
-        plat.start_pos = (t.x, t.y)  # carry_riders and sense_player take the difference
 
 
 def control_player(scene: Scene, dt: float) -> None:
@@ -196,32 +195,39 @@ def _touching(scene: Scene, entity: int) -> list[tuple[int, float, float, float]
     return out
 
 
-def _below_feet(scene: Scene, t: Transform, hb: Hitbox, mask: int) -> list[int]:
-    """Entities in a thin box just under a body's feet, a hair narrower than the body.
+def _on_top_of(t: Transform, hb: Hitbox, other_t: Transform, other_hb: Hitbox) -> bool:
+    """Whether ``other`` is right under the feet: it overlaps a thin box just below the body, a
+    hair narrower than the body (``framework.collide``, after the response has pushed the body out).
 
-    Asked after the response, when a body on the ground merely touches it. The pipeline's raw
-    contacts are not enough: a body pushed against a wall of tiles also overlaps, by a sliver, the
-    top of the tile below the one it hits (a contact with an upward normal that the response
-    then discards), which would let it jump off walls."""
+    The pipeline's raw contacts alone are not enough: a body pushed against a wall of tiles also
+    overlaps, by a sliver, the top of the tile below the one it hits, a contact with an upward
+    normal that the response then discards (it resolves the deepest contact first and measures
+    the others again); taken as ground, it would let the player jump off walls."""
     w, h = hb.shape.width, hb.shape.height
     x, bottom = t.x + hb.offset[0], t.y + hb.offset[1] - h * 0.5
-    inset, depth = 1e-3 * w, 0.05 * h
-    return scene.query_box(x - w * 0.5 + inset, bottom - depth, x + w * 0.5 - inset, bottom, mask=mask)
+    depth = 0.05 * h
+    feet = AABB(w * (1.0 - 2e-3), depth)
+    ox, oy = other_hb.offset
+    pose = (other_t.x + ox, other_t.y + oy, other_t.rotation)  # tiles and platforms: offsets never turn
+    return collide(feet, (x, bottom - depth * 0.5), other_hb.shape, pose) is not None
 
 
 def sense_player(scene: Scene, dt: float) -> None:
-    """Grounded: something solid right under the feet after the response (``scene.query_box``).
+    """Grounded: one of this step's contacts (``scene.contacts``) is below the player, with an
+    upward normal, and still right under the feet after the response.
 
     A one-way platform counts only if the feet were on or above its top when the step began (the
     pipeline's own landing rule), so rising through one or standing inside it is not standing on
     it; nothing counts while moving up, away from it. On a moving platform the player's vertical
     velocity is kept relative to it (zero while standing): carry_riders moves the player with it."""
     tol = 1e-3 * _tile(scene)
-    for _e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
+    for e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
         ground, best = None, -1
-        for other in _below_feet(scene, t, hb, hb.mask & (SOLID | ONE_WAY)):
-            ohb = scene.get(other, Hitbox)
-            if ohb.sensor:
+        for other, _nx, ny, _depth in _touching(scene, e):
+            if ny < GROUND_NORMAL:
+                continue
+            ohb = scene.try_get(other, Hitbox)
+            if ohb is None or ohb.sensor or scene.try_get(other, Enemy) is not None:
                 continue
             plat = scene.try_get(other, MovingPlatform)
             ov = scene.try_get(other, Velocity)
@@ -229,12 +235,14 @@ def sense_player(scene: Scene, dt: float) -> None:
             rel = p.vy_start if other == p.ground or ov is None else v.y - ov.y
             if rel > 1e-9:
                 continue
+            ot = scene.get(other, Transform)
             if ohb.one_way:
-                ot = scene.get(other, Transform)
                 y0 = plat.start_pos[1] if plat is not None else ot.y
                 top = y0 + ohb.offset[1] + ohb.shape.height * 0.5
                 if p.prev_bottom < top - tol:
                     continue
+            if not _on_top_of(t, hb, ot, ohb):
+                continue
             rank = 1 if plat is not None else 0  # on a platform and a tile at once: ride
             if rank > best:
                 ground, best = other, rank
@@ -245,33 +253,56 @@ def sense_player(scene: Scene, dt: float) -> None:
 
 
 def sense_enemies(scene: Scene, dt: float) -> None:
-    """Walkers turn where the response stopped them (a wall, another enemy) and before ledges
-    and spikes (``scene.query_box`` just ahead of their feet)."""
+    """Walkers turn where the response stopped them (a wall, another enemy), where they touch
+    spikes ahead (the pipeline's contacts with the sensor), and before a ledge
+    (``scene.query_point`` just ahead of and below their feet finds no ground; moving platforms
+    do not count, walkers keep off them)."""
     tile = _tile(scene)
-    for _e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
-        w, h = hb.shape.width, hb.shape.height
+    for e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
         turn = abs(v.x) < 0.5 * en.speed  # the response took away its walking speed
-        grounded = bool(_below_feet(scene, t, hb, SOLID | ONE_WAY))
+        grounded = False
+        for other, _nx, ny, _depth in _touching(scene, e):
+            if scene.try_get(other, Hazard) is not None:
+                if (scene.get(other, Transform).x - t.x) * en.direction > 0:
+                    turn = True  # spikes ahead
+            elif ny >= GROUND_NORMAL and not scene.get(other, Hitbox).sensor:
+                grounded = True
         if grounded and not turn:
-            front = t.x + en.direction * (w * 0.5 + 0.1 * tile)
-            bottom = t.y - h * 0.5
-            probe = (front - 0.05 * tile, bottom - 0.25 * tile, front + 0.05 * tile, bottom - 0.05 * tile)
-            if not scene.query_box(*probe, mask=SOLID | ONE_WAY):
+            front = t.x + en.direction * (hb.shape.width * 0.5 + 0.1 * tile)
+            below = t.y - hb.shape.height * 0.5 - 0.1 * tile
+            # Walkers keep off moving platforms, so the ground ahead is static and changes only
+            # where the probe enters another tile: the query is asked again only then.
+            cell = (math.floor(front / tile), math.floor(below / tile))
+            if cell != en.probe_cell:
+                en.probe_cell = cell
+                en.probe_ground = any(scene.try_get(o, MovingPlatform) is None
+                                      for o in scene.query_point(front, below, mask=SOLID | ONE_WAY))
+            if not en.probe_ground:
                 turn = True  # a ledge ahead
-            elif scene.query_box(front - 0.05 * tile, bottom + 0.05 * tile, front + 0.05 * tile,
-                                 bottom + 0.3 * tile, mask=HAZARD):
-                turn = True  # spikes ahead
         if turn and en.turned_frame != scene.frame:
             en.direction = -en.direction
             en.turned_frame = scene.frame
 
 
 def fall_out(scene: Scene, dt: float) -> None:
-    """Falling below the level kills."""
-    state = _state(scene)
+    """Falling below the level kills the player, and removes an enemy."""
+    floor = _state(scene).bounds[1] - 2.0 * _tile(scene)
     for e, (_p, t) in scene.query(Player, Transform):
-        if t.y < state.bounds[1] - 2.0 * _tile(scene):
+        if t.y < floor:
             kill_player(scene, e)
+    for e, (_en, t) in scene.query(Enemy, Transform):
+        if t.y < floor and scene.exists(e):
+            scene.despawn(e)
+
+
+def face(scene: Scene, dt: float) -> None:
+    """The player's picture looks the way it last ran (levels drawn with images only)."""
+    if not _state(scene).art:
+        return
+    for _e, (p, vis) in scene.query(Player, Visual):
+        want = "player_right.png" if p.facing > 0 else "player_left.png"
+        if vis.image is not None and not vis.image.endswith(want):
+            vis.image = vis.image.replace("player_left.png" if p.facing > 0 else "player_right.png", want)
 
 
 def follow_camera(scene: Scene, dt: float) -> None:
@@ -343,7 +374,7 @@ def on_enemy(scene: Scene, ev: CollisionEvent) -> None:
         scene.get(player, Velocity).y = (tu.jump_speed if held else tu.stomp_bounce) * tile
         p.jumping = held
         p.grounded, p.ground = False, None
-        _state(scene).messages.append("stomp")
+        _state(scene).stomps += 1
     else:
         kill_player(scene, player)
 
@@ -358,17 +389,21 @@ def on_checkpoint(scene: Scene, ev: CollisionEvent) -> None:
     t, hb = scene.get(ev.b, Transform), scene.get(ev.b, Hitbox)
     _state(scene).checkpoint = (t.x, t.y - hb.shape.height * 0.5)
     for _e, (c, vis) in scene.query(Checkpoint, Visual):
-        vis.color = (*CHECKPOINT_ON, 255) if c.active else (150, 150, 150, 255)
+        if vis.image is not None:
+            vis.image = vis.image.replace("checkpoint_on.png", "checkpoint.png")
+            if c.active:
+                vis.image = vis.image.replace("checkpoint.png", "checkpoint_on.png")
+        else:
+            vis.color = (*CHECKPOINT_ON, 255) if c.active else (150, 150, 150, 255)
 
 
 def on_goal(scene: Scene, ev: CollisionEvent) -> None:
     state = _state(scene)
-    if state.goal_timer > 0.0 or state.pending is not None:
+    if state.level_done or state.pending is not None:
         return
-    if not state.reached_goal or state.levels_completed <= state.level_index:
-        state.reached_goal = True
-        state.levels_completed += 1
-        state.goal_timer = 1.0  # a moment to see it, then the next level
+    state.level_done = state.reached_goal = True
+    state.levels_completed += 1
+    state.goal_timer = 1.0  # a moment to see it, then the next level
 
 
 def install(scene: Scene) -> None:
@@ -378,7 +413,7 @@ def install(scene: Scene) -> None:
     for system in (level_flow, move_platforms, control_player, walk_enemies):
         scene.add_system(system, before="movement")
     scene.add_system(carry_riders, after="movement")
-    for system in (sense_player, sense_enemies, fall_out, follow_camera):
+    for system in (sense_player, sense_enemies, fall_out, face, follow_camera):
         scene.add_system(system, after="response")
     scene.on_collision(P, Coin, on_coin)
     scene.on_collision(P, Hazard, on_hazard, kinds=("started", "ongoing"))

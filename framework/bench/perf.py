@@ -35,6 +35,7 @@ from ..shapes import AABB
 from .progress import Progress
 from .report import (
     Column,
+    fmt,
     format_table,
     frozen_gc,
     machine_info,
@@ -325,12 +326,13 @@ def _row(name: str, wl: Workload, tasks: dict[str, Task], label: str, ctx: dict[
     pm_ms = median(pm.ms) if pm is not None else None
     floor_ms = median(floor.ms)
     pairs = median(e["pairs"] for e in ours.extra)
-    per_step_other = [t - sum(v for k, v in e.items() if k != "pairs") for t, e in zip(ours.ms, ours.extra)]
+    # the rest of the median step: validation, hooks, event bookkeeping outside the stages, timing
+    other = max(0.0, ms - sum(v for v in stages.values() if v is not None))
     return {
         "scene": name, "bodies": wl.n, "static": wl.tiles, "ms_per_step": ms, "pymunk_ms_per_step": pm_ms,
         "ratio": ms / pm_ms if pm_ms else None, "pairs": pairs,
         "movement_ms": stages["movement"], "broad_ms": stages["broad_phase"], "narrow_ms": stages["narrow_phase"],
-        "response_ms": stages["response"], "other_ms": median(per_step_other),
+        "response_ms": stages["response"], "other_ms": other,
         "floor_ms": floor_ms, "floor_ratio": ms / floor_ms if floor_ms else None,
         "pairs_per_body": pairs / wl.n if pairs is not None else None,
         "cell_size": ctx["cell_size"], "rounds": len(ours.ms),
@@ -415,7 +417,8 @@ def run_perf(
             "boxes": "AABB, width and height uniform in [4, 16]", "velocity": "uniform in [-0.5, 0.5] per axis",
             "dt": DT, "world_side": "sqrt(N) * 14", "gravity": [0.0, 0.0], "effects": list(EFFECTS),
             "tiles": f"{tiles} static unit tiles on a unit grid below the movers, never touched",
-            "seed": seed, "warmup": WARMUP, "brute_force": "brute_force_pairs + the AABB narrow kernel (detection only)",
+            "seed": seed, "warmup": WARMUP,
+            "brute_force": "brute_force_pairs + the AABB narrow kernel (detection only)",
             "floor": "SpatialHash.pairs alone on the same bounds and cell size",
         },
         "rows": rows,
@@ -472,6 +475,36 @@ def _goal_rows(report):
     return [dict(g, verdict={True: "pass", False: "FAIL", None: "n/a"}[g["pass"]]) for g in report["goals"]]
 
 
+def notes(report: dict[str, Any]) -> list[str]:
+    """Observations computed from the rows (so they stay true when the numbers move)."""
+    rows = report["rows"]
+    out = []
+    plain = [r for r in rows if r["scene"].startswith("boxes-") and "+" not in r["scene"]]
+    if plain:
+        big = max(plain, key=lambda r: r["bodies"])
+        parts = {"movement": big["movement_ms"], "broad phase": big["broad_ms"], "narrow phase": big["narrow_ms"],
+                 "response": big["response_ms"], "other": big["other_ms"]}
+        tot = sum(v or 0.0 for v in parts.values()) or 1.0
+        shares = ", ".join(f"{k} {100 * (v or 0.0) / tot:.0f}%" for k, v in
+                           sorted(parts.items(), key=lambda kv: -(kv[1] or 0.0)))
+        out.append(f"At {big['bodies']:,} boxes the step splits: {shares}.")
+        out.append("Pairs per box during the timed steps: "
+                   + ", ".join(f"{_label(r['bodies'])} {r['pairs_per_body']:.2f}" for r in plain)
+                   + " (about 1.0 at set-up; the response pushes boxes apart, so the steady state has fewer).")
+    tiles = next((r for r in rows if "+tiles" in r["scene"]), None)
+    base = tiles and _find(rows, tiles["scene"].split("+")[0])
+    if tiles and base:
+        out.append(
+            f"Tiles level: the scene's automatic cell size is {tiles['cell_size']:.3g} (from the median body "
+            f"extent when the statics are entered: the unit tiles) against {base['cell_size']:.3g} without tiles; "
+            f"broad phase {fmt(tiles['broad_ms'], 'ms')} ms against {fmt(base['broad_ms'], 'ms')} ms "
+            f"(floor {fmt(tiles['floor_ms'], 'ms')} against {fmt(base['floor_ms'], 'ms')}), response "
+            f"{fmt(tiles['response_ms'], 'ms')} against {fmt(base['response_ms'], 'ms')} ms, movement "
+            f"{fmt(tiles['movement_ms'], 'ms')} against {fmt(base['movement_ms'], 'ms')} ms, for the same "
+            f"{tiles['bodies']:,} movers and the same pairs ({tiles['pairs']:.0f} and {base['pairs']:.0f}).")
+    return out
+
+
 def text_report(report: dict[str, Any]) -> str:
     m = report["machine"]
     lines = [
@@ -486,6 +519,7 @@ def text_report(report: dict[str, Any]) -> str:
         "",
         "pair checks (pipeline == brute_force_pairs): "
         + ", ".join(f"{c['bodies']} moving + {c['static']} static: ok" for c in report["checks"]),
+        *notes(report),
     ]
     if m["pymunk"] is None:
         lines.append("pymunk is not installed (pip install 'framework[bench]'): its columns are empty.")
@@ -512,6 +546,8 @@ def markdown(report: dict[str, Any], command: str, plot: str | None) -> str:
         "Pair check before timing (the pipeline's candidate pairs == `brute_force_pairs` on the same "
         "bounds, 3 steps each): " + ", ".join(f"{c['bodies']:,} moving + {c['static']:,} static"
                                               for c in report["checks"]) + ": all equal.",
+        "",
+        *(f"- {n}" for n in notes(report)),
     ]
     if plot:
         parts += ["", f"![ms per step against N, log-log, and the per-stage split]({plot})"]

@@ -1,8 +1,8 @@
 """A small progress bar on stderr (no dependency).
 
 On a terminal it redraws one line in place (``\\r``); elsewhere (a log, a pipe) it prints a line
-only when a task starts and when the bar finishes, so logs stay short. ``Progress(total=0)`` and
-``enabled=False`` print nothing.
+with the count and the task at most every few seconds, and one when it finishes, so logs stay
+short. ``Progress(total=0)`` and ``enabled=False`` print nothing.
 """
 
 from __future__ import annotations
@@ -29,6 +29,8 @@ class Progress:
         self.note = ""
         self.t0 = time.perf_counter()
         self._last_draw = 0.0
+        self._last_line: float | None = None
+        self.log_every = 5.0  # seconds between lines when not on a terminal
 
     def __enter__(self) -> Progress:
         self._draw(force=True)
@@ -42,8 +44,12 @@ class Progress:
         if note != self.note:
             self.note = note
             if self.enabled and not self.tty:
-                self.stream.write(f"{self.label}: {note} ...\n")
-                self.stream.flush()
+                now = time.perf_counter()
+                if self._last_line is None or now - self._last_line >= self.log_every:
+                    self._last_line = now
+                    pct = 100 * self.done / self.total if self.total else 100.0
+                    self.stream.write(f"{self.label}: {self.done}/{self.total} ({pct:.0f}%) {note} ...\n")
+                    self.stream.flush()
             self._draw(force=True)
 
     def advance(self, n: int = 1, note: str | None = None) -> None:

@@ -62,7 +62,7 @@ def frozen_gc():
 
 def machine_info() -> dict[str, Any]:
     info: dict[str, Any] = {
-        "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "date": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "python": platform.python_version(),
         "numpy": np.__version__,
         "platform": platform.platform(terse=True),

@@ -84,7 +84,9 @@ class Camera:
         try:
             x0, y0, x1, y1 = (finite("Camera bounds", v) for v in value)
         except (TypeError, ValueError) as exc:
-            raise InvalidValue(f"Camera bounds must be (minx, miny, maxx, maxy), got {value!r}: {exc}") from None
+            raise InvalidValue(
+                f"Camera bounds must be (minx, miny, maxx, maxy), got {value!r}: {exc}"
+            ) from None
         if not (x1 > x0 and y1 > y0):
             raise InvalidValue(f"Camera bounds need maxx > minx and maxy > miny, got {value!r}")
         self._bounds = (x0, y0, x1, y1)

@@ -23,7 +23,7 @@ import pyglet
 from pyglet import gl
 from pyglet.graphics import Batch, Group
 
-from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, STATIC
+from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON
 
 __all__ = ["OVERLAY_COLORS", "DebugOverlay"]
 
@@ -116,7 +116,8 @@ def _outline_segments(store: Any, geom: Any, rows: np.ndarray) -> list[tuple[np.
         col = np.broadcast_to(colors[ci][:, None, :], seg.shape[:2] + (4,))
         out.append((seg.reshape(-1, 4), col.reshape(-1, 4)))
         rot = store.rot[rows[ci]]
-        spoke = np.stack([hx[ci], hy[ci], hx[ci] + r[:, 0] * np.cos(rot), hy[ci] + r[:, 0] * np.sin(rot)], axis=1)
+        rim = r[:, 0]
+        spoke = np.stack([hx[ci], hy[ci], hx[ci] + rim * np.cos(rot), hy[ci] + rim * np.sin(rot)], axis=1)
         out.append((spoke, colors[ci]))
     return out
 
@@ -129,7 +130,8 @@ class DebugOverlay:
         ctx = gl.current_context
         self._program = ctx.create_program((_VERTEX, "vertex"), (_FRAGMENT, "fragment"))
         self._vao = pyglet.graphics.vertexarray.VertexArray()
-        self._vbo = pyglet.graphics.vertexbuffer.BufferObject(_VERTEX_DTYPE.itemsize * 64, gl.GL_STREAM_DRAW)
+        self._vbo = pyglet.graphics.vertexbuffer.BufferObject(_VERTEX_DTYPE.itemsize * 64,
+                                                              gl.GL_STREAM_DRAW)
         attrs = self._program.attributes
         with self._vao:
             self._vbo.bind()
@@ -231,12 +233,16 @@ class DebugOverlay:
     def _hud_lines(scene: Any, renderer: Any) -> str:
         fps = f"{renderer.fps:.0f}" if renderer.fps > 0 else "-"
         stats = renderer.stats
-        head = (f"FPS {fps}   entities {len(scene.store.row_of)}   drawn {stats.get('drawn', 0)}   "
-                f"contacts {len(scene.contacts.a)}   frame {scene.frame}")
-        ms = scene.stage_ms
-        stages = "   ".join(f"{k} {v:.2f}" for k, v in ms.items())
+        head = (f"FPS {fps}  entities {len(scene.store.row_of)}  drawn {stats.get('drawn', 0)}  "
+                f"contacts {len(scene.contacts.a)}  frame {scene.frame}")
+        ms = dict(scene.stage_ms)
+        if ms and "render" not in ms and renderer.draw_ms > 0:  # this stage is running: the last one's time
+            ms["render"] = renderer.draw_ms
+        stages = "  ".join(f"{k} {v:.2f}" for k, v in ms.items())
         total = sum(ms.values())
-        return f"{head}\nms/step: {stages}   total {total:.2f}" if ms else f"{head}\nms/step: (not stepped yet)"
+        if not ms:
+            return f"{head}\nms/step: (not stepped yet)"
+        return f"{head}\nms/step: {stages}  total {total:.2f}"
 
     def _upload(self, seg: np.ndarray, col: np.ndarray) -> None:
         m = seg.shape[0]

@@ -22,6 +22,7 @@ multi-draw call per group and state, whatever the number of entities.
 from __future__ import annotations
 
 import math
+import time
 from typing import Any
 
 import numpy as np
@@ -31,7 +32,7 @@ from pyglet.graphics import Batch, Group
 from pyglet.math import Mat4
 
 from ..components import Visual
-from ..store import KIND_AABB, KIND_POLYGON, STATIC
+from ..store import KIND_POLYGON, STATIC
 from .camera import Camera
 from .drawables import ConvexFill, Drawable, fill_triangles, load_image
 from .overlay import DebugOverlay
@@ -72,6 +73,7 @@ class Renderer:
         self.background = tuple(background)
         self.window = window
         self.fps = 0.0  # frames shown per second, measured by the window runner
+        self.draw_ms = 0.0  # how long the last draw (the render stage) took
         #: what the last draw did: visible rows, drawables shown, made, moved, deleted
         self.stats: dict[str, int] = {}
         self._batch: Batch | None = None
@@ -117,6 +119,7 @@ class Renderer:
         """The render stage: follow the camera's target, cull, and bring the drawables (and the
         overlay, with ``debug``) up to date with the scene. No GL draw call happens here."""
         prev = self._enter()
+        t0 = time.perf_counter()
         try:
             self._frame += 1
             self.camera.update(scene, self.width, self.height)
@@ -125,6 +128,7 @@ class Renderer:
             if store.version != self._gone_version:
                 self._forget_gone(store)
                 self._gone_version = store.version
+            self._first_sight(scene)
             rows = self.visible_rows(scene)
             self._sync(scene, rows)
             if self._frame % _SWEEP_EVERY == 0:
@@ -135,6 +139,7 @@ class Renderer:
                 self._overlay.build(scene, self, rows)
             self._scene_entities = len(store.row_of)
         finally:
+            self.draw_ms = (time.perf_counter() - t0) * 1e3
             self._leave(prev)
 
     def visible_rows(self, scene: Any) -> np.ndarray:
@@ -172,6 +177,23 @@ class Renderer:
         return np.sort(cand[inside])
 
     # --- bookkeeping ------------------------------------------------------------------------
+
+    def _first_sight(self, scene: Any) -> None:
+        """Look once at each entity not seen before: a sprite's reach beyond the entity's bounds
+        must be known before culling can keep a sprite that hangs into the view."""
+        store = scene.store
+        if store.n == 0:
+            return
+        ents = store.entity
+        self._grow(int(ents.max()) + 1)
+        new = ents[~self._seen[ents]]
+        if new.size:
+            for e in new.tolist():
+                vis = scene.try_get(e, Visual)
+                if vis is not None and vis.image is not None:
+                    tex = self._image(vis.image, e)
+                    self._pad[e] = 0.5 * math.hypot(tex.width, tex.height)
+            self._seen[new] = True
 
     def _grow(self, size: int) -> None:
         have = self._pad.shape[0]
@@ -225,7 +247,9 @@ class Renderer:
             try:
                 tex = load_image(path)
             except Exception as exc:  # a missing or unreadable file: say which entity and path
-                raise ValueError(f"entity {entity}: Visual image {path!r} could not be loaded: {exc}") from exc
+                raise ValueError(
+                    f"entity {entity}: Visual image {path!r} could not be loaded: {exc}"
+                ) from exc
             self._images[path] = tex
         return tex
 
@@ -254,13 +278,6 @@ class Renderer:
         made = moved_n = 0
         if rows.size:
             self._grow(int(ents.max()) + 1)
-            # First sight of an entity: learn its sprite's reach, so culling can use it from now on.
-            new = ents[~self._seen[ents]]
-            for e in new.tolist():
-                vis = scene.try_get(e, Visual)
-                if vis is not None and vis.image is not None:
-                    self._pad[e] = 0.5 * math.hypot(*_image_size(self._image(vis.image, e)))
-            self._seen[ents] = True
         cur = np.stack([geom.hx[rows], geom.hy[rows], store.x[rows], store.y[rows], store.rot[rows]], axis=1)
         moved = (cur != self._last[ents]).any(axis=1) if rows.size else np.zeros(0, dtype=bool)
         self._last[ents] = cur
@@ -406,7 +423,3 @@ class Renderer:
     def scene_entities(self) -> int:
         """Entities with a Transform in the scene at the last draw."""
         return self._scene_entities
-
-
-def _image_size(tex: Any) -> tuple[int, int]:
-    return tex.width, tex.height

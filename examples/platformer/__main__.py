@@ -1,0 +1,137 @@
+"""Command line: ``python -m examples.platformer [options]``.
+
+Plays in a window by default (arrows/WASD to run, space/up/W to jump, down+jump to drop through a
+one-way platform, R to restart the level, F1 for the debug overlay, Esc to quit).
+
+--headless         run without a window; print a one-line JSON summary as the last line
+--demo             scripted input instead of the keyboard (headless: stops at the first goal)
+--frames N         stop after N frames (headless default: 600, or 3600 with --demo)
+--level PATH       play this map (.tmj or .txt) instead of the shipped levels
+--screenshot PATH  after the run, write a PNG of the last frame (headless rendering)
+--debug            start with the debug overlay (and draw it in the screenshot)
+--zoom Z           camera zoom (screen pixels per world unit)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from typing import Any
+
+from .demo import Autoplay, level1, play_all
+from .game import DT, Game
+from .levels import LevelError, builtin_levels
+
+WIDTH, HEIGHT = 960, 540
+BACKGROUND = (24, 26, 38)
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    ap = argparse.ArgumentParser(prog="python -m examples.platformer", description="The example platformer.")
+    ap.add_argument("--headless", action="store_true", help="run without a window and print a JSON summary")
+    ap.add_argument("--demo", action="store_true", help="scripted input that plays the first level")
+    ap.add_argument("--frames", type=int, default=None, metavar="N", help="stop after N frames")
+    ap.add_argument("--level", default=None, metavar="PATH", help="a level file (.tmj or .txt)")
+    ap.add_argument("--screenshot", default=None, metavar="PATH", help="write a PNG of the last frame")
+    ap.add_argument("--debug", action="store_true", help="start with the debug overlay")
+    ap.add_argument("--zoom", type=float, default=1.0, metavar="Z", help="camera zoom (default 1)")
+    args = ap.parse_args(argv)
+    if args.frames is not None and args.frames < 0:
+        ap.error(f"--frames must be >= 0, got {args.frames}")
+    if not args.zoom > 0:
+        ap.error(f"--zoom must be > 0, got {args.zoom}")
+    return args
+
+
+def make_game(args: argparse.Namespace) -> Game:
+    levels = [args.level] if args.level else builtin_levels()
+    autoplay = None
+    if args.demo:
+        autoplay = Autoplay(level1 if args.headless or args.level else play_all)
+    view = (WIDTH / args.zoom, HEIGHT / args.zoom)
+    return Game(levels, view=view, autoplay=autoplay)
+
+
+def camera_for(game: Game, zoom: float) -> Any:
+    from framework.render import Camera
+
+    return Camera(target=game.state.player, bounds=game.state.bounds, zoom=zoom)
+
+
+def hud(game: Game) -> str:
+    st = game.state
+    text = (f"Platformer - {st.level_name} ({st.level_index + 1}/{len(game.levels)}) - "
+            f"coins {st.coins_in_level}/{st.coin_total_in_level} - deaths {st.deaths}")
+    if st.finished:
+        text += " - all levels done! R replays the last one"
+    elif st.level_done:
+        text += " - level complete!"
+    return text
+
+
+def run_headless(game: Game, args: argparse.Namespace) -> dict[str, Any]:
+    limit = args.frames if args.frames is not None else (3600 if args.demo else 600)
+    frames = 0
+    t0 = time.perf_counter()
+    while frames < limit:
+        if args.demo and game.state.reached_goal:
+            break
+        game.step()
+        frames += 1
+    elapsed = time.perf_counter() - t0
+    return {"frames": frames, "ms_per_frame": round(1e3 * elapsed / max(frames, 1), 4)}
+
+
+def run_window(game: Game, args: argparse.Namespace) -> dict[str, Any]:
+    from framework.render import run
+
+    scene = game.scene
+    camera = camera_for(game, args.zoom)
+
+    def window_hud(scene: Any, dt: float) -> None:
+        # The camera follows whichever player entity the current level has; the title is the HUD.
+        renderer = scene.renderer
+        if renderer is None:
+            return
+        renderer.camera.target = game.state.player
+        renderer.camera.bounds = game.state.bounds
+        renderer.background = BACKGROUND
+        window = getattr(renderer, "window", None)
+        text = hud(game)
+        if window is not None and getattr(window, "caption", None) != text:
+            window.set_caption(text)
+
+    scene.add_system(window_hud, after="response")
+    t0 = time.perf_counter()
+    run(scene, width=WIDTH, height=HEIGHT, title=hud(game), fps=round(1.0 / DT), camera=camera,
+        debug=args.debug, max_frames=args.frames)
+    ms = 1e3 * (time.perf_counter() - t0) / max(scene.frame, 1)
+    return {"frames": scene.frame, "ms_per_frame": round(ms, 4)}
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    try:
+        game = make_game(args)
+    except LevelError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    with game:
+        result = run_headless(game, args) if args.headless else run_window(game, args)
+        if args.screenshot:
+            from framework.render import screenshot
+
+            screenshot(game.scene, args.screenshot, width=WIDTH, height=HEIGHT,
+                       camera=camera_for(game, args.zoom), debug=args.debug, background=BACKGROUND)
+        if args.headless:
+            summary = {**result, **game.summary(), "levels": len(game.levels)}
+            if args.screenshot:
+                summary["screenshot"] = args.screenshot
+            print(json.dumps(summary))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,181 @@
+"""The platformer's tile images, drawn by code: ``python -m examples.platformer.art`` writes them.
+
+``images/``: ``ground.png`` and ``ground_top.png`` (a solid tile inside the ground and on its
+surface), ``plank.png`` (a one-way platform's slab), the player (looking either way), the enemy,
+the goal's and the checkpoints' flags; ``levels/tiles.png``: the tileset the ``.tmj`` maps name,
+so they open in Tiled with pictures (solid, one-way, spikes). The game uses the images for
+32-unit tiles and plain colours otherwise; runs without a renderer never load them.
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).parent
+IMAGES = HERE / "images"
+TILE = 32
+
+GROUND = (70, 80, 108)
+GROUND_DARK = (56, 64, 88)
+GRASS = (104, 190, 92)
+GRASS_DARK = (70, 150, 70)
+PLANK = (184, 138, 84)
+PLANK_DARK = (128, 90, 52)
+SPIKE = (226, 70, 70)
+
+
+def _noise(h: int, w: int, seed: int) -> np.ndarray:
+    """Deterministic speckle mask: about one pixel in nine."""
+    y, x = np.mgrid[0:h, 0:w]
+    v = (x * 374761393 + y * 668265263 + seed * 2246822519) & 0xFFFFFFFF
+    v = ((v ^ (v >> 13)) * 1274126177) & 0xFFFFFFFF
+    return (v % 9) == 0
+
+
+def _fill(h: int, w: int, color: tuple[int, int, int]) -> np.ndarray:
+    img = np.zeros((h, w, 4), dtype=np.uint8)
+    img[..., :3] = color
+    img[..., 3] = 255
+    return img
+
+
+def ground(top: bool) -> np.ndarray:
+    img = _fill(TILE, TILE, GROUND)
+    img[_noise(TILE, TILE, 1), :3] = GROUND_DARK
+    img[-1, :, :3] = GROUND_DARK  # a faint seam between tiles
+    img[:, -1, :3] = GROUND_DARK
+    if top:
+        x = np.arange(TILE)
+        depth = 5 + ((x * 7) % 5 == 0) + ((x * 3) % 4 == 0)  # grass hanging 5-7 px down
+        for col in range(TILE):
+            img[: depth[col], col, :3] = GRASS
+            img[depth[col] - 1, col, :3] = GRASS_DARK
+        img[0, :, :3] = (150, 220, 130)
+    return img
+
+
+def plank() -> np.ndarray:
+    img = _fill(8, TILE, PLANK)
+    img[0, :, :3] = (214, 170, 112)
+    img[-1, :, :3] = PLANK_DARK
+    img[:, 0, :3] = img[:, -1, :3] = PLANK_DARK
+    img[3:5, 3:5, :3] = img[3:5, -5:-3, :3] = PLANK_DARK  # nails
+    return img
+
+
+def spikes() -> np.ndarray:
+    img = np.zeros((TILE, TILE, 4), dtype=np.uint8)
+    h = int(0.55 * TILE)
+    for row in range(h):  # rows from the tip down (image rows are top first)
+        half = 0.42 * TILE * (row + 1) / h
+        y = TILE - h + row
+        x0, x1 = int(round(TILE / 2 - half)), int(round(TILE / 2 + half))
+        img[y, x0:x1, :3] = SPIKE
+        img[y, x0:x1, 3] = 255
+    return img
+
+
+def _ellipse_mask(h: int, w: int, cy: float, cx: float, ry: float, rx: float) -> np.ndarray:
+    y, x = np.mgrid[0:h, 0:w]
+    return ((y + 0.5 - cy) / ry) ** 2 + ((x + 0.5 - cx) / rx) ** 2 <= 1.0
+
+
+def _outline(img: np.ndarray, color: tuple[int, int, int]) -> None:
+    """Darken the opaque pixels that touch a transparent one (or the edge)."""
+    a = img[..., 3] > 0
+    pad = np.pad(a, 1)
+    inner = pad[:-2, 1:-1] & pad[2:, 1:-1] & pad[1:-1, :-2] & pad[1:-1, 2:]
+    img[a & ~inner, :3] = color
+
+
+def player(facing: int) -> np.ndarray:
+    """24 x 28: a round-cornered blue fellow with eyes looking where he goes."""
+    w, h = 24, 28
+    img = np.zeros((h, w, 4), dtype=np.uint8)
+    body = _ellipse_mask(h, w, 12, 12, 12.5, 12.5) | (np.mgrid[0:h, 0:w][0] >= 12)
+    img[body, :3] = (84, 176, 255)
+    img[body, 3] = 255
+    img[22:, :, :3] = np.where(body[22:, :, None], (60, 130, 210), 0)
+    _outline(img, (34, 84, 150))
+    for ex in (7, 15):
+        x = ex + (1 if facing > 0 else -1)
+        img[8:14, x - 2:x + 2, :3] = 255
+        px = x + (0 if facing > 0 else -2)
+        img[9:13, px:px + 2, :3] = (20, 24, 40)
+    return img
+
+
+def enemy() -> np.ndarray:
+    """24 x 22: a grumpy purple dome on dark feet."""
+    w, h = 24, 22
+    img = np.zeros((h, w, 4), dtype=np.uint8)
+    dome = _ellipse_mask(h, w, 12, 12, 12, 12.5) & (np.mgrid[0:h, 0:w][0] < 18)
+    img[dome, :3] = (196, 84, 164)
+    img[dome, 3] = 255
+    img[18:22, 2:10, :3] = img[18:22, 14:22, :3] = (70, 30, 60)
+    img[18:22, 2:10, 3] = img[18:22, 14:22, 3] = 255
+    _outline(img, (120, 40, 100))
+    for x in (6, 14):
+        img[8:13, x:x + 4, :3] = 255
+        img[10:13, x + 1:x + 3, :3] = (20, 24, 40)
+    img[6, 5:10, :3] = img[6, 14:19, :3] = (70, 30, 60)  # brows
+    img[7, 8:10, :3] = img[7, 14:16, :3] = (70, 30, 60)
+    return img
+
+
+def flag(width: int, color: tuple[int, int, int]) -> np.ndarray:
+    """``width`` x 32: a pole with a flag (the goal: 32 wide; a checkpoint: 16)."""
+    img = np.zeros((32, width, 4), dtype=np.uint8)
+    pole = 3 if width < 32 else 8
+    img[2:32, pole:pole + 2] = (200, 200, 210, 255)
+    img[1:3, pole - 1:pole + 3] = (240, 220, 120, 255)
+    fw = width - pole - 3
+    for row in range(3, 13):
+        span = fw - abs(row - 7) * (fw // 10 if width < 32 else 1)
+        img[row, pole + 2:pole + 2 + max(span, 2)] = (*color, 255)
+    img[29:32, max(pole - 3, 0):pole + 5] = (120, 120, 130, 255)
+    return img
+
+
+def tileset() -> np.ndarray:
+    """96 x 32: solid, one-way (a plank on the top quarter), spikes; for Tiled."""
+    img = np.zeros((TILE, 3 * TILE, 4), dtype=np.uint8)
+    img[:, :TILE] = ground(True)
+    img[:8, TILE:2 * TILE] = plank()
+    img[:, 2 * TILE:] = spikes()
+    return img
+
+
+def write_png(path: Path, rgba: np.ndarray) -> None:
+    """``(h, w, 4)`` uint8, top row first, as an RGBA PNG (stdlib only)."""
+    h, w = rgba.shape[:2]
+    raw = np.concatenate([np.zeros((h, 1), dtype=np.uint8), rgba.reshape(h, w * 4)], axis=1).tobytes()
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        crc = zlib.crc32(tag + data) & 0xFFFFFFFF
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", crc)
+
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0))
+                     + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+def main() -> None:
+    IMAGES.mkdir(exist_ok=True)
+    write_png(IMAGES / "ground.png", ground(False))
+    write_png(IMAGES / "ground_top.png", ground(True))
+    write_png(IMAGES / "plank.png", plank())
+    write_png(IMAGES / "player_right.png", player(1))
+    write_png(IMAGES / "player_left.png", player(-1))
+    write_png(IMAGES / "enemy.png", enemy())
+    write_png(IMAGES / "goal.png", flag(32, (90, 224, 120)))
+    write_png(IMAGES / "checkpoint.png", flag(16, (150, 150, 150)))
+    write_png(IMAGES / "checkpoint_on.png", flag(16, (120, 230, 255)))
+    write_png(HERE / "levels" / "tiles.png", tileset())
+
+
+if __name__ == "__main__":
+    main()

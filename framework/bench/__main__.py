@@ -1,0 +1,91 @@
+"""Command line: ``python -m framework.bench {perf,accuracy} [--quick] [--json] [--plot PATH] [--docs]``."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from .report import DATA_DIR, REPO, command_line, replace_generated, to_json, write_csv, write_json
+
+__all__ = ["main"]
+
+DOCS = {"perf": REPO / "docs" / "performance.md", "accuracy": REPO / "docs" / "accuracy.md"}
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m framework.bench", description=__doc__)
+    sub = p.add_subparsers(dest="benchmark", required=True)
+    for name, help_ in (("perf", "cost of a step: ours vs pymunk vs the broad-phase floor"),
+                        ("accuracy", "accuracy knobs against exact answers")):
+        s = sub.add_parser(name, help=help_)
+        s.add_argument("--quick", action="store_true", help="fewer sizes and rounds (perf < 2 min, accuracy < 1 min)")
+        s.add_argument("--json", action="store_true", help="print the report as JSON (an object with a 'rows' list)")
+        s.add_argument("--plot", metavar="PATH", help="write a PNG plot (needs matplotlib)")
+        s.add_argument("--docs", action="store_true",
+                       help=f"rewrite the generated section of {DOCS[name].relative_to(REPO)}")
+        s.add_argument("--out", metavar="DIR", default=str(DATA_DIR),
+                       help="where the raw JSON and CSV go (default docs/data)")
+        s.add_argument("--no-save", action="store_true", help="write no JSON/CSV files")
+        s.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+        if name == "perf":
+            s.add_argument("--sizes", type=_ints, metavar="N,N,...",
+                           help="box counts (default: 1k,10k,50k; quick: 1k,10k)")
+            s.add_argument("--rounds", type=int, metavar="R", help="timed rounds per size (default: by size)")
+            s.add_argument("--tiles", type=int, metavar="T", help="static tiles of the level (default 100,000)")
+            s.add_argument("--tile-bodies", type=int, metavar="N", help="moving boxes over the level (default 1,000)")
+        else:
+            s.add_argument("--scenarios", type=lambda v: tuple(v.split(",")), metavar="A,B,...",
+                           help="only these scenarios (default: all)")
+    return p
+
+
+def _ints(text: str) -> tuple[int, ...]:
+    return tuple(int(v.replace("k", "000")) for v in text.split(",") if v)
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = _parser().parse_args(argv)
+    progress = not args.no_progress
+    if args.benchmark == "perf":
+        from . import perf as mod
+
+        cfg = mod.QUICK if args.quick else mod.FULL
+        sizes = args.sizes or cfg["sizes"]
+        tile_bodies = args.tile_bodies or (1_000 if args.sizes is None else min(sizes))
+        rounds = {n: args.rounds for n in (*sizes, tile_bodies)} if args.rounds else cfg["rounds"]
+        small = [n for n in (*sizes, tile_bodies) if n <= cfg["check_up_to"]]
+        report = mod.run_perf(sizes=sizes, rounds=rounds, tiles=mod.TILES if args.tiles is None else args.tiles,
+                              tile_bodies=tile_bodies, brute_sizes=cfg["brute_sizes"] if args.sizes is None else
+                              (min(sizes),), check_up_to=max(small, default=min(sizes)), progress=progress,
+                              quick=args.quick)
+    else:
+        from . import accuracy as mod
+
+        report = mod.run_accuracy(progress=progress, quick=args.quick, scenarios=args.scenarios)
+    command = command_line(argv)
+    report["command"] = command
+    stem = args.benchmark + ("-quick" if args.quick else "")
+    if not args.no_save:
+        out = Path(args.out)
+        write_json(out / f"{stem}.json", report)
+        write_csv(out / f"{stem}.csv", report["rows"])
+    plot_rel = None
+    if args.plot:
+        from .plots import plot_accuracy, plot_perf
+
+        plot = Path(args.plot)
+        drawn = (plot_perf if args.benchmark == "perf" else plot_accuracy)(report, plot)
+        if drawn:
+            plot_rel = os.path.relpath(plot.resolve(), DOCS[args.benchmark].parent)
+    if args.docs:
+        replace_generated(DOCS[args.benchmark], f"python -m framework.bench {args.benchmark}",
+                          mod.markdown(report, command, plot_rel))
+    print(to_json(report) if args.json else mod.text_report(report))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

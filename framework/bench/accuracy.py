@@ -1,0 +1,570 @@
+"""``python -m framework.bench accuracy``: what the accuracy knobs buy, against exact answers.
+
+Scenarios (each has an exact reference, so every error is measured, not judged by eye):
+
+- **bullet**: a small circle shot at a thin static wall, at a range of speeds, in many lanes. The
+  analytic time of impact is known (the bullet's leading edge reaches the wall's face), so every
+  bullet must be stopped at the face. ``missed``: fraction that ended beyond the wall (tunnelled,
+  or detected too deep and pushed out the far side); ``undetected``: fraction that never produced
+  a contact event; ``stop_error``: the largest distance of a stopped bullet from the analytic
+  contact position. Modes ``discrete``, ``swept`` (``Hitbox(ccd=True)``) and ``substeps-N``.
+- **crate**: pairs of rotated rectangular crates at random placements, approximated by ``aabb``
+  (the crate's unrotated box: an AABB never turns), ``aabb-bounds`` (the box around the rotated
+  crate), ``circle`` (same area) or ``polygon`` (``Polygon.box``, rotating) hitboxes. The exact
+  answer is the rotated rectangles' interiors overlapping (separating axes, checked against shapely
+  in the tests). ``fp_rate``: contacts reported where the crates do not touch, over the pairs that
+  do not; ``fn_rate``: contacts missed, over the pairs that do.
+- **stack**, **character**, **character-walk**: a resting stack of unit boxes on a static ground;
+  a character box standing on a floor of unit tiles across a seam; the same character walking
+  along the tiles. Exact answer: at rest on the surface, no penetration, no motion.
+  ``max_depth``: the largest penetration after a step (measured with ``collide``) over the second
+  half of the run; ``jitter``: the largest standard deviation of a body's y over that half;
+  ``sink``: the largest mean distance below the exact resting height; ``snags``: steps in which the
+  walking character advanced less than half its commanded distance. Modes
+  ``response-iterations-N`` (one step each) and ``substeps-N`` (4 iterations each), plus
+  ``default-sleeping`` (the default effects, with sleeping: what a game gets).
+- **crowd**: 64 unit boxes dropped overlapping into a small square, no gravity; after one step,
+  ``max_depth`` (deepest overlap left) and ``residual`` (summed depth left over summed depth
+  before). Exact answer: nothing left. Dynamic bodies in several contacts with each other are what
+  ``response_iterations`` is for. Modes as for the stack.
+- **ball**: a ball with restitution 1 bouncing on a static floor under gravity. Exact answer: its
+  energy is conserved. ``energy_drift``: the least-squares slope of the energy over 1,000 steps,
+  relative to the initial energy; ``apex_drop``: how much lower than its start the last apex was,
+  relative. Modes ``substeps-N``.
+
+Sleeping is off in every scene (except ``default-sleeping``) so the solver is measured, not the
+sleep. ``ms_per_step``: median over the steps of every repeated run, timed in the same process
+(the scene's whole step, for the scenario's scene). All scenes use ``dt = 1/60`` s, gravity
+(0, -20) units/s^2 where there is gravity.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..collision import collide
+from ..components import Hitbox, Transform, Velocity
+from ..shapes import AABB, Circle, Polygon
+from .progress import Progress
+from .report import Column, format_table, frozen_gc, machine_info, median
+
+__all__ = [
+    "BULLET_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES", "ROW_KEYS", "analytic_bullet_toi",
+    "bullet_lanes", "crate_placements", "crates_overlap_exact", "markdown", "run_accuracy", "run_ball",
+    "run_bullets", "run_crates", "run_rest", "text_report",
+]
+
+DT = 1.0 / 60.0
+GRAVITY = (0.0, -20.0)
+
+WALL_THICKNESS = 0.25
+WALL_HEIGHT = 4.0
+BULLET_RADIUS = 0.125
+LANE_SPACING = 8.0
+#: bullet speeds in units per step (x 60 for units per second)
+SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 64.0)
+BULLET_MODES = ("discrete", "swept", "substeps-2", "substeps-4", "substeps-8")
+CRATE_MODES = ("aabb", "aabb-bounds", "circle", "polygon")
+REST_MODES = ("response-iterations-1", "response-iterations-2", "response-iterations-4",
+              "response-iterations-8", "substeps-2", "substeps-4", "substeps-8", "default-sleeping")
+BALL_MODES = ("substeps-1", "substeps-2", "substeps-4", "substeps-8")
+SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball")
+DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
+
+FULL = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3, "crate_steps": 10,
+        "crowds": 15}
+QUICK = {"lanes": 32, "crates": 2_000, "rest_steps": 240, "ball_steps": 1_000, "runs": 1, "crate_steps": 3,
+         "crowds": 5}
+CROWD_MODES = REST_MODES[:-1]
+CROWD_BOXES = 64
+
+ROW_KEYS = ["scenario", "mode", "speed", "ms_per_step", "missed", "undetected", "stop_error", "fp_rate", "fn_rate",
+            "max_depth", "jitter", "sink", "snags", "residual", "energy_drift", "apex_drop", "samples", "steps"]
+
+
+def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
+    row = {k: None for k in ROW_KEYS}
+    row.update(scenario=scenario, mode=mode, **values)
+    return row
+
+
+def _scene_for(mode: str, gravity=(0.0, 0.0), effects=None):
+    """A scene configured by a mode name: ``substeps-N``, ``response-iterations-N``, else defaults.
+    Sleeping is off unless the mode is ``default-sleeping``."""
+    from ..scene import DEFAULT_EFFECTS, Scene
+
+    kw: dict[str, Any] = {}
+    if mode.startswith("substeps-"):
+        kw["substeps"] = int(mode.rsplit("-", 1)[1])
+    elif mode.startswith("response-iterations-"):
+        kw["response_iterations"] = int(mode.rsplit("-", 1)[1])
+    if effects is None:
+        effects = DEFAULT_EFFECTS if mode == "default-sleeping" else DEFAULT_EFFECTS - {"sleeping"}
+    return Scene(gravity=gravity, effects=effects, **kw)
+
+
+def _timed_steps(scene, steps: int, before: Callable[[int], None] | None = None,
+                 after: Callable[[int], None] | None = None) -> list[float]:
+    """Step ``steps`` times; return each step's milliseconds (the callbacks are not timed)."""
+    out = []
+    with frozen_gc():
+        for k in range(steps):
+            if before is not None:
+                before(k)
+            t0 = time.perf_counter()
+            scene.step(DT)
+            out.append((time.perf_counter() - t0) * 1e3)
+            if after is not None:
+                after(k)
+    return out
+
+
+# --- bullets ------------------------------------------------------------------------------------------
+
+
+def analytic_bullet_toi(x0: float, speed: float) -> float:
+    """Steps until a bullet centred at ``x0`` moving at ``speed`` units per step along +x first
+    touches the wall (centred at x = 0): its leading edge ``x0 + r + speed * t`` meets the face
+    ``-thickness / 2``."""
+    return (-WALL_THICKNESS / 2 - BULLET_RADIUS - x0) / speed
+
+
+def bullet_lanes(lanes: int, speed: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Start ``(x0, y offset)`` of each lane's bullet: the first contact comes 1 to 2 steps in (so at
+    every fraction of a step), the path meets the wall's flat face."""
+    rng = np.random.default_rng(seed)
+    t_hit = rng.uniform(1.0, 2.0, lanes)
+    x0 = -WALL_THICKNESS / 2 - BULLET_RADIUS - speed * t_hit
+    dy = rng.uniform(-1.0, 1.0, lanes) * (WALL_HEIGHT / 2 - BULLET_RADIUS) * 0.9
+    return x0, dy
+
+
+def run_bullets(mode: str, speed: float, lanes: int = 32, runs: int = 1, seed: int = 0) -> dict[str, Any]:
+    """One bullet row: ``lanes`` bullets at ``speed`` units per step against thin walls."""
+    x0s, dys = bullet_lanes(lanes, speed, seed)
+    steps = 4  # first contact within 2 steps; 2 more to see a tunnelled bullet leave
+    times: list[float] = []
+    result: dict[str, Any] = {}
+    for _ in range(runs):
+        ms, result = _bullet_run(mode, speed, x0s, dys, steps)
+        times += ms
+    return _row("bullet", mode, speed=speed, ms_per_step=median(times), samples=lanes, steps=steps, **result)
+
+
+def _bullet_run(mode: str, speed: float, x0s: np.ndarray, dys: np.ndarray, steps: int):
+    contact_x = -WALL_THICKNESS / 2 - BULLET_RADIUS
+    scene = _scene_for("discrete" if mode == "swept" else mode)
+    try:
+        bullets = []
+        for k, (x0, dy) in enumerate(zip(x0s.tolist(), dys.tolist())):
+            y = k * LANE_SPACING
+            scene.spawn(Transform(0.0, y), Hitbox(AABB(WALL_THICKNESS, WALL_HEIGHT), body="static"))
+            bullets.append(scene.spawn(Transform(x0, y + dy), Velocity(speed / DT, 0.0),
+                                       Hitbox(Circle(BULLET_RADIUS), ccd=mode == "swept")))
+        detected: set[int] = set()
+        bullet_set = set(bullets)
+
+        def after(k: int) -> None:
+            for ev in scene.events:
+                if ev.kind == "started":
+                    detected.update({ev.a, ev.b} & bullet_set)
+
+        times = _timed_steps(scene, steps, after=after)
+        xs = np.array([scene.get(b, Transform).x for b in bullets])
+        missed = xs > 0.0
+        stopped = ~missed
+        return times, {
+            "missed": float(missed.mean()),
+            "undetected": float(np.mean([b not in detected for b in bullets])),
+            "stop_error": float(np.abs(xs[stopped] - contact_x).max()) if stopped.any() else None,
+        }
+    finally:
+        scene.close()
+
+
+# --- crates -------------------------------------------------------------------------------------------
+
+
+def crate_placements(k: int, seed: int = 0) -> dict[str, np.ndarray]:
+    """``k`` pairs of crates: sizes in [0.5, 2], any rotation; B's centre uniform over the disc in
+    which the two crates' bounding circles overlap (about two thirds of the pairs then overlap)."""
+    rng = np.random.default_rng(seed)
+    aw, ah, bw, bh = (rng.uniform(0.5, 2.0, k) for _ in range(4))
+    at, bt = rng.uniform(0.0, math.pi, k), rng.uniform(0.0, math.pi, k)
+    reach = 0.5 * (np.hypot(aw, ah) + np.hypot(bw, bh))
+    d = np.sqrt(rng.uniform(0.0, 1.0, k)) * reach
+    phi = rng.uniform(0.0, 2 * math.pi, k)
+    return {"ax": np.zeros(k), "ay": np.zeros(k), "aw": aw, "ah": ah, "at": at,
+            "bx": d * np.cos(phi), "by": d * np.sin(phi), "bw": bw, "bh": bh, "bt": bt}
+
+
+def crates_overlap_exact(p: dict[str, np.ndarray]) -> np.ndarray:
+    """Exact answer: the rotated rectangles' interiors overlap (separating axis theorem over the
+    four edge directions; touching is not an overlap)."""
+    dx, dy = p["bx"] - p["ax"], p["by"] - p["ay"]
+    ca, sa, cb, sb = np.cos(p["at"]), np.sin(p["at"]), np.cos(p["bt"]), np.sin(p["bt"])
+    axes_a = ((ca, sa), (-sa, ca))
+    axes_b = ((cb, sb), (-sb, cb))
+    overlap = np.ones(dx.shape, dtype=bool)
+    for ux, uy in (*axes_a, *axes_b):
+        ra = 0.5 * p["aw"] * np.abs(axes_a[0][0] * ux + axes_a[0][1] * uy) + \
+            0.5 * p["ah"] * np.abs(axes_a[1][0] * ux + axes_a[1][1] * uy)
+        rb = 0.5 * p["bw"] * np.abs(axes_b[0][0] * ux + axes_b[0][1] * uy) + \
+            0.5 * p["bh"] * np.abs(axes_b[1][0] * ux + axes_b[1][1] * uy)
+        overlap &= np.abs(dx * ux + dy * uy) < ra + rb
+    return overlap
+
+
+def crate_hitbox(mode: str, w: float, h: float, theta: float):
+    """The hitbox shape that stands for a ``w`` x ``h`` crate turned by ``theta``."""
+    if mode == "aabb":
+        return AABB(w, h)
+    if mode == "aabb-bounds":
+        c, s = abs(math.cos(theta)), abs(math.sin(theta))
+        return AABB(w * c + h * s, w * s + h * c)
+    if mode == "circle":
+        return Circle(math.sqrt(w * h / math.pi))
+    if mode == "polygon":
+        return Polygon.box(w, h)
+    raise ValueError(f"unknown crate mode {mode!r}; modes are {CRATE_MODES}")
+
+
+def crate_contacts(mode: str, p: dict[str, np.ndarray], steps: int = 1) -> tuple[np.ndarray, list[float]]:
+    """Which placements the pipeline reports in contact, with ``mode`` hitboxes; and step times.
+
+    Every pair sits in its own cell of a grid (20 units apart), both crates kinematic (static pairs
+    are never tested) and still; the scene declares detection and events only."""
+    from ..scene import Scene
+
+    k = p["aw"].size
+    cols = max(1, int(math.ceil(math.sqrt(k))))
+    scene = Scene(effects=("detection", "events"))
+    try:
+        owner: dict[int, int] = {}
+        for i in range(k):
+            ox, oy = 20.0 * (i % cols), 20.0 * (i // cols)
+            for s in "ab":
+                theta = float(p[s + "t"][i])
+                shape = crate_hitbox(mode, float(p[s + "w"][i]), float(p[s + "h"][i]), theta)
+                e = scene.spawn(Transform(ox + float(p[s + "x"][i]), oy + float(p[s + "y"][i]), theta),
+                                Hitbox(shape, body="kinematic"))
+                owner[e] = i
+        times = _timed_steps(scene, steps)
+        hit = np.zeros(k, dtype=bool)
+        for a, b in zip(scene.contacts.a.tolist(), scene.contacts.b.tolist()):
+            if owner[a] != owner[b]:
+                raise AssertionError(f"crates of different placements {owner[a]} and {owner[b]} touch")
+            hit[owner[a]] = True
+    finally:
+        scene.close()
+    return hit, times
+
+
+def run_crates(mode: str, count: int = 2_000, steps: int = 3, seed: int = 0) -> dict[str, Any]:
+    p = crate_placements(count, seed)
+    exact = crates_overlap_exact(p)
+    hit, times = crate_contacts(mode, p, steps)
+    fp = hit & ~exact
+    fn = ~hit & exact
+    return _row("crate", mode, ms_per_step=median(times), samples=count, steps=steps,
+                fp_rate=float(fp.sum() / max(1, (~exact).sum())), fn_rate=float(fn.sum() / max(1, exact.sum())))
+
+
+# --- resting: stack, character ------------------------------------------------------------------------
+
+
+def _rest_scene(scenario: str, mode: str, steps: int):
+    """``(scene, movers, exact resting y of each, walk speed)``: bodies start 1/16 above their rest."""
+    scene = _scene_for(mode, gravity=GRAVITY)
+    gap = 1.0 / 16.0
+    movers, rest_y = [], []
+    walk = 0.0
+    if scenario == "stack":
+        scene.spawn(Transform(0.0, -0.5), Hitbox(AABB(8.0, 1.0), body="static"))
+        for i in range(8):
+            movers.append(scene.spawn(Transform(0.0, 0.5 + i * (1.0 + gap) + gap), Velocity(), Hitbox(AABB(1.0, 1.0))))
+            rest_y.append(0.5 + i)
+    else:
+        walk = 6.0 if scenario == "character-walk" else 0.0
+        n_tiles = int(math.ceil(walk * DT * steps)) + 8
+        for k in range(-4, n_tiles - 4):
+            scene.spawn(Transform(k + 0.5, 0.5), Hitbox(AABB(1.0, 1.0), body="static"))
+        # centred on the seam at x = 0, its feet across two tiles
+        movers.append(scene.spawn(Transform(0.0, 1.0 + 0.875 + gap), Velocity(walk, 0.0),
+                                  Hitbox(AABB(0.75, 1.75))))
+        rest_y.append(1.875)
+    return scene, movers, np.array(rest_y), walk
+
+
+def _max_depth(scene, ents: list[int]) -> float:
+    """The deepest overlap, after the step, of any mover with anything near it (exact ``collide``)."""
+    deepest = 0.0
+    for e in ents:
+        t, hb = scene.get(e, Transform), scene.get(e, Hitbox)
+        ext = hb.shape.bounding_radius + 1.0
+        for o in scene.query_box(t.x - ext, t.y - ext, t.x + ext, t.y + ext):
+            if o == e:
+                continue
+            to, ho = scene.get(o, Transform), scene.get(o, Hitbox)
+            c = collide(hb.shape, (t.x, t.y, t.rotation), ho.shape, (to.x, to.y, to.rotation))
+            if c is not None:
+                deepest = max(deepest, c.depth)
+    return deepest
+
+
+def run_rest(scenario: str, mode: str, steps: int = 240, runs: int = 1) -> dict[str, Any]:
+    """A stack or character row; metrics over the second half of the run."""
+    times: list[float] = []
+    result: dict[str, Any] = {}
+    samples = 0
+    for _ in range(runs):
+        ms, result, samples = _rest_run(scenario, mode, steps)
+        times += ms
+    return _row(scenario, mode, ms_per_step=median(times), samples=samples, steps=steps, **result)
+
+
+def _rest_run(scenario: str, mode: str, steps: int):
+    scene, movers, rest_y, walk = _rest_scene(scenario, mode, steps)
+    try:
+        ys = np.zeros((steps, len(movers)))
+        xs = np.zeros((steps, len(movers)))
+        depth = np.zeros(steps)
+        window = steps // 2
+
+        def before(k: int) -> None:
+            if walk:  # game code: the player holds "right"
+                for e in movers:
+                    scene.get(e, Velocity).x = walk
+
+        def after(k: int) -> None:
+            for j, e in enumerate(movers):
+                t = scene.get(e, Transform)
+                xs[k, j], ys[k, j] = t.x, t.y
+            if k >= steps - window:
+                depth[k] = _max_depth(scene, movers)
+
+        times = _timed_steps(scene, steps, before, after)
+        w = ys[-window:]
+        dx = np.diff(xs[:, 0])
+        return times, {
+            "max_depth": float(depth.max()),
+            "jitter": float(w.std(axis=0).max()),
+            "sink": float((rest_y - w.mean(axis=0)).max()),
+            "snags": int((dx < 0.5 * walk * DT).sum()) if walk else None,
+        }, len(movers)
+    finally:
+        scene.close()
+
+
+# --- ball ---------------------------------------------------------------------------------------------
+
+
+def run_ball(mode: str, steps: int = 1_000, runs: int = 1) -> dict[str, Any]:
+    """A ball of radius 0.5 dropped from 5 units (its bottom 4.5 above the floor), restitution 1.
+
+    ``energy_drift``: least-squares slope of the energy per unit mass (``v^2 / 2 + g h``) over the
+    run, per 1,000 steps, relative to the initial energy; ``apex_drop``: how much lower than the
+    4.5 units it started from the ball's last apex of the run was, relative."""
+    times: list[float] = []
+    result: dict[str, Any] = {}
+    for _ in range(runs):
+        ms, result = _ball_run(mode, steps)
+        times += ms
+    return _row("ball", mode, ms_per_step=median(times), samples=1, steps=steps, **result)
+
+
+def _ball_run(mode: str, steps: int):
+    g = -GRAVITY[1]
+    scene = _scene_for(mode, gravity=GRAVITY)
+    try:
+        scene.spawn(Transform(0.0, -0.5), Hitbox(AABB(8.0, 1.0), body="static"))
+        ball = scene.spawn(Transform(0.0, 5.0), Velocity(), Hitbox(Circle(0.5), restitution=1.0))
+        t, v = scene.get(ball, Transform), scene.get(ball, Velocity)
+        energy, height, vy = np.zeros(steps), np.zeros(steps), np.zeros(steps)
+
+        def after(k: int) -> None:
+            height[k], vy[k] = t.y - 0.5, v.y
+            energy[k] = 0.5 * (v.x * v.x + v.y * v.y) + g * height[k]
+
+        times = _timed_steps(scene, steps, after=after)
+        e0 = g * 4.5
+        slope = float(np.polyfit(np.arange(steps), energy, 1)[0])
+        apex = height[1:][(vy[:-1] > 0.0) & (vy[1:] <= 0.0)]
+        return times, {"energy_drift": slope * 1000.0 / e0,
+                       "apex_drop": float((4.5 - apex[-1]) / 4.5) if apex.size else None}
+    finally:
+        scene.close()
+
+
+# --- crowd: overlaps among dynamic bodies -------------------------------------------------------------
+
+
+def _overlap_depths(scene, ents: list[int]) -> np.ndarray:
+    """Penetration depth of every overlapping pair among ``ents`` (exact ``collide``)."""
+    poses = [(scene.get(e, Transform), scene.get(e, Hitbox).shape) for e in ents]
+    out = []
+    for i, (ta, sa) in enumerate(poses):
+        for tb, sb in poses[i + 1:]:
+            if abs(ta.x - tb.x) < 2.0 and abs(ta.y - tb.y) < 2.0:
+                c = collide(sa, (ta.x, ta.y, ta.rotation), sb, (tb.x, tb.y, tb.rotation))
+                if c is not None:
+                    out.append(c.depth)
+    return np.array(out)
+
+
+def run_crowd(mode: str, crowds: int = 5, boxes: int = CROWD_BOXES) -> dict[str, Any]:
+    """``boxes`` unit boxes dropped overlapping into a small square, no gravity: the response must
+    push them apart. After one step, ``max_depth`` is the deepest remaining overlap and
+    ``residual`` the summed remaining depth over the summed initial depth (mean over ``crowds``
+    random crowds). Exact answer: no overlap left. This is where ``response_iterations`` works:
+    bodies in several contacts with other dynamic bodies."""
+    times, deepest, residual = [], [], []
+    side = math.sqrt(boxes) * 0.8
+    for seed in range(crowds):
+        rng = np.random.default_rng(seed)
+        scene = _scene_for(mode)
+        try:
+            ents = [scene.spawn(Transform(float(x), float(y)), Velocity(), Hitbox(AABB(1.0, 1.0)))
+                    for x, y in rng.uniform(0.0, side, (boxes, 2))]
+            before = _overlap_depths(scene, ents).sum()
+            times += _timed_steps(scene, 1)
+            after = _overlap_depths(scene, ents)
+            deepest.append(float(after.max()) if after.size else 0.0)
+            residual.append(float(after.sum() / before) if before > 0 else 0.0)
+        finally:
+            scene.close()
+    return _row("crowd", mode, ms_per_step=median(times), samples=crowds, steps=1,
+                max_depth=float(np.mean(deepest)), residual=float(np.mean(residual)))
+
+
+# --- the whole benchmark ------------------------------------------------------------------------------
+
+
+def run_accuracy(config: dict[str, Any] | None = None, progress: bool = True, quick: bool = False,
+                 speeds: tuple[float, ...] = SPEEDS, scenarios: tuple[str, ...] | None = None) -> dict[str, Any]:
+    """Every scenario and mode; returns the report (``rows``, ``machine``, ``config``)."""
+    cfg = dict(QUICK if quick else FULL)
+    cfg.update(config or {})
+    want = set(scenarios or SCENARIOS)
+    jobs: list[tuple[str, Callable[[], dict[str, Any]]]] = []
+    if "bullet" in want:
+        for mode in BULLET_MODES:
+            for s in speeds:
+                jobs.append((f"bullet {mode} {s:g}/step",
+                             lambda m=mode, s=s: run_bullets(m, s, cfg["lanes"], cfg["runs"])))
+    if "crate" in want:
+        for mode in CRATE_MODES:
+            jobs.append((f"crate {mode}", lambda m=mode: run_crates(m, cfg["crates"], cfg["crate_steps"])))
+    for scen in ("stack", "character", "character-walk"):
+        if scen in want:
+            for mode in REST_MODES:
+                jobs.append((f"{scen} {mode}", lambda sc=scen, m=mode: run_rest(sc, m, cfg["rest_steps"], cfg["runs"])))
+    if "crowd" in want:
+        for mode in CROWD_MODES:
+            jobs.append((f"crowd {mode}", lambda m=mode: run_crowd(m, cfg["crowds"])))
+    if "ball" in want:
+        for mode in BALL_MODES:
+            jobs.append((f"ball {mode}", lambda m=mode: run_ball(m, cfg["ball_steps"], cfg["runs"])))
+    rows = []
+    with Progress(len(jobs), "accuracy", enabled=progress) as bar:
+        for name, job in jobs:
+            bar.task(name)
+            rows.append(job())
+            bar.advance()
+    return {
+        "benchmark": "accuracy", "quick": quick, "machine": machine_info(), "config": cfg,
+        "setup": {"dt": DT, "gravity": list(GRAVITY), "wall_thickness": WALL_THICKNESS, "wall_height": WALL_HEIGHT,
+                  "bullet_radius": BULLET_RADIUS, "defaults": "response_iterations=4, substeps=1, ccd off per body"},
+        "rows": rows,
+    }
+
+
+# --- text ---------------------------------------------------------------------------------------------
+
+_COMMON: list[Column] = [("mode", "mode", "str"), ("ms_per_step", "ms/step", "ms")]
+TABLES: dict[str, tuple[str, list[Column]]] = {
+    "bullet": ("Bullets (r = 0.125) against walls 0.25 thick; speed in units per step",
+               [("mode", "mode", "str"), ("speed", "speed", "g"), ("ms_per_step", "ms/step", "ms"),
+                ("missed", "missed", "pct"), ("undetected", "undetected", "pct"),
+                ("stop_error", "stop error", "sci")]),
+    "crate": ("Rotated crates: contact decisions against the exact rotated rectangles",
+              [*_COMMON, ("fp_rate", "false positive", "pct"), ("fn_rate", "false negative", "pct"),
+               ("samples", "placements", "int")]),
+    "stack": ("Resting stack of 8 unit boxes (second half of the run)",
+              [*_COMMON, ("max_depth", "max depth", "sci"), ("jitter", "jitter (std y)", "sci"),
+               ("sink", "sink", "sci")]),
+    "character": ("Character 0.75 x 1.75 standing across a seam of unit tiles",
+                  [*_COMMON, ("max_depth", "max depth", "sci"), ("jitter", "jitter (std y)", "sci"),
+                   ("sink", "sink", "sci")]),
+    "character-walk": ("The character walking at 6 units/s along the tiles",
+                       [*_COMMON, ("max_depth", "max depth", "sci"), ("jitter", "jitter (std y)", "sci"),
+                        ("sink", "sink", "sci"), ("snags", "snags", "int")]),
+    "crowd": (f"Crowd: {CROWD_BOXES} overlapping unit boxes, no gravity, after one step",
+              [*_COMMON, ("max_depth", "max depth left", "g"), ("residual", "overlap left", "pct")]),
+    "ball": ("Ball with restitution 1 bouncing on a floor",
+             [*_COMMON, ("energy_drift", "energy drift / 1,000 steps", "pct"),
+              ("apex_drop", "last apex lower by", "pct")]),
+}
+
+
+def _marked(rows):
+    return [dict(r, mode=r["mode"] + (" (default)" if r["mode"] in DEFAULT_MODES else "")) for r in rows]
+
+
+def bullet_summary(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One line per bullet mode: missed fraction at each speed (a compact view of the bullet rows)."""
+    out = []
+    for mode in dict.fromkeys(r["mode"] for r in rows if r["scenario"] == "bullet"):
+        mr = [r for r in rows if r["scenario"] == "bullet" and r["mode"] == mode]
+        line: dict[str, Any] = {"mode": mode, "ms_per_step": median(r["ms_per_step"] for r in mr)}
+        for r in mr:
+            line[f"v{r['speed']:g}"] = r["missed"]
+        out.append(line)
+    return out
+
+
+def _tables(report: dict[str, Any], heading: str) -> list[str]:
+    rows = report["rows"]
+    parts: list[str] = []
+    bullets = [r for r in rows if r["scenario"] == "bullet"]
+    if bullets:
+        speeds = list(dict.fromkeys(r["speed"] for r in bullets))
+        cols: list[Column] = [("mode", "mode", "str"), ("ms_per_step", "ms/step (median)", "ms")]
+        cols += [(f"v{s:g}", f"{s:g}", "pct") for s in speeds]
+        parts += [f"{heading} Bullets: fraction missed, by speed (units per step; r = {BULLET_RADIUS}, "
+                  f"wall {WALL_THICKNESS} thick)", "", format_table(_marked(bullet_summary(rows)), cols), ""]
+        parts += [f"{heading} Bullets: every row", "", format_table(_marked(bullets), TABLES["bullet"][1]), ""]
+    for scen, (title, cols) in TABLES.items():
+        if scen == "bullet":
+            continue
+        sr = [r for r in rows if r["scenario"] == scen]
+        if sr:
+            parts += [f"{heading} {title}", "", format_table(_marked(sr), cols), ""]
+    return parts
+
+
+def text_report(report: dict[str, Any]) -> str:
+    m = report["machine"]
+    head = [f"accuracy{' --quick' if report['quick'] else ''}: {m['date']}, Python {m['python']}, numpy {m['numpy']}, "
+            f"dt = 1/60 s; defaults: response_iterations=4, substeps=1, ccd off", ""]
+    return "\n".join(head + _tables(report, "##")).rstrip()
+
+
+def markdown(report: dict[str, Any], command: str, plot: str | None) -> str:
+    m = report["machine"]
+    parts = [
+        f"Taken **{m['date']}** with `{command}` on {m['platform']} ({m['machine']}, {m['cpus']} cpus), "
+        f"Python {m['python']}, numpy {m['numpy']}, esper {m['esper']}. Rerunning the command rewrites this "
+        "section, the plot and `docs/data/accuracy.json` / `accuracy.csv`. Modes marked (default) are what a "
+        "scene gets without asking.",
+        "",
+    ]
+    if plot:
+        parts += [f"![accuracy against cost, per scenario]({plot})", ""]
+    parts += _tables(report, "###")
+    return "\n".join(parts)

@@ -1,0 +1,265 @@
+"""The benchmarks' reference answers and accuracy claims (``python -m framework.bench``).
+
+Tiny configurations only: the module functions are called with small sizes. Times are reported by
+the benchmarks, never asserted here.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+
+import numpy as np
+import pytest
+
+from framework import AABB, Circle
+from framework.bench import accuracy as acc
+from framework.bench import perf
+from framework.bench.__main__ import main
+from framework.bench.progress import Progress
+from framework.bench.report import format_table, replace_generated, to_json, write_csv
+from framework.collision import time_of_impact
+
+shapely = pytest.importorskip("shapely")
+from shapely.geometry import Polygon as ShapelyPolygon  # noqa: E402
+
+
+def tiny_perf(**kw):
+    args = dict(sizes=(48, 96), rounds={48: 3, 96: 3}, tiles=300, tile_bodies=48, brute_sizes=(48,),
+                check_up_to=96, progress=False)
+    args.update(kw)
+    return perf.run_perf(**args)
+
+
+# --- reference answers --------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("speed", [0.125, 1.0, 7.5, 64.0])
+def test_analytic_bullet_toi_equals_time_of_impact(speed):
+    x0s, dys = acc.bullet_lanes(16, speed, seed=3)
+    wall = AABB(acc.WALL_THICKNESS, acc.WALL_HEIGHT)
+    for x0, dy in zip(x0s.tolist(), dys.tolist()):
+        t = acc.analytic_bullet_toi(x0, speed)
+        assert 1.0 <= t <= 2.0
+        k = math.floor(t)  # the step in which the bullet first touches, and the fraction of it
+        imp = time_of_impact(Circle(acc.BULLET_RADIUS), (x0 + k * speed, dy, 0.0), (speed, 0.0), wall, (0.0, 0.0, 0.0))
+        assert imp is not None
+        assert imp.fraction == pytest.approx(t - k, rel=1e-9, abs=1e-12)
+        assert imp.normal == (1.0, 0.0)
+        # over the whole run at once: the same moment
+        whole = time_of_impact(Circle(acc.BULLET_RADIUS), (x0, dy, 0.0), (4 * speed, 0.0), wall, (0.0, 0.0, 0.0))
+        assert whole.fraction * 4 == pytest.approx(t, rel=1e-9)
+
+
+def _corners(x, y, w, h, theta):
+    c, s = math.cos(theta), math.sin(theta)
+    return [(x + c * px - s * py, y + s * px + c * py) for px, py in
+            ((-w / 2, -h / 2), (w / 2, -h / 2), (w / 2, h / 2), (-w / 2, h / 2))]
+
+
+def test_exact_crate_contact_equals_shapely_intersection():
+    p = acc.crate_placements(600, seed=7)
+    exact = acc.crates_overlap_exact(p)
+    assert 0.3 < exact.mean() < 0.85  # both answers well represented
+    for i in range(exact.size):
+        a = ShapelyPolygon(_corners(p["ax"][i], p["ay"][i], p["aw"][i], p["ah"][i], p["at"][i]))
+        b = ShapelyPolygon(_corners(p["bx"][i], p["by"][i], p["bw"][i], p["bh"][i], p["bt"][i]))
+        assert exact[i] == (a.intersection(b).area > 0.0), i
+
+
+def test_exact_crate_contact_touching_is_not_contact():
+    p = {k: np.array([v]) for k, v in dict(ax=0.0, ay=0.0, aw=2.0, ah=1.0, at=0.0,
+                                           bx=2.0, by=0.0, bw=2.0, bh=1.0, bt=0.0).items()}
+    assert not acc.crates_overlap_exact(p)[0]
+    p["bx"] = np.array([1.75])
+    assert acc.crates_overlap_exact(p)[0]
+
+
+def test_crate_hitbox_shapes():
+    assert acc.crate_hitbox("aabb", 2.0, 1.0, 0.5) == AABB(2.0, 1.0)
+    turned = acc.crate_hitbox("aabb-bounds", 2.0, 1.0, math.pi / 2)
+    assert (turned.width, turned.height) == (pytest.approx(1.0), pytest.approx(2.0))
+    assert acc.crate_hitbox("circle", 2.0, 1.0, 0.0).radius == pytest.approx(math.sqrt(2.0 / math.pi))
+    with pytest.raises(ValueError, match="unknown crate mode"):
+        acc.crate_hitbox("ellipse", 1.0, 1.0, 0.0)
+
+
+# --- accuracy claims ----------------------------------------------------------------------------------
+
+
+def test_swept_detection_misses_no_bullet_at_any_speed():
+    for speed in (0.25, 1.0, 8.0, 64.0):
+        row = acc.run_bullets("swept", speed, lanes=8)
+        assert row["missed"] == 0.0 and row["undetected"] == 0.0, row
+        assert row["stop_error"] < 1e-5  # stopped at the analytic contact position
+
+
+def test_discrete_detection_misses_fast_bullets_but_not_slow_ones():
+    assert acc.run_bullets("discrete", 0.125, lanes=8)["missed"] == 0.0
+    fast = acc.run_bullets("discrete", 64.0, lanes=8)
+    assert fast["missed"] > 0.5 and fast["undetected"] > 0.5
+
+
+def test_substeps_catch_what_their_smaller_step_allows():
+    # at 1 unit per step, 8 sub-steps move 1/8 per sub-step: less than the wall's half-thickness
+    # plus the bullet's radius, so none passes; one step does let bullets through
+    assert acc.run_bullets("substeps-8", 1.0, lanes=8)["missed"] == 0.0
+    assert acc.run_bullets("discrete", 1.0, lanes=8)["missed"] > 0.0
+
+
+def test_polygon_hitboxes_are_exact_and_bounds_never_miss():
+    poly = acc.run_crates("polygon", count=150, steps=1)
+    assert poly["fp_rate"] == 0.0 and poly["fn_rate"] == 0.0
+    bounds = acc.run_crates("aabb-bounds", count=150, steps=1)
+    assert bounds["fn_rate"] == 0.0 and bounds["fp_rate"] > 0.0
+    box = acc.run_crates("aabb", count=150, steps=1)
+    assert box["fp_rate"] > 0.0 and box["fn_rate"] > 0.0
+
+
+def test_more_response_iterations_leave_less_overlap_in_a_crowd():
+    one = acc.run_crowd("response-iterations-1", crowds=2)
+    eight = acc.run_crowd("response-iterations-8", crowds=2)
+    assert eight["residual"] < one["residual"]
+
+
+def test_substeps_reduce_the_elastic_balls_energy_drift():
+    one = acc.run_ball("substeps-1", steps=300)
+    four = acc.run_ball("substeps-4", steps=300)
+    assert abs(four["energy_drift"]) < abs(one["energy_drift"])
+
+
+def test_resting_stack_metrics_have_the_documented_keys():
+    row = acc.run_rest("stack", "response-iterations-4", steps=20)
+    assert row["max_depth"] >= 0.0 and row["jitter"] >= 0.0 and row["snags"] is None
+    walk = acc.run_rest("character-walk", "response-iterations-4", steps=20)
+    assert isinstance(walk["snags"], int)
+
+
+# --- the perf benchmark -------------------------------------------------------------------------------
+
+
+def test_perf_pipeline_pairs_equal_brute_force():
+    wl = perf.make_boxes(300, seed=5)
+    out = perf.check_pairs(wl)
+    assert out["ok"] and min(out["pairs"]) > 100  # about one pair per box
+    tiled = perf.check_pairs(perf.with_tiles(wl, count=600, overlapping=True))
+    assert tiled["ok"] and tiled["pairs"][0] > out["pairs"][0]  # the moving-static pairs are found too
+
+
+def test_perf_pair_check_fails_loudly(monkeypatch):
+    real = perf.brute_force_pairs
+
+    def one_pair_short(*a, **k):
+        i, j = real(*a, **k)
+        return i[1:], j[1:]
+
+    monkeypatch.setattr(perf, "brute_force_pairs", one_pair_short)
+    with pytest.raises(perf.PairMismatch, match="candidate pairs"):
+        perf.check_pairs(perf.make_boxes(100, seed=1), steps=1)
+
+
+def test_perf_workload_density_and_tiles():
+    wl = perf.make_boxes(2000, seed=2)
+    assert wl.side == pytest.approx(math.sqrt(2000) * 14)
+    i, _ = perf.brute_force_pairs(wl.x - wl.w / 2, wl.y - wl.h / 2, wl.x + wl.w / 2, wl.y + wl.h / 2)
+    assert 0.8 < i.size / wl.n < 1.2  # about one overlapping pair per box
+    t = perf.with_tiles(wl, count=5000, steps=100)
+    assert t.tiles == 5000
+    # the level lies below anything a mover can reach in 100 steps
+    assert (t.tile_y + 0.5).max() < (wl.y - wl.h / 2).min() - 0.5 * 100
+
+
+def test_perf_report_has_the_documented_columns_and_json():
+    report = tiny_perf()
+    rows = report["rows"]
+    assert [r["scene"] for r in rows] == ["boxes-48", "boxes-48+tiles-300", "brute-force-48", "boxes-96"]
+    for r in rows:
+        assert set(perf.ROW_KEYS) <= set(r)
+    data = json.loads(to_json(report))
+    assert isinstance(data["rows"], list) and data["rows"][0]["bodies"] == 48
+    assert {g["goal"].split(" ")[0] for g in data["goals"]} >= {"ours", "tiles", "log-log"}
+    assert all(c["ok"] for c in report["checks"])
+    assert "boxes-48+tiles-300" in perf.text_report(report)
+    assert "| scene" in perf.markdown(report, "python -m framework.bench perf", "images/perf.png")
+
+
+def test_perf_without_pymunk_has_null_columns(monkeypatch, tmp_path):
+    monkeypatch.setenv("FRAMEWORK_BENCH_WITHOUT", "pymunk,matplotlib")
+    report = tiny_perf(sizes=(48,), rounds={48: 2}, tile_bodies=None, brute_sizes=())
+    (row,) = report["rows"]
+    assert row["pymunk_ms_per_step"] is None and row["ratio"] is None and row["ms_per_step"] > 0
+    from framework.bench.plots import plot_perf
+
+    assert plot_perf(report, tmp_path / "p.png") is False and not (tmp_path / "p.png").exists()
+
+
+def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
+    plot = tmp_path / "perf.png"
+    code = main(["perf", "--quick", "--json", "--sizes", "40,80", "--tiles", "200", "--rounds", "2",
+                 "--no-progress", "--out", str(tmp_path), "--plot", str(plot)])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [r["scene"] for r in data["rows"]][:2] == ["boxes-40", "boxes-40+tiles-200"]
+    for r in data["rows"]:
+        assert set(perf.ROW_KEYS) <= set(r)
+    assert data["command"].startswith("python -m framework.bench perf --quick")
+    assert json.loads((tmp_path / "perf-quick.json").read_text())["rows"] == data["rows"]
+    assert (tmp_path / "perf-quick.csv").read_text().startswith("scene,bodies,static,ms_per_step")
+    if perf.optional_module("matplotlib") is not None:
+        assert plot.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_accuracy_report_of_a_tiny_configuration(tmp_path):
+    cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1}
+    report = acc.run_accuracy(cfg, progress=False, speeds=(1.0, 64.0))
+    rows = report["rows"]
+    assert {r["scenario"] for r in rows} == set(acc.SCENARIOS)
+    for r in rows:
+        assert list(r) == acc.ROW_KEYS
+        assert r["ms_per_step"] > 0
+        assert (r["missed"] is not None) == (r["scenario"] == "bullet")
+    assert len([r for r in rows if r["scenario"] == "bullet"]) == 2 * len(acc.BULLET_MODES)
+    data = json.loads(to_json(report))
+    assert isinstance(data["rows"], list)
+    text = acc.text_report(report)
+    assert "discrete (default)" in text and "energy drift" in text
+    if perf.optional_module("matplotlib") is not None:
+        from framework.bench.plots import plot_accuracy
+
+        assert plot_accuracy(report, tmp_path / "a.png")
+        assert (tmp_path / "a.png").read_bytes()[:4] == b"\x89PNG"
+
+
+# --- plumbing -----------------------------------------------------------------------------------------
+
+
+def test_generated_section_is_replaced_between_markers(tmp_path):
+    doc = tmp_path / "d.md"
+    begin = "<!-- generated by `x`: begin (do not edit by hand; rerun the command) -->"
+    doc.write_text(f"intro\n{begin}\nold\n<!-- generated by `x`: end -->\noutro\n")
+    replace_generated(doc, "x", "new table")
+    assert doc.read_text() == f"intro\n{begin}\nnew table\n<!-- generated by `x`: end -->\noutro\n"
+    with pytest.raises(SystemExit, match="markers"):
+        replace_generated(doc, "y", "t")
+
+
+def test_table_and_csv_formatting(tmp_path):
+    rows = [{"name": "a", "ms": 1.23456, "rate": 0.5, "n": None}]
+    cols = [("name", "name", "str"), ("ms", "ms", "ms"), ("rate", "rate", "pct"), ("n", "n", "int")]
+    table = format_table(rows, cols)
+    assert table.splitlines()[2] == "| a    | 1.23 | 50.0% | – |"
+    write_csv(tmp_path / "x.csv", rows)
+    assert (tmp_path / "x.csv").read_text().splitlines() == ["name,ms,rate,n", "a,1.23456,0.5,"]
+
+
+def test_progress_bar_writes_to_its_stream_only_when_enabled():
+    out = io.StringIO()
+    with Progress(3, "t", stream=out) as bar:
+        bar.advance(note="one")
+        bar.advance(2)
+    assert "t: 1/3 (33%) one ..." in out.getvalue() and "done" in out.getvalue()
+    quiet = io.StringIO()
+    with Progress(3, "t", stream=quiet, enabled=False) as bar:
+        bar.advance()
+    assert quiet.getvalue() == ""

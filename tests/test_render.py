@@ -1,0 +1,431 @@
+"""Rendering: pixel-exact headless screenshots, the camera, culling, the overlay, the runner.
+
+Every picture is rendered offscreen into an RGBA8 texture (EGL + Mesa's llvmpipe without a
+display) and compared exactly. Shapes sit on whole pixel coordinates, so each edge falls between
+pixel centres and the expected image is a plain rectangle fill. Pixel ``(sx, sy)`` counts from the
+bottom-left (y up); arrays come top row first, so it is ``img[H - 1 - sy, sx]``.
+
+Skipped, with the reason, only where no OpenGL library can make a context.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
+from framework.components import Visual
+from framework.input import Input
+
+RED, GREEN, BLUE, BG = (255, 0, 0), (0, 255, 0), (0, 0, 255), (0, 0, 40)
+
+
+@pytest.fixture(scope="module")
+def render():
+    try:
+        import framework.render as render
+
+        render.offscreen_window()
+    except Exception as exc:  # no GL library, no EGL device: not a failure of the code under test
+        pytest.skip(f"no OpenGL context available here ({type(exc).__name__}: {exc})")
+    return render
+
+
+@pytest.fixture
+def scene():
+    s = Scene()
+    yield s
+    s.close()
+
+
+def canvas(w: int, h: int, color=BG) -> np.ndarray:
+    img = np.empty((h, w, 3), dtype=np.uint8)
+    img[...] = color
+    return img
+
+
+def rect(img: np.ndarray, x0: int, y0: int, x1: int, y1: int, color) -> np.ndarray:
+    """Fill screen pixels x0 <= sx < x1, y0 <= sy < y1 (y up) of a top-row-first image."""
+    h = img.shape[0]
+    img[h - y1: h - y0, x0:x1] = color
+    return img
+
+
+def px(img: np.ndarray, sx: int, sy: int) -> tuple[int, ...]:
+    return tuple(int(v) for v in img[img.shape[0] - 1 - sy, sx, :3])
+
+
+def count(img: np.ndarray, color) -> int:
+    return int((img[..., :3] == np.array(color[:3], dtype=np.uint8)).all(axis=2).sum())
+
+
+# --- pyglet stays out of the simulation -------------------------------------------------------------
+
+
+def test_framework_and_a_scene_never_import_pyglet_gl():
+    code = textwrap.dedent("""
+        import sys
+        import framework
+        from framework import AABB, Circle, Hitbox, Scene, Transform, Velocity
+        from framework.components import Visual
+        s = Scene(gravity=(0.0, -10.0))
+        s.spawn(Transform(0.0, 0.0), Hitbox(AABB(10.0, 1.0), body="static"), Visual((1, 2, 3)))
+        s.spawn(Transform(0.0, 2.0), Velocity(0.0, 0.0), Hitbox(Circle(0.5)), Visual((4, 5, 6)))
+        for _ in range(30):
+            s.step(1 / 60)
+        s.raycast((0.0, 5.0), (0.0, -1.0))
+        bad = sorted(m for m in sys.modules
+                     if m.split(".")[:2] in (["pyglet", "gl"], ["pyglet", "window"], ["pyglet", "graphics"])
+                     or m.startswith("framework.render"))
+        print(bad, s.counters["systems"])
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("[] "), out.stdout
+    assert "render" not in out.stdout.split("] ", 1)[1]  # no render stage without a renderer
+
+
+# --- pixels -----------------------------------------------------------------------------------------
+
+
+def test_a_box_is_drawn_exactly_where_it_is_and_nothing_else(render, scene):
+    scene.spawn(Transform(30.0, 20.0), Hitbox(AABB(20.0, 10.0)), Visual(RED))
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert img.shape == (48, 64, 4) and img.dtype == np.uint8
+    assert np.array_equal(img[..., :3], rect(canvas(64, 48), 20, 15, 40, 25, RED))
+    assert (img[..., 3] == 255).all()
+
+
+def test_same_picture_before_and_after_a_step_and_a_static_body(render, scene):
+    scene.spawn(Transform(30.0, 20.0), Hitbox(AABB(20.0, 10.0), body="static"), Visual(RED))
+    before = render.screenshot(scene, width=64, height=48, background=BG)
+    scene.step(1 / 60)  # now the statics come from the spatial hash
+    after = render.screenshot(scene, width=64, height=48, background=BG)
+    assert np.array_equal(before, after)
+    assert np.array_equal(after[..., :3], rect(canvas(64, 48), 20, 15, 40, 25, RED))
+
+
+def test_camera_offset_moves_the_picture_by_exact_pixels(render, scene):
+    scene.spawn(Transform(30.0, 20.0), Hitbox(AABB(20.0, 10.0)), Visual(RED))
+    # The camera 7 right of and 3 below the default centre (32, 24): the world shifts 7 left, 3 up.
+    img = render.screenshot(scene, width=64, height=48, camera=render.Camera(32.0 + 7.0, 24.0 - 3.0),
+                            background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(64, 48), 13, 18, 33, 28, RED))
+
+
+def test_zoom_scales_about_the_view(render, scene):
+    scene.spawn(Transform(30.0, 20.0), Hitbox(AABB(20.0, 10.0)), Visual(RED))
+    img = render.screenshot(scene, width=96, height=64, camera=render.Camera(zoom=2.0), background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(96, 64), 40, 30, 80, 50, RED))  # origin stays put
+    img = render.screenshot(scene, width=96, height=64, camera=render.Camera(30.0, 20.0, zoom=2.0),
+                            background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(96, 64), 28, 22, 68, 42, RED))  # centred on the box
+
+
+def test_rotation_turns_a_polygon_box_counter_clockwise_and_never_an_aabb(render, scene):
+    scene.spawn(Transform(32.0, 24.0, math.pi / 2), Hitbox(Polygon.box(30.0, 10.0)), Visual(RED))
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(64, 48), 27, 9, 37, 39, RED))
+    with Scene() as s2:
+        s2.spawn(Transform(32.0, 24.0, math.pi / 2), Hitbox(AABB(30.0, 10.0)), Visual(RED))
+        img = render.screenshot(s2, width=64, height=48, background=BG)
+        assert np.array_equal(img[..., :3], rect(canvas(64, 48), 17, 19, 47, 29, RED))
+    with Scene() as s3:
+        # A right triangle along +x; a quarter turn counter-clockwise puts it along +y, left of x = 32.
+        s3.spawn(Transform(32.0, 12.0, math.pi / 2), Hitbox(Polygon([(0, 0), (20, 0), (0, 10)])), Visual(RED))
+        img = render.screenshot(s3, width=64, height=48, background=BG)
+        assert px(img, 27, 14) == RED and px(img, 31, 30) == RED
+        assert px(img, 36, 10) == BG and px(img, 36, 14) == BG and px(img, 27, 8) == BG
+
+
+def test_a_circle_fills_its_disc(render, scene):
+    scene.spawn(Transform(32.0, 24.0), Hitbox(Circle(10.0)), Visual(GREEN))
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    ys, xs = np.mgrid[0:48, 0:64]
+    d = np.hypot(xs + 0.5 - 32.0, (47 - ys) + 0.5 - 24.0)
+    green = (img[..., :3] == GREEN).all(axis=2)
+    bg = (img[..., :3] == BG).all(axis=2)
+    assert green[d <= 9.5].all() and bg[d >= 10.01].all() and (green | bg).all()
+
+
+def test_higher_z_draws_on_top_whatever_the_spawn_order(render, scene):
+    scene.spawn(Transform(24.0, 24.0), Hitbox(AABB(20.0, 20.0)), Visual(RED, z=1))
+    scene.spawn(Transform(36.0, 24.0), Hitbox(AABB(20.0, 20.0)), Visual(BLUE, z=0))
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert px(img, 30, 24) == RED and px(img, 20, 24) == RED and px(img, 42, 24) == BLUE
+
+
+def test_image_sprites_centre_on_the_entity_and_turn_with_it(render, scene, tmp_path):
+    path = tmp_path / "block.png"
+    image = np.zeros((4, 6, 4), dtype=np.uint8)
+    image[...] = (10, 200, 30, 255)
+    render.write_png(path, image)
+    e = scene.spawn(Transform(32.0, 24.0), Visual(image=str(path)))  # no hitbox needed for a sprite
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(64, 48), 29, 22, 35, 26, (10, 200, 30)))
+    scene.get(e, Transform).rotation = math.pi / 2
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(64, 48), 30, 21, 34, 27, (10, 200, 30)))
+    # Mostly off screen (centre at x = -2): the sprite's reach keeps it in the view box.
+    scene.get(e, Transform).rotation = 0.0
+    scene.get(e, Transform).x = -2.0
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert np.array_equal(img[..., :3], rect(canvas(64, 48), 0, 22, 1, 26, (10, 200, 30)))
+
+
+def test_invisible_and_visual_less_entities_are_not_drawn(render, scene):
+    scene.spawn(Transform(20.0, 20.0), Hitbox(AABB(10.0, 10.0)))
+    scene.spawn(Transform(40.0, 20.0), Hitbox(AABB(10.0, 10.0)), Visual(RED, visible=False))
+    scene.spawn(Transform(40.0, 40.0), Visual(RED))  # neither a hitbox nor an image: nothing to draw
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert np.array_equal(img[..., :3], canvas(64, 48))
+
+
+def test_screenshot_writes_a_png_of_the_returned_pixels(render, scene, tmp_path):
+    import pyglet
+
+    scene.spawn(Transform(30.0, 20.0), Hitbox(AABB(20.0, 10.0)), Visual((250, 120, 7)))
+    path = tmp_path / "shot.png"
+    img = render.screenshot(scene, path, width=64, height=48, background=BG)
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and int.from_bytes(data[16:20], "big") == 64
+    decoded = pyglet.image.load(str(path)).get_image_data()
+    rgba = np.frombuffer(decoded.get_data("RGBA", -64 * 4), dtype=np.uint8).reshape(48, 64, 4)
+    assert np.array_equal(rgba, img)
+
+
+# --- the render stage: kept drawables, culling ------------------------------------------------------
+
+
+def test_attached_renderer_updates_its_drawables_in_place(render, scene):
+    renderer = render.Renderer(width=64, height=48, background=BG)
+    scene.renderer = renderer
+    e = scene.spawn(Transform(20.0, 24.0), Velocity(64.0, 0.0), Hitbox(AABB(8.0, 8.0)), Visual(RED))
+    scene.step(1 / 16)  # moves 4 px
+    assert "render" in scene.counters["systems"]
+    assert renderer.stats["made"] == 1
+    first = renderer.capture()
+    assert np.array_equal(first[..., :3], rect(canvas(64, 48), 20, 20, 28, 28, RED))
+    scene.step(1 / 16)
+    assert renderer.stats["made"] == 0 and renderer.stats["moved"] == 1
+    second = renderer.capture()
+    assert np.array_equal(second[..., :3], np.roll(first[..., :3], 4, axis=1))
+    # Colour and z are read from the Visual every frame; the drawable is kept.
+    scene.get(e, Visual).color = (0, 255, 0, 255)
+    scene.get(e, Velocity).x = 0.0
+    scene.step(1 / 16)
+    assert renderer.stats["made"] == 0 and renderer.stats["moved"] == 0
+    assert px(renderer.capture(), 30, 24) == GREEN
+    # Gone with its entity.
+    scene.despawn(e)
+    scene.step(1 / 16)
+    assert renderer.stats["drawables"] == 0
+    assert np.array_equal(renderer.capture()[..., :3], canvas(64, 48))
+    renderer.close()
+
+
+def test_z_change_at_run_time_reorders(render, scene):
+    renderer = render.Renderer(width=64, height=48, background=BG)
+    scene.renderer = renderer
+    a = scene.spawn(Transform(24.0, 24.0), Hitbox(AABB(20.0, 20.0), sensor=True), Visual(RED, z=1))
+    scene.spawn(Transform(36.0, 24.0), Hitbox(AABB(20.0, 20.0), sensor=True), Visual(BLUE, z=0))
+    scene.step(1 / 60)
+    assert px(renderer.capture(), 30, 24) == RED
+    scene.get(a, Visual).z = -1
+    scene.step(1 / 60)
+    assert renderer.stats["made"] == 0
+    assert px(renderer.capture(), 30, 24) == BLUE
+    renderer.close()
+
+
+def test_culling_draws_only_what_the_view_meets(render, scene):
+    for i in range(200):  # a long floor of static tiles, 16 units each
+        scene.spawn(Transform(8.0 + 16.0 * i, 8.0), Hitbox(AABB(16.0, 16.0), body="static"), Visual(RED))
+    for i in range(50):  # moving boxes along the floor
+        scene.spawn(Transform(30.0 + 64.0 * i, 40.0), Velocity(0.0, 0.0), Hitbox(AABB(8.0, 8.0)),
+                    Visual(BLUE))
+    camera = render.Camera(32.0, 24.0)
+    renderer = render.Renderer(width=64, height=48, camera=camera)
+    scene.renderer = renderer
+    calls = []
+    query_box = scene.hash.query_box
+    scene.hash.query_box = lambda *box: calls.append(box) or query_box(*box)
+    scene.step(1 / 60)
+    assert calls, "the statics are culled through the spatial hash"
+
+    def expected() -> int:
+        x0, y0, x1, y1 = camera.view_box()
+        g = scene.geometry
+        on = (g.minx < x1 + 1) & (g.maxx > x0 - 1) & (g.miny < y1 + 1) & (g.maxy > y0 - 1)
+        return int(on.sum())
+
+    assert renderer.stats["drawn"] == expected() == 6  # tiles 0-4 (one pixel of margin) and a box
+    assert renderer.stats["drawables"] == 6
+    camera.x = 1000.0
+    scene.step(1 / 60)
+    assert renderer.stats["drawn"] == expected()
+    assert renderer.stats["made"] == expected()  # new ones made; the old ones hidden, not deleted
+    assert renderer.stats["drawables"] == 6 + expected()
+    img = renderer.capture()
+    assert px(img, 5, 5) == RED and px(img, 40, 30) == (0, 0, 0)
+    renderer.close()
+
+
+# --- camera -----------------------------------------------------------------------------------------
+
+
+def test_camera_follows_its_target_within_the_level(render, scene):
+    e = scene.spawn(Transform(100.0, 50.0))
+    cam = render.Camera(target=e, bounds=(0.0, 0.0, 400.0, 200.0))
+    cam.update(scene, 100, 60)
+    assert cam.center == (100.0, 50.0)
+    assert cam.view_box() == (50.0, 20.0, 150.0, 80.0)
+    assert cam.world_to_screen(100.0, 50.0) == (50.0, 30.0)
+    assert cam.screen_to_world(0.0, 0.0) == (50.0, 20.0)
+    scene.get(e, Transform).x = 10.0  # near the left end: the view stops at the level's edge
+    scene.get(e, Transform).y = 195.0
+    cam.update(scene, 100, 60)
+    assert cam.view_box() == (0.0, 140.0, 100.0, 200.0)
+    cam.zoom = 2.0  # zoomed in, the view is 50 x 30 world units
+    cam.update(scene, 100, 60)
+    assert cam.view_box() == (0.0, 170.0, 50.0, 200.0)
+    cam.bounds = (0.0, 0.0, 40.0, 400.0)  # narrower than the view: centred across
+    cam.update(scene, 100, 60)
+    assert cam.center[0] == 20.0
+    scene.despawn(e)  # a vanished target: the camera stays
+    cam.update(scene, 100, 60)
+    assert cam.center[0] == 20.0
+    with pytest.raises(ValueError):
+        render.Camera(zoom=0.0)
+    with pytest.raises(ValueError):
+        render.Camera(bounds=(0.0, 0.0, -1.0, 1.0))
+
+
+def test_camera_target_and_bounds_in_pixels(render, scene):
+    # Level 0..200 x 0..100 in a 64 x 48 view; the player near the right end.
+    scene.spawn(Transform(100.0, 50.0), Hitbox(AABB(200.0, 100.0), body="static"), Visual(BLUE, z=-1))
+    p = scene.spawn(Transform(195.0, 50.0), Hitbox(AABB(4.0, 4.0)), Visual(RED))
+    cam = render.Camera(target=p, bounds=(0.0, 0.0, 200.0, 100.0))
+    img = render.screenshot(scene, width=64, height=48, camera=cam, background=BG)
+    # The view's right edge is the level's (x = 200): the player (193..197) is 3 px from it.
+    expect = rect(canvas(64, 48, BLUE), 64 - 7, 22, 64 - 3, 26, RED)
+    assert np.array_equal(img[..., :3], expect)
+
+
+# --- the debug overlay ------------------------------------------------------------------------------
+
+
+def test_overlay_outlines_every_hitbox_in_its_colour(render):
+    colors = render.OVERLAY_COLORS
+    scene = Scene(cell_size=64.0)  # hash cell lines at multiples of 64, away from the pixels tested
+    scene.spawn(Transform(30.0, 20.0), Hitbox(AABB(20.0, 10.0), body="static"))  # no Visual
+    scene.spawn(Transform(80.0, 20.0), Velocity(0.0, 0.0), Hitbox(AABB(20.0, 10.0)), Visual(RED))
+    scene.step(1 / 60)
+    plain = render.screenshot(scene, width=128, height=96, background=BG)
+    assert px(plain, 30, 15) == BG
+    img = render.screenshot(scene, width=128, height=96, background=BG, debug=True)
+    # Lines are drawn half a pixel in: an edge at x (or y) lights pixel column (row) x.
+    assert px(img, 30, 15) == colors["static"][:3] and px(img, 30, 25) == colors["static"][:3]
+    assert px(img, 20, 20) == colors["static"][:3] and px(img, 40, 20) == colors["static"][:3]
+    assert px(img, 30, 20) == BG  # an outline, not a fill
+    assert px(img, 80, 15) == colors["dynamic"][:3] and px(img, 80, 20) == RED
+    scene.close()
+
+
+def test_overlay_shows_contacts_sweeps_rays_cells_and_the_text_line(render, scene):
+    colors = render.OVERLAY_COLORS
+    scene.spawn(Transform(40.0, 20.0), Velocity(0.0, 0.0), Hitbox(AABB(20.0, 20.0)))
+    scene.spawn(Transform(55.0, 20.0), Velocity(0.0, 0.0), Hitbox(AABB(20.0, 20.0)))
+    scene.spawn(Transform(20.0, 60.0), Velocity(600.0, 0.0), Hitbox(Circle(2.0), ccd=True))
+    scene.spawn(Transform(150.0, 20.0), Hitbox(AABB(20.0, 20.0), body="static"))
+    scene.add_system(lambda s, dt: s.raycast((100.0, 80.0), (1.0, -1.0), 200.0), after="response")
+    scene.step(1 / 30)
+    assert len(scene.contacts.a) == 1 and scene.swept_paths and scene.ray_log
+    img = render.screenshot(scene, width=200, height=120, background=BG, debug=True)
+    for key in ("contact", "normal", "swept", "ray", "ray_rest", "cell"):
+        assert count(img, colors[key]) > 0, key
+    assert count(img[:36, :120], colors["text"]) > 20  # the text line, top left
+    without = render.screenshot(scene, width=200, height=120, background=BG)
+    assert count(without, colors["swept"]) == 0
+
+
+def test_scene_effect_debug_overlay_turns_the_overlay_on(render):
+    with Scene(effects=["movement", "detection", "debug_overlay"]) as s:
+        r = render.Renderer(width=32, height=32)
+        s.renderer = r
+        assert r.debug
+        r.close()
+
+
+# --- the window runner ------------------------------------------------------------------------------
+
+
+def test_key_names_are_lower_case_names(render):
+    from pyglet.window import key
+
+    names = [render.key_name(k) for k in (key.LEFT, key.SPACE, key.A, key.F1, key.ESCAPE, key._1, key.R)]
+    assert names == ["left", "space", "a", "f1", "escape", "1", "r"]
+
+
+def test_runner_feeds_keys_to_input_toggles_overlay_and_restarts(render, scene):
+    from pyglet.window import key
+
+    seen = []
+    fresh = Scene()
+
+    def on_key(s, name):
+        seen.append(name)
+        return fresh if name == "r" else None
+
+    runner = render.Runner(scene, width=64, height=48, on_key=on_key)
+    try:
+        assert scene.renderer is runner.renderer
+        runner.on_key_press(key.LEFT, 0)
+        inp = scene.resources[Input]
+        assert inp.held == {"left"} and inp.pressed == {"left"}
+        assert runner.tick(runner.dt) == 1  # the step saw the press; the edge is then forgotten
+        assert inp.pressed == set() and inp.held == {"left"}
+        runner.on_key_release(key.LEFT, 0)
+        assert inp.released == {"left"}
+        assert not runner.renderer.debug
+        runner.on_key_press(key.F1, 0)
+        assert runner.renderer.debug
+        runner.on_key_press(key.D, 0)  # held into the new scene
+        runner.on_key_press(key.R, 0)
+        assert runner.scene is fresh and fresh.renderer is runner.renderer and scene.renderer is None
+        assert fresh.resources[Input].held == {"d", "f1", "r"}
+        assert seen == ["left", "f1", "d", "r"]
+        runner.frame()  # steps and draws one frame into the window
+        assert runner.frames == 1
+        runner.on_key_press(key.ESCAPE, 0)
+        assert runner.window.context is None  # closed
+    finally:
+        runner.close()
+        fresh.close()
+
+
+def test_runner_fixed_timestep_accumulator(render, scene):
+    runner = render.Runner(scene, width=32, height=32, fps=60)
+    try:
+        dt = runner.dt
+        assert runner.tick(0.5 * dt) == 0
+        assert runner.tick(0.5 * dt) == 1  # the two halves make a step
+        assert runner.tick(3 * dt) == 3
+        assert scene.frame == 4 and scene.time == pytest.approx(4 * dt)
+        # A stall: at most MAX_STEPS_PER_FRAME steps, the rest of the time is dropped.
+        assert runner.tick(10.0) == render.window.MAX_STEPS_PER_FRAME
+        assert runner.accumulator <= dt
+    finally:
+        runner.close()
+
+
+def test_run_opens_steps_and_closes(render, scene):
+    e = scene.spawn(Transform(10.0, 10.0), Velocity(60.0, 0.0), Hitbox(AABB(4.0, 4.0)), Visual(RED))
+    render.run(scene, width=64, height=48, max_frames=3, debug=True)
+    assert scene.frame >= 1 and scene.renderer is None
+    assert scene.get(e, Transform).x > 10.0
