@@ -81,6 +81,7 @@ def resolve_effects(effects: Iterable[str] | None) -> frozenset[str]:
 _ALL_BITS = 0xFFFFFFFF
 _scene_ids = itertools.count(1)
 _NO_SUPPORT = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0))
+_NO_RESOLVED = (*_NO_SUPPORT, np.zeros(0))
 
 System = Callable[["Scene", float], Any]
 
@@ -171,7 +172,10 @@ class Scene:
         self._ended = StepContacts.empty()
         self._events: list[CollisionEvent] | None = []
         self._support = _NO_SUPPORT
+        self._resolved = _NO_RESOLVED
         self._row_lookup = np.zeros(1, dtype=np.int64)
+        self._moved = 0  # bumped whenever a stage moves bodies (see ensure_geometry)
+        self._geometry_stamp: tuple[int, ...] | None = None
         self._lookup_version = -1
         esper.switch_world(self.world)
 
@@ -233,7 +237,7 @@ class Scene:
                 # Whatever slept on or against it wakes.
                 r = 1.1 * float(store.bound[row])
                 x, y = float(store.x[row]), float(store.y[row])
-                self.geometry.update(store)
+                self.ensure_geometry()
                 g = self.geometry
                 near = (g.minx < x + r) & (g.maxx > x - r) & (g.miny < y + r) & (g.maxy > y - r)
                 store.wake(np.flatnonzero(near & store.asleep))
@@ -453,6 +457,7 @@ class Scene:
         self._ccd_rows = ccd
         self._ccd_start = (store.x[ccd].copy(), store.y[ccd].copy())
         rows = integrate(store, dt, self._gravity())
+        self._moved += 1
         self.counters["integrated"] = int(rows.size)
         return True
 
@@ -463,18 +468,29 @@ class Scene:
         store, geom = self.store, self.geometry
         if rows.size == 0 or rows.max() >= store.n:
             return False
-        geom.update(store)
+        self.ensure_geometry()
         self._sync_static()
         stopped = sweep_ccd_bodies(
             store, geom, rows, *self._ccd_start, self._static_entities_in_box, self.counters
         )
         self.counters["ccd_stopped"] = stopped
+        if stopped:
+            self._moved += 1
         x0, y0 = self._ccd_start
         self.swept_paths = list(zip(zip(x0.tolist(), y0.tolist()),
                                     zip(store.x[rows].tolist(), store.y[rows].tolist())))
-        if stopped:
-            geom.update(store)
         return True
+
+    def ensure_geometry(self) -> None:
+        """Bring ``scene.geometry`` (hitbox origins and bounds) up to date, if anything moved.
+
+        Queries, the renderer and the stages call this; it recomputes only after the pipeline or
+        game code moved something (or the entities changed) since the last time."""
+        store = self.store
+        stamp = (self._moved, store.writes, store.version, store.n)
+        if stamp != self._geometry_stamp:
+            self.geometry.update(store)
+            self._geometry_stamp = stamp
 
     def _static_entities_in_box(self, minx: float, miny: float, maxx: float, maxy: float) -> list[int]:
         ids = self.hash.query_box(minx, miny, maxx, maxy)
@@ -513,7 +529,7 @@ class Scene:
         if "detection" not in self.effects:
             return False
         store, geom = self.store, self.geometry
-        geom.update(store)
+        self.ensure_geometry()
         self._sync_static()
         awake = (store.kind >= 0) & (store.body != STATIC) & ~store.asleep
         moving = np.flatnonzero(awake)
@@ -611,6 +627,8 @@ class Scene:
         old = ~sorted_member(pair_keys(sa, sb), pair_keys(c.a, c.b))
         sra, srb = self._rows_of(sa[old]), self._rows_of(sb[old])
         live = (sra >= 0) & (srb >= 0)
+        ok = np.flatnonzero(live)  # ...and both still have hitboxes whose layers meet
+        live[ok] = (store.kind[sra[ok]] >= 0) & (store.kind[srb[ok]] >= 0) & filter_layers(store, sra[ok], srb[ok])
         ra = np.concatenate([self._contact_rows[0], sra[live]])
         rb = np.concatenate([self._contact_rows[1], srb[live]])
         ents_a = np.concatenate([c.a, sa[old][live]])
@@ -619,6 +637,7 @@ class Scene:
         depth = np.concatenate([c.depth, np.zeros(int(live.sum()))])
         alive0 = np.arange(ra.size) < c.a.size
         self._support = _NO_SUPPORT
+        self._resolved = _NO_RESOLVED
         if ra.size and ra.max() >= store.n:  # rows spawned mid-step are not in this step
             return False
         movable = (store.inv_mass > 0) & ~store.asleep  # sleeping bodies keep still
@@ -639,11 +658,14 @@ class Scene:
             r = pair_contacts(store, geom, a, b, remeasure=True)
             return r.hit, r.nx, r.ny, r.depth
 
-        done = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
-                       self.response_iterations, recompute, alive0[idx])
-        keep = idx[done]
-        keep = keep[np.argsort(pair_keys(ents_a[keep], ents_b[keep]), kind="stable")]
+        self._moved += 1
+        done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
+                                          self.response_iterations, recompute, alive0[idx])
+        self._moved += 1
+        order = np.argsort(pair_keys(ents_a[idx[done]], ents_b[idx[done]]), kind="stable")
+        keep = idx[done][order]
         self._support = (ents_a[keep], ents_b[keep], nx[keep], ny[keep])
+        self._resolved = (ents_a[keep], ents_b[keep], anx[done][order], any_[done][order], pushed[done][order])
         self.counters["resolved"] = int(done.sum())
         return True
 
@@ -707,6 +729,15 @@ class Scene:
         return self._events
 
     @property
+    def resolved(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The contacts the response actually applied this step, as arrays ``(a, b, nx, ny,
+        pushed)`` (entity ids a < b, the normal from a to b it pushed along, the total push-out),
+        sorted by pair. A contact the response discarded (the sliver of a tile under a body
+        pushed into a wall, once the wall's push freed it) is not here: a game asking "am I
+        standing on something?" should look here, not at every contact."""
+        return self._resolved
+
+    @property
     def contacts(self) -> StepContacts:
         """This step's overlapping pairs as arrays (entity ids a < b, normal from a to b)."""
         return self._contacts
@@ -742,7 +773,7 @@ class Scene:
         """Rows whose current bounds strictly meet the box: statics via the hash, moving bodies by
         one vectorised test over their current bounds."""
         store, geom = self.store, self.geometry
-        geom.update(store)
+        self.ensure_geometry()
         self._sync_static()
         st = self._rows_of(self.hash.query_box(minx, miny, maxx, maxy))
         st = st[(st >= 0)]
@@ -793,7 +824,7 @@ class Scene:
 
     def _world_extent(self, ox: float, oy: float) -> float:
         g = self.geometry
-        g.update(self.store)
+        self.ensure_geometry()
         if self.store.n == 0:
             return 1.0
         far = max(abs(float(g.minx.min()) - ox), abs(float(g.maxx.max()) - ox),

@@ -65,6 +65,7 @@ class BodyStore:
         self.static_dirty = True  # the static set or a static body changed: re-hash the statics
         self.sleep_dirty = False  # a body fell asleep or woke: re-hash the sleepers
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
+        self.writes = 0  # bumped by every write from game code (component views)
 
     # --- columns ---------------------------------------------------------------------------
 
@@ -221,6 +222,7 @@ class BodyStore:
 
     def write(self, entity: int, col: str, value: object) -> None:
         row = self.row_of[entity]
+        self.writes += 1
         if self.cols["asleep"][row] or self.cols["still"][row]:
             self.wake(row)
         try:

@@ -425,3 +425,40 @@ def test_substeps_stop_a_fast_body_tunnelling():
             return s.get(bullet, Transform).x > 10.0
 
     assert crosses(1) and not crosses(4)
+
+
+def test_one_way_platform_lands_from_above_and_lets_through_from_below():
+    with Scene(gravity=(0.0, -10.0)) as s:
+        s.spawn(Transform(0.0, 0.0), Hitbox(AABB(4.0, 0.5), body="static", one_way=True))
+        up = s.spawn(Transform(0.0, -1.0), Velocity(0.0, 8.0), Hitbox(AABB(0.5, 0.5), ccd=True))
+        ys = []
+        for _ in range(90):
+            s.step(1 / 60)
+            ys.append(s.get(up, Transform).y)
+        # Jumps up through (no stop under it), then lands on top: bottom on y = 0.25.
+        assert max(ys) > 1.5
+        assert s.get(up, Transform).y == pytest.approx(0.5, abs=1e-9)
+        assert s.get(up, Velocity).y == pytest.approx(0.0, abs=1e-9)
+
+
+def test_sideways_into_a_one_way_platform_passes():
+    with Scene() as s:
+        s.spawn(Transform(0.0, 0.0), Hitbox(AABB(2.0, 1.0), body="static", one_way=True))
+        b = s.spawn(Transform(-2.0, 0.0), Velocity(4.0, 0.0), Hitbox(AABB(0.5, 0.5)))
+        for _ in range(60):
+            s.step(1 / 60)
+        assert s.get(b, Transform).x == pytest.approx(2.0)
+
+
+def test_resolved_lists_only_the_contacts_the_response_applied():
+    with Scene(gravity=(0.0, -1408.0)) as s:
+        for row in range(4):  # a wall of stacked tiles
+            s.spawn(Transform(16.0, 16.0 + 32 * row), Hitbox(AABB(32, 32), body="static"))
+        b = s.spawn(Transform(-12.0, 77.9), Velocity(224.0, -10.0), Hitbox(AABB(24, 28)))
+        s.step(1 / 60)
+        a_, b_, nx, ny, pushed = s.resolved
+        # The body was pushed out of the wall sideways only; the tile below it, which the body
+        # overlapped by a sliver before that, is among the contacts but was not applied.
+        assert a_.size >= 1 and np.all(b_ == b)
+        assert np.all(nx == -1.0) and np.all(ny == 0.0) and np.all(pushed > 0)
+        assert any(e.normal == (0.0, 1.0) for e in s.events)

@@ -123,8 +123,8 @@ class Renderer:
         try:
             self._frame += 1
             self.camera.update(scene, self.width, self.height)
-            store, geom = scene.store, scene.geometry
-            geom.update(store)
+            store = scene.store
+            scene.ensure_geometry()
             if store.version != self._gone_version:
                 self._forget_gone(store)
                 self._gone_version = store.version

@@ -11,6 +11,8 @@ in pay nothing.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..collision.sweep import time_of_impact
@@ -68,6 +70,12 @@ def sweep_ccd_bodies(
             imp = time_of_impact(
                 hb._shape, start, (mx, my), other._shape, (float(geom.hx[o]), float(geom.hy[o]), float(c["rot"][o]))
             )
+            if imp is not None and other._one_way:
+                # A one-way platform stops only a body coming down onto it (its local +y up).
+                rot_o = float(c["rot"][o])
+                ux, uy = -math.sin(rot_o), math.cos(rot_o)
+                if imp.normal[0] * ux + imp.normal[1] * uy > -0.7071:
+                    imp = None
             if imp is not None and imp.fraction > 0.0 and (best is None or imp.fraction < best[0]):
                 best = (imp.fraction, imp.normal)
         if best is None:

@@ -48,8 +48,11 @@ def resolve(
     iterations: int,
     recompute: Recompute,
     alive0: np.ndarray | None = None,
-) -> np.ndarray:
-    """Resolve the contacts ``(ra, rb)`` (normal from a to b); return the mask of those resolved.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Resolve the contacts ``(ra, rb)`` (normal from a to b).
+
+    Returns ``(resolved, nx, ny, pushed)``: the mask of the contacts the response applied, the
+    normal each was applied along and the total push-out along it.
 
     ``alive0`` marks the contacts overlapping now; the others are last step's contacts that no
     longer overlap (a resting stack's bodies fall by the same amount and merely touch). They keep
@@ -58,7 +61,7 @@ def resolve(
     C = ra.size
     resolved = np.zeros(C, dtype=bool)
     if C == 0:
-        return resolved
+        return resolved, nx, ny, np.zeros(0)
     c = store.cols
     inv = c["inv_mass"]
     ia, ib = inv[ra].copy(), inv[rb].copy()
@@ -167,7 +170,7 @@ def resolve(
 
     _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
                 resolved, gravity, iterations, mob_level)
-    return resolved
+    return resolved, applied_nx, applied_ny, pushed
 
 
 def _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity) -> None:
