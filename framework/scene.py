@@ -8,6 +8,7 @@ any stage with :meth:`Scene.add_system`.
 
 from __future__ import annotations
 
+import inspect
 import itertools
 import math
 import time
@@ -84,6 +85,16 @@ _NO_SUPPORT = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zero
 _NO_RESOLVED = (*_NO_SUPPORT, np.zeros(0))
 
 System = Callable[["Scene", float], Any]
+
+
+def _takes_one_argument(fn: Callable[..., Any]) -> bool:
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    if any(p.kind == p.VAR_POSITIONAL for p in params):
+        return False
+    return sum(p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) for p in params) == 1
 
 
 def _add_counters(total: dict[str, Any], step: dict[str, Any]) -> None:
@@ -350,10 +361,17 @@ class Scene:
     ) -> None:
         """Call ``handler(scene, event)`` for collision events between an entity with a ``type_a``
         component and one with a ``type_b`` component. The event is turned so that ``event.a``
-        is the ``type_a`` entity (its normal then points from it toward the ``type_b`` one)."""
-        ks = frozenset(kinds)
+        is the ``type_a`` entity (its normal then points from it toward the ``type_b`` one).
+        A handler that takes a single argument is called as ``handler(event)``. ``kinds`` may be
+        one kind name or several."""
+        ks = frozenset([kinds] if isinstance(kinds, str) else kinds)
         if not ks <= {"started", "ongoing", "ended"}:
             raise InvalidValue(f"kinds must be among 'started', 'ongoing', 'ended', got {sorted(ks)!r}")
+        if not callable(handler):
+            raise InvalidValue(f"handler must be callable, got {handler!r}")
+        if _takes_one_argument(handler):
+            one = handler
+            handler = lambda scene, event: one(event)  # noqa: E731
         self._handlers.append((type_a, type_b, handler, ks))
 
     # --- stepping ----------------------------------------------------------------------------

@@ -462,3 +462,19 @@ def test_resolved_lists_only_the_contacts_the_response_applied():
         assert a_.size >= 1 and np.all(b_ == b)
         assert np.all(nx == -1.0) and np.all(ny == 0.0) and np.all(pushed > 0)
         assert any(e.normal == (0.0, 1.0) for e in s.events)
+
+
+def test_handlers_may_take_only_the_event(scene):
+    class A:
+        pass
+
+    class B:
+        pass
+
+    seen = []
+    scene.on_collision(A, B, seen.append, kinds="started")
+    scene.on_collision(A, B, lambda ev: seen.append(ev.kind))
+    scene.spawn(Transform(0, 0), Hitbox(AABB(1, 1), body="static"), A())
+    scene.spawn(Transform(0.5, 0), Velocity(), Hitbox(AABB(1, 1), sensor=True), B())
+    scene.step(DT)
+    assert seen[0].kind == "started" and seen[1] == "started"
