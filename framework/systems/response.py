@@ -169,7 +169,7 @@ def resolve(
         push_out_deepest(s_idx)
 
     _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
-                resolved, gravity, iterations, mob_level)
+                resolved, gravity, iterations, mob_level, lone)
     return resolved, applied_nx, applied_ny, pushed
 
 
@@ -213,21 +213,24 @@ def _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity) -> None:
 
 
 def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed, resolved, gravity,
-                iterations, mob_level) -> None:
+                iterations, mob_level, lone) -> None:
     c = store.cols
     rest = np.maximum(c["restitution"][ra], c["restitution"][rb])
     gx, gy = gravity
     # Potential energy (per unit mass) the push-out added to the mobile body of a solid contact.
     dpe = -(gx * nx + gy * ny) * sgn * pushed
     done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
-    for _ in range(max(1, iterations)):
+    for it in range(max(1, iterations)):
         vx, vy = c["vx"], c["vy"]
         vn = (vx[rb] - vx[ra]) * nx + (vy[rb] - vy[ra]) * ny
         approaching = resolved & (vn < 0.0) & ~done
+        if it == 0:
+            done |= lone  # a contact whose bodies touch nothing else is settled by one pass
         if not approaching.any():
             return
-        levels = np.unique(mob_level[approaching & solid])
-        for lv in levels.tolist():  # ground up: each level sees the velocities below it settled
+        s_any = approaching & solid
+        levels = np.unique(mob_level[s_any]).tolist() if s_any.any() else []
+        for lv in levels:  # ground up: each level sees the velocities below it settled
             s_idx = np.flatnonzero(approaching & solid & (mob_level == lv))
             if lv != levels[0]:
                 vx, vy = c["vx"], c["vy"]
