@@ -56,7 +56,7 @@ def plot_perf(report: dict[str, Any], path: Path) -> bool:
     ax.set_ylabel("ms per step (median)")
     ax.set_title("Cost of a step, ~1 pair per box")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="lower right")
 
     staged = [r for r in rows if r["movement_ms"] is not None]
     labels = [r["scene"] for r in staged]
