@@ -599,6 +599,11 @@ class Scene:
         if "detection" not in self.effects:
             return False
         ea, eb, ra, rb = self._pairs
+        if self.geometry.version != self.store.version:
+            # A system changed hitboxes after the broad phase: measure the pairs as they are now.
+            live = (self.store.kind[ra] >= 0) & (self.store.kind[rb] >= 0)
+            ea, eb, ra, rb = ea[live], eb[live], ra[live], rb[live]
+            self.geometry.update(self.store)
         res = pair_contacts(self.store, self.geometry, ra, rb, self.counters["narrow_tests"])
         h = np.flatnonzero(res.hit)
         contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
@@ -660,6 +665,7 @@ class Scene:
             return False
         movable = (store.inv_mass > 0) & ~store.asleep  # sleeping bodies keep still
         solid = ~(store.sensor[ra] | store.sensor[rb]) & (movable[ra] | movable[rb])
+        solid &= (store.kind[ra] >= 0) & (store.kind[rb] >= 0)  # a system may have removed a hitbox
         one_way = store.one_way[ra] | store.one_way[rb]
         if one_way.any():
             solid &= ~one_way | self._lands_on_one_way(ra, rb, nx, ny, depth, alive0)
@@ -669,7 +675,7 @@ class Scene:
         geom = self.geometry
 
         def recompute(a: np.ndarray, b: np.ndarray):
-            if not (store.ox.any() or store.oy.any()):
+            if geom.version == store.version and not (store.ox.any() or store.oy.any()):
                 geom.hx, geom.hy = store.x, store.y
             else:
                 geom.update(store)
@@ -678,7 +684,7 @@ class Scene:
 
         self._moved += 1
         done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
-                                          self.response_iterations, recompute, alive0[idx])
+                                          self.response_iterations, recompute, alive0[idx], dt)
         self._moved += 1
         order = np.argsort(pair_keys(ents_a[idx[done]], ents_b[idx[done]]), kind="stable")
         keep = idx[done][order]
@@ -705,9 +711,35 @@ class Scene:
         still[rows] = np.where(rest, still[rows] + 1, 0)
         sleepy = rows[still[rows] >= SLEEP_STEPS]
         if sleepy.size:
+            sleepy = self._whole_islands(sleepy)
+        if sleepy.size:
             c["asleep"][sleepy] = True
             c["vx"][sleepy] = c["vy"][sleepy] = c["w"][sleepy] = 0.0
             store.sleep_dirty = True
+
+    def _whole_islands(self, ready_rows: np.ndarray) -> np.ndarray:
+        """The ready rows whose whole group of touching dynamic bodies is ready (or asleep).
+
+        A stack sleeps as one: a body touching an awake, restless dynamic body stays awake, and
+        so, in turn, does whatever touches it."""
+        store = self.store
+        ready = np.zeros(store.n, dtype=bool)
+        ready[ready_rows] = True
+        ra, rb = self._contact_rows
+        sa, sb = self._rows_of(self._support[0]), self._rows_of(self._support[1])
+        ea = np.concatenate([ra, sa])
+        eb = np.concatenate([rb, sb])
+        ok = (ea >= 0) & (eb >= 0) & (ea < store.n) & (eb < store.n)
+        ea, eb = ea[ok], eb[ok]
+        restless = (store.body == 0) & ~store.asleep
+        for _ in range(store.n):
+            blocked_a = ready[ea] & restless[eb] & ~ready[eb]
+            blocked_b = ready[eb] & restless[ea] & ~ready[ea]
+            if not (blocked_a.any() or blocked_b.any()):
+                break
+            ready[ea[blocked_a]] = False
+            ready[eb[blocked_b]] = False
+        return ready_rows[ready[ready_rows]]
 
     def _lands_on_one_way(self, ra, rb, nx, ny, depth, alive0) -> np.ndarray:
         """Mask of contacts a one-way platform takes: the other body comes from above (the

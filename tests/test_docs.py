@@ -1,16 +1,36 @@
-"""The docs cannot rot: every ``>>>`` sample in docs/*.md runs as a doctest, and every complete
-```python block marked runnable (the README's example and the docs' full programs) runs."""
+"""The docs cannot rot.
+
+- Every ``>>>`` sample in docs/*.md runs as a doctest.
+- Every complete ```python block runs: on the pages listed in ``EVERY_BLOCK_RUNS`` all of them
+  (fragments there are written as ``>>>`` doctests instead), elsewhere the ones marked with a
+  ``<!-- runnable -->`` line just above. A ```text block right after a runnable block is what it
+  prints, exactly. A block calling ``framework.render.run`` gets a stand-in that checks the
+  arguments against the real signature and steps the scene headless instead of opening a window.
+- The README's example runs and prints what its comments say; its links lead somewhere.
+- The site's navigation (mkdocs.yml) lists every page, and lists no page that is missing.
+"""
 
 from __future__ import annotations
 
 import doctest
+import importlib.util
+import inspect
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-DOC_FILES = sorted(p for p in (ROOT / "docs").rglob("*.md") if ">>>" in p.read_text())
+DOCS = ROOT / "docs"
+DOC_FILES = sorted(p for p in DOCS.rglob("*.md") if ">>>" in p.read_text())
+# Pages on which every ```python block is a complete program (or a >>> doctest), and runs.
+EVERY_BLOCK_RUNS = {"index.md", "concepts.md", "events.md", "examples.md", "api.md"}
+RUNNABLE_MARK = "<!-- runnable -->"
+_BLOCK = re.compile(r"(?P<mark><!-- runnable -->\n)?```python\n(?P<code>.*?)```\n"
+                    r"(?:\n(?:[^`\n][^\n]*\n)*?\n?```text\n(?P<out>.*?)```)?", re.S)
 
 
 @pytest.mark.parametrize("path", DOC_FILES, ids=lambda p: p.name)
@@ -23,6 +43,48 @@ def _python_blocks(path: Path) -> list[str]:
     return re.findall(r"```python\n(.*?)```", path.read_text(), flags=re.S)
 
 
+def _runnable_blocks() -> list[tuple[str, int, str, str | None]]:
+    """(page, block number on the page, code, expected output or None) of every block that runs."""
+    found = []
+    for path in sorted(DOCS.glob("*.md")):
+        for i, m in enumerate(_BLOCK.finditer(path.read_text()), 1):
+            code = m.group("code")
+            if code.lstrip().startswith(">>>"):
+                continue  # a doctest: test_doctests_in_docs runs it
+            if path.name in EVERY_BLOCK_RUNS or m.group("mark"):
+                found.append((path.name, i, code, m.group("out")))
+    return found
+
+
+RUNNABLE = _runnable_blocks()
+
+
+def test_the_pages_that_run_every_block_exist_and_have_blocks():
+    for name in EVERY_BLOCK_RUNS:
+        assert (DOCS / name).exists(), name
+    assert {"index.md", "concepts.md"} <= {page for page, *_ in RUNNABLE}
+
+
+@pytest.mark.parametrize("page,number,code,expected", RUNNABLE, ids=[f"{p}#{n}" for p, n, _c, _o in RUNNABLE])
+def test_complete_python_blocks_in_docs_run(page, number, code, expected, capsys, monkeypatch, tmp_path):
+    if "framework.render" in code:
+        import framework.render
+
+        real_run = framework.render.run
+
+        def headless_run(scene, *args, **kwargs):  # the window runner, minus the window
+            inspect.signature(real_run).bind(scene, *args, **kwargs)
+            for _ in range(kwargs.get("max_frames") or 60):
+                scene.step(1.0 / kwargs.get("fps", 60))
+
+        monkeypatch.setattr(framework.render, "run", headless_run)
+    monkeypatch.chdir(tmp_path)  # whatever a sample writes lands in a temporary directory
+    exec(compile(code, f"docs/{page} (python block {number})", "exec"), {"__name__": "__main__"})
+    out = capsys.readouterr().out
+    if expected is not None:
+        assert out == expected, f"docs/{page} block {number} printed:\n{out}"
+
+
 def test_readme_example_runs_and_prints_what_it_says(capsys):
     (block,) = [b for b in _python_blocks(ROOT / "README.md") if "Scene(" in b]
     exec(compile(block, "README.md", "exec"), {})
@@ -30,3 +92,29 @@ def test_readme_example_runs_and_prints_what_it_says(capsys):
     # The comments in the block say what it prints.
     expected = re.findall(r"# (\[.*?\]|[0-9.]+):", block)
     assert out == expected
+
+
+def test_readme_links_lead_to_files():
+    links = re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", (ROOT / "README.md").read_text())
+    local = [link for link in links if "://" not in link]
+    assert local, "the README links into the docs"
+    missing = [link for link in local if not (ROOT / link).exists()]
+    assert not missing, f"README links to missing files: {missing}"
+
+
+def test_site_navigation_lists_every_page_and_only_pages_that_exist():
+    nav = re.findall(r"^\s*- [^:\n]+: (\S+\.md)\s*$", (ROOT / "mkdocs.yml").read_text(), flags=re.M)
+    pages = sorted(p.name for p in DOCS.glob("*.md"))
+    assert sorted(set(nav)) == sorted(nav), "a page is listed twice"
+    assert sorted(set(pages) - set(nav)) == [], "pages missing from the nav in mkdocs.yml"
+    assert sorted(set(nav) - set(pages)) == [], "mkdocs.yml lists pages that do not exist"
+
+
+@pytest.mark.skipif(importlib.util.find_spec("mkdocs") is None or importlib.util.find_spec("mkdocstrings") is None,
+                    reason="the docs extra is not installed (pip install -e '.[docs]')")
+def test_site_builds_strict(tmp_path):
+    out = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
+                         cwd=ROOT, capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "NO_MKDOCS_2_WARNING": "1"})
+    assert out.returncode == 0, out.stderr[-4000:]
+    assert (tmp_path / "site" / "api" / "index.html").exists()

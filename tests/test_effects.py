@@ -152,3 +152,15 @@ def test_headless_scene_never_imports_pyglet_gl():
     """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_a_stack_falls_asleep_as_one_and_stays_exact():
+    with Scene(gravity=(0.0, -10.0)) as s:
+        s.spawn(Transform(0, 0), Hitbox(AABB(4, 1), body="static"))
+        boxes = [s.spawn(Transform(0.0, 1.0 + k), Velocity(), Hitbox(AABB(1, 1))) for k in range(8)]
+        for i in range(200):
+            s.step(1 / 60)
+            ys = [s.get(b, Transform).y for b in boxes]
+            if i >= 10:  # once the stack has come to rest (it starts exactly touching, in free fall)
+                assert max(abs(y - (1.0 + k)) for k, y in enumerate(ys)) < 1e-9
+        assert s.counters["asleep"] == 8 and s.counters["integrated"] == 0

@@ -221,17 +221,16 @@ def test_elastic_ball_never_bounces_higher_than_it_started():
         floor_tiles(s, 3, x0=-1.0)
         ball = s.spawn(Transform(0.0, 5.0), Velocity(), Hitbox(Circle(0.5), restitution=1.0))
         top = 5.0
-        peak_after = 0.0
-        bounced = False
-        for _ in range(5000):
+        late_peak = 0.0
+        for i in range(5000):
             s.step(1 / 60)
             y = s.get(ball, Transform).y
-            assert y <= top + 1e-9
-            if s.get(ball, Velocity).y > 0:
-                bounced = True
-            if bounced:
-                peak_after = max(peak_after, y)
-        assert peak_after > 4.0  # it does keep bouncing (no heavy energy loss)
+            assert y <= top  # exactly: never higher than it started
+            if i >= 4000:  # the last bounces
+                late_peak = max(late_peak, y)
+        # It keeps bouncing: each bounce gives up at most g dt^2 / 8 of height (see response.py),
+        # about 45 bounces here.
+        assert late_peak > 5.0 - 50 * 10 / 60**2 / 8
 
 
 def test_resolved_dynamic_static_pairs_no_longer_overlap(scene):

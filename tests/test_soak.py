@@ -42,7 +42,7 @@ ENERGY_MARGIN = 1e-3  # relative to the initial total (measured from the floor)
 MEMORY_BOUND = 256 * 1024  # bytes of growth allowed between the early and the late snapshot
 
 
-def build_level(n_bodies: int, seed: int) -> tuple[Scene, np.ndarray, list]:
+def build_level(n_bodies: int, seed: int, restitution: bool = True) -> tuple[Scene, np.ndarray, list]:
     """The level and its bodies; returns (scene, entity ids, local outline of each body)."""
     rng = np.random.default_rng(seed)
     s = Scene(gravity=(0.0, -G))
@@ -69,7 +69,7 @@ def build_level(n_bodies: int, seed: int) -> tuple[Scene, np.ndarray, list]:
             shape = Polygon.box(size, float(rng.uniform(0.3, 0.8)))
         else:
             shape = Polygon([(-size / 2, -size / 3), (size / 2, -size / 3), (0.0, size / 2)])
-        bouncy = k % 3 != 0
+        bouncy = restitution and k % 3 != 0
         fast = k % 25 == 0
         speed = 40.0 if fast else 4.0
         angle = float(rng.uniform(0.0, 2 * math.pi))
@@ -131,15 +131,17 @@ class Meter:
 
 
 def soak(steps: int, n_bodies: int, seed: int = 1, check_every: int = 1, memory_from: int = 200,
-         report=None) -> dict[str, float]:
-    """Step the level ``steps`` times; assert the invariants; return a summary."""
-    s, ents, shapes = build_level(n_bodies, seed)
+         report=None, restitution: bool = True) -> dict:
+    """Step the level ``steps`` times, checking every ``check_every`` steps; return a summary with
+    the first step that broke each invariant (``None``: never broken) and the worst values seen."""
+    s, ents, shapes = build_level(n_bodies, seed, restitution)
     meter = Meter(s, ents, shapes)
-    first = meter.measure()
-    e0 = first["energy"]
-    worst_pen, worst_energy, min_energy = 0.0, e0, e0
+    e0 = meter.measure()["energy"]
+    first: dict[str, int | None] = {"nan": None, "escape": None, "penetration": None, "energy": None}
+    worst_pen, worst_energy, escaped = 0.0, e0, 0
     t0 = time.perf_counter()
     mem0 = None
+    growth = 0
     try:
         for i in range(1, steps + 1):
             s.step(DT)
@@ -147,33 +149,37 @@ def soak(steps: int, n_bodies: int, seed: int = 1, check_every: int = 1, memory_
                 gc.collect()
                 tracemalloc.start()
                 mem0 = tracemalloc.take_snapshot()
-            if i % check_every == 0 or i == steps:
-                m = meter.measure()
-                assert m["finite"], f"NaN or inf in the store at step {i}"
-                assert m["escaped"] == 0, f"{m['escaped']} bodies escaped the level at step {i}"
-                assert m["penetration"] <= PENETRATION_BOUND, f"penetration {m['penetration']} at step {i}"
-                assert m["energy"] <= e0 * (1 + ENERGY_MARGIN), f"energy {m['energy']} > {e0} at step {i}"
-                worst_pen = max(worst_pen, m["penetration"])
-                worst_energy = max(worst_energy, m["energy"])
-                min_energy = min(min_energy, m["energy"])
-                if report is not None and i % max(1, steps // 20) == 0:
-                    report(f"step {i}: {time.perf_counter() - t0:.0f} s, energy {m['energy'] / e0:.4f} of the "
-                           f"initial, worst penetration {worst_pen:.4f}, asleep {m['asleep']}")
-        gc.collect()
-        growth = 0
+            if i % check_every and i != steps:
+                continue
+            m = meter.measure()
+            broken = {"nan": not m["finite"], "escape": m["escaped"] > 0,
+                      "penetration": m["penetration"] > PENETRATION_BOUND,
+                      "energy": m["energy"] > e0 * (1 + ENERGY_MARGIN)}
+            for k, bad in broken.items():
+                if bad and first[k] is None:
+                    first[k] = i
+            if broken["nan"]:
+                break
+            worst_pen = max(worst_pen, m["penetration"])
+            worst_energy = max(worst_energy, m["energy"])
+            escaped = max(escaped, m["escaped"])
+            if report is not None and i % max(1, steps // 20) == 0:
+                report(f"step {i}: {time.perf_counter() - t0:.0f} s, energy {m['energy'] / e0:.4f} of the initial "
+                       f"(max {worst_energy / e0:.4f}), worst penetration {worst_pen:.4f}, asleep {m['asleep']}, "
+                       f"first violations {first}")
         if mem0 is not None:
+            gc.collect()
             mem1 = tracemalloc.take_snapshot()
             growth = sum(st.size_diff for st in mem1.compare_to(mem0, "filename"))
-            tracemalloc.stop()
         last = meter.measure()
     finally:
         if tracemalloc.is_tracing():
             tracemalloc.stop()
         s.close()
-    return {"steps": steps, "bodies": n_bodies, "seconds": time.perf_counter() - t0,
-            "worst_penetration": worst_pen, "energy_max_ratio": worst_energy / e0,
-            "energy_final_ratio": last["energy"] / e0, "asleep_final": last["asleep"],
-            "memory_growth_bytes": growth}
+    return {"steps": steps, "bodies": n_bodies, "seconds": round(time.perf_counter() - t0, 1),
+            "first_violation": first, "worst_penetration": worst_pen, "most_escaped": escaped,
+            "energy_max_ratio": worst_energy / e0, "energy_final_ratio": last["energy"] / e0,
+            "asleep_final": last["asleep"], "memory_growth_bytes": growth}
 
 
 def test_short_soak():

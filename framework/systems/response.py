@@ -48,6 +48,7 @@ def resolve(
     iterations: int,
     recompute: Recompute,
     alive0: np.ndarray | None = None,
+    dt: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Resolve the contacts ``(ra, rb)`` (normal from a to b).
 
@@ -169,7 +170,7 @@ def resolve(
         push_out_deepest(s_idx)
 
     _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
-                resolved, gravity, iterations, mob_level, lone)
+                resolved, gravity, iterations, mob_level, lone, dt)
     return resolved, applied_nx, applied_ny, pushed
 
 
@@ -212,27 +213,50 @@ def _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity) -> None:
     return level
 
 
+def _bounce_speed(u: np.ndarray, g: np.ndarray, d: np.ndarray, dt: float) -> np.ndarray:
+    """Speed off an immovable surface that keeps the energy of an elastic bounce.
+
+    Semi-implicit Euler under gravity ``g`` (its component against the push-out) conserves
+    ``F = v^2/2 + g h - g v dt/2`` exactly in flight (v, h along the push-out; derivation: one
+    step changes the three terms by ``-g dt (v0 + v1)/2``, ``g v1 dt`` and ``g^2 dt^2/2``, which
+    sum to 0). The push-out raised the body by ``d``; solving ``F_after = F_before`` for the new
+    speed, with ``u`` (< 0) the approach speed, gives the positive root of
+    ``v^2 - g dt v - (u^2 - g u dt - 2 g d) = 0``. In flight the height at a discrete apex can
+    still exceed ``F / g`` by up to ``g dt^2 / 8`` (the last upward step), so a bounce also gives
+    up that much: an elastic ball never climbs higher than it started, and loses only that hair
+    of height per bounce (instead of a share of its energy proportional to dt). No real root: the
+    push-out took more than the energy there was, so the body stops.
+    """
+    gp = np.maximum(g, 0.0)
+    k = u * u - g * u * dt - 2.0 * g * d - 0.25 * gp * gp * dt * dt
+    disc = g * g * dt * dt + 4.0 * k
+    root = 0.5 * (g * dt + np.sqrt(np.maximum(disc, 0.0)))
+    return np.where(disc >= 0.0, np.maximum(root, 0.0), 0.0)
+
+
 def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed, resolved, gravity,
-                iterations, mob_level, lone) -> None:
+                iterations, mob_level, lone, dt) -> None:
     c = store.cols
     rest = np.maximum(c["restitution"][ra], c["restitution"][rb])
     gx, gy = gravity
-    # Potential energy (per unit mass) the push-out added to the mobile body of a solid contact.
-    dpe = -(gx * nx + gy * ny) * sgn * pushed
+    # Gravity against the push-out direction of a solid contact's mobile body.
+    gn = -(gx * nx + gy * ny) * sgn
     done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
     for it in range(max(1, iterations)):
         vx, vy = c["vx"], c["vy"]
         vn = (vx[rb] - vx[ra]) * nx + (vy[rb] - vy[ra]) * ny
         approaching = resolved & (vn < 0.0) & ~done
-        if it == 0:
-            done |= lone  # a contact whose bodies touch nothing else is settled by one pass
         if not approaching.any():
             return
         s_any = approaching & solid
-        levels = np.unique(mob_level[s_any]).tolist() if s_any.any() else []
-        for lv in levels:  # ground up: each level sees the velocities below it settled
-            s_idx = np.flatnonzero(approaching & solid & (mob_level == lv))
-            if lv != levels[0]:
+        lowest = mob_level[s_any].min() if s_any.any() else np.inf
+        # Ground up: each level sees the velocities below it settled, so a level whose bodies
+        # all fell together (not approaching at first) is looked at again once those below stop.
+        cand = resolved & solid & ~done & (mob_level >= lowest)
+        levels = np.unique(mob_level[cand]).tolist() if s_any.any() else []
+        for lv in levels:
+            s_idx = np.flatnonzero((approaching if lv == lowest else cand) & solid & (mob_level == lv))
+            if lv != lowest:
                 vx, vy = c["vx"], c["vy"]
                 vn_l = (vx[rb[s_idx]] - vx[ra[s_idx]]) * nx[s_idx] + (vy[rb[s_idx]] - vy[ra[s_idx]]) * ny[s_idx]
                 vn[s_idx] = vn_l
@@ -242,7 +266,7 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
             pick = s_idx[_first_per_group(mobile[s_idx], vn[s_idx])]
             v = vn[pick]
             e = rest[pick]
-            target = e * np.sqrt(np.maximum(v * v - 2.0 * np.maximum(dpe[pick], 0.0), 0.0))
+            target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
             dv = (target - v) * sgn[pick]
             m = mobile[pick]
             c["vx"][m] += dv * nx[pick]
@@ -258,3 +282,5 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
             c["vx"][:n] += np.bincount(b, jx * ib[d_idx], n) - np.bincount(a, jx * ia[d_idx], n)
             c["vy"][:n] += np.bincount(b, jy * ib[d_idx], n) - np.bincount(a, jy * ia[d_idx], n)
             done[d_idx] = rest[d_idx] > 0.0
+        if it == 0:
+            done |= lone  # a contact whose bodies touch nothing else is settled by one pass
