@@ -21,6 +21,7 @@ import numpy as np
 
 from .collision import batch
 from .collision.broad_phase import SpatialHash
+from .collision.grid import auto_cell_size
 from .collision.placement import check_shape
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
@@ -186,6 +187,8 @@ class Scene:
         self._resolved = _NO_RESOLVED
         self._row_lookup = np.zeros(1, dtype=np.int64)
         self._moved = 0  # bumped whenever a stage moves bodies (see ensure_geometry)
+        self._start_key: tuple[int, ...] | None = None
+        self._start_buf = (np.zeros(0), np.zeros(0))
         self._geometry_stamp: tuple[int, ...] | None = None
         self._lookup_version = -1
         esper.switch_world(self.world)
@@ -470,8 +473,18 @@ class Scene:
         if "movement" not in self.effects:
             return False
         store = self.store
-        self._start_x, self._start_y = store.x.copy(), store.y.copy()
-        ccd = np.flatnonzero(store.ccd & store.has_vel & (store.body != STATIC))
+        # Where every row starts the step (for one-way platforms and sleeping); static rows are
+        # copied again only when the static set changed.
+        key = (store.version, store.static_epoch, store.n)
+        if key != self._start_key:
+            self._start_buf = (store.x.copy(), store.y.copy())
+            self._start_key = key
+        else:
+            rows = store.active()[2]
+            self._start_buf[0][rows], self._start_buf[1][rows] = store.x[rows], store.y[rows]
+        self._start_x, self._start_y = self._start_buf
+        movers = store.active()[0]
+        ccd = movers[store.ccd[movers]]
         self._ccd_rows = ccd
         self._ccd_start = (store.x[ccd].copy(), store.y[ccd].copy())
         rows = integrate(store, dt, self._gravity())
@@ -530,6 +543,22 @@ class Scene:
         out[ok] = self._row_lookup[entities[ok]]
         return out
 
+    def _choose_cell_size(self, static_rows: np.ndarray) -> None:
+        """The automatic cell: about twice the median extent of the moving bodies or of the static
+        ones, whichever is larger, so small tiles do not make every mover span dozens of cells
+        and small movers do not cut large tiles into many."""
+        store, geom = self.store, self.geometry
+        moving = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
+        sizes = []
+        for rows in (moving, static_rows):
+            if rows.size:
+                c = auto_cell_size(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows])
+                if c is not None:
+                    sizes.append(c)
+        if sizes:
+            self.hash.set_cell_size(max(sizes))
+            self.sleep_hash.set_cell_size(max(sizes))
+
     def _sync_static(self) -> None:
         store, geom = self.store, self.geometry
         if not store.static_dirty:
@@ -537,6 +566,8 @@ class Scene:
         if store.asleep.any():  # the level changed under the sleepers
             store.wake(np.flatnonzero(store.asleep))
         rows = np.flatnonzero((store.kind >= 0) & (store.body == STATIC))
+        if self.hash.cell_size is None:
+            self._choose_cell_size(rows)
         self.hash.set_static(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
                              store.entity[rows])
         self.counters["rehashed"] = self.counters.get("rehashed", 0) + int(rows.size)
@@ -549,8 +580,7 @@ class Scene:
         store, geom = self.store, self.geometry
         self.ensure_geometry()
         self._sync_static()
-        awake = (store.kind >= 0) & (store.body != STATIC) & ~store.asleep
-        moving = np.flatnonzero(awake)
+        moving = store.active()[1]
         bounds = (geom.minx[moving], geom.miny[moving], geom.maxx[moving], geom.maxy[moving])
         ea, eb = self.hash.pairs(*bounds, store.entity[moving])
         self.counters["rehashed"] += int(moving.size)
@@ -663,8 +693,9 @@ class Scene:
         self._resolved = _NO_RESOLVED
         if ra.size and ra.max() >= store.n:  # rows spawned mid-step are not in this step
             return False
-        movable = (store.inv_mass > 0) & ~store.asleep  # sleeping bodies keep still
-        solid = ~(store.sensor[ra] | store.sensor[rb]) & (movable[ra] | movable[rb])
+        inv, asleep = store.inv_mass, store.asleep  # sleeping bodies keep still
+        movable_a, movable_b = (inv[ra] > 0) & ~asleep[ra], (inv[rb] > 0) & ~asleep[rb]
+        solid = ~(store.sensor[ra] | store.sensor[rb]) & (movable_a | movable_b)
         solid &= (store.kind[ra] >= 0) & (store.kind[rb] >= 0)  # a system may have removed a hitbox
         one_way = store.one_way[ra] | store.one_way[rb]
         if one_way.any():

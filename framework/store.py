@@ -62,10 +62,54 @@ class BodyStore:
         self.bad: dict[tuple[int, str], object] = {}
         self.dirty_hitboxes: set[int] = set()
         self.moved_static: set[int] = set()  # static entities whose transform game code changed
+        self.static_epoch = 0  # bumped whenever static_dirty is set
+        self.sleep_epoch = 0  # bumped whenever sleep_dirty is set
         self.static_dirty = True  # the static set or a static body changed: re-hash the statics
         self.sleep_dirty = False  # a body fell asleep or woke: re-hash the sleepers
+        self.written: set[int] = set()  # entities game code wrote to since the last check
+        self._active_key: tuple[int, int, int] | None = None
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
         self.writes = 0  # bumped by every write from game code (component views)
+
+    # --- change flags and the rows that can move ---------------------------------------------
+
+    @property
+    def static_dirty(self) -> bool:
+        return self._static_dirty
+
+    @static_dirty.setter
+    def static_dirty(self, value: bool) -> None:
+        self._static_dirty = value
+        if value:
+            self.static_epoch += 1
+
+    @property
+    def sleep_dirty(self) -> bool:
+        return self._sleep_dirty
+
+    @sleep_dirty.setter
+    def sleep_dirty(self, value: bool) -> None:
+        self._sleep_dirty = value
+        if value:
+            self.sleep_epoch += 1
+
+    def active(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(movers, awake_bodies, nonstatic)`` rows, cached until rows, kinds or sleep change:
+        movers have a Velocity and are neither static nor asleep; awake bodies have a hitbox and
+        are neither static nor asleep. Per-step work walks these, never the static level."""
+        key = (self.version, self.sleep_epoch, self.n)
+        if key != self._active_key:
+            n = self.n
+            c = self.cols
+            nonstatic = c["body"][:n] != STATIC
+            awake = nonstatic & ~c["asleep"][:n]
+            self._active = (
+                np.flatnonzero(awake & c["has_vel"][:n]),
+                np.flatnonzero(awake & (c["kind"][:n] >= 0)),
+                np.flatnonzero(nonstatic),
+            )
+            self._active_key = key
+        return self._active
 
     # --- columns ---------------------------------------------------------------------------
 
@@ -223,6 +267,7 @@ class BodyStore:
     def write(self, entity: int, col: str, value: object) -> None:
         row = self.row_of[entity]
         self.writes += 1
+        self.written.add(entity)
         if self.cols["asleep"][row] or self.cols["still"][row]:
             self.wake(row)
         try:
@@ -250,15 +295,19 @@ class BodyStore:
 
         Changes nothing, so a failed step leaves the scene exactly as it was."""
         problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
-        n = self.n
+        # Static rows change only through game code's writes: check those and the rows that move.
+        rows = self.active()[2]
+        if self.written:
+            extra = [self.row_of[e] for e in self.written if e in self.row_of]
+            rows = np.union1d(rows, np.array(extra, dtype=np.int64))
         for col in ("x", "y", "rot", "vx", "vy", "w"):
-            values = self.cols[col][:n]
+            values = self.cols[col][rows]
             ok = np.isfinite(values)
             if not ok.all():
-                for row in np.flatnonzero(~ok):
+                for row in rows[~ok]:
                     e = int(self.cols["entity"][row])
                     if (e, col) not in self.bad:
-                        problems.append((e, col, float(values[row])))
+                        problems.append((e, col, float(self.cols[col][row])))
         for e in sorted(self.dirty_hitboxes):
             hb = self.hitboxes[self.row_of[e]]
             assert hb is not None
@@ -273,6 +322,7 @@ class BodyStore:
         if problems:
             e, col, v = min(problems, key=lambda p: (p[0], p[1]))
             raise InvalidValue(f"entity {e}: {_FIELD_NAMES[col]} must be a finite number, got {v!r}")
+        self.written.clear()
 
     def apply_hitbox_changes(self) -> set[int]:
         """Re-derive the rows of hitboxes that game code edited; return those entities."""

@@ -10,12 +10,16 @@ pair, ``brute_force_pairs`` on the bounds):
 - every ``started`` is followed by exactly one ``ended`` before the pair starts again, despawns
   included, and no event names an entity after its ``ended``;
 - the contacts of a step are exactly the pairs ``collide`` finds overlapping among those the
-  layers allow (not static-static, not both sleeping), with the same depth and normal;
+  layers allow (not static-static, not both sleeping), with the same depth and normal, measured on
+  the same hitbox origins (a pair overlapping by less than the rounding of its bounds may be
+  missed by the broad phase, nothing deeper);
 - the broad phase's candidate pairs are exactly the brute-force overlaps of the bounds;
-- after the response, no dynamic body overlaps a static one (beyond 1e-6 of its size) unless it is
-  squeezed between immovable bodies (statics are placed far apart so that only kinematic bodies
-  can squeeze);
+- after the response, a dynamic body whose contacts this step were all with static bodies does
+  not overlap them (beyond 1e-6 of its size). Statics are placed far apart, so none can squeeze a
+  body; a body also pressed by a moving one (a pile, a kinematic lift) is not checked;
 - the store agrees with the components (rows, kinds, views).
+
+``RELIABILITY_EXAMPLES=2000`` runs the machine longer (minutes) to hunt for new failures.
 
 Part 2 feeds bad values (NaN, inf, None, wrong types, out of range) through every door game code
 has: each must raise ``ValueError``/``TypeError`` naming the entity and field, and leave the scene
@@ -61,7 +65,8 @@ def snapshot(scene: Scene) -> tuple:
         store.static_dirty, store.sleep_dirty,
         comps, repr(scene.events), tuple(a.tobytes() for a in scene.contacts),
         tuple(a.tobytes() for a in scene.tracker.active), scene.tracker.keys.tobytes(),
-        scene.frame, scene.time, scene.gravity, sorted(scene._pending_despawn),
+        scene.frame, scene.time, scene.gravity, sorted(scene._pending_despawn), repr(scene.counters),
+        tuple(a.tobytes() for a in scene._support),
     )
 
 
@@ -138,10 +143,8 @@ class Doomed:
 # Static bodies sit in slots far apart (8 units; statics at most 2 across, movers at most 1.5),
 # above a floor whose top is y = 0, so no mover can be squeezed between two statics.
 SLOTS = [(float(x), float(y)) for x in range(-24, 25, 8) for y in (5, 12)]
-FLOOR = 0  # slot index used by nobody: the floor is spawned at set-up
 
 coord = st.floats(-1.0, 1.0, allow_nan=False)
-size = st.floats(0.125, 1.5, allow_nan=False)
 POLYGONS = [
     [(0.0, 0.0), (1.0, 0.0), (0.3, 0.8)],
     [(-0.5, -0.3), (0.5, -0.3), (0.7, 0.2), (0.0, 0.6), (-0.7, 0.2)],
@@ -216,7 +219,6 @@ class SceneMachine(RuleBasedStateMachine):
         self.dead: set[int] = set()  # entities despawned (their pairs end in the next step)
         self.queued: list[tuple[tuple[str, str], str, int, object]] = []  # mid-step actions
         self.exempt: set[int] = set()  # moved by game code after this step's response
-        self.narrow_checks = 0
         self.late: set[int] = set()  # moved or spawned by game code after this sub-step's broad phase
         # The checks run first at their hook, then the game code queued there.
         s.add_system(self._check_broad_phase, after="broad_phase")
@@ -315,7 +317,6 @@ class SceneMachine(RuleBasedStateMachine):
         assert got == want, f"broad phase: missing {want - got}, extra {got - want}"
 
     def _check_narrow_phase(self, scene: Scene, dt: float) -> None:
-        self.narrow_checks += 1
         want = {k: v for k, v in brute_force_contacts(scene).items() if not self.late.intersection(k)}
         c = scene.contacts
         got = {}
@@ -329,6 +330,15 @@ class SceneMachine(RuleBasedStateMachine):
             if ia and ib:
                 continue  # frozen: two sleepers (or a sleeper and a static) keep their contact
             got[(a, b)] = (float(c.nx[k]), float(c.ny[k]), float(c.depth[k]))
+        # The broad phase tests bounds rounded to float64, strictly: a pair whose exact overlap is
+        # below the rounding of its bounds (depth ~1e-17, e.g. boxes stacked exactly at y + h/2) is
+        # not a candidate. Such a pair may be missing; nothing deeper may.
+        for key in set(want) - set(got):
+            ref, pose = want[key], bs[key[0]][1]
+            assert ref.depth <= 64 * 2.0**-52 * (1.0 + abs(pose[0]) + abs(pose[1])), \
+                f"contacts: missing {key} {ref}"
+            event("contact within rounding missed by the broad phase")
+            del want[key]
         assert set(got) == set(want), f"contacts: missing {set(want) - set(got)}, extra {set(got) - set(want)}"
         for key, ref in want.items():
             nx, ny, depth = got[key]
@@ -518,7 +528,10 @@ class SceneMachine(RuleBasedStateMachine):
         c = s.contacts
         bs = bodies(s)
         touching: dict[int, set[int]] = {}
-        for a, b in zip(c.a.tolist(), c.b.tolist()):
+        # This step's contacts and the pairs the response resolved (which include last step's
+        # resting contacts it kept as support).
+        sa, sb = s._support[0], s._support[1]
+        for a, b in zip(c.a.tolist() + sa.tolist(), c.b.tolist() + sb.tolist()):
             if a in bs and b in bs and not (bs[a][2].sensor or bs[b][2].sensor):
                 touching.setdefault(a, set()).add(b)
                 touching.setdefault(b, set()).add(a)
@@ -559,7 +572,7 @@ class SceneMachine(RuleBasedStateMachine):
 
 
 SceneMachine.TestCase.settings = settings(
-    max_examples=int(os.environ.get("RELIABILITY_EXAMPLES", "40")), stateful_step_count=30, deadline=None,
+    max_examples=int(os.environ.get("RELIABILITY_EXAMPLES", "200")), stateful_step_count=40, deadline=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 TestSceneMachine = SceneMachine.TestCase

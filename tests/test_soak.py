@@ -25,6 +25,7 @@ from __future__ import annotations
 import gc
 import math
 import os
+import sys
 import time
 import tracemalloc
 
@@ -35,11 +36,19 @@ from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 
 G = 10.0
 DT = 1.0 / 60.0
-W, H = 40, 24  # level size in tiles: tiles centred at x = 0..W-1, y = 0..H-1 on the border
+W, H = 64, 20  # level size in tiles: tiles centred at x = 0..W-1, y = 0..H-1 on the border
 LEFT, RIGHT, BOTTOM, TOP = 0.5, W - 1.5, 0.5, H - 1.5  # inner faces of the walls, floor and ceiling
 PENETRATION_BOUND = 0.25  # world units; bodies are 0.3 to 0.8 across
 ENERGY_MARGIN = 1e-3  # relative to the initial total (measured from the floor)
-MEMORY_BOUND = 256 * 1024  # bytes of growth allowed between the early and the late snapshot
+MEMORY_BOUND = 256 * 1024  # bytes of growth allowed between the two tracemalloc snapshots
+BLOCK_BOUND = 20_000  # Python memory blocks of growth allowed between an early step and the end
+RSS_BOUND = 32 * 2**20  # resident size growth allowed (bytes): coarse, the allocator keeps freed pages
+# Sizes (environment variables override them): the short soak must stay well under 20 s on a busy
+# 2-core machine; the long one under about 40 minutes. Stepping costs about 0.5 ms per body per
+# step in a settled pile today (the response re-measures each support level), so "hundreds of
+# bodies" for 100,000 steps is hours: run it with LONG_SOAK_BODIES=200 to see them.
+SHORT_STEPS, SHORT_BODIES = int(os.environ.get("SOAK_STEPS", 1500)), int(os.environ.get("SOAK_BODIES", 20))
+LONG_STEPS, LONG_BODIES = int(os.environ.get("LONG_SOAK_STEPS", 100_000)), int(os.environ.get("LONG_SOAK_BODIES", 40))
 
 
 def build_level(n_bodies: int, seed: int, restitution: bool = True) -> tuple[Scene, np.ndarray, list]:
@@ -130,25 +139,42 @@ class Meter:
                 "finite": finite, "asleep": int(store.asleep.sum())}
 
 
+def _rss_bytes() -> int:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
 def soak(steps: int, n_bodies: int, seed: int = 1, check_every: int = 1, memory_from: int = 200,
-         report=None, restitution: bool = True) -> dict:
+         trace_from: int | None = None, trace_steps: int = 100, report=None, restitution: bool = True) -> dict:
     """Step the level ``steps`` times, checking every ``check_every`` steps; return a summary with
-    the first step that broke each invariant (``None``: never broken) and the worst values seen."""
+    the first step that broke each invariant (``None``: never broken) and the worst values seen.
+
+    Memory: Python's allocated blocks and the process's resident size are compared between step
+    ``memory_from`` and the end (cheap, whole run); tracemalloc (which slows stepping about five
+    times) compares snapshots ``trace_steps`` steps apart from step ``trace_from``."""
     s, ents, shapes = build_level(n_bodies, seed, restitution)
     meter = Meter(s, ents, shapes)
     e0 = meter.measure()["energy"]
     first: dict[str, int | None] = {"nan": None, "escape": None, "penetration": None, "energy": None}
     worst_pen, worst_energy, escaped = 0.0, e0, 0
     t0 = time.perf_counter()
-    mem0 = None
-    growth = 0
+    blocks0 = rss0 = snap0 = None
+    traced = 0
     try:
         for i in range(1, steps + 1):
             s.step(DT)
             if i == memory_from:
                 gc.collect()
+                blocks0, rss0 = sys.getallocatedblocks(), _rss_bytes()
+            if i == trace_from:
+                gc.collect()
                 tracemalloc.start()
-                mem0 = tracemalloc.take_snapshot()
+                snap0 = tracemalloc.take_snapshot()
+            elif trace_from is not None and i == trace_from + trace_steps:
+                gc.collect()
+                snap1 = tracemalloc.take_snapshot()
+                traced = sum(st.size_diff for st in snap1.compare_to(snap0, "filename"))
+                tracemalloc.stop()
             if i % check_every and i != steps:
                 continue
             m = meter.measure()
@@ -163,14 +189,13 @@ def soak(steps: int, n_bodies: int, seed: int = 1, check_every: int = 1, memory_
             worst_pen = max(worst_pen, m["penetration"])
             worst_energy = max(worst_energy, m["energy"])
             escaped = max(escaped, m["escaped"])
-            if report is not None and i % max(1, steps // 20) == 0:
+            if report is not None and i % max(1, steps // 50) == 0:
                 report(f"step {i}: {time.perf_counter() - t0:.0f} s, energy {m['energy'] / e0:.4f} of the initial "
                        f"(max {worst_energy / e0:.4f}), worst penetration {worst_pen:.4f}, asleep {m['asleep']}, "
                        f"first violations {first}")
-        if mem0 is not None:
-            gc.collect()
-            mem1 = tracemalloc.take_snapshot()
-            growth = sum(st.size_diff for st in mem1.compare_to(mem0, "filename"))
+        gc.collect()
+        blocks = sys.getallocatedblocks() - blocks0 if blocks0 is not None else 0
+        rss = _rss_bytes() - rss0 if rss0 is not None else 0
         last = meter.measure()
     finally:
         if tracemalloc.is_tracing():
@@ -179,18 +204,78 @@ def soak(steps: int, n_bodies: int, seed: int = 1, check_every: int = 1, memory_
     return {"steps": steps, "bodies": n_bodies, "seconds": round(time.perf_counter() - t0, 1),
             "first_violation": first, "worst_penetration": worst_pen, "most_escaped": escaped,
             "energy_max_ratio": worst_energy / e0, "energy_final_ratio": last["energy"] / e0,
-            "asleep_final": last["asleep"], "memory_growth_bytes": growth}
+            "asleep_final": last["asleep"], "block_growth": blocks, "rss_growth_bytes": rss,
+            "traced_growth_bytes": traced}
+
+
+def check(out: dict) -> None:
+    """Every invariant held over the whole run; memory stayed flat."""
+    assert out["first_violation"] == {"nan": None, "escape": None, "penetration": None, "energy": None}, out
+    assert out["worst_penetration"] <= PENETRATION_BOUND and out["energy_max_ratio"] <= 1 + ENERGY_MARGIN, out
+    assert out["traced_growth_bytes"] <= MEMORY_BOUND, out
+    assert out["block_growth"] <= BLOCK_BOUND and out["rss_growth_bytes"] <= RSS_BOUND, out
 
 
 def test_short_soak():
-    out = soak(2000, 240, seed=1, check_every=1, memory_from=500)
-    assert out["memory_growth_bytes"] <= MEMORY_BOUND, out
-    assert out["energy_final_ratio"] < 1.0  # the dead bodies lost energy
+    out = soak(SHORT_STEPS, SHORT_BODIES, seed=1, memory_from=200, trace_from=600, trace_steps=100)
+    check(out)
+    assert out["energy_final_ratio"] < 1.0  # collisions lose energy (restitution < 1, dead bodies)
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(os.environ.get("RUN_SLOW") != "1", reason="long soak: set RUN_SLOW=1 to run it")
 def test_long_soak():
-    out = soak(100_000, 240, seed=2, check_every=10, memory_from=1000, report=print)
+    out = soak(LONG_STEPS, LONG_BODIES, seed=2, check_every=10, memory_from=1000, trace_from=LONG_STEPS - 500,
+               trace_steps=300, report=print)
     print("long soak:", out)
-    assert out["memory_growth_bytes"] <= MEMORY_BOUND, out
+    check(out)
+
+
+# --- what the soak found (in the response stage; open) --------------------------------------------
+
+
+def _energy(s: Scene, ents) -> float:
+    return sum(s.get(e, Hitbox).mass * (0.5 * (s.get(e, Velocity).x ** 2 + s.get(e, Velocity).y ** 2)
+                                        + G * s.get(e, Transform).y) for e in ents)
+
+
+@pytest.mark.xfail(strict=True, reason="response: a body bouncing off the floor counts as immovable (shock "
+                                       "propagation) for the box it hits next step, which takes a full "
+                                       "reflection while the ball keeps its speed")
+def test_a_ball_bouncing_into_a_box_creates_no_energy():
+    with Scene(gravity=(0.0, -G)) as s:
+        s.spawn(Transform(0.0, 0.0), Hitbox(AABB(4.0, 1.0), body="static"))  # top at y = 0.5
+        ball = s.spawn(Transform(0.0, 0.76), Velocity(0.0, -20.0), Hitbox(Circle(0.25), restitution=1.0))
+        box = s.spawn(Transform(0.0, 1.7), Velocity(0.0, 0.0), Hitbox(AABB(1.0, 1.0), restitution=1.0))
+        e0 = _energy(s, (ball, box))
+        for _ in range(3):
+            s.step(DT)  # the ball bounces, then hits the box: today the box leaves at 40 units/s
+            assert _energy(s, (ball, box)) <= e0 * (1 + 1e-9)
+
+
+@pytest.mark.xfail(strict=True, reason="response: a bouncy body resting on the floor bounces by e*g*dt every "
+                                       "step forever, so it never sleeps (no restitution threshold)")
+def test_a_bouncy_ball_comes_to_rest_and_sleeps():
+    with Scene(gravity=(0.0, -G)) as s:
+        s.spawn(Transform(0.0, 0.0), Hitbox(AABB(4.0, 1.0), body="static"))
+        ball = s.spawn(Transform(0.0, 1.5), Velocity(), Hitbox(Circle(0.25), restitution=0.8))
+        for _ in range(1200):
+            s.step(DT)
+        assert s.store.asleep[s.store.row_of[ball]]
+
+
+@pytest.mark.xfail(strict=True, reason="response: entering a wall's lowest tile deeper (in x) than it overlaps it "
+                                       "(in y), the tile pushes the body down into the floor, which pushes it "
+                                       "back up: it stays in the corner, then leaves through the wall")
+def test_a_fast_box_sliding_into_a_tiled_corner_stays_inside():
+    # Found by the soak with 200 bodies: a box knocked to 47 units/s (0.78 per step, less than the
+    # wall's thickness) slides along the floor out of the level at step 45.
+    with Scene(gravity=(0.0, -G)) as s:
+        for x in range(12):
+            s.spawn(Transform(float(x), 0.0), Hitbox(AABB(1.0, 1.0), body="static"))  # floor, top at y = 0.5
+        for y in range(1, 4):
+            s.spawn(Transform(11.0, float(y)), Hitbox(AABB(1.0, 1.0), body="static"))  # wall, face at x = 10.5
+        box = s.spawn(Transform(9.994, 0.728), Velocity(46.8, 0.0), Hitbox(AABB(0.392, 0.456)))
+        for _ in range(3):
+            s.step(DT)
+            assert s.get(box, Transform).x <= 10.5 - 0.196 + 1e-9

@@ -127,6 +127,13 @@ class SpatialHash:
         """The cell side; ``None`` only while automatic and nothing has been built yet."""
         return self._cell
 
+    def set_cell_size(self, cell_size: float) -> None:
+        """Fix the cell side before anything is built (a caller that knows the scene better than
+        the first build's bodies, e.g. both the movers and the tiles)."""
+        if self._static.entries or self._moving.n:
+            raise InvalidValue("set_cell_size must come before the first set_static or pairs call")
+        self._cell = positive("cell_size", cell_size)
+
     def _choose_cell(self, bounds: tuple) -> float:
         if self._cell is None:
             self._cell = grid.auto_cell_size(*bounds)

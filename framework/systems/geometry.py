@@ -42,49 +42,59 @@ class Geometry:
         self.version = store.version
 
     def update(self, store: BodyStore) -> None:
-        """Hitbox origins and bounds of every row, from the current transforms."""
+        """Hitbox origins and bounds from the current transforms: every row after a structural or
+        static change, otherwise only the rows that can move (static ones keep theirs)."""
         if self.version != store.version:
             self.rebuild_tables(store)
+        key = (store.version, store.static_epoch, store.n)
+        if key != getattr(self, "_full_key", None):
+            self._compute(store, np.arange(store.n), full=True)
+            self._full_key = key
+        else:
+            self._compute(store, store.active()[2], full=False)
+
+    def _compute(self, store: BodyStore, rows: np.ndarray, full: bool) -> None:
+        n = store.n
         x, y, rot = store.x, store.y, store.rot
         ox, oy = store.ox, store.oy
-        pr = self.poly_rows
-        offset = np.flatnonzero((ox != 0.0) | (oy != 0.0))
+        if full:
+            self.cos, self.sin = np.ones(n), np.zeros(n)
+            self.has_offset = bool(ox.any() or oy.any())
+            self.minx, self.maxx, self.miny, self.maxy = (np.zeros(n) for _ in range(4))
+            self.poly_slot = np.full(n, -1, dtype=np.int64)
+            self.poly_slot[self.poly_rows] = np.arange(self.poly_rows.size)
+            self.world_poly = np.zeros((self.poly_rows.size, self.K, 2))
+            if self.has_offset:
+                self.hx, self.hy = x.copy(), y.copy()
+        kind = store.kind[rows]
+        offset = rows[(ox[rows] != 0.0) | (oy[rows] != 0.0)] if self.has_offset else rows[:0]
+        polys = rows[kind == KIND_POLYGON]
         # Rotations matter only to polygons and to offset hitboxes (AABBs and circles ignore them).
-        turned = np.union1d(pr, offset) if offset.size else pr
-        c = np.ones(store.n)
-        s = np.zeros(store.n)
+        turned = np.union1d(polys, offset) if offset.size else polys
         if turned.size:
-            c[turned], s[turned] = np.cos(rot[turned]), np.sin(rot[turned])
-        if offset.size:
-            self.hx, self.hy = x.copy(), y.copy()
-            co, so = c[offset], s[offset]
-            self.hx[offset] += co * ox[offset] - so * oy[offset]
-            self.hy[offset] += so * ox[offset] + co * oy[offset]
+            self.cos[turned], self.sin[turned] = np.cos(rot[turned]), np.sin(rot[turned])
+        if self.has_offset:
+            self.hx[rows], self.hy[rows] = x[rows], y[rows]
+            if offset.size:
+                co, so = self.cos[offset], self.sin[offset]
+                self.hx[offset] += co * ox[offset] - so * oy[offset]
+                self.hy[offset] += so * ox[offset] + co * oy[offset]
         else:
             self.hx, self.hy = x, y
-        self.cos, self.sin = c, s
-        ex, ey = store.hw, store.hh
-        if pr.size:
-            loc = self.local[pr]
-            cc, ss = c[pr, None], s[pr, None]
+        hx, hy = self.hx[rows], self.hy[rows]
+        ex, ey = store.hw[rows], store.hh[rows]
+        self.minx[rows], self.maxx[rows] = hx - ex, hx + ex
+        self.miny[rows], self.maxy[rows] = hy - ey, hy + ey
+        if polys.size:
+            loc = self.local[polys]
+            cc, ss = self.cos[polys, None], self.sin[polys, None]
             wx = cc * loc[:, :, 0] - ss * loc[:, :, 1]
             wy = ss * loc[:, :, 0] + cc * loc[:, :, 1]
-            self.world_poly = np.stack([wx, wy], axis=-1)  # rotated, relative to the hitbox origin
-            self.poly_slot = np.full(store.n, -1, dtype=np.int64)
-            self.poly_slot[pr] = np.arange(pr.size)
-            self.minx = self.hx - ex
-            self.maxx = self.hx + ex
-            self.miny = self.hy - ey
-            self.maxy = self.hy + ey
-            self.minx[pr] = self.hx[pr] + wx.min(axis=1)
-            self.maxx[pr] = self.hx[pr] + wx.max(axis=1)
-            self.miny[pr] = self.hy[pr] + wy.min(axis=1)
-            self.maxy[pr] = self.hy[pr] + wy.max(axis=1)
-        else:
-            self.world_poly = np.zeros((0, self.K, 2))
-            self.poly_slot = np.full(store.n, -1, dtype=np.int64)
-            self.minx, self.maxx = self.hx - ex, self.hx + ex
-            self.miny, self.maxy = self.hy - ey, self.hy + ey
+            self.world_poly[self.poly_slot[polys]] = np.stack([wx, wy], axis=-1)  # about the hitbox origin
+            self.minx[polys] = self.hx[polys] + wx.min(axis=1)
+            self.maxx[polys] = self.hx[polys] + wx.max(axis=1)
+            self.miny[polys] = self.hy[polys] + wy.min(axis=1)
+            self.maxy[polys] = self.hy[polys] + wy.max(axis=1)
 
     def outlines(self, store: BodyStore, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows."""

@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..store import DYNAMIC, STATIC, BodyStore
+from ..store import DYNAMIC, BodyStore
 
 __all__ = ["integrate"]
 
 
 def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> np.ndarray:
     """Advance every moving row by ``dt``; return the rows integrated."""
-    rows = np.flatnonzero(store.has_vel & (store.body != STATIC) & ~store.asleep)
+    rows = store.active()[0]
     if rows.size == 0:
         return rows
     c = store.cols

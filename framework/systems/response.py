@@ -66,9 +66,15 @@ def resolve(
     c = store.cols
     inv = c["inv_mass"]
     ia, ib = inv[ra].copy(), inv[rb].copy()
-    level = _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity)
+    # Per-body bookkeeping runs over the bodies in contact only (local numbers la, lb), not over
+    # every row of the store: a level of 100,000 tiles costs nothing here.
+    rows_u, local = np.unique(np.concatenate([ra, rb]), return_inverse=True)
+    la, lb = local[:C], local[C:]
+    L = rows_u.size
+    level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity)
     solid = (ia == 0.0) != (ib == 0.0)
     mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
+    mobile_l = np.where(ib > 0.0, lb, la)
     sgn = np.where(ib > 0.0, 1.0, -1.0)  # it moves along +n if it is b, along -n if it is a
     both = (ia > 0.0) & (ib > 0.0)
     applied_nx, applied_ny = nx.copy(), ny.copy()
@@ -77,20 +83,20 @@ def resolve(
     cur_nx, cur_ny, cur_depth = nx.copy(), ny.copy(), depth.copy()
     # Support level of each solid contact's mobile body: a stack is resolved from the ground up,
     # each level measured again after the one below it moved (inf: not resting on anything).
-    mob_level = level[mobile]
+    mob_level = level[mobile_l]
     levels = np.unique(mob_level[solid & np.isfinite(mob_level)])
 
-    moved = np.zeros(store.n, dtype=bool)  # rows moved since their contacts were last measured
+    moved = np.zeros(L, dtype=bool)  # bodies moved since their contacts were last measured
     # A contact whose movable bodies are in no other contact is settled by its own push-out and
     # never needs measuring again (most contacts, in a sparse scene).
-    per_row = np.bincount(np.concatenate([ra, rb]), minlength=store.n)
-    lone = np.where(solid, per_row[mobile] == 1, (per_row[ra] == 1) & (per_row[rb] == 1))
+    per_row = np.bincount(local, minlength=L)
+    lone = np.where(solid, per_row[mobile_l] == 1, (per_row[la] == 1) & (per_row[lb] == 1))
 
     # Where each row stood when the response began: contacts between two dynamic bodies are
     # re-measured along their normal from how far the bodies moved since (SAT depth is linear in
     # translation along a fixed axis, as in Box2D's solver); contacts with immovable bodies are
     # measured again from the geometry, because there the axis matters (tile seams).
-    x0, y0 = c["x"][: store.n].copy(), c["y"][: store.n].copy()
+    x0, y0 = c["x"][rows_u], c["y"][rows_u]
 
     def remeasure(sel: np.ndarray) -> None:
         idx = np.flatnonzero(sel & solid)
@@ -100,9 +106,9 @@ def resolve(
             cur_nx[idx], cur_ny[idx], cur_depth[idx] = rnx, rny, rdepth
         idx = np.flatnonzero(sel & both)
         if idx.size:
-            a, b = ra[idx], rb[idx]
-            mx = (c["x"][b] - x0[b]) - (c["x"][a] - x0[a])
-            my = (c["y"][b] - y0[b]) - (c["y"][a] - y0[a])
+            a, b, al, bl = ra[idx], rb[idx], la[idx], lb[idx]
+            mx = (c["x"][b] - x0[bl]) - (c["x"][a] - x0[al])
+            my = (c["y"][b] - y0[bl]) - (c["y"][a] - y0[al])
             rel = mx * nx[idx] + my * ny[idx]
             cur_depth[idx] = depth[idx] - rel
             alive[idx] = cur_depth[idx] > 0.0
@@ -114,7 +120,7 @@ def resolve(
         d = cur_depth[pick] * sgn[pick]
         c["x"][m] += cur_nx[pick] * d
         c["y"][m] += cur_ny[pick] * d
-        moved[m] = True
+        moved[mobile_l[pick]] = True
         applied_nx[pick], applied_ny[pick] = cur_nx[pick], cur_ny[pick]
         pushed[pick] += cur_depth[pick]
         resolved[pick] = True
@@ -124,17 +130,16 @@ def resolve(
         # Dynamic pairs: split by inverse mass, mean over each body's contacts.
         d_idx = np.flatnonzero(alive & both)
         if d_idx.size:
-            a, b = ra[d_idx], rb[d_idx]
+            a, b = la[d_idx], lb[d_idx]
             w = 1.0 / (ia[d_idx] + ib[d_idx])
             ddx = cur_nx[d_idx] * cur_depth[d_idx] * w
             ddy = cur_ny[d_idx] * cur_depth[d_idx] * w
-            n = store.n
-            n_rows = np.bincount(np.concatenate([a, b]), minlength=n).astype(float)
-            sx = np.bincount(a, -ddx * ia[d_idx], n) + np.bincount(b, ddx * ib[d_idx], n)
-            sy = np.bincount(a, -ddy * ia[d_idx], n) + np.bincount(b, ddy * ib[d_idx], n)
+            n_rows = np.bincount(np.concatenate([a, b]), minlength=L).astype(float)
+            sx = np.bincount(a, -ddx * ia[d_idx], L) + np.bincount(b, ddx * ib[d_idx], L)
+            sy = np.bincount(a, -ddy * ia[d_idx], L) + np.bincount(b, ddy * ib[d_idx], L)
             touched = np.flatnonzero(n_rows)
-            c["x"][touched] += sx[touched] / n_rows[touched]
-            c["y"][touched] += sy[touched] / n_rows[touched]
+            c["x"][rows_u[touched]] += sx[touched] / n_rows[touched]
+            c["y"][rows_u[touched]] += sy[touched] / n_rows[touched]
             moved[touched] = True
             applied_nx[d_idx], applied_ny[d_idx] = cur_nx[d_idx], cur_ny[d_idx]
             pushed[d_idx] += cur_depth[d_idx]
@@ -144,14 +149,14 @@ def resolve(
         # each level measured again where the bodies under it moved.
         for lv in [*levels.tolist(), np.inf]:
             at_level = solid & (mob_level == lv)
-            remeasure(at_level & (moved[ra] | moved[rb]))
+            remeasure(at_level & (moved[la] | moved[lb]))
             s_idx = np.flatnonzero(at_level & alive)
             if s_idx.size == 0:
                 continue
             push_out_deepest(s_idx)
         if it + 1 >= iterations:
             break
-        stale = (moved[ra] | moved[rb]) & ~lone
+        stale = (moved[la] | moved[lb]) & ~lone
         if not stale.any():
             break
         remeasure(stale)
@@ -162,7 +167,7 @@ def resolve(
     # Clean-up: immovable contacts only, so no dynamic body is left inside static geometry by a
     # push from another dynamic body in the last pass.
     for _ in range(max(1, iterations)):
-        remeasure(solid & (moved[ra] | moved[rb]))
+        remeasure(solid & (moved[la] | moved[lb]))
         moved[:] = False
         s_idx = np.flatnonzero(solid & alive)
         if s_idx.size == 0:
@@ -170,11 +175,11 @@ def resolve(
         push_out_deepest(s_idx)
 
     _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
-                resolved, gravity, iterations, mob_level, lone, dt)
+                resolved, gravity, iterations, mob_level, lone, dt, la, lb, rows_u)
     return resolved, applied_nx, applied_ny, pushed
 
 
-def _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity) -> None:
+def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity) -> np.ndarray:
     """Make a stack solid from the ground up (in place on ``ia``/``ib``).
 
     A dynamic body resting on something immovable has support level 1; one resting on a level-k
@@ -183,7 +188,7 @@ def _shock_propagation(store, ra, rb, nx, ny, ia, ib, gravity) -> None:
     counts as immovable, so a pass pushes the upper one fully out instead of pressing the lower one
     into the floor: a stack settles in a few passes instead of sinking.
     """
-    level = np.full(store.n, np.inf)
+    level = np.full(n, np.inf)
     gx, gy = gravity
     g = (gx * gx + gy * gy) ** 0.5
     if g == 0.0:
@@ -235,7 +240,7 @@ def _bounce_speed(u: np.ndarray, g: np.ndarray, d: np.ndarray, dt: float) -> np.
 
 
 def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed, resolved, gravity,
-                iterations, mob_level, lone, dt) -> None:
+                iterations, mob_level, lone, dt, la, lb, rows_u) -> None:
     c = store.cols
     rest = np.maximum(c["restitution"][ra], c["restitution"][rb])
     gx, gy = gravity
@@ -274,13 +279,13 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
             done[pick] = e > 0.0
         d_idx = np.flatnonzero(approaching & both)
         if d_idx.size:
-            a, b = ra[d_idx], rb[d_idx]
+            a, b = la[d_idx], lb[d_idx]
             v = vn[d_idx]
             j = -(1.0 + rest[d_idx]) * v / (ia[d_idx] + ib[d_idx])
-            n = store.n
+            L = rows_u.size
             jx, jy = j * nx[d_idx], j * ny[d_idx]
-            c["vx"][:n] += np.bincount(b, jx * ib[d_idx], n) - np.bincount(a, jx * ia[d_idx], n)
-            c["vy"][:n] += np.bincount(b, jy * ib[d_idx], n) - np.bincount(a, jy * ia[d_idx], n)
+            c["vx"][rows_u] += np.bincount(b, jx * ib[d_idx], L) - np.bincount(a, jx * ia[d_idx], L)
+            c["vy"][rows_u] += np.bincount(b, jy * ib[d_idx], L) - np.bincount(a, jy * ia[d_idx], L)
             done[d_idx] = rest[d_idx] > 0.0
         if it == 0:
             done |= lone  # a contact whose bodies touch nothing else is settled by one pass

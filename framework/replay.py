@@ -1,0 +1,187 @@
+"""Replays: recorded input, one set of held keys per frame, to play a game back exactly.
+
+A scene is deterministic (the same components and the same input give the same bytes, whatever
+``PYTHONHASHSEED``; see ``docs/reliability.md``), so the keys held at each frame, the step ``dt``
+and the seed the game used for its own randomness are all it takes to replay a session: a bug
+report, a demo, a regression test.
+
+File format: JSON lines, UTF-8. The first line is a header object, each further line one frame:
+the sorted list of the key names held during that frame (the names of :class:`~framework.input.Input`,
+e.g. ``"left"``, ``"space"``)::
+
+    {"format": "framework-replay", "version": 1, "dt": 0.016666666666666666, "seed": 7, "frames": 3, "meta": {}}
+    []
+    ["right"]
+    ["right", "space"]
+
+``frames`` in the header is the number of frame lines, so a truncated file is caught. ``seed`` is
+an int or null; ``meta`` any JSON object (level name, game version...). :meth:`Replay.load`
+refuses anything else with a ``ValueError`` naming the file and the line.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Iterable, Iterator
+from typing import Any
+
+from .input import Input
+from .validation import InvalidValue
+
+__all__ = ["FORMAT", "VERSION", "Replay"]
+
+FORMAT = "framework-replay"
+VERSION = 1
+
+
+def _keys(keys: object, where: str) -> frozenset[str]:
+    if isinstance(keys, (str, bytes)) or not isinstance(keys, Iterable):
+        raise InvalidValue(f"{where}: the held keys must be a list of key names, got {keys!r}")
+    out = []
+    for k in keys:
+        if not isinstance(k, str) or not k:
+            raise InvalidValue(f"{where}: a key name must be a non-empty string, got {k!r}")
+        out.append(k)
+    held = frozenset(out)
+    if len(held) != len(out):
+        raise InvalidValue(f"{where}: a key is listed twice in {sorted(out)!r}")
+    return held
+
+
+def _dt(value: object, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value) and value > 0):
+        raise InvalidValue(f"{where}: dt must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+def _seed(value: object, where: str) -> int | None:
+    if value is not None and (isinstance(value, bool) or not isinstance(value, int)):
+        raise InvalidValue(f"{where}: seed must be an int or null, got {value!r}")
+    return value
+
+
+def _meta(value: object, where: str) -> dict[str, Any]:
+    if not isinstance(value, dict) or not all(isinstance(k, str) for k in value):
+        raise InvalidValue(f"{where}: meta must be an object with string keys, got {value!r}")
+    try:
+        json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise InvalidValue(f"{where}: meta must hold only JSON values ({exc})") from None
+    return dict(value)
+
+
+class Replay:
+    """The keys held at each frame of a session, with the step ``dt``, the game's ``seed`` and free
+    ``meta`` data. Frames are frozensets of key names; frame ``i`` is the input of step ``i``."""
+
+    def __init__(self, frames: Iterable[Iterable[str]] = (), *, dt: float = 1 / 60, seed: int | None = None,
+                 meta: dict[str, Any] | None = None) -> None:
+        self.dt = _dt(dt, "Replay")
+        self.seed = _seed(seed, "Replay")
+        self.meta = _meta({} if meta is None else meta, "Replay")
+        self.frames: list[frozenset[str]] = [_keys(f, f"Replay frame {i}") for i, f in enumerate(frames)]
+
+    # --- recording and playing ----------------------------------------------------------------
+
+    def record(self, keys: Iterable[str]) -> None:
+        """Append a frame: the keys held during the next step (e.g. ``scene.resources[Input].held``)."""
+        self.frames.append(_keys(keys, f"Replay frame {len(self.frames)}"))
+
+    def apply(self, scene: Any, frame: int) -> None:
+        """Make the keys of ``frame`` the held keys of ``scene.resources[Input]`` (presses and
+        releases follow, as from a keyboard); call it before stepping that frame."""
+        if isinstance(frame, bool) or not isinstance(frame, int) or not 0 <= frame < len(self.frames):
+            raise InvalidValue(f"frame must be an int in [0, {len(self.frames)}), got {frame!r}")
+        inp = scene.resources.get(Input)
+        if inp is None:
+            inp = scene.resources[Input] = Input()
+        inp.set_held(self.frames[frame])
+
+    def play(self, scene: Any, start: int = 0, stop: int | None = None) -> None:
+        """Apply and step frames ``start`` to ``stop`` (default: the end) with the replay's ``dt``."""
+        for i in range(start, len(self.frames) if stop is None else stop):
+            self.apply(scene, i)
+            scene.step(self.dt)
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    def __iter__(self) -> Iterator[frozenset[str]]:
+        return iter(self.frames)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Replay):
+            return NotImplemented
+        return (self.frames, self.dt, self.seed, self.meta) == (other.frames, other.dt, other.seed, other.meta)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable
+
+    def __repr__(self) -> str:
+        return f"Replay({len(self.frames)} frames, dt={self.dt!r}, seed={self.seed!r}, meta={self.meta!r})"
+
+    # --- files --------------------------------------------------------------------------------
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the replay as JSON lines (see the module docstring), replacing ``path``."""
+        header = {"format": FORMAT, "version": VERSION, "dt": self.dt, "seed": self.seed, "frames": len(self.frames),
+                  "meta": self.meta}
+        lines = [json.dumps(header, allow_nan=False)]
+        lines.extend(json.dumps(sorted(f)) for f in self.frames)
+        tmp = f"{os.fspath(path)}.tmp"
+        with open(tmp, "w", encoding="utf-8", newline="\n") as f:
+            f.write("\n".join(lines) + "\n")
+        os.replace(tmp, path)  # never a half-written replay under the real name
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Replay:
+        """Read a replay written by :meth:`save`; ``ValueError`` naming the file (and line) if it
+        is not one. A missing file raises ``FileNotFoundError``."""
+        name = os.fspath(path)
+        try:
+            with open(name, encoding="utf-8") as f:
+                text = f.read()
+        except UnicodeDecodeError as exc:
+            raise InvalidValue(f"{name}: not a replay: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        lines = text.split("\n")
+        if lines and lines[-1] == "":
+            lines.pop()  # the final newline
+        if not lines:
+            raise InvalidValue(f"{name}: not a replay: the file is empty")
+
+        def parse(i: int) -> Any:
+            try:
+                return json.loads(lines[i], parse_constant=_no_constant)
+            except ValueError as exc:
+                raise InvalidValue(f"{name}: line {i + 1}: not JSON ({exc})") from None
+
+        header = parse(0)
+        if not isinstance(header, dict) or header.get("format") != FORMAT:
+            raise InvalidValue(f"{name}: line 1: not a replay header (expected an object with "
+                               f'"format": "{FORMAT}"), got {lines[0][:80]!r}')
+        if header.get("version") != VERSION:
+            raise InvalidValue(f"{name}: line 1: unsupported replay version {header.get('version')!r} "
+                               f"(this framework reads version {VERSION})")
+        unknown = set(header) - {"format", "version", "dt", "seed", "frames", "meta"}
+        if unknown:
+            raise InvalidValue(f"{name}: line 1: unknown header fields {sorted(unknown)!r}")
+        where = f"{name}: line 1"
+        count = header.get("frames")
+        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+            raise InvalidValue(f"{where}: frames must be an int >= 0, got {count!r}")
+        if count != len(lines) - 1:
+            raise InvalidValue(f"{name}: the header promises {count} frames but the file has {len(lines) - 1} "
+                               "(truncated or edited?)")
+        replay = cls(dt=_dt(header.get("dt"), where), seed=_seed(header.get("seed"), where),
+                     meta=_meta(header.get("meta", {}), where))
+        for i in range(1, len(lines)):
+            frame = parse(i)
+            if not isinstance(frame, list):
+                raise InvalidValue(f"{name}: line {i + 1}: a frame must be a list of key names, got {lines[i][:80]!r}")
+            replay.frames.append(_keys(frame, f"{name}: line {i + 1}"))
+        return replay
+
+
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not JSON")
