@@ -71,7 +71,8 @@ def resolve(
     rows_u, local = np.unique(np.concatenate([ra, rb]), return_inverse=True)
     la, lb = local[:C], local[C:]
     L = rows_u.size
-    level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity)
+    vn0 = (c["vx"][rb] - c["vx"][ra]) * nx + (c["vy"][rb] - c["vy"][ra]) * ny
+    level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity, vn0, dt)
     solid = (ia == 0.0) != (ib == 0.0)
     mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
     mobile_l = np.where(ib > 0.0, lb, la)
@@ -179,7 +180,7 @@ def resolve(
     return resolved, applied_nx, applied_ny, pushed
 
 
-def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity) -> np.ndarray:
+def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity, vn, dt) -> np.ndarray:
     """Make a stack solid from the ground up (in place on ``ia``/``ib``).
 
     A dynamic body resting on something immovable has support level 1; one resting on a level-k
@@ -187,6 +188,10 @@ def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity) -> np.ndarray:
     against gravity). In a contact between two dynamic bodies at different levels, the lower one
     counts as immovable, so a pass pushes the upper one fully out instead of pressing the lower one
     into the floor: a stack settles in a few passes instead of sinking.
+
+    Only a body *resting* on its support counts: one leaving it faster than gravity brings it back
+    in a step (``vn > g dt``, e.g. a ball bouncing off the floor) supports nothing, so what it hits
+    next meets a body of its real mass (momentum and energy kept) rather than a wall.
     """
     level = np.full(n, np.inf)
     gx, gy = gravity
@@ -195,6 +200,7 @@ def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity) -> np.ndarray:
         return level
     ux, uy = -gx / g, -gy / g
     up = nx * ux + ny * uy  # > 0: b sits on a
+    up = np.where(vn > g * dt, 0.0, up)  # separating: not resting
     solid = (ia == 0.0) != (ib == 0.0)
     on_ground = solid & (((ib > 0.0) & (up > 0.5)) | ((ia > 0.0) & (up < -0.5)))
     level[np.where(ib > 0.0, rb, ra)[on_ground]] = 1.0
@@ -246,6 +252,10 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
     gx, gy = gravity
     # Gravity against the push-out direction of a solid contact's mobile body.
     gn = -(gx * nx + gy * ny) * sgn
+    # Restitution threshold: an approach no faster than gravity gives in two steps along the
+    # normal is a body resting, not a bounce; without it a bouncy body on the floor hops by
+    # e*g*dt every step forever and never sleeps.
+    resting_speed = 2.0 * np.abs(gx * nx + gy * ny) * dt
     done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
     for it in range(max(1, iterations)):
         vx, vy = c["vx"], c["vy"]
@@ -270,7 +280,7 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                 continue
             pick = s_idx[_first_per_group(mobile[s_idx], vn[s_idx])]
             v = vn[pick]
-            e = rest[pick]
+            e = np.where(-v > resting_speed[pick], rest[pick], 0.0)
             target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
             dv = (target - v) * sgn[pick]
             m = mobile[pick]
@@ -281,11 +291,12 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
         if d_idx.size:
             a, b = la[d_idx], lb[d_idx]
             v = vn[d_idx]
-            j = -(1.0 + rest[d_idx]) * v / (ia[d_idx] + ib[d_idx])
+            e = np.where(-v > resting_speed[d_idx], rest[d_idx], 0.0)
+            j = -(1.0 + e) * v / (ia[d_idx] + ib[d_idx])
             L = rows_u.size
             jx, jy = j * nx[d_idx], j * ny[d_idx]
             c["vx"][rows_u] += np.bincount(b, jx * ib[d_idx], L) - np.bincount(a, jx * ia[d_idx], L)
             c["vy"][rows_u] += np.bincount(b, jy * ib[d_idx], L) - np.bincount(a, jy * ia[d_idx], L)
-            done[d_idx] = rest[d_idx] > 0.0
+            done[d_idx] = e > 0.0
         if it == 0:
             done |= lone  # a contact whose bodies touch nothing else is settled by one pass
