@@ -11,8 +11,7 @@ pair, ``brute_force_pairs`` on the bounds):
   included, and no event names an entity after its ``ended``;
 - the contacts of a step are exactly the pairs ``collide`` finds overlapping among those the
   layers allow (not static-static, not both sleeping), with the same depth and normal, measured on
-  the same hitbox origins (a pair overlapping by less than the rounding of its bounds may be
-  missed by the broad phase, nothing deeper);
+  the same hitbox origins (also pairs overlapping by less than the rounding of their bounds);
 - the broad phase's candidate pairs are exactly the brute-force overlaps of the bounds;
 - after the response, a dynamic body whose contacts this step were all with static bodies does
   not overlap them (beyond 1e-6 of its size). Statics are placed far apart, so none can squeeze a
@@ -330,15 +329,6 @@ class SceneMachine(RuleBasedStateMachine):
             if ia and ib:
                 continue  # frozen: two sleepers (or a sleeper and a static) keep their contact
             got[(a, b)] = (float(c.nx[k]), float(c.ny[k]), float(c.depth[k]))
-        # The broad phase tests bounds rounded to float64, strictly: a pair whose exact overlap is
-        # below the rounding of its bounds (depth ~1e-17, e.g. boxes stacked exactly at y + h/2) is
-        # not a candidate. Such a pair may be missing; nothing deeper may.
-        for key in set(want) - set(got):
-            ref, pose = want[key], bs[key[0]][1]
-            assert ref.depth <= 64 * 2.0**-52 * (1.0 + abs(pose[0]) + abs(pose[1])), \
-                f"contacts: missing {key} {ref}"
-            event("contact within rounding missed by the broad phase")
-            del want[key]
         assert set(got) == set(want), f"contacts: missing {set(want) - set(got)}, extra {set(got) - set(want)}"
         for key, ref in want.items():
             nx, ny, depth = got[key]

@@ -477,3 +477,19 @@ def test_handlers_may_take_only_the_event(scene):
     scene.spawn(Transform(0.5, 0), Velocity(), Hitbox(AABB(1, 1), sensor=True), B())
     scene.step(DT)
     assert seen[0].kind == "started" and seen[1] == "started"
+
+
+def test_an_overlap_below_the_rounding_of_the_bounds_is_still_a_contact():
+    # Exactly: box a reaches up to 7.887233511355132 + 0.5, box b down to 8.88723351135513 - 0.5,
+    # which overlap by 2^-50; rounded to float64 the two bounds are equal (touching, no pair).
+    from fractions import Fraction
+
+    ya, yb = 7.887233511355132, 8.88723351135513
+    exact = (Fraction(ya) + Fraction(1, 2)) - (Fraction(yb) - Fraction(1, 2))
+    assert exact == Fraction(1, 2**50) and not (ya + 0.5 > yb - 0.5)
+    with Scene() as s:
+        a = s.spawn(Transform(0.0, ya), Velocity(), Hitbox(AABB(1.0, 1.0)))
+        b = s.spawn(Transform(0.25, yb), Velocity(), Hitbox(AABB(1.0, 1.0)))
+        s.step(1 / 60)
+        assert [(int(s.contacts.a[0]), int(s.contacts.b[0]))] == [(a, b)]
+        assert s.contacts.depth[0] == 2.0**-50 and s.contacts.ny[0] == 1.0

@@ -95,6 +95,13 @@ class Geometry:
             self.maxx[polys] = self.hx[polys] + wx.max(axis=1)
             self.miny[polys] = self.hy[polys] + wy.min(axis=1)
             self.maxy[polys] = self.hy[polys] + wy.max(axis=1)
+        # Widen by one ulp: a bound is a rounded sum, so two shapes overlapping by less than the
+        # rounding (boxes stacked at non-dyadic heights) could have strictly disjoint bounds and
+        # never reach the (exact) narrow phase. The broad phase may now also pair shapes that
+        # merely touch; the narrow phase drops those.
+        for lo, hi in ((self.minx, self.maxx), (self.miny, self.maxy)):
+            lo[rows] = np.nextafter(lo[rows], -np.inf)
+            hi[rows] = np.nextafter(hi[rows], np.inf)
 
     def outlines(self, store: BodyStore, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows."""
