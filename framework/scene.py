@@ -185,6 +185,7 @@ class Scene:
         self._events: list[CollisionEvent] | None = []
         self._support = _NO_SUPPORT
         self._resolved = _NO_RESOLVED
+        self._n_static = 0
         self._row_lookup = np.zeros(1, dtype=np.int64)
         self._moved = 0  # bumped whenever a stage moves bodies (see ensure_geometry)
         self._start_key: tuple[int, ...] | None = None
@@ -423,7 +424,7 @@ class Scene:
         self._stepping = True
         self.counters = counters = {"systems": [], "integrated": 0, "rehashed": 0, "candidate_pairs": 0,
                                     "narrow_tests": {}, "contacts": 0, "events": 0, "resolved": 0,
-                                    "ccd_stopped": 0, "asleep": 0}
+                                    "late_contacts": 0, "ccd_stopped": 0, "asleep": 0}
         self.stage_ms = {}
         self.ray_log = []
         self.swept_paths = []
@@ -570,6 +571,7 @@ class Scene:
             self._choose_cell_size(rows)
         self.hash.set_static(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
                              store.entity[rows])
+        self._n_static = int(rows.size)
         self.counters["rehashed"] = self.counters.get("rehashed", 0) + int(rows.size)
         store.static_dirty = False
         store.moved_static.clear()
@@ -716,13 +718,61 @@ class Scene:
         self._moved += 1
         done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
                                           self.response_iterations, recompute, alive0[idx], dt)
+        ea, eb = ents_a[idx[done]], ents_b[idx[done]]
+        snx, sny = nx[idx[done]], ny[idx[done]]
+        anx, any_, pushed = anx[done], any_[done], pushed[done]
+        # Bodies pushed by other dynamic bodies may have been shoved into static geometry they did
+        # not touch when the step's contacts were found (a pile spawned on one spot): find those
+        # contacts now and push them out, so no body ends the step inside a static it can fall
+        # through. Pushes out of statics themselves need no such look (they move away from them).
+        pushed_rows = np.unique(np.concatenate([ra[idx[done]], rb[idx[done]]])[np.tile(
+            (store.inv_mass[ra[idx[done]]] > 0) & (store.inv_mass[rb[idx[done]]] > 0), 2)])
+        for _ in range(max(1, self.response_iterations)):
+            if pushed_rows.size == 0 or self._n_static == 0:
+                break
+            extra = self._new_static_contacts(pushed_rows, np.concatenate([pair_keys(ea, eb), pair_keys(eb, ea)]))
+            if extra is None:
+                break
+            xa, xb, xra, xrb, xr = extra
+            xdone, xanx, xany, xpushed = resolve(store, xra, xrb, xr.nx, xr.ny, xr.depth, self._gravity(),
+                                                 self.response_iterations, recompute, None, dt)
+            ea, eb = np.concatenate([ea, xa[xdone]]), np.concatenate([eb, xb[xdone]])
+            snx, sny = np.concatenate([snx, xr.nx[xdone]]), np.concatenate([sny, xr.ny[xdone]])
+            anx, any_ = np.concatenate([anx, xanx[xdone]]), np.concatenate([any_, xany[xdone]])
+            pushed = np.concatenate([pushed, xpushed[xdone]])
+            pushed_rows = np.unique(np.where(store.inv_mass[xra] > 0, xra, xrb)[xdone])
+            self.counters["late_contacts"] += int(xdone.sum())
         self._moved += 1
-        order = np.argsort(pair_keys(ents_a[idx[done]], ents_b[idx[done]]), kind="stable")
-        keep = idx[done][order]
-        self._support = (ents_a[keep], ents_b[keep], nx[keep], ny[keep])
-        self._resolved = (ents_a[keep], ents_b[keep], anx[done][order], any_[done][order], pushed[done][order])
-        self.counters["resolved"] = int(done.sum())
+        order = np.argsort(pair_keys(ea, eb), kind="stable")
+        self._support = (ea[order], eb[order], snx[order], sny[order])
+        self._resolved = (ea[order], eb[order], anx[order], any_[order], pushed[order])
+        self.counters["resolved"] = int(ea.size)
         return True
+
+    def _new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
+        """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs
+        ``known`` (keys, either order): ``(ents_a, ents_b, rows_a, rows_b, contacts)`` or None."""
+        store, geom = self.store, self.geometry
+        rows = rows[(store.kind[rows] >= 0) & ~store.asleep[rows] & ~store.sensor[rows]]
+        if rows.size == 0:
+            return None
+        geom.update_rows(store, rows)
+        ea, eb = self.hash.pairs(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
+                                 store.entity[rows], moving_pairs=False)
+        if ea.size == 0:
+            return None
+        ra, rb = self._rows_of(ea), self._rows_of(eb)
+        keep = filter_layers(store, ra, rb) & ~(store.sensor[ra] | store.sensor[rb])
+        keep &= ~(store.one_way[ra] | store.one_way[rb])  # a platform is passed through from below
+        keep &= ~np.isin(pair_keys(ea, eb), known)
+        if not keep.any():
+            return None
+        ea, eb, ra, rb = ea[keep], eb[keep], ra[keep], rb[keep]
+        r = pair_contacts(store, geom, ra, rb, remeasure=True)
+        if not r.hit.any():
+            return None
+        h = np.flatnonzero(r.hit)
+        return ea[h], eb[h], ra[h], rb[h], batch.ContactArrays(*(v[h] for v in r))
 
     def _update_sleep(self, dt: float) -> None:
         """Count the steps each awake dynamic body has been at rest; put the restful to sleep."""

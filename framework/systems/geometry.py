@@ -53,6 +53,15 @@ class Geometry:
         else:
             self._compute(store, store.active()[2], full=False)
 
+    def update_rows(self, store: BodyStore, rows: np.ndarray) -> None:
+        """Origins and bounds of ``rows`` only (bodies the response just moved); a full
+        :meth:`update` if the structure changed since the last one."""
+        if self.version != store.version or (store.version, store.static_epoch, store.n) != getattr(
+                self, "_full_key", None):
+            self.update(store)
+        else:
+            self._compute(store, rows, full=False)
+
     def _compute(self, store: BodyStore, rows: np.ndarray, full: bool) -> None:
         n = store.n
         x, y, rot = store.x, store.y, store.rot
