@@ -757,8 +757,8 @@ class Scene:
         if rows.size == 0:
             return None
         geom.update_rows(store, rows)
-        ea, eb = self.hash.pairs(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
-                                 store.entity[rows], moving_pairs=False)
+        ea, eb = self.hash.static_pairs(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
+                                        store.entity[rows])
         if ea.size == 0:
             return None
         ra, rb = self._rows_of(ea), self._rows_of(eb)

@@ -657,3 +657,9 @@ def test_moving_pairs_false_gives_only_moving_static_pairs():
     cross = (ra < n_s) != (rb < n_s)
     assert np.array_equal(a, ra[cross]) and np.array_equal(b, rb[cross])
     assert a.size > 0 and (ra.size - a.size) > 0
+    # static_pairs gives the same pairs and leaves the last pairs() call's movers for queries.
+    before = h.query_box(0.0, 0.0, 50.0, 50.0)
+    sa, sb = h.static_pairs(mx[1:50], my[1:50], mx[1:50] + mw[1:50], my[1:50] + mw[1:50], ids[1:50])
+    keep = np.isin(a, ids[1:50]) | np.isin(b, ids[1:50])
+    assert np.array_equal(sa, a[keep]) and np.array_equal(sb, b[keep]) and sa.size > 0
+    assert np.array_equal(h.query_box(0.0, 0.0, 50.0, 50.0), before)

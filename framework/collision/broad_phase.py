@@ -164,22 +164,16 @@ class SpatialHash:
         self._queries = 0
         self._moving_ids = ids = ids.copy()
         self.rehashed_last = mov.n
-        stat, sids = self._static, self._static_ids
 
         out_a, out_b = [], []
-        if mov.entries:
-            if moving_pairs:
+        if moving_pairs:
+            if mov.entries:
                 a, c = mov.self_pairs()
                 out_a.append(ids[a])
                 out_b.append(ids[c])
-            if stat.entries:
-                m, s = mov.cross_pairs(stat)
-                out_a.append(ids[m])
-                out_b.append(sids[s])
-        if mov.large.shape[0]:
-            # large movers against every mover (each large-large pair once) and every static
-            lg = mov.large
-            if moving_pairs:
+            if mov.large.shape[0]:
+                # large movers against every mover (each large-large pair once)
+                lg = mov.large
                 i, j = overlap_pairs(subset(b, lg), b)
                 i = lg[i]
                 is_large = np.zeros(mov.n, dtype=bool)
@@ -187,6 +181,34 @@ class SpatialHash:
                 keep = ~is_large[j] | (i < j)
                 out_a.append(ids[i[keep]])
                 out_b.append(ids[j[keep]])
+        self._cross_static(mov, b, ids, out_a, out_b)
+        if not out_a:
+            return _EMPTY_I, _EMPTY_I
+        return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
+
+    def static_pairs(self, minx, miny, maxx, maxy, ids) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs of the given bodies with the static ones, like ``pairs(..., moving_pairs=False)``
+        but leaving the last :meth:`pairs` call's moving bodies (and queries on them) as they were."""
+        b = as_bounds(minx, miny, maxx, maxy)
+        ids = _as_ids(ids, b[0].shape[0])
+        out_a: list[np.ndarray] = []
+        out_b: list[np.ndarray] = []
+        if b[0].shape[0] and self._static.bounds[0].shape[0]:
+            self._cross_static(StripSweep(b, self._choose_cell(b)), b, ids, out_a, out_b)
+        if not out_a:
+            return _EMPTY_I, _EMPTY_I
+        return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
+
+    def _cross_static(self, mov: StripSweep, b: tuple, ids: np.ndarray, out_a: list, out_b: list) -> None:
+        """Append the pairs of the swept bodies ``mov`` (bounds ``b``, ids ``ids``) with the statics."""
+        stat, sids = self._static, self._static_ids
+        if mov.entries and stat.entries:
+            m, s = mov.cross_pairs(stat)
+            out_a.append(ids[m])
+            out_b.append(sids[s])
+        if mov.large.shape[0]:
+            # large movers against every static
+            lg = mov.large
             i, s = overlap_pairs(subset(b, lg), stat.bounds)
             out_a.append(ids[lg[i]])
             out_b.append(sids[s])
@@ -198,9 +220,6 @@ class SpatialHash:
             s, m = overlap_pairs(subset(stat.bounds, stat.large), subset(b, sm))
             out_a.append(sids[stat.large[s]])
             out_b.append(ids[sm[m]])
-        if not out_a:
-            return _EMPTY_I, _EMPTY_I
-        return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
 
     # --- queries ----------------------------------------------------------------------------------
 
