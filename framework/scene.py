@@ -32,6 +32,7 @@ from .shapes import AABB, Circle
 from .store import STATIC, BodyStore
 from .systems.ccd import sweep_ccd_bodies
 from .systems.geometry import Geometry
+from .systems.internal_faces import InternalFaces
 from .systems.movement import integrate
 from .systems.narrow_phase import filter_layers, pair_contacts
 from .systems.response import resolve
@@ -186,6 +187,7 @@ class Scene:
         self._support = _NO_SUPPORT
         self._resolved = _NO_RESOLVED
         self._n_static = 0
+        self._internal_faces = InternalFaces()
         self._row_lookup = np.zeros(1, dtype=np.int64)
         self._moved = 0  # bumped whenever a stage moves bodies (see ensure_geometry)
         self._start_key: tuple[int, ...] | None = None
@@ -707,19 +709,30 @@ class Scene:
             return True
         geom = self.geometry
 
+        faces = self._n_static > 0  # push-outs avoid the internal faces of tiles
+
         def recompute(a: np.ndarray, b: np.ndarray):
             if geom.version == store.version and not (store.ox.any() or store.oy.any()):
                 geom.hx, geom.hy = store.x, store.y
             else:
                 geom.update(store)
             r = pair_contacts(store, geom, a, b, remeasure=True)
-            return r.hit, r.nx, r.ny, r.depth
+            rank = r.depth.copy()
+            if faces:
+                self._internal_faces.redirect(store, geom, self.hash, self._rows_of, a, b, r.nx, r.ny, r.depth, r.hit,
+                                              rank)
+            return r.hit, r.nx, r.ny, r.depth, rank
 
         self._moved += 1
-        done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx[idx], ny[idx], depth[idx], self._gravity(),
-                                          self.response_iterations, recompute, alive0[idx], dt)
+        nx, ny, depth = nx[idx], ny[idx], depth[idx]
+        rank = depth.copy()
+        if faces:
+            self._internal_faces.redirect(store, geom, self.hash, self._rows_of, ra[idx], rb[idx], nx, ny, depth,
+                                          alive0[idx], rank)
+        done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx, ny, depth, self._gravity(),
+                                          self.response_iterations, recompute, alive0[idx], dt, rank)
         ea, eb = ents_a[idx[done]], ents_b[idx[done]]
-        snx, sny = nx[idx[done]], ny[idx[done]]
+        snx, sny = nx[done], ny[done]
         anx, any_, pushed = anx[done], any_[done], pushed[done]
         # Bodies pushed by other dynamic bodies may have been shoved into static geometry they did
         # not touch when the step's contacts were found (a pile spawned on one spot): find those
@@ -734,8 +747,11 @@ class Scene:
             if extra is None:
                 break
             xa, xb, xra, xrb, xr = extra
+            xrank = xr.depth.copy()
+            self._internal_faces.redirect(store, geom, self.hash, self._rows_of, xra, xrb, xr.nx, xr.ny, xr.depth,
+                                          xr.hit, xrank)
             xdone, xanx, xany, xpushed = resolve(store, xra, xrb, xr.nx, xr.ny, xr.depth, self._gravity(),
-                                                 self.response_iterations, recompute, None, dt)
+                                                 self.response_iterations, recompute, None, dt, xrank)
             ea, eb = np.concatenate([ea, xa[xdone]]), np.concatenate([eb, xb[xdone]])
             snx, sny = np.concatenate([snx, xr.nx[xdone]]), np.concatenate([sny, xr.ny[xdone]])
             anx, any_ = np.concatenate([anx, xanx[xdone]]), np.concatenate([any_, xany[xdone]])

@@ -25,7 +25,9 @@ from ..store import BodyStore
 
 __all__ = ["resolve"]
 
-Recompute = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+# (rows a, rows b) -> (hit, nx, ny, depth, rank): rank orders a body's immovable contacts (deepest
+# first); it is the depth, except where the scene re-aimed a push (systems.internal_faces).
+Recompute = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 
 def _first_per_group(groups: np.ndarray, keys: np.ndarray) -> np.ndarray:
@@ -49,6 +51,7 @@ def resolve(
     recompute: Recompute,
     alive0: np.ndarray | None = None,
     dt: float = 0.0,
+    rank0: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Resolve the contacts ``(ra, rb)`` (normal from a to b).
 
@@ -58,6 +61,9 @@ def resolve(
     ``alive0`` marks the contacts overlapping now; the others are last step's contacts that no
     longer overlap (a resting stack's bodies fall by the same amount and merely touch). They keep
     the support chain whole and are resolved if a push below makes them overlap again.
+
+    ``rank0`` orders each body's immovable contacts for the deepest-first push-out (default: the
+    depth): a push re-aimed away from an internal tile face keeps the rank of its measured depth.
     """
     C = ra.size
     resolved = np.zeros(C, dtype=bool)
@@ -82,6 +88,7 @@ def resolve(
     pushed = np.zeros(C)  # total push-out along the applied normal (for the energy correction)
     alive = np.ones(C, dtype=bool) if alive0 is None else alive0.copy()
     cur_nx, cur_ny, cur_depth = nx.copy(), ny.copy(), depth.copy()
+    cur_rank = depth.copy() if rank0 is None else rank0.copy()
     # Support level of each solid contact's mobile body: a stack is resolved from the ground up,
     # each level measured again after the one below it moved (inf: not resting on anything).
     mob_level = level[mobile_l]
@@ -102,9 +109,9 @@ def resolve(
     def remeasure(sel: np.ndarray) -> None:
         idx = np.flatnonzero(sel & solid)
         if idx.size:
-            hit, rnx, rny, rdepth = recompute(ra[idx], rb[idx])
+            hit, rnx, rny, rdepth, rrank = recompute(ra[idx], rb[idx])
             alive[idx] = hit
-            cur_nx[idx], cur_ny[idx], cur_depth[idx] = rnx, rny, rdepth
+            cur_nx[idx], cur_ny[idx], cur_depth[idx], cur_rank[idx] = rnx, rny, rdepth, rrank
         idx = np.flatnonzero(sel & both)
         if idx.size:
             a, b, al, bl = ra[idx], rb[idx], la[idx], lb[idx]
@@ -116,7 +123,7 @@ def resolve(
 
     def push_out_deepest(s_idx: np.ndarray) -> None:
         """Push each mobile body fully out of its deepest immovable contact among ``s_idx``."""
-        pick = s_idx[_first_per_group(mobile[s_idx], -cur_depth[s_idx])]
+        pick = s_idx[_first_per_group(mobile[s_idx], -cur_rank[s_idx])]
         m = mobile[pick]
         d = cur_depth[pick] * sgn[pick]
         c["x"][m] += cur_nx[pick] * d

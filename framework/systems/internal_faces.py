@@ -1,0 +1,158 @@
+"""Internal faces of static boxes: the response never pushes a body out through a face that another
+static box covers.
+
+In a tiled level the bottom face of a wall's lowest tile lies flat on the floor tile under it. A
+body that slid into the wall and entered that tile deeper sideways than it overlaps it vertically
+would, by the minimum-depth rule, be pushed *down* out of the tile, into the floor, which pushes it
+back up: it stays in the corner, and its next step carries it through the wall. Such a covered
+face is *internal*: nothing can be outside it. The response therefore re-measures a contact whose
+push-out direction leaves a static box through an internal face along the box's open faces and
+takes the shallowest of those (the same idea as Box2D's ghost vertices on chain shapes).
+
+A face of static box ``T`` is internal when one other static box ``N`` (not one-way, not a sensor,
+the same layer and mask) spans the whole face and reaches past it, to within a tolerance of the
+coordinates' rounding. Computed lazily, per static box that meets a contact, and kept until the
+static set changes. Events keep the contact normal of the contract; only the push changes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..collision.broad_phase import SpatialHash
+from ..store import KIND_AABB, STATIC, BodyStore
+from .geometry import Geometry
+
+__all__ = ["InternalFaces"]
+
+RowsOf = Callable[[np.ndarray], np.ndarray]  # entity ids -> store rows
+
+# Face bits, by the direction a body leaves the box through them.
+LEFT, RIGHT, DOWN, UP = 1, 2, 4, 8
+_UNKNOWN = 255
+
+
+class InternalFaces:
+    """Per static row, which faces of its box are covered by another static box (lazily)."""
+
+    def __init__(self) -> None:
+        self._key: tuple = ()
+        self._mask = np.zeros(0, dtype=np.uint8)
+
+    def masks(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
+              rows: np.ndarray) -> np.ndarray:
+        """Face bits of the static AABB ``rows`` (0 for rows of other kinds)."""
+        key = (store.version, store.static_epoch, store.n)
+        if key != self._key:
+            self._key = key
+            self._mask = np.full(store.n, _UNKNOWN, dtype=np.uint8)
+        todo = np.unique(rows[self._mask[rows] == _UNKNOWN])
+        if todo.size:
+            self._mask[todo] = self._compute(store, geom, hash_, rows_of, todo)
+        return self._mask[rows]
+
+    @staticmethod
+    def _eligible(store: BodyStore, rows: np.ndarray) -> np.ndarray:
+        return (store.kind[rows] == KIND_AABB) & (store.body[rows] == STATIC) & ~store.one_way[rows] \
+            & ~store.sensor[rows]
+
+    def _compute(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
+                 rows: np.ndarray) -> np.ndarray:
+        out = np.zeros(rows.size, dtype=np.uint8)
+        ok = self._eligible(store, rows)
+        if not ok.any():
+            return out
+        t = rows[ok]
+        tx0, tx1 = geom.hx[t] - store.hw[t], geom.hx[t] + store.hw[t]
+        ty0, ty1 = geom.hy[t] - store.hh[t], geom.hy[t] + store.hh[t]
+        tol = 1e-9 * (1.0 + np.maximum(np.abs(tx0), np.abs(tx1)) + np.maximum(np.abs(ty0), np.abs(ty1)))
+        # Ask with ids above every entity id, so each pair comes as (neighbour entity, query).
+        base = int(store.entity.max()) + 1
+        ea, eb = hash_.static_pairs(tx0 - tol, ty0 - tol, tx1 + tol, ty1 + tol, base + np.arange(t.size))
+        i, n = eb - base, rows_of(ea)
+        keep = (n >= 0) & (n != t[i])
+        i, n = i[keep], n[keep]
+        r = t[i]
+        good = self._eligible(store, n) & (store.layer[n] == store.layer[r]) & (store.mask[n] == store.mask[r])
+        n, i = n[good], i[good]
+        nx0, nx1 = geom.hx[n] - store.hw[n], geom.hx[n] + store.hw[n]
+        ny0, ny1 = geom.hy[n] - store.hh[n], geom.hy[n] + store.hh[n]
+        e = tol[i]
+        spans_x = (nx0 <= tx0[i] + e) & (nx1 >= tx1[i] - e)
+        spans_y = (ny0 <= ty0[i] + e) & (ny1 >= ty1[i] - e)
+        bits = np.zeros(i.size, dtype=np.uint8)
+        bits |= np.where(spans_x & (ny0 < ty0[i] - e) & (ny1 >= ty0[i] - e), DOWN, 0).astype(np.uint8)
+        bits |= np.where(spans_x & (ny1 > ty1[i] + e) & (ny0 <= ty1[i] + e), UP, 0).astype(np.uint8)
+        bits |= np.where(spans_y & (nx0 < tx0[i] - e) & (nx1 >= tx0[i] - e), LEFT, 0).astype(np.uint8)
+        bits |= np.where(spans_y & (nx1 > tx1[i] + e) & (nx0 <= tx1[i] + e), RIGHT, 0).astype(np.uint8)
+        acc = np.zeros(t.size, dtype=np.uint8)
+        np.bitwise_or.at(acc, i, bits)
+        out[ok] = acc
+        return out
+
+    def redirect(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf, ra: np.ndarray,
+                 rb: np.ndarray, nx: np.ndarray, ny: np.ndarray, depth: np.ndarray, hit: np.ndarray,
+                 rank: np.ndarray) -> int:
+        """Re-aim (in place) the contacts whose push-out leaves a static box through an internal face:
+        along the box's open face the body is least deep behind. Returns how many changed.
+
+        ``rank`` (the depth, on entry) orders a body's contacts for the deepest-first push-out. A
+        re-aimed contact ranks below every plain one, and among re-aimed ones by its measured
+        depth: its body also overlaps the box that covers the face, and that contact goes first
+        (a box that slid into a wall's lowest tile leaves it sideways, and the floor tile under the
+        wall, whose top is covered, is then not touched at all)."""
+        static_a = store.body[ra] == STATIC
+        static_b = store.body[rb] == STATIC
+        axis = (nx == 0.0) | (ny == 0.0)
+        cand = np.flatnonzero(hit & (static_a != static_b) & axis
+                              & (store.kind[np.where(static_a, ra, rb)] == KIND_AABB))
+        if cand.size == 0:
+            return 0
+        t = np.where(static_a[cand], ra[cand], rb[cand])  # the static box
+        m = np.where(static_a[cand], rb[cand], ra[cand])  # the body pushed out of it
+        sgn = np.where(static_a[cand], 1.0, -1.0)  # the body moves along sgn * n
+        px, py = nx[cand] * sgn, ny[cand] * sgn
+        leave = np.where(px < 0, LEFT, np.where(px > 0, RIGHT, np.where(py < 0, DOWN, UP))).astype(np.uint8)
+        faces = self.masks(store, geom, hash_, rows_of, t)
+        bad = (faces & leave) != 0
+        if not bad.any():
+            return 0
+        cand, t, m, sgn, faces = cand[bad], t[bad], m[bad], sgn[bad], faces[bad]
+        # The body's extent along the box's axes (exact for any convex shape: its bounds).
+        lo_x, hi_x, lo_y, hi_y = _extent(store, geom, m)
+        tx, ty = geom.hx[t], geom.hy[t]
+        d = np.stack([
+            hi_x - (tx - store.hw[t]),  # LEFT: leave through the left face
+            (tx + store.hw[t]) - lo_x,  # RIGHT
+            hi_y - (ty - store.hh[t]),  # DOWN
+            (ty + store.hh[t]) - lo_y,  # UP
+        ], axis=1)
+        blocked = (faces[:, None] & np.array([LEFT, RIGHT, DOWN, UP], dtype=np.uint8)[None, :]) != 0
+        d = np.where(blocked | ~(d > 0.0), np.inf, d)
+        best = np.argmin(d, axis=1)
+        dd = d[np.arange(cand.size), best]
+        ok = np.isfinite(dd)  # every face covered (a body buried in the ground): keep the contact
+        if not ok.any():
+            return 0
+        cand, best, dd, sgn = cand[ok], best[ok], dd[ok], sgn[ok]
+        dirs = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0], [0.0, 1.0]])
+        nx[cand] = dirs[best, 0] * sgn
+        ny[cand] = dirs[best, 1] * sgn
+        depth[cand] = dd
+        rank[cand] = -1.0 / (1.0 + rank[cand])  # in (-1, 0): below every plain depth, same order
+        return int(cand.size)
+
+
+def _extent(store: BodyStore, geom: Geometry, rows: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(minx, maxx, miny, maxy)`` of the rows' hitboxes where their origins are now."""
+    hx, hy = geom.hx[rows], geom.hy[rows]
+    ex, ey = store.hw[rows].copy(), store.hh[rows].copy()
+    lo_x, hi_x, lo_y, hi_y = hx - ex, hx + ex, hy - ey, hy + ey
+    poly = np.flatnonzero(geom.poly_slot[rows] >= 0) if geom.poly_slot.size else np.zeros(0, dtype=np.int64)
+    if poly.size:
+        w = geom.world_poly[geom.poly_slot[rows[poly]]]  # relative to the hitbox origin
+        lo_x[poly], hi_x[poly] = hx[poly] + w[:, :, 0].min(axis=1), hx[poly] + w[:, :, 0].max(axis=1)
+        lo_y[poly], hi_y[poly] = hy[poly] + w[:, :, 1].min(axis=1), hy[poly] + w[:, :, 1].max(axis=1)
+    return lo_x, hi_x, lo_y, hi_y
