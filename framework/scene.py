@@ -29,7 +29,7 @@ from .components import Body, Hitbox, Transform, Velocity, check_component
 from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, sorted_member, to_events
 from .input import Input
 from .shapes import AABB, Circle
-from .store import STATIC, BodyStore
+from .store import KIND_POLYGON, STATIC, BodyStore
 from .systems.ccd import sweep_ccd_bodies
 from .systems.geometry import Geometry
 from .systems.internal_faces import InternalFaces
@@ -709,7 +709,8 @@ class Scene:
             return True
         geom = self.geometry
 
-        faces = self._n_static > 0  # push-outs avoid the internal faces of tiles
+        # Push-outs avoid the internal faces of tiles (only looked at when a static is touched).
+        faces = self._n_static > 0 and bool(((store.body[ra[idx]] == STATIC) | (store.body[rb[idx]] == STATIC)).any())
 
         def recompute(a: np.ndarray, b: np.ndarray):
             if geom.version == store.version and not (store.ox.any() or store.oy.any()):
@@ -738,8 +739,14 @@ class Scene:
         # not touch when the step's contacts were found (a pile spawned on one spot): find those
         # contacts now and push them out, so no body ends the step inside a static it can fall
         # through. Pushes out of statics themselves need no such look (they move away from them).
-        pushed_rows = np.unique(np.concatenate([ra[idx[done]], rb[idx[done]]])[np.tile(
-            (store.inv_mass[ra[idx[done]]] > 0) & (store.inv_mass[rb[idx[done]]] > 0), 2)])
+        if self._n_static:
+            dd = idx[done]
+            dd = dd[(store.inv_mass[ra[dd]] > 0) & (store.inv_mass[rb[dd]] > 0)]
+            flag = np.zeros(store.n, dtype=bool)
+            flag[ra[dd]] = flag[rb[dd]] = True
+            pushed_rows = np.flatnonzero(flag)
+        else:
+            pushed_rows = idx[:0]
         for _ in range(max(1, self.response_iterations)):
             if pushed_rows.size == 0 or self._n_static == 0:
                 break
@@ -770,6 +777,17 @@ class Scene:
         ``known`` (keys, either order): ``(ents_a, ents_b, rows_a, rows_b, contacts)`` or None."""
         store, geom = self.store, self.geometry
         rows = rows[(store.kind[rows] >= 0) & ~store.asleep[rows] & ~store.sensor[rows]]
+        if rows.size == 0:
+            return None
+        # First a cheap look with bounds that hold the hitbox at any rotation: most bodies have
+        # no static in their cells, and their exact bounds are not needed.
+        reach = np.hypot(store.ox[rows], store.oy[rows])
+        ex = np.where(store.kind[rows] == KIND_POLYGON, store.bound[rows], store.hw[rows]) + reach
+        ey = np.where(store.kind[rows] == KIND_POLYGON, store.bound[rows], store.hh[rows]) + reach
+        x, y = store.x[rows], store.y[rows]
+        near = self.hash.near_statics(np.nextafter(x - ex, -np.inf), np.nextafter(y - ey, -np.inf),
+                                      np.nextafter(x + ex, np.inf), np.nextafter(y + ey, np.inf))
+        rows = rows[near]
         if rows.size == 0:
             return None
         geom.update_rows(store, rows)

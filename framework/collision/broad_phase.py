@@ -194,10 +194,43 @@ class SpatialHash:
         out_a: list[np.ndarray] = []
         out_b: list[np.ndarray] = []
         if b[0].shape[0] and self._static.bounds[0].shape[0]:
-            self._cross_static(StripSweep(b, self._choose_cell(b)), b, ids, out_a, out_b)
+            near = np.flatnonzero(self._near_statics(b))
+            if near.size:
+                b, ids = subset(b, near), ids[near]
+                self._cross_static(StripSweep(b, self._choose_cell(b)), b, ids, out_a, out_b)
         if not out_a:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
+
+    def near_statics(self, minx, miny, maxx, maxy) -> np.ndarray:
+        """Mask of the boxes that may strictly overlap a static body (a cheap superset test)."""
+        b = as_bounds(minx, miny, maxx, maxy)
+        return self._near_statics(b)
+
+    def _near_statics(self, b: tuple) -> np.ndarray:
+        """Mask of the boxes that may meet a static body: one shares a cell they need (no false
+        negatives: strictly overlapping bounds always share a cell), a large static overlaps them,
+        or they span many cells (not looked at closely)."""
+        stat = self._static
+        keep = ~np.isfinite(b[0] + b[1] + b[2] + b[3])
+        fb = [np.where(keep, 0.0, v) for v in b] if keep.any() else b
+        if stat.large.shape[0]:
+            i, _ = overlap_pairs(b, subset(stat.bounds, stat.large))
+            keep[i] = True
+        if stat.entries == 0:
+            return keep
+        with np.errstate(over="ignore"):
+            cx0, cx1 = grid.cell_range(fb[0], fb[2], stat.cell)
+            cy0, cy1 = grid.cell_range(fb[1], fb[3], stat.cell)
+        keep |= (cx1 - cx0 > 1) | (cy1 - cy0 > 1)
+        inside = np.flatnonzero(~keep & (cx1 >= stat.x0) & (cx0 < stat.x0 + stat.wx)
+                                & (cy1 >= stat.y0) & (cy0 < stat.y0 + stat.wy))  # the statics' grid
+        if inside.size:
+            cx0, cx1, cy0, cy1 = cx0[inside], cx1[inside], cy0[inside], cy1[inside]
+            for cx, cy in ((cx0, cy0), (cx1, cy0), (cx0, cy1), (cx1, cy1)):  # all their cells (<= 2 x 2)
+                lo, hi = stat.lookup(cx, cy)
+                keep[inside[hi > lo]] = True
+        return keep
 
     def _cross_static(self, mov: StripSweep, b: tuple, ids: np.ndarray, out_a: list, out_b: list) -> None:
         """Append the pairs of the swept bodies ``mov`` (bounds ``b``, ids ``ids``) with the statics."""
