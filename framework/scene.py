@@ -767,8 +767,14 @@ class Scene:
             self.counters["late_contacts"] += int(xdone.sum())
         self._moved += 1
         order = np.argsort(pair_keys(ea, eb), kind="stable")
-        self._support = (ea[order], eb[order], snx[order], sny[order])
         self._resolved = (ea[order], eb[order], anx[order], any_[order], pushed[order])
+        # Kept for the next step: the pairs that rest one on the other (normal within 60 degrees of
+        # the vertical), which gravity presses together again; none without gravity.
+        gx, gy = self._gravity()
+        g = math.hypot(gx, gy)
+        rests = np.abs(snx * gx + sny * gy) > 0.5 * g if g > 0.0 else np.zeros(ea.size, dtype=bool)
+        keep = order[rests[order]]
+        self._support = (ea[keep], eb[keep], snx[keep], sny[keep])
         self.counters["resolved"] = int(ea.size)
         return True
 

@@ -41,6 +41,12 @@ def _reach(o, q, ha, hb):
     return (*_two_sum(q, -o), *_two_sum(ha, hb))
 
 
+def _dd_overlap(dh, dl, rh, rl) -> np.ndarray:
+    """``(rh + rl) - |dh + dl|`` (reach less distance), to about double-double accuracy."""
+    sgn = np.where(dh < 0.0, -1.0, 1.0)
+    return (rh - np.abs(dh)) + (rl - sgn * dl)
+
+
 def _less(dh, dl, rh, rl) -> np.ndarray:
     """``|dh + dl| < rh + rl`` exactly (``dh``, ``rh`` the rounded leading parts, ``rh >= 0``)."""
     adh = np.abs(dh)
@@ -200,11 +206,12 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
 
     That centre is the mean of the rectangle's corners, which is what :func:`aabb_aabb` (and
     ``collide``) average except where corners coincide; it lies in the overlap region either way.
-    Rows are decided with plain floats where the answer is clear; the few within the band around
-    touching (or with extreme magnitudes) go through :func:`aabb_aabb`, exact. With
-    ``exact=False`` those rows count as not overlapping (the response re-measuring pairs it has
-    just pushed apart: an overlap within about 1e-12 of the sizes is not worth resolving), and
-    with ``points=False`` the points are left at 0.
+    Rows are decided with plain floats where the answer is clear; those within the rounding band
+    around touching (boxes just pushed apart, common) are decided exactly on double-doubles, as
+    :func:`overlap_aabb_aabb`, with double-double push-outs; extreme magnitudes go through
+    :func:`aabb_aabb`. With ``exact=False`` rows within about 1e-12 of the sizes of touching count
+    as not overlapping (the response re-measuring pairs it has just pushed apart: such an overlap
+    is not worth resolving), and with ``points=False`` the points are left at 0.
     """
     ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
     dx, dy = bx - ax, by - ay
@@ -212,10 +219,21 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
     sx, sy = ahw + bhw, ahh + bhh
     ox, oy = sx - adx, sy - ady  # the shortest push-out along x and along y
     mag = sx + sy + adx + ady
-    band = (8.0 * BAND) * mag
+    # ox and oy each come from three roundings of terms below mag, so their error is under
+    # 2**-51 * mag; a sign decided outside 2**-48 * mag is the exact one. Re-measuring (not
+    # exact), overlaps within 8 * BAND of the magnitudes count as touching.
+    band = (2.0**-48 if exact else 8.0 * BAND) * mag
     unclear = ((np.abs(ox) <= band) & (oy >= -band)) | ((np.abs(oy) <= band) & (ox >= -band))
-    unclear |= ~(mag <= 1e150) | (mag < 1e-150)
-    hit = (ox > 0.0) & (oy > 0.0) & ~unclear
+    extreme = ~(mag <= 1e150) | (mag < 1e-150)
+    hit = (ox > 0.0) & (oy > 0.0) & ~unclear & ~extreme
+    u = np.flatnonzero(unclear & ~extreme) if exact else np.zeros(0, dtype=np.intp)
+    if u.size:
+        # Near touching: the exact decision, and the push-outs as double-doubles (their leading
+        # parts nearly cancel, so their difference is exact and the tails carry the rest).
+        rx = _reach(ax[u], bx[u], ahw[u], bhw[u])
+        ry = _reach(ay[u], by[u], ahh[u], bhh[u])
+        hit[u] = _less(*rx) & _less(*ry)
+        ox[u], oy[u] = _dd_overlap(*rx), _dd_overlap(*ry)
     # The tie rule on the 4 candidates (up sy - dy, down sy + dy, right sx - dx, left sx + dx):
     # keep those within DEPTH_TOL * size of the shortest, prefer vertical, then up (or right). The
     # depth is then the shortest of the kept direction's pair, i.e. oy (or ox).
@@ -231,9 +249,10 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
         py = np.where(hit, 0.5 * (np.maximum(ay - ahh, by - bhh) + np.minimum(ay + ahh, by + bhh)), zero)
     else:
         px, py = zero, zero.copy()
-    u = np.flatnonzero(unclear) if exact else np.zeros(0, dtype=np.intp)
-    if u.size:
-        ref = aabb_aabb(ax[u], ay[u], ahw[u], ahh[u], bx[u], by[u], bhw[u], bhh[u])
-        hit[u] = ref.hit
-        nx[u], ny[u], depth[u], px[u], py[u] = ref.nx, ref.ny, ref.depth, ref.px, ref.py
+    e = np.flatnonzero(extreme) if exact else np.zeros(0, dtype=np.intp)
+    if e.size:  # extreme magnitudes: the scaled exact kernel
+        ref = aabb_aabb(ax[e], ay[e], ahw[e], ahh[e], bx[e], by[e], bhw[e], bhh[e])
+        hit[e] = ref.hit
+        nx[e], ny[e], depth[e], px[e], py[e] = ref.nx, ref.ny, ref.depth, ref.px, ref.py
     return ContactArrays(hit, nx, ny, depth, px, py)
+

@@ -30,6 +30,17 @@ __all__ = ["resolve"]
 Recompute = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 
+def _local_numbers(n: int, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(unique, local)``: the distinct rows (sorted) and each entry's number among them, like
+    ``np.unique(rows, return_inverse=True)`` but by a lookup table over the ``n`` rows (no sort)."""
+    seen = np.zeros(n, dtype=bool)
+    seen[rows] = True
+    unique = np.flatnonzero(seen)
+    table = np.empty(n, dtype=np.int64)
+    table[unique] = np.arange(unique.size)
+    return unique, table[rows]
+
+
 def _first_per_group(groups: np.ndarray, keys: np.ndarray) -> np.ndarray:
     """Indices of the smallest key within each group (ties: the lowest index)."""
     order = np.lexsort((np.arange(groups.size), keys, groups))
@@ -74,7 +85,7 @@ def resolve(
     ia, ib = inv[ra].copy(), inv[rb].copy()
     # Per-body bookkeeping runs over the bodies in contact only (local numbers la, lb), not over
     # every row of the store: a level of 100,000 tiles costs nothing here.
-    rows_u, local = np.unique(np.concatenate([ra, rb]), return_inverse=True)
+    rows_u, local = _local_numbers(store.n, np.concatenate([ra, rb]))
     la, lb = local[:C], local[C:]
     L = rows_u.size
     vn0 = (c["vx"][rb] - c["vx"][ra]) * nx + (c["vy"][rb] - c["vy"][ra]) * ny
@@ -107,12 +118,13 @@ def resolve(
     x0, y0 = c["x"][rows_u], c["y"][rows_u]
 
     def remeasure(sel: np.ndarray) -> None:
-        idx = np.flatnonzero(sel & solid)
+        """Measure the contacts ``sel`` (indices) again."""
+        idx = sel[solid[sel]]
         if idx.size:
             hit, rnx, rny, rdepth, rrank = recompute(ra[idx], rb[idx])
             alive[idx] = hit
             cur_nx[idx], cur_ny[idx], cur_depth[idx], cur_rank[idx] = rnx, rny, rdepth, rrank
-        idx = np.flatnonzero(sel & both)
+        idx = sel[both[sel]]
         if idx.size:
             a, b, al, bl = ra[idx], rb[idx], la[idx], lb[idx]
             mx = (c["x"][b] - x0[bl]) - (c["x"][a] - x0[al])
@@ -134,9 +146,19 @@ def resolve(
         resolved[pick] = True
         alive[pick] = False  # touching now
 
+    # The passes work on index sets: the dynamic pairs, the immovable contacts of each support
+    # level, and the contacts that may need measuring again (not lone).
+    dyn_all = np.flatnonzero(both)
+    sol_all = np.flatnonzero(solid)
+    by_level = [sol_all[mob_level[sol_all] == lv] for lv in [*levels.tolist(), np.inf]] if sol_all.size else []
+    shared = np.flatnonzero(~lone)
+
+    def moved_of(sel: np.ndarray) -> np.ndarray:
+        return sel[moved[la[sel]] | moved[lb[sel]]]
+
     for it in range(max(1, iterations)):
         # Dynamic pairs: split by inverse mass, mean over each body's contacts.
-        d_idx = np.flatnonzero(alive & both)
+        d_idx = dyn_all[alive[dyn_all]]
         if d_idx.size:
             a, b = la[d_idx], lb[d_idx]
             w = 1.0 / (ia[d_idx] + ib[d_idx])
@@ -155,17 +177,16 @@ def resolve(
             alive[d_idx[lone[d_idx]]] = False  # touching now
         # Immovable contacts: deepest one per dynamic body, level by level from the ground up,
         # each level measured again where the bodies under it moved.
-        for lv in [*levels.tolist(), np.inf]:
-            at_level = solid & (mob_level == lv)
-            remeasure(at_level & (moved[la] | moved[lb]))
-            s_idx = np.flatnonzero(at_level & alive)
+        for at_level in by_level:
+            remeasure(moved_of(at_level))
+            s_idx = at_level[alive[at_level]]
             if s_idx.size == 0:
                 continue
             push_out_deepest(s_idx)
         if it + 1 >= iterations:
             break
-        stale = (moved[la] | moved[lb]) & ~lone
-        if not stale.any():
+        stale = moved_of(shared)
+        if stale.size == 0:
             break
         remeasure(stale)
         moved[:] = False
@@ -174,10 +195,10 @@ def resolve(
 
     # Clean-up: immovable contacts only, so no dynamic body is left inside static geometry by a
     # push from another dynamic body in the last pass.
-    for _ in range(max(1, iterations)):
-        remeasure(solid & (moved[la] | moved[lb]))
+    for _ in range(max(1, iterations) if sol_all.size else 0):
+        remeasure(moved_of(sol_all))
         moved[:] = False
-        s_idx = np.flatnonzero(solid & alive)
+        s_idx = sol_all[alive[sol_all]]
         if s_idx.size == 0:
             break
         push_out_deepest(s_idx)
@@ -264,46 +285,56 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
     # e*g*dt every step forever and never sleeps.
     resting_speed = 2.0 * np.abs(gx * nx + gy * ny) * dt
     done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
+    act = np.flatnonzero(resolved)  # the contacts still to look at
+    L = rows_u.size
     for it in range(max(1, iterations)):
+        if act.size == 0:
+            return
         vx, vy = c["vx"], c["vy"]
-        vn = (vx[rb] - vx[ra]) * nx + (vy[rb] - vy[ra]) * ny
-        approaching = resolved & (vn < 0.0) & ~done
+        vn = (vx[rb[act]] - vx[ra[act]]) * nx[act] + (vy[rb[act]] - vy[ra[act]]) * ny[act]
+        approaching = vn < 0.0
         if not approaching.any():
             return
-        s_any = approaching & solid
-        lowest = mob_level[s_any].min() if s_any.any() else np.inf
-        # Ground up: each level sees the velocities below it settled, so a level whose bodies
-        # all fell together (not approaching at first) is looked at again once those below stop.
-        cand = resolved & solid & ~done & (mob_level >= lowest)
-        levels = np.unique(mob_level[cand]).tolist() if s_any.any() else []
-        for lv in levels:
-            s_idx = np.flatnonzero((approaching if lv == lowest else cand) & solid & (mob_level == lv))
-            if lv != lowest:
-                vx, vy = c["vx"], c["vy"]
-                vn_l = (vx[rb[s_idx]] - vx[ra[s_idx]]) * nx[s_idx] + (vy[rb[s_idx]] - vy[ra[s_idx]]) * ny[s_idx]
-                vn[s_idx] = vn_l
-                s_idx = s_idx[vn_l < 0.0]
-            if s_idx.size == 0:
-                continue
-            pick = s_idx[_first_per_group(mobile[s_idx], vn[s_idx])]
-            v = vn[pick]
-            e = np.where(-v > resting_speed[pick], rest[pick], 0.0)
-            target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
-            dv = (target - v) * sgn[pick]
-            m = mobile[pick]
-            c["vx"][m] += dv * nx[pick]
-            c["vy"][m] += dv * ny[pick]
-            done[pick] = e > 0.0
-        d_idx = np.flatnonzero(approaching & both)
-        if d_idx.size:
+        s_act = solid[act]
+        s_appr = approaching & s_act
+        if s_appr.any():
+            lvl = mob_level[act]
+            lowest = lvl[s_appr].min()
+            # Ground up: each level sees the velocities below it settled, so a level whose bodies
+            # all fell together (not approaching at first) is looked at again once those below stop.
+            cand = s_act & (lvl >= lowest)
+            for lv in np.unique(lvl[cand]).tolist():
+                sel = np.flatnonzero((s_appr if lv == lowest else cand) & (lvl == lv))
+                s_idx = act[sel]
+                if lv == lowest:
+                    v_s = vn[sel]
+                else:
+                    vx, vy = c["vx"], c["vy"]
+                    v_s = (vx[rb[s_idx]] - vx[ra[s_idx]]) * nx[s_idx] + (vy[rb[s_idx]] - vy[ra[s_idx]]) * ny[s_idx]
+                    keep = v_s < 0.0
+                    s_idx, v_s = s_idx[keep], v_s[keep]
+                if s_idx.size == 0:
+                    continue
+                first = _first_per_group(mobile[s_idx], v_s)
+                pick, v = s_idx[first], v_s[first]
+                e = np.where(-v > resting_speed[pick], rest[pick], 0.0)
+                target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
+                dv = (target - v) * sgn[pick]
+                m = mobile[pick]
+                c["vx"][m] += dv * nx[pick]
+                c["vy"][m] += dv * ny[pick]
+                done[pick] = e > 0.0
+        d_sel = approaching & both[act]
+        if d_sel.any():
+            d_idx = act[d_sel]
             a, b = la[d_idx], lb[d_idx]
-            v = vn[d_idx]
+            v = vn[d_sel]
             e = np.where(-v > resting_speed[d_idx], rest[d_idx], 0.0)
             j = -(1.0 + e) * v / (ia[d_idx] + ib[d_idx])
-            L = rows_u.size
             jx, jy = j * nx[d_idx], j * ny[d_idx]
             c["vx"][rows_u] += np.bincount(b, jx * ib[d_idx], L) - np.bincount(a, jx * ia[d_idx], L)
             c["vy"][rows_u] += np.bincount(b, jy * ib[d_idx], L) - np.bincount(a, jy * ia[d_idx], L)
             done[d_idx] = e > 0.0
         if it == 0:
             done |= lone  # a contact whose bodies touch nothing else is settled by one pass
+        act = act[~done[act]]
