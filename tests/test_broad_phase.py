@@ -663,3 +663,25 @@ def test_moving_pairs_false_gives_only_moving_static_pairs():
     keep = np.isin(a, ids[1:50]) | np.isin(b, ids[1:50])
     assert np.array_equal(sa, a[keep]) and np.array_equal(sb, b[keep]) and sa.size > 0
     assert np.array_equal(h.query_box(0.0, 0.0, 50.0, 50.0), before)
+
+
+@pytest.mark.parametrize("large", [False, True])
+def test_near_statics_never_misses_a_static_pair(large):
+    rng = np.random.default_rng(3)
+    sx, sy = rng.uniform(0, 60, 400), rng.uniform(0, 60, 400)
+    sw = rng.uniform(0.5, 3.0, 400)
+    if large:
+        sw[0] = 40.0  # one large static
+    h = SpatialHash(2.0)
+    h.set_static(sx, sy, sx + sw, sy + sw, np.arange(400))
+    mx, my = rng.uniform(-40, 100, 3000), rng.uniform(-40, 100, 3000)
+    mw = rng.uniform(0.1, 6.0, 3000)
+    near = h.near_statics(mx, my, mx + mw, my + mw)
+    i, j = brute_force_pairs(np.concatenate([mx, sx]), np.concatenate([my, sy]), np.concatenate([mx + mw, sx + sw]),
+                             np.concatenate([my + mw, sy + sw]), static=np.arange(3400) >= 3000)
+    meets = np.zeros(3000, dtype=bool)
+    meets[i[(i < 3000) & (j >= 3000)]] = True
+    assert meets.sum() > 100 and (~near).sum() > 100  # both kinds are present
+    assert not (meets & ~near).any()
+    h2 = SpatialHash(2.0)
+    assert not h2.near_statics(mx, my, mx + mw, my + mw).any()  # no statics at all

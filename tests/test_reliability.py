@@ -521,13 +521,16 @@ class SceneMachine(RuleBasedStateMachine):
         # This step's contacts and the pairs the response resolved (which include last step's
         # resting contacts it kept as support).
         sa, sb = s._support[0], s._support[1]
+        pressed_by_the_dead = set()  # pressed by a body despawned later in the step: not checked
         for a, b in zip(c.a.tolist() + sa.tolist(), c.b.tolist() + sb.tolist()):
             if a in bs and b in bs and not (bs[a][2].sensor or bs[b][2].sensor):
                 touching.setdefault(a, set()).add(b)
                 touching.setdefault(b, set()).add(a)
+            elif (a in bs) != (b in bs):
+                pressed_by_the_dead.add(a if a in bs else b)
         for e, others in touching.items():
             shape, pose, hb, _asleep = bs[e]
-            if hb.body is not Body.DYNAMIC or hb.inverse_mass == 0.0 or e in self.exempt:
+            if hb.body is not Body.DYNAMIC or hb.inverse_mass == 0.0 or e in self.exempt or e in pressed_by_the_dead:
                 continue
             if any(bs[o][2].body is not Body.STATIC for o in others):
                 continue  # pressed by a moving body

@@ -115,6 +115,7 @@ class SpatialHash:
         self._cell = None if cell_size is None else positive("cell_size", cell_size)
         self._static = CellIndex(_EMPTY_BOUNDS, 1.0)
         self._static_ids = _EMPTY_I
+        self._static_extent: tuple[float, float, float, float] | None = None
         self._moving = StripSweep(_EMPTY_BOUNDS, 1.0)
         self._moving_ids = _EMPTY_I
         self._moving_cells: CellIndex | None = None
@@ -147,6 +148,11 @@ class SpatialHash:
         ids = _as_ids(ids, b[0].shape[0])
         self._static = CellIndex(b, self._choose_cell(b))
         self._static_ids = ids.copy()
+        # The box around every static (None if some static is not finite, or there is none).
+        with np.errstate(over="ignore"):  # a huge sum only makes the extent unknown
+            fin = np.isfinite(b[0] + b[1] + b[2] + b[3])
+        self._static_extent = (float(b[0].min()), float(b[1].min()), float(b[2].max()),
+                               float(b[3].max())) if fin.size and fin.all() else None
         self.rehashed_last = b[0].shape[0]
 
     def pairs(self, minx, miny, maxx, maxy, ids, *, moving_pairs: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -210,26 +216,37 @@ class SpatialHash:
     def _near_statics(self, b: tuple) -> np.ndarray:
         """Mask of the boxes that may meet a static body: one shares a cell they need (no false
         negatives: strictly overlapping bounds always share a cell), a large static overlaps them,
-        or they span many cells (not looked at closely)."""
-        stat = self._static
-        keep = ~np.isfinite(b[0] + b[1] + b[2] + b[3])
-        fb = [np.where(keep, 0.0, v) for v in b] if keep.any() else b
-        if stat.large.shape[0]:
-            i, _ = overlap_pairs(b, subset(stat.bounds, stat.large))
-            keep[i] = True
-        if stat.entries == 0:
+        or they span many cells or are not finite (not looked at closely). Boxes outside the box
+        around every static are dismissed first."""
+        stat, ext = self._static, self._static_extent
+        with np.errstate(over="ignore"):  # a huge sum only makes a box "not looked at closely"
+            keep = ~np.isfinite(b[0] + b[1] + b[2] + b[3])
+        if stat.n == 0:
             return keep
-        with np.errstate(over="ignore"):
-            cx0, cx1 = grid.cell_range(fb[0], fb[2], stat.cell)
-            cy0, cy1 = grid.cell_range(fb[1], fb[3], stat.cell)
-        keep |= (cx1 - cx0 > 1) | (cy1 - cy0 > 1)
-        inside = np.flatnonzero(~keep & (cx1 >= stat.x0) & (cx0 < stat.x0 + stat.wx)
-                                & (cy1 >= stat.y0) & (cy0 < stat.y0 + stat.wy))  # the statics' grid
-        if inside.size:
-            cx0, cx1, cy0, cy1 = cx0[inside], cx1[inside], cy0[inside], cy1[inside]
-            for cx, cy in ((cx0, cy0), (cx1, cy0), (cx0, cy1), (cx1, cy1)):  # all their cells (<= 2 x 2)
-                lo, hi = stat.lookup(cx, cy)
-                keep[inside[hi > lo]] = True
+        ok = ~keep
+        if ext is not None:
+            ok &= (b[2] > ext[0]) & (b[0] < ext[2]) & (b[3] > ext[1]) & (b[1] < ext[3])
+        cand = np.flatnonzero(ok)
+        if cand.size == 0:
+            return keep
+        cb = subset(b, cand)
+        near = np.zeros(cand.size, dtype=bool)
+        if stat.large.shape[0]:
+            i, _ = overlap_pairs(cb, subset(stat.bounds, stat.large))
+            near[i] = True
+        if stat.entries:
+            with np.errstate(over="ignore"):
+                cx0, cx1 = grid.cell_range(cb[0], cb[2], stat.cell)
+                cy0, cy1 = grid.cell_range(cb[1], cb[3], stat.cell)
+            near |= (cx1 - cx0 > 1) | (cy1 - cy0 > 1)
+            inside = np.flatnonzero(~near & (cx1 >= stat.x0) & (cx0 < stat.x0 + stat.wx)
+                                    & (cy1 >= stat.y0) & (cy0 < stat.y0 + stat.wy))  # the statics' grid
+            if inside.size:
+                cx0, cx1, cy0, cy1 = cx0[inside], cx1[inside], cy0[inside], cy1[inside]
+                for cx, cy in ((cx0, cy0), (cx1, cy0), (cx0, cy1), (cx1, cy1)):  # all their cells (<= 2 x 2)
+                    lo, hi = stat.lookup(cx, cy)
+                    near[inside[hi > lo]] = True
+        keep[cand[near]] = True
         return keep
 
     def _cross_static(self, mov: StripSweep, b: tuple, ids: np.ndarray, out_a: list, out_b: list) -> None:
