@@ -424,8 +424,17 @@ def test_runner_fixed_timestep_accumulator(render, scene):
         runner.close()
 
 
-def test_run_opens_steps_and_closes(render, scene):
+def test_run_opens_steps_and_closes(render, scene, monkeypatch):
     e = scene.spawn(Transform(10.0, 10.0), Velocity(60.0, 0.0), Hitbox(AABB(4.0, 4.0)), Visual(RED))
-    render.run(scene, width=64, height=48, max_frames=3, debug=True)
+    seen = []
+    init = render.window.Runner.__init__
+
+    def spy(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        seen.append(self.renderer.background)
+
+    monkeypatch.setattr(render.window.Runner, "__init__", spy)
+    render.run(scene, width=64, height=48, max_frames=3, debug=True, background=BG)
+    assert seen == [tuple(BG)]
     assert scene.frame >= 1 and scene.renderer is None
     assert scene.get(e, Transform).x > 10.0

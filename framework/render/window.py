@@ -207,12 +207,14 @@ def run(
     debug: bool = False,
     on_key: Callable[[Any, str], Any] | None = None,
     max_frames: int | None = None,
+    background: tuple[int, int, int] = (0, 0, 0),
 ) -> None:
     """Open a window and run ``scene`` in it at ``fps`` fixed steps per second until the window
     is closed (Escape), or for ``max_frames`` frames.
 
     ``camera``: the view (see :class:`~framework.render.camera.Camera`; e.g. ``Camera(target=player,
     bounds=level, zoom=2)``); ``debug``: start with the overlay on (F1 toggles it); ``on_key(scene,
-    key)``: called on every key press with the key's name; return a new scene to switch to it."""
+    key)``: called on every key press with the key's name; return a new scene to switch to it;
+    ``background``: the clear colour (r, g, b), 0-255."""
     Runner(scene, width=width, height=height, title=title, fps=fps, camera=camera, debug=debug,
-           on_key=on_key, max_frames=max_frames).run()
+           on_key=on_key, max_frames=max_frames, background=background).run()
