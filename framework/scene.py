@@ -713,10 +713,12 @@ class Scene:
         faces = self._n_static > 0 and bool(((store.body[ra[idx]] == STATIC) | (store.body[rb[idx]] == STATIC)).any())
 
         def recompute(a: np.ndarray, b: np.ndarray):
-            if geom.version == store.version and not (store.ox.any() or store.oy.any()):
-                geom.hx, geom.hy = store.x, store.y
-            else:
+            if geom.version != store.version:
                 geom.update(store)
+            elif geom.has_offset:  # hitbox origins of just these rows
+                geom.update_rows(store, np.concatenate([a, b]))
+            else:  # origins are the positions
+                geom.hx, geom.hy = store.x, store.y
             r = pair_contacts(store, geom, a, b, remeasure=True)
             rank = r.depth.copy()
             if faces:
