@@ -118,3 +118,6 @@ def test_site_builds_strict(tmp_path):
                          env={**os.environ, "NO_MKDOCS_2_WARNING": "1"})
     assert out.returncode == 0, out.stderr[-4000:]
     assert (tmp_path / "site" / "api" / "index.html").exists()
+    api = (tmp_path / "site" / "api" / "index.html").read_text()
+    assert "<code>Camera</code>" in api and not re.search(r":(class|func|meth|mod|attr):<code>", api), \
+        "Sphinx roles in docstrings must render as plain code (docs_hooks/sphinx_roles.py)"
