@@ -727,13 +727,13 @@ class Scene:
             return r.hit, r.nx, r.ny, r.depth, rank
 
         self._moved += 1
-        nx, ny, depth = nx[idx], ny[idx], depth[idx]
+        nx, ny, depth, live0 = nx[idx], ny[idx], depth[idx], alive0[idx]
         rank = depth.copy()
         if faces:
             self._internal_faces.redirect(store, geom, self.hash, self._rows_of, ra[idx], rb[idx], nx, ny, depth,
-                                          alive0[idx], rank)
+                                          live0, rank)
         done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx, ny, depth, self._gravity(),
-                                          self.response_iterations, recompute, alive0[idx], dt, rank)
+                                          self.response_iterations, recompute, live0, dt, rank)
         ea, eb = ents_a[idx[done]], ents_b[idx[done]]
         snx, sny = nx[done], ny[done]
         anx, any_, pushed = anx[done], any_[done], pushed[done]
@@ -760,7 +760,7 @@ class Scene:
             self._internal_faces.redirect(store, geom, self.hash, self._rows_of, xra, xrb, xr.nx, xr.ny, xr.depth,
                                           xr.hit, xrank)
             xdone, xanx, xany, xpushed = resolve(store, xra, xrb, xr.nx, xr.ny, xr.depth, self._gravity(),
-                                                 self.response_iterations, recompute, None, dt, xrank)
+                                                 self.response_iterations, recompute, xr.hit, dt, xrank)
             ea, eb = np.concatenate([ea, xa[xdone]]), np.concatenate([eb, xb[xdone]])
             snx, sny = np.concatenate([snx, xr.nx[xdone]]), np.concatenate([sny, xr.ny[xdone]])
             anx, any_ = np.concatenate([anx, xanx[xdone]]), np.concatenate([any_, xany[xdone]])

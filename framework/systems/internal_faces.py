@@ -96,7 +96,9 @@ class InternalFaces:
                  rb: np.ndarray, nx: np.ndarray, ny: np.ndarray, depth: np.ndarray, hit: np.ndarray,
                  rank: np.ndarray) -> int:
         """Re-aim (in place) the contacts whose push-out leaves a static box through an internal face:
-        along the box's open face the body is least deep behind. Returns how many changed.
+        along the box's open face the body is least deep behind; or, if the body's middle lies
+        beyond that face, drop them (``hit`` False: the covering box's own contact resolves the
+        body). Returns how many changed.
 
         ``rank`` (the depth, on entry) orders a body's contacts for the deepest-first push-out. A
         re-aimed contact ranks below every plain one, and among re-aimed ones by its measured
@@ -120,9 +122,22 @@ class InternalFaces:
         if not bad.any():
             return 0
         cand, t, m, sgn, faces = cand[bad], t[bad], m[bad], sgn[bad], faces[bad]
+        px, py = px[bad], py[bad]
         # The body's extent along the box's axes (exact for any convex shape: its bounds).
         lo_x, hi_x, lo_y, hi_y = _extent(store, geom, m)
         tx, ty = geom.hx[t], geom.hy[t]
+        # A body whose middle lies beyond the covered face is mostly in the box covering it, and
+        # that contact resolves it: this one is dropped (a triangle resting in a corner, poking a
+        # sliver into the floor tile under the wall, must not be pushed through that tile).
+        beyond = np.where(px != 0.0, (0.5 * (lo_x + hi_x) - tx) * px - store.hw[t],
+                          (0.5 * (lo_y + hi_y) - ty) * py - store.hh[t]) > 0.0
+        if beyond.any():
+            hit[cand[beyond]] = False
+            keep = ~beyond
+            cand, t, m, sgn, faces = cand[keep], t[keep], m[keep], sgn[keep], faces[keep]
+            lo_x, hi_x, lo_y, hi_y, tx, ty = lo_x[keep], hi_x[keep], lo_y[keep], hi_y[keep], tx[keep], ty[keep]
+            if cand.size == 0:
+                return int(beyond.sum())
         d = np.stack([
             hi_x - (tx - store.hw[t]),  # LEFT: leave through the left face
             (tx + store.hw[t]) - lo_x,  # RIGHT
@@ -135,14 +150,14 @@ class InternalFaces:
         dd = d[np.arange(cand.size), best]
         ok = np.isfinite(dd)  # every face covered (a body buried in the ground): keep the contact
         if not ok.any():
-            return 0
+            return int(beyond.sum())
         cand, best, dd, sgn = cand[ok], best[ok], dd[ok], sgn[ok]
         dirs = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0], [0.0, 1.0]])
         nx[cand] = dirs[best, 0] * sgn
         ny[cand] = dirs[best, 1] * sgn
         depth[cand] = dd
         rank[cand] = -1.0 / (1.0 + rank[cand])  # in (-1, 0): below every plain depth, same order
-        return int(cand.size)
+        return int(cand.size + beyond.sum())
 
 
 def _extent(store: BodyStore, geom: Geometry, rows: np.ndarray) -> tuple[np.ndarray, ...]:
