@@ -19,6 +19,7 @@ from framework.collision import collide
 from framework.collision.batch import (
     ContactArrays,
     aabb_aabb,
+    aabb_aabb_fast,
     circle_circle,
     collide_many,
     outlines,
@@ -193,8 +194,9 @@ def _kind(shape: object) -> str:
     return "circle" if isinstance(shape, Circle) else "polygon"
 
 
-def kernel_results(pairs: list[Pair]) -> tuple[ContactArrays, np.ndarray]:
-    """The kernel of this (single) kind combination on the pairs, and its ``overlap_*`` twin."""
+def kernel_results(pairs: list[Pair], fallback: bool = True) -> tuple[ContactArrays, np.ndarray]:
+    """The kernel of this (single) kind combination on the pairs, and its ``overlap_*`` twin.
+    ``fallback=False``: the kernels as the response calls them (no exact fallback, no points)."""
     sa = [p[0] for p in pairs]
     sb = [p[2] for p in pairs]
     ta = np.array([p[1] for p in pairs], dtype=float).reshape(-1, 3)
@@ -205,19 +207,21 @@ def kernel_results(pairs: list[Pair]) -> tuple[ContactArrays, np.ndarray]:
     ax, ay, bx, by = ta[:, 0], ta[:, 1], tb[:, 0], tb[:, 1]
     if ka_ == kb_ == "circle":
         args = (ax, ay, [s.radius for s in sa], bx, by, [s.radius for s in sb])
-        return circle_circle(*args), overlap_circle_circle(*args)
+        return circle_circle(*args, exact=fallback), overlap_circle_circle(*args)
     if ka_ == kb_ == "aabb":
         args = (ax, ay, [s.width / 2 for s in sa], [s.height / 2 for s in sa],
                 bx, by, [s.width / 2 for s in sb], [s.height / 2 for s in sb])
+        if not fallback:
+            return aabb_aabb_fast(*args, exact=False, points=False), overlap_aabb_aabb(*args)
         return aabb_aabb(*args), overlap_aabb_aabb(*args)
     if kb_ == "circle":
         args = (ax, ay, *outlines(sa, ta[:, 2]), bx, by, [s.radius for s in sb])
-        return polygon_circle(*args), overlap_polygon_circle(*args)
+        return polygon_circle(*args, exact=fallback), overlap_polygon_circle(*args)
     if ka_ == "circle":
         args = (bx, by, *outlines(sb, tb[:, 2]), ax, ay, [s.radius for s in sa])
-        return polygon_circle(*args, flip=True), overlap_polygon_circle(*args, flip=True)
+        return polygon_circle(*args, flip=True, exact=fallback), overlap_polygon_circle(*args, flip=True)
     args = (ax, ay, *outlines(sa, ta[:, 2]), bx, by, *outlines(sb, tb[:, 2]))
-    return polygon_polygon(*args), overlap_polygon_polygon(*args)
+    return polygon_polygon(*args, exact=fallback, points=fallback), overlap_polygon_polygon(*args)
 
 
 # --- comparison ------------------------------------------------------------------------------
@@ -480,3 +484,82 @@ def test_fast_box_kernel_matches_the_exact_one_within_ulps_of_touching():
     mag = (ahw + bhw) + (ahh + bhh) + np.abs(bx - ax) + np.abs(by - ay)
     assert np.all(np.abs(fast.depth - ref.depth) <= 2.0**-50 * mag)
     assert (fast.depth[fast.hit] > 0).all()
+
+
+@pytest.mark.parametrize(("ka", "kb"), COMBOS, ids=[f"{a}-{b}" for a, b in COMBOS])
+def test_kernels_without_the_exact_fallback_drop_only_touching_rows(ka: str, kb: str) -> None:
+    """As the response re-measures (``exact=False``): a pair within rounding of touching counts
+    as apart; every other row is the exact kernel's answer (same normal, same depth)."""
+    pairs = all_pairs(ka, kb)
+    ref, _ = kernel_results(pairs)
+    fast, _ = kernel_results(pairs, fallback=False)
+    assert not (fast.hit & ~ref.hit).any()
+    dropped = np.flatnonzero(ref.hit & ~fast.hit)
+    for i in dropped.tolist():
+        sa, ta, sb, tb = pairs[i]
+        scale = sa.bounding_radius + sb.bounding_radius + abs(tb[0] - ta[0]) + abs(tb[1] - ta[1])
+        assert ref.depth[i] <= 1e-9 * scale, (i, pairs[i], ref.depth[i])
+    both = ref.hit & fast.hit
+    assert both[:N_RANDOM].sum() >= 0.99 * ref.hit[:N_RANDOM].sum()  # random pairs seldom touch
+    assert np.array_equal(ref.nx[both], fast.nx[both]) and np.array_equal(ref.ny[both], fast.ny[both])
+    np.testing.assert_allclose(fast.depth[both], ref.depth[both], rtol=1e-12, atol=0)
+
+
+def test_kernels_without_the_exact_fallback_drop_one_ulp_overlaps() -> None:
+    # Two unit boxes overlapping by one ulp of their offset: an overlap to collide, touching to
+    # the response; the same for polygons and circles.
+    x = np.nextafter(1.0, 0.0)
+    box = outlines([Polygon.box(1.0, 1.0)], [0.0])
+    pp = (0.0, 0.0, *box, x, 0.0, *box)
+    assert polygon_polygon(*pp).hit[0] and not polygon_polygon(*pp, exact=False).hit[0]
+    pc = (0.0, 0.0, *box, x, 0.0, [0.5])
+    assert polygon_circle(*pc).hit[0] and not polygon_circle(*pc, exact=False).hit[0]
+    cc = (0.0, 0.0, [0.5], x, 0.0, [0.5])
+    assert circle_circle(*cc).hit[0] and not circle_circle(*cc, exact=False).hit[0]
+
+
+def test_polygon_circle_takes_a_flip_per_row() -> None:
+    """One call with a flip per row (the pipeline mixes polygon-circle and circle-polygon pairs)
+    gives bit for bit what two calls give, touching and exact rows included."""
+    pc, cp = all_pairs("polygon", "circle"), all_pairs("circle", "box")
+    poly = [p[0] for p in pc] + [p[2] for p in cp]
+    circ = [p[2] for p in pc] + [p[0] for p in cp]
+    tp = np.array([p[1] for p in pc] + [p[3] for p in cp], dtype=float).reshape(-1, 3)
+    tc = np.array([p[3] for p in pc] + [p[1] for p in cp], dtype=float).reshape(-1, 3)
+    v, n = outlines(poly, tp[:, 2])
+    joined = [tp[:, 0], tp[:, 1], v, n, tc[:, 0], tc[:, 1], np.array([c.radius for c in circ])]
+    k = len(pc)
+    one, two = [a[:k] for a in joined], [a[k:] for a in joined]
+    flip = np.r_[np.zeros(len(pc), dtype=bool), np.ones(len(cp), dtype=bool)]
+    got = polygon_circle(*joined, flip=flip)
+    want = [np.concatenate([a, b]) for a, b in zip(polygon_circle(*one), polygon_circle(*two, flip=True), strict=True)]
+    for g, w in zip(got, want, strict=True):
+        assert np.array_equal(g, w)
+    assert got.hit[: len(pc)].any() and got.hit[len(pc):].any()
+
+
+def test_the_pipeline_measures_a_mixed_batch_as_it_measures_each_pair() -> None:
+    """pair_contacts gives a kernel one call per family of pairs (boxes, circles, polygon-circle
+    either way round, polygons with boxes): each row's answer is what it gets on its own."""
+    from framework import Hitbox, Scene
+    from framework.systems.narrow_phase import pair_contacts
+
+    rng = np.random.default_rng(21)
+    with Scene() as s:
+        ents = []
+        for i in range(40):
+            kind = KINDS[i % len(KINDS)]
+            t = Transform(dyadic(rng, -4, 4), dyadic(rng, -4, 4), random_rotation(rng, kind))
+            ents.append(s.spawn(t, Hitbox(random_shape(rng, kind), body="static" if i % 5 == 0 else "dynamic")))
+        s.step(0.0625)
+        rows = np.array([s.store.row_of[e] for e in ents])
+        ra, rb = (g.ravel() for g in np.meshgrid(rows, rows, indexing="ij"))
+        keep = ra != rb
+        ra, rb = ra[keep], rb[keep]
+        for remeasure in (False, True):
+            whole = pair_contacts(s.store, s.geometry, ra, rb, remeasure=remeasure)
+            assert 0.1 < whole.hit.mean() < 0.9
+            for i in range(0, ra.size, 7):
+                one = pair_contacts(s.store, s.geometry, ra[i:i + 1], rb[i:i + 1], remeasure=remeasure)
+                for w, o in zip(whole, one, strict=True):
+                    assert w[i] == o[0], (i, remeasure, whole, one)

@@ -35,7 +35,7 @@ __all__ = ["circle_circle", "overlap_circle_circle", "overlap_polygon_circle", "
 
 # --- circle / circle -------------------------------------------------------------------------
 
-def _circle_circle(ax, ay, ar, bx, by, br, details: bool):
+def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True):
     ax, ay, ar, bx, by, br = columns(ax, ay, ar, bx, by, br)
     dx, dy, k = frame(ax, ay, bx, by, np.maximum(ar, br))
     ra, rb = np.ldexp(ar, -k), np.ldexp(br, -k)
@@ -44,7 +44,7 @@ def _circle_circle(ax, ay, ar, bx, by, br, details: bool):
     band = BAND * (d2 + r2)
     hit = d2 <= r2 - band
     # Too close to touching for floats: decide on the exact |d|^2 < (ra + rb)^2.
-    near = np.flatnonzero((d2 > r2 - band) & (d2 < r2 + band))
+    near = np.flatnonzero((d2 > r2 - band) & (d2 < r2 + band)) if fallback else np.zeros(0, dtype=np.int64)
     num = np.zeros(near.size, dtype=F64)
     for j, i in enumerate(near):
         exact = circle_circle_exact((ax[i], ay[i], bx[i], by[i], int(k[i])), ra[i], rb[i])
@@ -77,21 +77,22 @@ def overlap_circle_circle(ax, ay, ar, bx, by, br) -> np.ndarray:
     return _circle_circle(ax, ay, ar, bx, by, br, details=False)
 
 
-def circle_circle(ax, ay, ar, bx, by, br) -> ContactArrays:
-    """Circles of radius ``ar`` at (ax, ay) (A) and ``br`` at (bx, by) (B), all ``[P]``."""
-    return _circle_circle(ax, ay, ar, bx, by, br, details=True)
+def circle_circle(ax, ay, ar, bx, by, br, exact: bool = True) -> ContactArrays:
+    """Circles of radius ``ar`` at (ax, ay) (A) and ``br`` at (bx, by) (B), all ``[P]``.
+    ``exact=False``: pairs within rounding of touching count as apart (for the response)."""
+    return _circle_circle(ax, ay, ar, bx, by, br, details=True, fallback=exact)
 
 
 # --- polygon / circle ------------------------------------------------------------------------
 
-def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, details: bool):
+def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: bool, fallback: bool = True):
     vx, vy, count = outline_rows(averts, acount, "polygon vertices")
     p = vx.shape[1]
     ax, ay, bx, by, r = columns_of(p, ax, ay, bx, by, br)
     if p == 0:
         return np.zeros(0, dtype=bool) if not details else finish(
             np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
-    f = -1.0 if flip else 1.0
+    f = np.where(np.broadcast_to(np.asarray(flip, dtype=bool), (p,)), -1.0, 1.0)  # per row
     # The polygon's frame, whichever shape of the pair it is.
     cx, cy, k = frame(ax, ay, bx, by, np.maximum(extent(vx, vy), r))
     vx, vy, r = np.ldexp(vx, -k), np.ldexp(vy, -k), np.ldexp(r, -k)
@@ -125,11 +126,11 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
     exact = (inside & ~inside_clear) | (~inside & ((dist == 0.0) | ((dist > r - tol) & (dist < r + tol))))
     hit = inside_clear | out_hit
     results = {}
-    for i in np.flatnonzero(exact):
+    for i in np.flatnonzero(exact) if fallback else ():
         n = int(count[i])
         poly = list(zip(vx[:n, i].tolist(), vy[:n, i].tolist(), strict=True))
         res = polygon_circle_exact(
-            poly, (ax[i], ay[i], bx[i], by[i], int(k[i])), r[i], cx[i], cy[i], size[i], f
+            poly, (ax[i], ay[i], bx[i], by[i], int(k[i])), r[i], cx[i], cy[i], size[i], float(f[i])
         )
         if res is not None:
             hit[i] = True
@@ -141,19 +142,19 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip: bool, size, detail
     m = np.flatnonzero(inside_clear)
     if m.size:
         mex, mey, mln = cols(ex, m), cols(ey, m), cols(ln, m)
-        depth[m], nx[m], ny[m] = pick(cols(cdepth, m), f * mey / mln, -f * mex / mln, size[m])
+        depth[m], nx[m], ny[m] = pick(cols(cdepth, m), f[m] * mey / mln, -f[m] * mex / mln, size[m])
         px[m], py[m] = cx[m], cy[m]
     m = np.flatnonzero(out_hit & has_face)
     if m.size:
         d, ln_ = dist[m], fln[m]
         unx, uny = fey[m] / ln_, -fex[m] / ln_
-        nx[m], ny[m] = f * unx, f * uny
+        nx[m], ny[m] = f[m] * unx, f[m] * uny
         depth[m] = r[m] - d
         px[m], py[m] = cx[m] - unx * d, cy[m] - uny * d
     m = np.flatnonzero(out_hit & ~has_face)
     if m.size:
         d = dist[m]  # > 0 on these rows
-        nx[m], ny[m] = f * ddx[m] / d, f * ddy[m] / d
+        nx[m], ny[m] = f[m] * ddx[m] / d, f[m] * ddy[m] / d
         depth[m] = r[m] - d
         j = vi[m]
         px[m], py[m] = vx[j, m], vy[j, m]
@@ -167,14 +168,16 @@ def overlap_polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False) -> np
     return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, None, details=False)
 
 
-def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None) -> ContactArrays:
+def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None, exact: bool = True) -> ContactArrays:
     """Convex polygons (hitbox origins (ax, ay) ``[P]``, outlines ``averts [P, K, 2]`` with
     ``acount`` vertices, as :func:`~framework.collision.batch.outlines` gives them) against circles
     of radius ``br`` at (bx, by).
 
-    Normals point from the polygon to the circle; with ``flip`` the circle is shape A of the pair
-    (``collide(circle, ..., polygon, ...)``) and normals point from the circle to the polygon.
+    Normals point from the polygon to the circle; with ``flip`` (a bool, or one per row) the circle
+    is shape A of the pair (``collide(circle, ..., polygon, ...)``) and normals point from the
+    circle to the polygon.
     ``size`` (optional ``[P]``): the pair's bounding radii summed, the scale of the tie-break
-    tolerance; by default it is measured from the outlines.
+    tolerance; by default it is measured from the outlines. ``exact=False``: pairs within rounding
+    of touching count as apart (the response re-measuring pairs it has just pushed apart).
     """
-    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details=True)
+    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details=True, fallback=exact)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..validation import InvalidValue
-from .batch_box import aabb_aabb, overlap_aabb_aabb
+from .batch_box import aabb_aabb, aabb_aabb_fast, overlap_aabb_aabb
 from .batch_common import (
     BIG,
     F64,
@@ -92,12 +92,13 @@ def _extent(ux: np.ndarray, uy: np.ndarray, vx: np.ndarray, vy: np.ndarray):
     return lo, hi
 
 
-def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size):
+def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, exact: bool = True):
     """The separating-axis decision of every row, and the per-axis overlaps ``[C, P]``.
 
     A projection is ``u . local + u . offset``: B is projected about its own origin and
     ``ud = u . d`` added, as in the scalar code. Rows within the band of touching on some axis
-    are decided exactly; their overlaps are then the exact ones.
+    are decided exactly; their overlaps are then the exact ones (with ``exact`` False they count
+    as apart: the response re-measuring pairs it has just pushed to touching).
     """
     # Unnormalised outward normal (ey, -ex) of each edge of a CCW outline; exact for dyadic input.
     ux = np.concatenate((edges(avy), edges(bvy)))
@@ -114,7 +115,7 @@ def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size):
     apart = ((least < -tol) & valid).any(axis=0) | ~valid.any(axis=0)
     border = ((least <= tol) & valid).any(axis=0) & ~apart
     hit = ~apart & ~border
-    for i in np.flatnonzero(border):
+    for i in np.flatnonzero(border) if exact else ():
         pa = list(zip(avx[: acount[i], i].tolist(), avy[: acount[i], i].tolist(), strict=True))
         lb = list(zip(bvx[: bcount[i], i].tolist(), bvy[: bcount[i], i].tolist(), strict=True))
         exact = polygon_polygon_exact(pa, lb, (ax[i], ay[i], bx[i], by[i], int(k[i])))
@@ -141,13 +142,18 @@ def overlap_polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount) -> n
     return hit
 
 
-def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None) -> ContactArrays:
+def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None, exact: bool = True,
+                    points: bool = True) -> ContactArrays:
     """Convex polygons A and B: hitbox origins (ax, ay), (bx, by) ``[P]`` and outlines relative
     to them, ``averts [P, Ka, 2]`` / ``bverts [P, Kb, 2]`` with ``acount`` / ``bcount`` vertices,
     as :func:`~framework.collision.batch.outlines` gives them (gathered per pair).
 
     ``size`` (optional ``[P]``): the pair's bounding radii summed (the scale of the tie-break and
     contact-point tolerances); by default it is measured from the outlines.
+
+    ``exact=False``: pairs within rounding of touching count as apart (no exact fallback);
+    ``points=False``: contact points are not computed. Both are for the response,
+    which re-measures pairs it has just pushed apart and needs only normals and depths.
     """
     avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, boxes, rest, box_args = _rows(
         ax, ay, averts, acount, bx, by, bverts, bcount
@@ -156,22 +162,23 @@ def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None) -
     if size is not None:
         size = columns_of(p, size)[0]
     if not boxes.size:
-        return _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size)
+        return _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size, exact, points)
     out = no_contacts(p)
-    res = aabb_aabb(*box_args)
+    res = aabb_aabb(*box_args) if exact and points else aabb_aabb_fast(*box_args, exact=exact, points=points)
     for dst, src in zip(out, res, strict=True):
         dst[boxes] = src
     if rest.size:
         res = _polygon_polygon(
             *(cols(v, rest) if v.ndim == 2 else v[rest] for v in (avx, avy, acount, bvx, bvy, bcount)),
-            *(v[rest] for v in (ax, ay, bx, by)), None if size is None else size[rest],
+            *(v[rest] for v in (ax, ay, bx, by)), None if size is None else size[rest], exact, points,
         )
         for dst, src in zip(out, res, strict=True):
             dst[rest] = src
     return out
 
 
-def _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size) -> ContactArrays:
+def _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size, exact=True,
+                     points=True) -> ContactArrays:
     """:func:`polygon_polygon` on slot-major rows, by separating axes."""
     p = ax.shape[0]
     if p == 0:
@@ -179,7 +186,7 @@ def _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size) -
     avx, avy, bvx, bvy, dx, dy, k, sz = _frame(avx, avy, bvx, bvy, ax, ay, bx, by)
     if size is not None:
         sz = np.ldexp(size, -k)
-    hit, axes = _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, sz)
+    hit, axes = _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, sz, exact)
     h = np.flatnonzero(hit)
     ux, uy, valid, fwd, bwd, avx, avy, bvx, bvy = (cols(a, h) for a in (*axes, avx, avy, bvx, bvy))
     acount, bcount = acount[h], bcount[h]
@@ -201,6 +208,9 @@ def _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size) -
         d += absent
     depth, nx, ny = pick(*(a.reshape(2 * c, n) for a in (cdepth, cnx, cny)), sz)
     # The point is found with B at its offset.
-    bvx, bvy = bvx + dx, bvy + dy
-    px, py = overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, sz)
+    if points:
+        bvx, bvy = bvx + dx, bvy + dy
+        px, py = overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, sz)
+    else:
+        px, py = np.zeros(h.size), np.zeros(h.size)
     return finish(hit, nx, ny, depth, px, py, k[h], ax[h], ay[h])

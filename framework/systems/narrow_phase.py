@@ -34,8 +34,8 @@ def pair_contacts(
 ) -> batch.ContactArrays:
     """Contacts of B (rows ``rb``) against A (rows ``ra``), in input order.
 
-    ``remeasure``: the response measuring pairs it has just pushed apart; box pairs then skip
-    their points and count overlaps within rounding of touching as none."""
+    ``remeasure``: the response measuring pairs it has just pushed apart; pairs then count
+    overlaps within rounding of touching as none, and box and polygon pairs skip their points."""
     P = ra.size
     hit = np.zeros(P, dtype=bool)
     nx, ny, depth, px, py = (np.zeros(P) for _ in range(5))
@@ -44,31 +44,38 @@ def pair_contacts(
     ka = store.kind[ra].astype(np.int64)
     kb = store.kind[rb].astype(np.int64)
     code = ka * 3 + kb
+    if counts is not None:
+        for c, n in zip(*np.unique(code, return_counts=True), strict=True):
+            name = KIND_PAIR_NAMES[divmod(int(c), 3)]
+            counts[name] = counts.get(name, 0) + int(n)
+    # One kernel call per family of pairs, not per ordered pair of kinds: a box is a polygon to
+    # the polygon kernels, and a circle may be either shape of a polygon-circle pair (the
+    # kernel flips the normal per row). Per-call overhead dominates the response's small batches.
+    ca, cb = ka == KIND_CIRCLE, kb == KIND_CIRCLE
+    family = np.where(ca & cb, 1, np.where(ca | cb, 2, np.where((ka == KIND_AABB) & (kb == KIND_AABB), 0, 3)))
+    fams = [int(family[0])] if (family == family[0]).all() else np.unique(family).tolist()
     hx, hy = geom.hx, geom.hy
-    kinds = [int(code[0])] if (code == code[0]).all() else np.unique(code).tolist()
-    for c in kinds:
-        idx = np.flatnonzero(code == c) if len(kinds) > 1 else np.arange(P)
+    for f in fams:
+        idx = np.flatnonzero(family == f) if len(fams) > 1 else np.arange(P)
         a, b = ra[idx], rb[idx]
-        kind_a, kind_b = divmod(c, 3)
-        if counts is not None:
-            name = KIND_PAIR_NAMES[(kind_a, kind_b)]
-            counts[name] = counts.get(name, 0) + idx.size
-        if kind_a == KIND_AABB and kind_b == KIND_AABB:
+        if f == 0:
             res = batch.aabb_aabb_fast(
                 hx[a], hy[a], store.hw[a], store.hh[a], hx[b], hy[b], store.hw[b], store.hh[b],
                 exact=not remeasure, points=not remeasure,
             )
-        elif kind_a == KIND_CIRCLE and kind_b == KIND_CIRCLE:
-            res = batch.circle_circle(hx[a], hy[a], store.radius[a], hx[b], hy[b], store.radius[b])
-        elif kind_b == KIND_CIRCLE:
-            va, na = geom.outlines(store, a)
-            res = batch.polygon_circle(hx[a], hy[a], va, na, hx[b], hy[b], store.radius[b])
-        elif kind_a == KIND_CIRCLE:
-            vb, nb = geom.outlines(store, b)
-            res = batch.polygon_circle(hx[b], hy[b], vb, nb, hx[a], hy[a], store.radius[a], flip=True)
+        elif f == 1:
+            res = batch.circle_circle(hx[a], hy[a], store.radius[a], hx[b], hy[b], store.radius[b],
+                                       exact=not remeasure)
+        elif f == 2:
+            flip = ca[idx]  # the circle is shape A: normals from it to the polygon
+            poly, circ = np.where(flip, b, a), np.where(flip, a, b)
+            vp, np_ = geom.outlines(store, poly)
+            res = batch.polygon_circle(hx[poly], hy[poly], vp, np_, hx[circ], hy[circ], store.radius[circ],
+                                      flip=flip, exact=not remeasure)
         else:
             va, na = geom.outlines(store, a)
             vb, nb = geom.outlines(store, b)
-            res = batch.polygon_polygon(hx[a], hy[a], va, na, hx[b], hy[b], vb, nb)
+            res = batch.polygon_polygon(hx[a], hy[a], va, na, hx[b], hy[b], vb, nb,
+                                        exact=not remeasure, points=not remeasure)
         hit[idx], nx[idx], ny[idx], depth[idx], px[idx], py[idx] = res
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
