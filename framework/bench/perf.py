@@ -509,8 +509,8 @@ def notes(report: dict[str, Any]) -> list[str]:
     base = tiles and _find(rows, tiles["scene"].split("+")[0])
     if tiles and base:
         out.append(
-            f"Tiles level: the scene's automatic cell size is {tiles['cell_size']:.3g} (from the median body "
-            f"extent when the statics are entered: the unit tiles) against {base['cell_size']:.3g} without tiles; "
+            f"Tiles level: the scene's automatic cell size is {tiles['cell_size']:.3g} (about twice the larger "
+            f"median extent, of the movers or of the tiles) against {base['cell_size']:.3g} without tiles; "
             f"broad phase {fmt(tiles['broad_ms'], 'ms')} ms against {fmt(base['broad_ms'], 'ms')} ms "
             f"(floor {fmt(tiles['floor_ms'], 'ms')} against {fmt(base['floor_ms'], 'ms')}), response "
             f"{fmt(tiles['response_ms'], 'ms')} against {fmt(base['response_ms'], 'ms')} ms, movement "
