@@ -691,7 +691,7 @@ class Scene:
         ents_a = np.concatenate([c.a, sa[old][live]])
         ents_b = np.concatenate([c.b, sb[old][live]])
         nx, ny = np.concatenate([c.nx, snx[old][live]]), np.concatenate([c.ny, sny[old][live]])
-        depth = np.concatenate([c.depth, np.zeros(int(live.sum()))])
+        depth = np.concatenate([c.depth, self._support_gaps(sra[live], srb[live], snx[old][live], sny[old][live])])
         alive0 = np.arange(ra.size) < c.a.size
         self._support = _NO_SUPPORT
         self._resolved = _NO_RESOLVED
@@ -779,6 +779,19 @@ class Scene:
         self._support = (ea[keep], eb[keep], snx[keep], sny[keep])
         self.counters["resolved"] = int(ea.size)
         return True
+
+    def _support_gaps(self, ra: np.ndarray, rb: np.ndarray, nx: np.ndarray, ny: np.ndarray) -> np.ndarray:
+        """The depth (<= 0) of last step's resting pairs that no longer overlap: how far apart the
+        step's movement took them along their normal. They touched when it began; a pair that
+        fell together stays at 0 (and is resolved again if a push below makes them overlap),
+        one flying apart starts this far from touching, so a small push below does not count
+        as an overlap (a box bouncing off a base kept being pushed by it, a little every step)."""
+        sx, sy, store = self._start_x, self._start_y, self.store
+        if ra.size == 0 or sx.size <= max(int(ra.max()), int(rb.max())):
+            return np.zeros(ra.size)
+        gap = (((store.x[rb] - sx[rb]) - (store.x[ra] - sx[ra])) * nx
+               + ((store.y[rb] - sy[rb]) - (store.y[ra] - sy[ra])) * ny)
+        return np.minimum(-gap, 0.0)
 
     def _new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
         """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs

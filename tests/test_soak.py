@@ -258,6 +258,52 @@ def test_a_ball_bouncing_into_a_box_creates_no_energy():
         assert s.get(box, Velocity).y > 19.0 and abs(s.get(ball, Velocity).y) < 1.0  # equal masses swap speeds
 
 
+def test_a_body_hit_by_three_at_once_gains_no_energy():
+    # Was: the velocity pass summed the full impulse of each of a body's contacts, all measured
+    # from the same velocities: a slab hit by three falling blocks took three full bounces
+    # (kinetic energy 6 -> 18). Each contact's impulse is now shared out (1/3 here).
+    with Scene() as s:
+        slab = s.spawn(Transform(0.0, 0.0), Velocity(0.0, 0.0), Hitbox(AABB(3.0, 1.0), restitution=1.0))
+        blocks = [s.spawn(Transform(x, 0.9921875), Velocity(0.0, -2.0), Hitbox(AABB(0.875, 1.0), restitution=1.0))
+                  for x in (-1.0, 0.0, 1.0)]
+        ents = (slab, *blocks)
+
+        def kinetic() -> float:
+            return sum(0.5 * s.get(e, Hitbox).mass * (s.get(e, Velocity).x ** 2 + s.get(e, Velocity).y ** 2)
+                       for e in ents)
+
+        def momentum() -> float:
+            return sum(s.get(e, Hitbox).mass * s.get(e, Velocity).y for e in ents)
+
+        k0, p0 = kinetic(), momentum()
+        s.step(1.0 / 64.0)
+        assert kinetic() <= k0 and momentum() == p0 == -6.0
+        assert s.get(slab, Velocity).y == -2.0  # 3 x (2 x 2 / 2) / 3: one full exchange, shared
+
+
+def test_a_box_bouncing_up_under_a_resting_ball_makes_no_energy():
+    # Was: a box falling with a ball on it bounced off the box below, and the ball (one level up
+    # the stack) then bounced off it as off a wall moving up, while the box kept its speed: the
+    # long soak's runaway (a box at 80 units/s down through the floor, step 9,215 with 200
+    # bodies). A stack's lower body moving into the upper one meets it as the dynamic body it is.
+    with Scene(gravity=(0.0, -G)) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(8.0, 1.0), body="static"))  # top at y = 0
+        base = s.spawn(Transform(0.0, 0.5), Velocity(0.0, 0.0), Hitbox(AABB(1.0, 1.0)))
+        box = s.spawn(Transform(0.0, 1.2421875), Velocity(0.0, -4.0), Hitbox(AABB(1.0, 0.5), restitution=1.0))
+        ball = s.spawn(Transform(0.0, 1.734375), Velocity(0.0, -4.0), Hitbox(Circle(0.25), restitution=1.0))
+        ents = (base, box, ball)
+        e0 = _energy(s, ents)
+        for i in range(30):
+            s.step(DT)
+            if i == 0:  # the box bounced off the base and handed its bounce to the ball (equal masses)
+                assert s.get(ball, Velocity).y > 4.0 and s.get(box, Velocity).y < -4.0
+            # Allowed: the ball rides up with the box's push-out (0.086 units), potential energy
+            # the response does not take back for a body lifted by another (only for one bounced
+            # off something immovable). Before the fix the total reached 120 (from 51.4).
+            assert _energy(s, ents) <= e0 + G * 0.09
+            assert s.get(box, Transform).y >= 1.25 and s.get(ball, Transform).y >= s.get(box, Transform).y + 0.5
+
+
 def test_a_bouncy_ball_comes_to_rest_and_sleeps():
     # Was: resting on the floor, it bounced by e*g*dt every step forever (no restitution threshold).
     with Scene(gravity=(0.0, -G)) as s:

@@ -89,6 +89,7 @@ def resolve(
     la, lb = local[:C], local[C:]
     L = rows_u.size
     vn0 = (c["vx"][rb] - c["vx"][ra]) * nx + (c["vy"][rb] - c["vy"][ra]) * ny
+    ia0, ib0 = ia.copy(), ib.copy()  # the real inverse masses (the stack makes lower bodies 0)
     level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity, vn0, dt)
     solid = (ia == 0.0) != (ib == 0.0)
     mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
@@ -203,7 +204,7 @@ def resolve(
             break
         push_out_deepest(s_idx)
 
-    _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
+    _velocities(store, ra, rb, ia0, ib0, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
                 resolved, gravity, iterations, mob_level, lone, dt, la, lb, rows_u)
     return resolved, applied_nx, applied_ny, pushed
 
@@ -275,7 +276,16 @@ def _bounce_speed(u: np.ndarray, g: np.ndarray, d: np.ndarray, dt: float) -> np.
 
 def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed, resolved, gravity,
                 iterations, mob_level, lone, dt, la, lb, rows_u) -> None:
+    """Velocity passes over the resolved contacts (``ia``/``ib``: the real inverse masses).
+
+    A contact ``solid`` only because its lower body is lower in a stack treats that body as
+    immovable while it rests; once it moves into the upper one faster than a body at rest does
+    (it bounced off its own support earlier in the pass), the two meet as the dynamic bodies
+    they are: an immovable body moving up would hand the upper one a bounce off a moving wall
+    and keep its own speed, making energy.
+    """
     c = store.cols
+    stacked = solid & (ia > 0.0) & (ib > 0.0)
     rest = np.maximum(c["restitution"][ra], c["restitution"][rb])
     gx, gy = gravity
     # Gravity against the push-out direction of a solid contact's mobile body.
@@ -287,6 +297,25 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
     done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
     act = np.flatnonzero(resolved)  # the contacts still to look at
     L = rows_u.size
+
+    def pair_impulses(idx: np.ndarray, v: np.ndarray) -> None:
+        """Impulses between the dynamic bodies of the closing contacts ``idx`` (normal speeds ``v``).
+
+        Jacobi, made safe: a contact's impulse is divided by the larger number of these contacts
+        its two bodies are in. Each body's new velocity is then a convex combination of
+        single-contact updates, none of which gains energy, so the pass gains none. (Full
+        impulses summed let a box bouncing up into three bodies take three full bounces at once
+        and shoot down through the floor: the 200-body soak found it.)"""
+        a, b = la[idx], lb[idx]
+        e = np.where(-v > resting_speed[idx], rest[idx], 0.0)
+        per_body = np.bincount(np.concatenate([a, b]), minlength=L)
+        w = 1.0 / np.maximum(per_body[a], per_body[b])
+        j = -(1.0 + e) * v * w / (ia[idx] + ib[idx])
+        jx, jy = j * nx[idx], j * ny[idx]
+        c["vx"][rows_u] += np.bincount(b, jx * ib[idx], L) - np.bincount(a, jx * ia[idx], L)
+        c["vy"][rows_u] += np.bincount(b, jy * ib[idx], L) - np.bincount(a, jy * ia[idx], L)
+        done[idx] = (e > 0.0) & (w == 1.0)  # a shared bounce is looked at again next pass
+
     for it in range(max(1, iterations)):
         if act.size == 0:
             return
@@ -317,6 +346,15 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                     continue
                 first = _first_per_group(mobile[s_idx], v_s)
                 pick, v = s_idx[first], v_s[first]
+                if stacked[pick].any():
+                    low = np.where(sgn[pick] > 0.0, ra[pick], rb[pick])
+                    v_low = sgn[pick] * (c["vx"][low] * nx[pick] + c["vy"][low] * ny[pick])
+                    loose = stacked[pick] & (v_low > resting_speed[pick])
+                    if loose.any():
+                        pair_impulses(pick[loose], v[loose])
+                        pick, v = pick[~loose], v[~loose]
+                        if pick.size == 0:
+                            continue
                 e = np.where(-v > resting_speed[pick], rest[pick], 0.0)
                 target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
                 dv = (target - v) * sgn[pick]
@@ -324,17 +362,16 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                 c["vx"][m] += dv * nx[pick]
                 c["vy"][m] += dv * ny[pick]
                 done[pick] = e > 0.0
-        d_sel = approaching & both[act]
-        if d_sel.any():
-            d_idx = act[d_sel]
-            a, b = la[d_idx], lb[d_idx]
-            v = vn[d_sel]
-            e = np.where(-v > resting_speed[d_idx], rest[d_idx], 0.0)
-            j = -(1.0 + e) * v / (ia[d_idx] + ib[d_idx])
-            jx, jy = j * nx[d_idx], j * ny[d_idx]
-            c["vx"][rows_u] += np.bincount(b, jx * ib[d_idx], L) - np.bincount(a, jx * ia[d_idx], L)
-            c["vy"][rows_u] += np.bincount(b, jy * ib[d_idx], L) - np.bincount(a, jy * ia[d_idx], L)
-            done[d_idx] = e > 0.0
+        d_idx = act[both[act]]
+        if d_idx.size and s_appr.any():  # the pass above changed velocities: measure after it
+            vx, vy = c["vx"], c["vy"]
+            v = (vx[rb[d_idx]] - vx[ra[d_idx]]) * nx[d_idx] + (vy[rb[d_idx]] - vy[ra[d_idx]]) * ny[d_idx]
+        else:
+            v = vn[both[act]]
+        closing = v < 0.0
+        d_idx, v = d_idx[closing], v[closing]
+        if d_idx.size:
+            pair_impulses(d_idx, v)
         if it == 0:
             done |= lone  # a contact whose bodies touch nothing else is settled by one pass
         act = act[~done[act]]
