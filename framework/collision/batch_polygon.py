@@ -92,12 +92,12 @@ def _extent(ux: np.ndarray, uy: np.ndarray, vx: np.ndarray, vy: np.ndarray):
     return lo, hi
 
 
-def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, exact: bool = True):
+def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, fallback: bool = True):
     """The separating-axis decision of every row, and the per-axis overlaps ``[C, P]``.
 
     A projection is ``u . local + u . offset``: B is projected about its own origin and
     ``ud = u . d`` added, as in the scalar code. Rows within the band of touching on some axis
-    are decided exactly; their overlaps are then the exact ones (with ``exact`` False they count
+    are decided exactly; their overlaps are then the exact ones (with ``fallback`` False they count
     as apart: the response re-measuring pairs it has just pushed to touching).
     """
     # Unnormalised outward normal (ey, -ex) of each edge of a CCW outline; exact for dyadic input.
@@ -115,7 +115,7 @@ def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, ex
     apart = ((least < -tol) & valid).any(axis=0) | ~valid.any(axis=0)
     border = ((least <= tol) & valid).any(axis=0) & ~apart
     hit = ~apart & ~border
-    for i in np.flatnonzero(border) if exact else ():
+    for i in np.flatnonzero(border) if fallback else ():
         pa = list(zip(avx[: acount[i], i].tolist(), avy[: acount[i], i].tolist(), strict=True))
         lb = list(zip(bvx[: bcount[i], i].tolist(), bvy[: bcount[i], i].tolist(), strict=True))
         exact = polygon_polygon_exact(pa, lb, (ax[i], ay[i], bx[i], by[i], int(k[i])))

@@ -298,6 +298,11 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
     act = np.flatnonzero(resolved)  # the contacts still to look at
     L = rows_u.size
 
+    def closing_speed(idx: np.ndarray) -> np.ndarray:
+        """Normal speed of b relative to a, now (< 0: closing)."""
+        vx, vy = c["vx"], c["vy"]
+        return (vx[rb[idx]] - vx[ra[idx]]) * nx[idx] + (vy[rb[idx]] - vy[ra[idx]]) * ny[idx]
+
     def pair_impulses(idx: np.ndarray, v: np.ndarray) -> None:
         """Impulses between the dynamic bodies of the closing contacts ``idx`` (normal speeds ``v``).
 
@@ -319,8 +324,7 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
     for it in range(max(1, iterations)):
         if act.size == 0:
             return
-        vx, vy = c["vx"], c["vy"]
-        vn = (vx[rb[act]] - vx[ra[act]]) * nx[act] + (vy[rb[act]] - vy[ra[act]]) * ny[act]
+        vn = closing_speed(act)
         approaching = vn < 0.0
         if not approaching.any():
             return
@@ -338,8 +342,7 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                 if lv == lowest:
                     v_s = vn[sel]
                 else:
-                    vx, vy = c["vx"], c["vy"]
-                    v_s = (vx[rb[s_idx]] - vx[ra[s_idx]]) * nx[s_idx] + (vy[rb[s_idx]] - vy[ra[s_idx]]) * ny[s_idx]
+                    v_s = closing_speed(s_idx)
                     keep = v_s < 0.0
                     s_idx, v_s = s_idx[keep], v_s[keep]
                 if s_idx.size == 0:
@@ -363,11 +366,8 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                 c["vy"][m] += dv * ny[pick]
                 done[pick] = e > 0.0
         d_idx = act[both[act]]
-        if d_idx.size and s_appr.any():  # the pass above changed velocities: measure after it
-            vx, vy = c["vx"], c["vy"]
-            v = (vx[rb[d_idx]] - vx[ra[d_idx]]) * nx[d_idx] + (vy[rb[d_idx]] - vy[ra[d_idx]]) * ny[d_idx]
-        else:
-            v = vn[both[act]]
+        # The pass above changed velocities: measure after it.
+        v = closing_speed(d_idx) if d_idx.size and s_appr.any() else vn[both[act]]
         closing = v < 0.0
         d_idx, v = d_idx[closing], v[closing]
         if d_idx.size:
