@@ -117,19 +117,30 @@ def resolve(
     # translation along a fixed axis, as in Box2D's solver); contacts with immovable bodies are
     # measured again from the geometry, because there the axis matters (tile seams).
     x0, y0 = c["x"][rows_u], c["y"][rows_u]
+    # The passes move the bodies in these local copies (no scatter into the store per pass); the
+    # store is written before a geometric re-measure reads it, and at the end.
+    xl, yl = x0.copy(), y0.copy()
+    dirty = [False]
+
+    def flush() -> None:
+        if dirty[0]:
+            c["x"][rows_u], c["y"][rows_u] = xl, yl
+            dirty[0] = False
 
     def remeasure(sel: np.ndarray) -> None:
         """Measure the contacts ``sel`` (indices) again."""
         idx = sel[solid[sel]]
         if idx.size:
+            flush()
             hit, rnx, rny, rdepth, rrank = recompute(ra[idx], rb[idx])
             alive[idx] = hit
             cur_nx[idx], cur_ny[idx], cur_depth[idx], cur_rank[idx] = rnx, rny, rdepth, rrank
         idx = sel[both[sel]]
         if idx.size:
-            a, b, al, bl = ra[idx], rb[idx], la[idx], lb[idx]
-            mx = (c["x"][b] - x0[bl]) - (c["x"][a] - x0[al])
-            my = (c["y"][b] - y0[bl]) - (c["y"][a] - y0[al])
+            al, bl = la[idx], lb[idx]
+            dx, dy = xl - x0, yl - y0  # how far each body moved since the response began
+            mx = dx[bl] - dx[al]
+            my = dy[bl] - dy[al]
             rel = mx * nx[idx] + my * ny[idx]
             cur_depth[idx] = depth[idx] - rel
             alive[idx] = cur_depth[idx] > 0.0
@@ -137,11 +148,12 @@ def resolve(
     def push_out_deepest(s_idx: np.ndarray) -> None:
         """Push each mobile body fully out of its deepest immovable contact among ``s_idx``."""
         pick = s_idx[_first_per_group(mobile[s_idx], -cur_rank[s_idx])]
-        m = mobile[pick]
+        m = mobile_l[pick]
         d = cur_depth[pick] * sgn[pick]
-        c["x"][m] += cur_nx[pick] * d
-        c["y"][m] += cur_ny[pick] * d
-        moved[mobile_l[pick]] = True
+        xl[m] += cur_nx[pick] * d
+        yl[m] += cur_ny[pick] * d
+        dirty[0] = True
+        moved[m] = True
         applied_nx[pick], applied_ny[pick] = cur_nx[pick], cur_ny[pick]
         pushed[pick] += cur_depth[pick]
         resolved[pick] = True
@@ -162,15 +174,17 @@ def resolve(
         d_idx = dyn_all[alive[dyn_all]]
         if d_idx.size:
             a, b = la[d_idx], lb[d_idx]
-            w = 1.0 / (ia[d_idx] + ib[d_idx])
+            wa, wb = ia[d_idx], ib[d_idx]
+            w = 1.0 / (wa + wb)
             ddx = cur_nx[d_idx] * cur_depth[d_idx] * w
             ddy = cur_ny[d_idx] * cur_depth[d_idx] * w
             n_rows = np.bincount(np.concatenate([a, b]), minlength=L).astype(float)
-            sx = np.bincount(a, -ddx * ia[d_idx], L) + np.bincount(b, ddx * ib[d_idx], L)
-            sy = np.bincount(a, -ddy * ia[d_idx], L) + np.bincount(b, ddy * ib[d_idx], L)
+            sx = np.bincount(a, -ddx * wa, L) + np.bincount(b, ddx * wb, L)
+            sy = np.bincount(a, -ddy * wa, L) + np.bincount(b, ddy * wb, L)
             touched = np.flatnonzero(n_rows)
-            c["x"][rows_u[touched]] += sx[touched] / n_rows[touched]
-            c["y"][rows_u[touched]] += sy[touched] / n_rows[touched]
+            xl[touched] += sx[touched] / n_rows[touched]
+            yl[touched] += sy[touched] / n_rows[touched]
+            dirty[0] = True
             moved[touched] = True
             applied_nx[d_idx], applied_ny[d_idx] = cur_nx[d_idx], cur_ny[d_idx]
             pushed[d_idx] += cur_depth[d_idx]
@@ -204,7 +218,8 @@ def resolve(
             break
         push_out_deepest(s_idx)
 
-    _velocities(store, ra, rb, ia0, ib0, solid, both, mobile, sgn, applied_nx, applied_ny, pushed,
+    flush()
+    _velocities(store, ra, rb, ia0, ib0, solid, both, mobile_l, sgn, applied_nx, applied_ny, pushed,
                 resolved, gravity, iterations, mob_level, lone, dt, la, lb, rows_u)
     return resolved, applied_nx, applied_ny, pushed
 
@@ -274,9 +289,12 @@ def _bounce_speed(u: np.ndarray, g: np.ndarray, d: np.ndarray, dt: float) -> np.
     return np.where(disc >= 0.0, np.maximum(root, 0.0), 0.0)
 
 
-def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed, resolved, gravity,
+def _velocities(store, ra, rb, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, gravity,
                 iterations, mob_level, lone, dt, la, lb, rows_u) -> None:
-    """Velocity passes over the resolved contacts (``ia``/``ib``: the real inverse masses).
+    """Velocity passes over the resolved contacts (``ia``/``ib``: the real inverse masses; ``la``,
+    ``lb``, ``mobile_l``: local numbers of the bodies, rows ``rows_u`` of the store).
+
+    The passes work on local copies of the bodies' velocities, written back once at the end.
 
     A contact ``solid`` only because its lower body is lower in a stack treats that body as
     immovable while it rests; once it moves into the upper one faster than a body at rest does
@@ -294,14 +312,23 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
     # normal is a body resting, not a bounce; without it a bouncy body on the floor hops by
     # e*g*dt every step forever and never sleeps.
     resting_speed = 2.0 * np.abs(gx * nx + gy * ny) * dt
-    done = np.zeros(ra.size, dtype=bool)  # bounces are applied once per contact
-    act = np.flatnonzero(resolved)  # the contacts still to look at
     L = rows_u.size
+    vx, vy = c["vx"][rows_u], c["vy"][rows_u]
+    _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, iterations, mob_level,
+                     lone, dt, la, lb, L, stacked, rest, gn, resting_speed)
+    c["vx"][rows_u], c["vy"][rows_u] = vx, vy
+
+
+def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, iterations, mob_level,
+                     lone, dt, la, lb, L, stacked, rest, gn, resting_speed) -> None:
+    """The passes of ``_velocities`` on the local velocities ``vx``/``vy`` (changed in place)."""
+    done = np.zeros(resolved.size, dtype=bool)  # bounces are applied once per contact
+    act = np.flatnonzero(resolved)  # the contacts still to look at
 
     def closing_speed(idx: np.ndarray) -> np.ndarray:
         """Normal speed of b relative to a, now (< 0: closing)."""
-        vx, vy = c["vx"], c["vy"]
-        return (vx[rb[idx]] - vx[ra[idx]]) * nx[idx] + (vy[rb[idx]] - vy[ra[idx]]) * ny[idx]
+        a, b = la[idx], lb[idx]
+        return (vx[b] - vx[a]) * nx[idx] + (vy[b] - vy[a]) * ny[idx]
 
     def pair_impulses(idx: np.ndarray, v: np.ndarray) -> None:
         """Impulses between the dynamic bodies of the closing contacts ``idx`` (normal speeds ``v``).
@@ -315,10 +342,11 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
         e = np.where(-v > resting_speed[idx], rest[idx], 0.0)
         per_body = np.bincount(np.concatenate([a, b]), minlength=L)
         w = 1.0 / np.maximum(per_body[a], per_body[b])
-        j = -(1.0 + e) * v * w / (ia[idx] + ib[idx])
+        wa, wb = ia[idx], ib[idx]
+        j = -(1.0 + e) * v * w / (wa + wb)
         jx, jy = j * nx[idx], j * ny[idx]
-        c["vx"][rows_u] += np.bincount(b, jx * ib[idx], L) - np.bincount(a, jx * ia[idx], L)
-        c["vy"][rows_u] += np.bincount(b, jy * ib[idx], L) - np.bincount(a, jy * ia[idx], L)
+        np.add(vx, np.bincount(b, jx * wb, L) - np.bincount(a, jx * wa, L), out=vx)
+        np.add(vy, np.bincount(b, jy * wb, L) - np.bincount(a, jy * wa, L), out=vy)
         done[idx] = (e > 0.0) & (w == 1.0)  # a shared bounce is looked at again next pass
 
     for it in range(max(1, iterations)):
@@ -347,11 +375,11 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                     s_idx, v_s = s_idx[keep], v_s[keep]
                 if s_idx.size == 0:
                     continue
-                first = _first_per_group(mobile[s_idx], v_s)
+                first = _first_per_group(mobile_l[s_idx], v_s)
                 pick, v = s_idx[first], v_s[first]
                 if stacked[pick].any():
-                    low = np.where(sgn[pick] > 0.0, ra[pick], rb[pick])
-                    v_low = sgn[pick] * (c["vx"][low] * nx[pick] + c["vy"][low] * ny[pick])
+                    low = np.where(sgn[pick] > 0.0, la[pick], lb[pick])
+                    v_low = sgn[pick] * (vx[low] * nx[pick] + vy[low] * ny[pick])
                     loose = stacked[pick] & (v_low > resting_speed[pick])
                     if loose.any():
                         pair_impulses(pick[loose], v[loose])
@@ -361,9 +389,9 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile, sgn, nx, ny, pushed,
                 e = np.where(-v > resting_speed[pick], rest[pick], 0.0)
                 target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
                 dv = (target - v) * sgn[pick]
-                m = mobile[pick]
-                c["vx"][m] += dv * nx[pick]
-                c["vy"][m] += dv * ny[pick]
+                m = mobile_l[pick]
+                vx[m] += dv * nx[pick]
+                vy[m] += dv * ny[pick]
                 done[pick] = e > 0.0
         d_idx = act[both[act]]
         # The pass above changed velocities: measure after it.
