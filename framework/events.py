@@ -17,7 +17,7 @@ import numpy as np
 
 from .collision.results import Vec2
 
-__all__ = ["CollisionEvent", "PairTracker", "STARTED", "ONGOING", "ENDED"]
+__all__ = ["CollisionEvent", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_member", "sorted_members"]
 
 STARTED: Literal["started"] = "started"
 ONGOING: Literal["ongoing"] = "ongoing"
@@ -74,6 +74,24 @@ def sorted_member(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
     return table[pos] == keys
 
 
+def sorted_members(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(np.isin(a, b), np.isin(b, a))`` for two sorted arrays of distinct keys, by one merge.
+
+    A stable sort of the two runs one after the other is a linear merge (timsort finds the runs),
+    and every key in both sits next to its twin, the copy from ``a`` first: several times faster
+    than a binary search per key, which the tracker would otherwise pay twice per step."""
+    if a.size == 0 or b.size == 0:
+        return np.zeros(a.size, dtype=bool), np.zeros(b.size, dtype=bool)
+    merged = np.concatenate([a, b])
+    order = np.argsort(merged, kind="stable")
+    twin = np.flatnonzero(merged[order[1:]] == merged[order[:-1]])
+    in_b = np.zeros(a.size, dtype=bool)
+    in_a = np.zeros(b.size, dtype=bool)
+    in_b[order[twin]] = True
+    in_a[order[twin + 1] - a.size] = True
+    return in_b, in_a
+
+
 class PairTracker:
     """Turns each step's overlapping pairs into started / ongoing / ended events."""
 
@@ -84,8 +102,8 @@ class PairTracker:
     def update(self, now: StepContacts) -> tuple[np.ndarray, np.ndarray, StepContacts]:
         """Record this step's pairs; return (started mask over ``now``, ongoing mask, ended pairs)."""
         keys = pair_keys(now.a, now.b)
-        was = sorted_member(keys, self.keys)
-        gone = ~sorted_member(self.keys, keys)
+        was, kept = sorted_members(keys, self.keys)
+        gone = ~kept
         ended = self.active.take(np.flatnonzero(gone))
         self.active, self.keys = now, keys
         return ~was, was, ended

@@ -33,7 +33,7 @@ from .store import KIND_POLYGON, STATIC, BodyStore
 from .systems.ccd import sweep_ccd_bodies
 from .systems.geometry import Geometry
 from .systems.internal_faces import InternalFaces
-from .systems.movement import integrate
+from .systems.movement import integrate, integrate_rows
 from .systems.narrow_phase import filter_layers, pair_contacts
 from .systems.response import resolve
 from .validation import InvalidValue, finite, positive, vector2
@@ -398,12 +398,12 @@ class Scene:
         self.store.check()
         n = self.substeps
         if n == 1:
-            self._substep(dt, render=True)
+            self._substep(dt, render=True, checked=True)
         else:
             frame_events: list[CollisionEvent] = []
             total: dict[str, Any] = {}
             for k in range(n):
-                self._substep(dt / n, render=k == n - 1)
+                self._substep(dt / n, render=k == n - 1, checked=k == 0)
                 frame_events.extend(self.events)
                 _add_counters(total, self.counters)
             self._events = frame_events
@@ -421,7 +421,8 @@ class Scene:
             raise InvalidValue(f"{exc} (at the end of step {self.frame}: written by a system or a collision "
                                "handler during the step, or an overflow)") from None
 
-    def _substep(self, dt: float, render: bool) -> None:
+    def _substep(self, dt: float, render: bool, checked: bool = False) -> None:
+        """One pass of the pipeline (``checked``: the store was just checked, nothing ran since)."""
         store = self.store
         self._stepping = True
         self.counters = counters = {"systems": [], "integrated": 0, "rehashed": 0, "candidate_pairs": 0,
@@ -432,7 +433,8 @@ class Scene:
         self.swept_paths = []
         self._start_x = self._start_y = np.zeros(0)  # set by movement
         try:
-            store.check()
+            if not checked:
+                store.check()
             store.apply_hitbox_changes()
             for stage in STAGES if render else STAGES[:-1]:
                 self._run_hooks("before", stage, dt)
@@ -483,11 +485,11 @@ class Scene:
             self._start_buf = (store.x.copy(), store.y.copy())
             self._start_key = key
         else:
-            rows = store.active()[2]
-            self._start_buf[0][rows], self._start_buf[1][rows] = store.x[rows], store.y[rows]
+            sel = store.active_sel()[2]
+            self._start_buf[0][sel], self._start_buf[1][sel] = store.x[sel], store.y[sel]
         self._start_x, self._start_y = self._start_buf
         movers = store.active()[0]
-        ccd = movers[store.ccd[movers]]
+        ccd = movers[store.ccd[store.active_sel()[0]]]
         self._ccd_rows = ccd
         self._ccd_start = (store.x[ccd].copy(), store.y[ccd].copy())
         rows = integrate(store, dt, self._gravity())
@@ -584,10 +586,10 @@ class Scene:
         store, geom = self.store, self.geometry
         self.ensure_geometry()
         self._sync_static()
-        moving = store.active()[1]
+        moving = store.active_sel()[1]  # a slice where the bodies are one run of rows: views, no gathers
         bounds = (geom.minx[moving], geom.miny[moving], geom.maxx[moving], geom.maxy[moving])
         ea, eb = self.hash.pairs(*bounds, store.entity[moving])
-        self.counters["rehashed"] += int(moving.size)
+        self.counters["rehashed"] += int(store.active()[1].size)
         if store.sleep_dirty:
             sleepers = np.flatnonzero(store.asleep)
             self.sleep_hash.set_static(geom.minx[sleepers], geom.miny[sleepers], geom.maxx[sleepers],
@@ -662,7 +664,10 @@ class Scene:
             solid = ~(store.sensor[a_] | store.sensor[b_])
             wake_b = solid & store.asleep[b_] & ~store.asleep[a_] & (store.body[a_] != STATIC)
             wake_a = solid & store.asleep[a_] & ~store.asleep[b_] & (store.body[b_] != STATIC)
-            store.wake(np.concatenate([b_[wake_b], a_[wake_a]]))
+            woken = np.unique(np.concatenate([b_[wake_b], a_[wake_a]]))
+            if woken.size:
+                store.wake(woken)
+                contacts, crows = self._catch_up_woken(woken, dt, contacts, crows)
         self._contacts = contacts
         self._contact_rows = crows
         self._started, _ongoing, self._ended = self.tracker.update(self._contacts)
@@ -671,6 +676,32 @@ class Scene:
         self.counters["contacts"] = int(self._contacts.a.size)
         self.counters["events"] = int(h.size + self._ended.a.size)
         return True
+
+    def _catch_up_woken(self, woken: np.ndarray, dt: float, contacts: StepContacts,
+                        crows: tuple[np.ndarray, np.ndarray]):
+        """Bodies woken by a touch in this narrow phase slept through the movement stage: move them
+        now as it would have (a body resting on the floor sinks into it by gravity's step, as an
+        awake one does, and the response pushes it out), then measure their contacts again: those
+        kept from last step are as the narrow phase found them before that step's response moved
+        the body. A contact now apart is dropped. So a woken body's contacts are real ones, and a
+        resting body bumped awake keeps its floor contact (``ongoing``) rather than ending it."""
+        store = self.store
+        if "movement" in self.effects:
+            integrate_rows(store, woken, dt, self._gravity())
+            self._moved += 1
+            self.geometry.update_rows(store, woken)
+        flag = np.zeros(store.n, dtype=bool)
+        flag[woken] = True
+        stale = np.flatnonzero(flag[crows[0]] | flag[crows[1]])
+        if stale.size == 0:
+            return contacts, crows
+        r = pair_contacts(store, self.geometry, crows[0][stale], crows[1][stale])
+        cols = [c.copy() for c in contacts]
+        for col, new in zip(cols[2:], (r.nx, r.ny, r.depth, r.px, r.py)):
+            col[stale] = new
+        keep = np.ones(contacts.a.size, dtype=bool)
+        keep[stale[~r.hit]] = False
+        return StepContacts(*(c[keep] for c in cols)), (crows[0][keep], crows[1][keep])
 
     def _stage_response(self, dt: float) -> bool:
         if "response" not in self.effects:
@@ -707,10 +738,12 @@ class Scene:
         idx = np.flatnonzero(solid)
         if idx.size == 0:
             return True
+        every = idx.size == ra.size  # (then the columns are used as they are, not gathered)
+        pa, pb = (ra, rb) if every else (ra[idx], rb[idx])
         geom = self.geometry
 
         # Push-outs avoid the internal faces of tiles (only looked at when a static is touched).
-        faces = self._n_static > 0 and bool(((store.body[ra[idx]] == STATIC) | (store.body[rb[idx]] == STATIC)).any())
+        faces = self._n_static > 0 and bool(((store.body[pa] == STATIC) | (store.body[pb] == STATIC)).any())
 
         def recompute(a: np.ndarray, b: np.ndarray):
             if geom.version != store.version:
@@ -727,16 +760,21 @@ class Scene:
             return r.hit, r.nx, r.ny, r.depth, rank
 
         self._moved += 1
-        nx, ny, depth, live0 = nx[idx], ny[idx], depth[idx], alive0[idx]
-        rank = depth.copy()
+        if not every:
+            nx, ny, depth, alive0 = nx[idx], ny[idx], depth[idx], alive0[idx]
+        rank = None
         if faces:
-            self._internal_faces.redirect(store, geom, self.hash, self._rows_of, ra[idx], rb[idx], nx, ny, depth,
-                                          live0, rank)
-        done, anx, any_, pushed = resolve(store, ra[idx], rb[idx], nx, ny, depth, self._gravity(),
-                                          self.response_iterations, recompute, live0, dt, rank)
-        ea, eb = ents_a[idx[done]], ents_b[idx[done]]
-        snx, sny = nx[done], ny[done]
-        anx, any_, pushed = anx[done], any_[done], pushed[done]
+            rank = depth.copy()
+            self._internal_faces.redirect(store, geom, self.hash, self._rows_of, pa, pb, nx, ny, depth, alive0, rank)
+        done, anx, any_, pushed = resolve(store, pa, pb, nx, ny, depth, self._gravity(),
+                                          self.response_iterations, recompute, alive0, dt, rank)
+        snx, sny = nx, ny
+        if done.all():
+            ea, eb = (ents_a, ents_b) if every else (ents_a[idx], ents_b[idx])
+        else:
+            ea, eb = ents_a[idx[done]], ents_b[idx[done]]
+            snx, sny = nx[done], ny[done]
+            anx, any_, pushed = anx[done], any_[done], pushed[done]
         # Bodies pushed by other dynamic bodies may have been shoved into static geometry they did
         # not touch when the step's contacts were found (a pile spawned on one spot): find those
         # contacts now and push them out, so no body ends the step inside a static it can fall
@@ -768,15 +806,20 @@ class Scene:
             pushed_rows = np.unique(np.where(store.inv_mass[xra] > 0, xra, xrb)[xdone])
             self.counters["late_contacts"] += int(xdone.sum())
         self._moved += 1
-        order = np.argsort(pair_keys(ea, eb), kind="stable")
-        self._resolved = (ea[order], eb[order], anx[order], any_[order], pushed[order])
+        keys = pair_keys(ea, eb)
+        if keys.size > 1 and not (keys[1:] > keys[:-1]).all():  # late contacts were appended
+            order = np.argsort(keys, kind="stable")
+            ea, eb, snx, sny, anx, any_, pushed = (v[order] for v in (ea, eb, snx, sny, anx, any_, pushed))
+        self._resolved = (ea, eb, anx, any_, pushed)
         # Kept for the next step: the pairs that rest one on the other (normal within 60 degrees of
         # the vertical), which gravity presses together again; none without gravity.
         gx, gy = self._gravity()
         g = math.hypot(gx, gy)
-        rests = np.abs(snx * gx + sny * gy) > 0.5 * g if g > 0.0 else np.zeros(ea.size, dtype=bool)
-        keep = order[rests[order]]
-        self._support = (ea[keep], eb[keep], snx[keep], sny[keep])
+        if g > 0.0:
+            keep = np.flatnonzero(np.abs(snx * gx + sny * gy) > 0.5 * g)
+            self._support = (ea[keep], eb[keep], snx[keep], sny[keep])
+        else:
+            self._support = _NO_SUPPORT
         self.counters["resolved"] = int(ea.size)
         return True
 

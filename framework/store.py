@@ -23,7 +23,7 @@ from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field
 from .shapes import AABB, Circle
 from .validation import InvalidValue
 
-__all__ = ["BodyStore", "KIND_AABB", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE"]
+__all__ = ["BodyStore", "KIND_AABB", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "as_selector"]
 
 KIND_NONE, KIND_AABB, KIND_CIRCLE, KIND_POLYGON = -1, 0, 1, 2
 BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
@@ -44,6 +44,13 @@ _FIELD_NAMES = {
 }
 
 
+def as_selector(rows: np.ndarray) -> slice | np.ndarray:
+    """Sorted distinct ``rows`` as a slice when they are one contiguous run, else as they are."""
+    if rows.size and int(rows[-1]) - int(rows[0]) + 1 == rows.size:
+        return slice(int(rows[0]), int(rows[-1]) + 1)
+    return rows
+
+
 class BodyStore:
     """Columns of every entity that has a Transform (and optionally Velocity and Hitbox)."""
 
@@ -59,6 +66,9 @@ class BodyStore:
             self.cols[name] = np.zeros(capacity, dtype=bool)
         self.row_of: dict[int, int] = {}
         self.hitboxes: list[Hitbox | None] = []
+        # The shape each row's columns were derived from: a hitbox's shape edited by game code
+        # takes effect at the next step, and until then geometry must not mix the two.
+        self.shapes: list[Any] = []
         self.bad: dict[tuple[int, str], object] = {}
         self.dirty_hitboxes: set[int] = set()
         self.moved_static: set[int] = set()  # static entities whose transform game code changed
@@ -108,8 +118,15 @@ class BodyStore:
                 np.flatnonzero(awake & (c["kind"][:n] >= 0)),
                 np.flatnonzero(nonstatic),
             )
+            self._active_sel = tuple(as_selector(rows) for rows in self._active)
             self._active_key = key
         return self._active
+
+    def active_sel(self) -> tuple[slice | np.ndarray, ...]:
+        """:meth:`active` as selectors: a slice where the rows are one contiguous run (the usual
+        case: movers spawned together), so the per-step column reads are views, not gathers."""
+        self.active()
+        return self._active_sel
 
     # --- columns ---------------------------------------------------------------------------
 
@@ -146,6 +163,7 @@ class BodyStore:
         self.n += 1
         self.row_of[entity] = row
         self.hitboxes.append(None)
+        self.shapes.append(None)
         self._set_hitbox_row(row, hitbox)
         if hitbox is not None and hitbox._body is Body.STATIC:
             self.static_dirty = True
@@ -173,8 +191,10 @@ class BodyStore:
             for col in self.cols.values():
                 col[row] = col[last]
             self.hitboxes[row] = self.hitboxes[last]
+            self.shapes[row] = self.shapes[last]
             self.row_of[int(self.cols["entity"][row])] = row
         self.hitboxes.pop()
+        self.shapes.pop()
         self.n -= 1
         self.version += 1
 
@@ -220,6 +240,7 @@ class BodyStore:
     def _set_hitbox_row(self, row: int, hb: Hitbox | None) -> None:
         c = self.cols
         self.hitboxes[row] = hb
+        self.shapes[row] = None if hb is None else hb._shape
         if hb is None:
             c["kind"][row] = KIND_NONE
             c["body"][row] = DYNAMIC
@@ -297,11 +318,12 @@ class BodyStore:
         problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
         # Static rows change only through game code's writes: check those and the rows that move.
         rows = self.active()[2]
+        sel = self.active_sel()[2]
         if self.written:
             extra = [self.row_of[e] for e in self.written if e in self.row_of]
-            rows = np.union1d(rows, np.array(extra, dtype=np.int64))
+            rows = sel = np.union1d(rows, np.array(extra, dtype=np.int64))
         for col in ("x", "y", "rot", "vx", "vy", "w"):
-            values = self.cols[col][rows]
+            values = self.cols[col][sel]
             ok = np.isfinite(values)
             if not ok.all():
                 for row in rows[~ok]:

@@ -164,3 +164,43 @@ def test_a_stack_falls_asleep_as_one_and_stays_exact():
             if i >= 10:  # once the stack has come to rest (it starts exactly touching, in free fall)
                 assert max(abs(y - (1.0 + k)) for k, y in enumerate(ys)) < 1e-9
         assert s.counters["asleep"] == 8 and s.counters["integrated"] == 0
+
+
+def test_a_body_bumped_awake_has_real_contacts_and_keeps_its_floor_contact():
+    """A sleeper woken by a touch slept through the movement stage; it catches up (sinks into the
+    floor by gravity's step like any resting body) and its contacts are measured again, so the
+    narrow phase reports exactly what the geometry says and the floor pair stays ``ongoing``.
+    (Found by the state machine: the woken body's kept contact was the one measured before the
+    response of the step it fell asleep in.)"""
+    from framework.collision.collide import collide
+
+    s = Scene(gravity=(0.0, -10.0))
+    floor = s.spawn(Transform(0.0, -0.5), Hitbox(AABB(20.0, 1.0), body="static"))
+    box = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0)))
+    for _ in range(SLEEP_STEPS + 30):
+        s.step(1 / 64)
+    row = s.store.row_of[box]
+    assert s.store.asleep[row]
+    seen = []
+
+    def check(scene, dt):  # right after the narrow phase: contacts against the components
+        c = scene.contacts
+        for k in range(c.a.size):
+            a, b = int(c.a[k]), int(c.b[k])
+            ref = collide(scene.get(a, Hitbox).shape, scene.get(a, Transform),
+                          scene.get(b, Hitbox).shape, scene.get(b, Transform))
+            awake = [e for e in (a, b) if scene.get(e, Hitbox).body.value == "dynamic"
+                     and not scene.store.asleep[scene.store.row_of[e]]]
+            if awake:
+                assert ref is not None and ref.depth == pytest.approx(float(c.depth[k]), abs=1e-12), (a, b)
+        seen.append(scene.store.asleep[row])
+
+    s.add_system(check, after="narrow_phase")
+    s.spawn(Transform(-0.76, 0.5), Velocity(1.0, 0.0), Hitbox(AABB(0.5, 0.5)))  # touches it next step
+    kinds = []
+    for _ in range(4):
+        s.step(1 / 64)
+        kinds += [ev.kind for ev in s.events if (ev.a, ev.b) == (floor, box)]
+    assert seen[0] == np.False_  # woken in the first step
+    assert kinds == ["ongoing"] * 4
+    assert s.get(box, Transform).y == pytest.approx(0.5, abs=1e-9)  # pushed back out, no hop

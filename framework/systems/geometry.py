@@ -28,7 +28,7 @@ class Geometry:
         """Re-read the polygon outlines after a structural change."""
         n = store.n
         self.poly_rows = np.flatnonzero(store.kind == KIND_POLYGON)
-        shapes: list[Polygon] = [store.hitboxes[r]._shape for r in self.poly_rows]  # type: ignore[union-attr]
+        shapes: list[Polygon] = [store.shapes[r] for r in self.poly_rows.tolist()]  # as the columns know them
         K = max([4] + [len(s.points) for s in shapes])
         local = np.zeros((n, K, 2))
         count = np.zeros(n, dtype=np.int64)
@@ -51,7 +51,7 @@ class Geometry:
             self._compute(store, np.arange(store.n), full=True)
             self._full_key = key
         else:
-            self._compute(store, store.active()[2], full=False)
+            self._compute(store, store.active()[2], full=False, sel=store.active_sel()[2])
 
     def update_rows(self, store: BodyStore, rows: np.ndarray) -> None:
         """Origins and bounds of ``rows`` only (bodies the response just moved); a full
@@ -62,8 +62,11 @@ class Geometry:
         else:
             self._compute(store, rows, full=False)
 
-    def _compute(self, store: BodyStore, rows: np.ndarray, full: bool) -> None:
+    def _compute(self, store: BodyStore, rows: np.ndarray, full: bool, sel: slice | np.ndarray | None = None) -> None:
+        """Origins and bounds of ``rows`` (``sel``: the same rows as a slice, if they are one run)."""
         n = store.n
+        if sel is None:
+            sel = slice(0, n) if full else rows
         x, y, rot = store.x, store.y, store.rot
         ox, oy = store.ox, store.oy
         if full:
@@ -75,25 +78,25 @@ class Geometry:
             self.world_poly = np.zeros((self.poly_rows.size, self.K, 2))
             if self.has_offset:
                 self.hx, self.hy = x.copy(), y.copy()
-        kind = store.kind[rows]
-        offset = rows[(ox[rows] != 0.0) | (oy[rows] != 0.0)] if self.has_offset else rows[:0]
-        polys = rows[kind == KIND_POLYGON]
+        kind = store.kind[sel]
+        offset = rows[(ox[sel] != 0.0) | (oy[sel] != 0.0)] if self.has_offset else rows[:0]
+        polys = rows[kind == KIND_POLYGON] if self.poly_rows.size else rows[:0]
         # Rotations matter only to polygons and to offset hitboxes (AABBs and circles ignore them).
         turned = np.union1d(polys, offset) if offset.size else polys
         if turned.size:
             self.cos[turned], self.sin[turned] = np.cos(rot[turned]), np.sin(rot[turned])
         if self.has_offset:
-            self.hx[rows], self.hy[rows] = x[rows], y[rows]
+            self.hx[sel], self.hy[sel] = x[sel], y[sel]
             if offset.size:
                 co, so = self.cos[offset], self.sin[offset]
                 self.hx[offset] += co * ox[offset] - so * oy[offset]
                 self.hy[offset] += so * ox[offset] + co * oy[offset]
         else:
             self.hx, self.hy = x, y
-        hx, hy = self.hx[rows], self.hy[rows]
-        ex, ey = store.hw[rows], store.hh[rows]
-        self.minx[rows], self.maxx[rows] = hx - ex, hx + ex
-        self.miny[rows], self.maxy[rows] = hy - ey, hy + ey
+        hx, hy = self.hx[sel], self.hy[sel]
+        ex, ey = store.hw[sel], store.hh[sel]
+        self.minx[sel], self.maxx[sel] = hx - ex, hx + ex
+        self.miny[sel], self.maxy[sel] = hy - ey, hy + ey
         if polys.size:
             loc = self.local[polys]
             cc, ss = self.cos[polys, None], self.sin[polys, None]
@@ -109,8 +112,8 @@ class Geometry:
         # never reach the (exact) narrow phase. The broad phase may now also pair shapes that
         # merely touch; the narrow phase drops those.
         for lo, hi in ((self.minx, self.maxx), (self.miny, self.maxy)):
-            lo[rows] = np.nextafter(lo[rows], -np.inf)
-            hi[rows] = np.nextafter(hi[rows], np.inf)
+            lo[sel] = np.nextafter(lo[sel], -np.inf)
+            hi[sel] = np.nextafter(hi[sel], np.inf)
 
     def outlines(self, store: BodyStore, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows."""

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..store import DYNAMIC, BodyStore
+from ..store import DYNAMIC, STATIC, BodyStore
 
-__all__ = ["integrate"]
+__all__ = ["integrate", "integrate_rows"]
 
 
 def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> np.ndarray:
@@ -26,10 +26,27 @@ def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> np.n
             c["vx"][dyn] += gx * dt
         if gy:
             c["vy"][dyn] += gy * dt
-    c["x"][rows] += c["vx"][rows] * dt
-    c["y"][rows] += c["vy"][rows] * dt
-    w = c["w"][rows]
+    sel = store.active_sel()[0]  # a slice where the movers are one run of rows (views, no gathers)
+    c["x"][sel] += c["vx"][sel] * dt
+    c["y"][sel] += c["vy"][sel] * dt
+    w = c["w"][sel]
     spinning = w != 0.0
     if spinning.any():
         c["rot"][rows[spinning]] += w[spinning] * dt
     return rows
+
+
+def integrate_rows(store: BodyStore, rows: np.ndarray, dt: float, gravity: tuple[float, float]) -> None:
+    """:func:`integrate` for some rows only (bodies woken after the movement stage, catching up on
+    the step they slept through); rows without a Velocity, and static rows, stay put."""
+    c = store.cols
+    rows = rows[c["has_vel"][rows] & (c["body"][rows] != STATIC)]
+    if rows.size == 0:
+        return
+    gx, gy = gravity
+    dyn = rows[c["body"][rows] == DYNAMIC]
+    c["vx"][dyn] += gx * dt
+    c["vy"][dyn] += gy * dt
+    c["x"][rows] += c["vx"][rows] * dt
+    c["y"][rows] += c["vy"][rows] * dt
+    c["rot"][rows] += c["w"][rows] * dt

@@ -88,9 +88,8 @@ def resolve(
     rows_u, local = _local_numbers(store.n, np.concatenate([ra, rb]))
     la, lb = local[:C], local[C:]
     L = rows_u.size
-    vn0 = (c["vx"][rb] - c["vx"][ra]) * nx + (c["vy"][rb] - c["vy"][ra]) * ny
     ia0, ib0 = ia.copy(), ib.copy()  # the real inverse masses (the stack makes lower bodies 0)
-    level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity, vn0, dt)
+    level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity, c["vx"], c["vy"], ra, rb, dt)
     solid = (ia == 0.0) != (ib == 0.0)
     mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
     mobile_l = np.where(ib > 0.0, lb, la)
@@ -127,23 +126,13 @@ def resolve(
             c["x"][rows_u], c["y"][rows_u] = xl, yl
             dirty[0] = False
 
-    def remeasure(sel: np.ndarray) -> None:
-        """Measure the contacts ``sel`` (indices) again."""
-        idx = sel[solid[sel]]
+    def remeasure(idx: np.ndarray) -> None:
+        """Measure the immovable contacts ``idx`` (indices) again."""
         if idx.size:
             flush()
             hit, rnx, rny, rdepth, rrank = recompute(ra[idx], rb[idx])
             alive[idx] = hit
             cur_nx[idx], cur_ny[idx], cur_depth[idx], cur_rank[idx] = rnx, rny, rdepth, rrank
-        idx = sel[both[sel]]
-        if idx.size:
-            al, bl = la[idx], lb[idx]
-            dx, dy = xl - x0, yl - y0  # how far each body moved since the response began
-            mx = dx[bl] - dx[al]
-            my = dy[bl] - dy[al]
-            rel = mx * nx[idx] + my * ny[idx]
-            cur_depth[idx] = depth[idx] - rel
-            alive[idx] = cur_depth[idx] > 0.0
 
     def push_out_deepest(s_idx: np.ndarray) -> None:
         """Push each mobile body fully out of its deepest immovable contact among ``s_idx``."""
@@ -159,37 +148,21 @@ def resolve(
         resolved[pick] = True
         alive[pick] = False  # touching now
 
-    # The passes work on index sets: the dynamic pairs, the immovable contacts of each support
-    # level, and the contacts that may need measuring again (not lone).
-    dyn_all = np.flatnonzero(both)
+    # The immovable contacts work on index sets: those of each support level, and those that may
+    # need measuring again (not lone). The dynamic pairs are two groups of columns (see
+    # _DynamicPairs): lone ones, settled by the first pass, and shared ones, passed over each time.
     sol_all = np.flatnonzero(solid)
     by_level = [sol_all[mob_level[sol_all] == lv] for lv in [*levels.tolist(), np.inf]] if sol_all.size else []
-    shared = np.flatnonzero(~lone)
+    sol_shared = sol_all[~lone[sol_all]]
+    dyn = _DynamicPairs(np.flatnonzero(both), la, lb, nx, ny, depth, ia, ib, alive, lone, L)
 
     def moved_of(sel: np.ndarray) -> np.ndarray:
         return sel[moved[la[sel]] | moved[lb[sel]]]
 
     for it in range(max(1, iterations)):
         # Dynamic pairs: split by inverse mass, mean over each body's contacts.
-        d_idx = dyn_all[alive[dyn_all]]
-        if d_idx.size:
-            a, b = la[d_idx], lb[d_idx]
-            wa, wb = ia[d_idx], ib[d_idx]
-            w = 1.0 / (wa + wb)
-            ddx = cur_nx[d_idx] * cur_depth[d_idx] * w
-            ddy = cur_ny[d_idx] * cur_depth[d_idx] * w
-            n_rows = np.bincount(np.concatenate([a, b]), minlength=L).astype(float)
-            sx = np.bincount(a, -ddx * wa, L) + np.bincount(b, ddx * wb, L)
-            sy = np.bincount(a, -ddy * wa, L) + np.bincount(b, ddy * wb, L)
-            touched = np.flatnonzero(n_rows)
-            xl[touched] += sx[touched] / n_rows[touched]
-            yl[touched] += sy[touched] / n_rows[touched]
+        if dyn.push(xl, yl, moved):
             dirty[0] = True
-            moved[touched] = True
-            applied_nx[d_idx], applied_ny[d_idx] = cur_nx[d_idx], cur_ny[d_idx]
-            pushed[d_idx] += cur_depth[d_idx]
-            resolved[d_idx] = True
-            alive[d_idx[lone[d_idx]]] = False  # touching now
         # Immovable contacts: deepest one per dynamic body, level by level from the ground up,
         # each level measured again where the bodies under it moved.
         for at_level in by_level:
@@ -200,13 +173,15 @@ def resolve(
             push_out_deepest(s_idx)
         if it + 1 >= iterations:
             break
-        stale = moved_of(shared)
-        if stale.size == 0:
+        stale = moved_of(sol_shared)
+        if stale.size == 0 and not dyn.shared_moved(moved):
             break
         remeasure(stale)
+        dyn.measure(xl - x0, yl - y0)
         moved[:] = False
-        if not alive.any():
+        if not (dyn.any_alive() or alive[sol_all].any()):
             break
+    dyn.store_results(pushed, resolved)
 
     # Clean-up: immovable contacts only, so no dynamic body is left inside static geometry by a
     # push from another dynamic body in the last pass.
@@ -224,7 +199,150 @@ def resolve(
     return resolved, applied_nx, applied_ny, pushed
 
 
-def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity, vn, dt) -> np.ndarray:
+
+class _DynamicPairs:
+    """The position passes over contacts between two dynamic bodies, as columns.
+
+    Every pass pushes the overlapping pairs apart, each body moving by the mean of its pushes
+    (Jacobi); the pairs are then measured again along their own normal: the depth of a fixed axis
+    changes by exactly the relative displacement along it. Lone pairs (bodies in no other contact)
+    are settled by the first pass and left alone. Masked arithmetic over all the pairs costs less
+    than gathering the overlapping ones every pass.
+    """
+
+    def __init__(self, idx, la, lb, nx, ny, depth, ia, ib, alive, lone, L) -> None:
+        self.idx, self.L = idx, L
+        cols = (la, lb, nx, ny, depth, ia, ib, alive, lone)
+        if idx.size != la.size:  # (all contacts dynamic: the columns as they are)
+            cols = tuple(col[idx] for col in cols)
+        self.a, self.b, self.nx, self.ny, self.depth0, wa, wb, self.alive, self.lone = cols
+        w = 1.0 / (wa + wb)
+        self.fa, self.fb = wa * w, wb * w  # each body's share of a push
+        self.cur = self.depth0
+        self.any_lone = bool(self.lone.any())
+        self.pushed = np.zeros(idx.size)
+        self.resolved = np.zeros(idx.size, dtype=bool)
+
+    def push(self, xl, yl, moved) -> bool:
+        """One pass: push every overlapping pair apart. Returns whether anything moved."""
+        if not self.alive.any():
+            return False
+        a, b, L = self.a, self.b, self.L
+        on = self.alive.astype(np.float64)
+        p = self.cur * on
+        count = np.zeros(L)
+        np.add.at(count, a, on)
+        np.add.at(count, b, on)
+        for pos, n in ((xl, self.nx), (yl, self.ny)):
+            pn = p * n
+            sums = np.zeros(L)
+            np.subtract.at(sums, a, pn * self.fa)
+            np.add.at(sums, b, pn * self.fb)
+            sums /= np.maximum(count, 1.0)
+            pos += sums
+        moved |= count > 0.0
+        self.pushed += p
+        self.resolved |= self.alive
+        if self.any_lone:
+            self.alive &= ~self.lone  # touching now, and nothing else moves them
+        return True
+
+    def shared_moved(self, moved) -> bool:
+        return bool(moved[self.a].any() or moved[self.b].any())
+
+    def measure(self, dx, dy) -> None:
+        """Depths after the bodies moved by ``(dx, dy)`` since the start (lone pairs stay apart)."""
+        a, b = self.a, self.b
+        self.cur = self.depth0 - ((dx[b] - dx[a]) * self.nx + (dy[b] - dy[a]) * self.ny)
+        self.alive = self.cur > 0.0
+        if self.any_lone:
+            self.alive &= ~self.lone
+
+    def any_alive(self) -> bool:
+        return bool(self.alive.any())
+
+    def store_results(self, pushed, resolved) -> None:
+        """Write the total push and the resolved flag of every dynamic pair into the contact arrays."""
+        pushed[self.idx] = self.pushed
+        resolved[self.idx] = self.resolved
+
+
+class _DynamicImpulses:
+    """The velocity passes over resolved contacts between two dynamic bodies, as columns.
+
+    Jacobi, made safe: a closing contact's impulse is divided by the larger number of closing
+    contacts its two bodies are in. Each body's new velocity is then a convex combination of
+    single-contact updates, none of which gains energy, so the pass gains none. (Full impulses
+    summed let a box bouncing up into three bodies take three full bounces at once and shoot down
+    through the floor: the 200-body soak found it.) A bounce applied whole is not looked at again;
+    nor is a lone contact after the first pass.
+    """
+
+    def __init__(self, idx, la, lb, nx, ny, ia, ib, rest, resting_speed, lone, L) -> None:
+        self.L = L
+        cols = (la, lb, nx, ny, ia, ib, rest, resting_speed, lone)
+        if idx.size != la.size:  # (all contacts dynamic: the columns as they are)
+            cols = tuple(col[idx] for col in cols)
+        self._take(*cols, np.zeros(idx.size, dtype=bool))
+
+    def _take(self, a, b, nx, ny, wa, wb, rest, resting, lone, done) -> None:
+        self.a, self.b, self.nx, self.ny, self.wa, self.wb = a, b, nx, ny, wa, wb
+        self.rest, self.resting, self.lone, self.done = rest, resting, lone, done
+        self.bouncy = bool(rest.any())
+        self.skipping = bool(done.any())  # whether ``done`` masks anything
+        inv = 1.0 / (wa + wb)
+        # a unit impulse along the normal, as velocity changes of a and b
+        self.dva = (nx * wa * inv, ny * wa * inv)
+        self.dvb = (nx * wb * inv, ny * wb * inv)
+        self.n = a.size
+        self.v = self.mask = np.zeros(0)
+
+    def closing(self, vx, vy) -> bool:
+        """Measure the normal speeds; whether any contact still to look at is closing."""
+        if self.n == 0:
+            return False
+        a, b = self.a, self.b
+        self.v = (vx[b] - vx[a]) * self.nx + (vy[b] - vy[a]) * self.ny
+        self.mask = self.v < 0.0
+        if self.skipping:
+            self.mask &= ~self.done
+        return bool(self.mask.any())
+
+    def impulses(self, vx, vy) -> None:
+        """Apply the impulses of the closing contacts (as last measured) to ``vx``/``vy``."""
+        if self.n == 0 or not self.mask.any():
+            return
+        m, a, b = self.mask, self.a, self.b
+        on = m.astype(np.float64)
+        count = np.zeros(self.L)
+        np.add.at(count, a, on)
+        np.add.at(count, b, on)
+        w = 1.0 / np.maximum(np.maximum(count[a], count[b]), 1.0)
+        j = self.v * w  # minus the impulse (in units of the pair's reduced mass) that stops them
+        j *= on
+        if self.bouncy:
+            e = np.where(-self.v > self.resting, self.rest, 0.0)
+            j *= 1.0 + e
+            self.done |= m & (e > 0.0) & (w == 1.0)  # a shared bounce is looked at again next pass
+            self.skipping = bool(self.done.any())
+        for vel, da, db in ((vx, self.dva[0], self.dvb[0]), (vy, self.dva[1], self.dvb[1])):
+            np.add.at(vel, a, j * da)
+            np.subtract.at(vel, b, j * db)
+
+    def drop_settled(self) -> None:
+        """After the first pass: leave out the contacts settled (compacting the columns when that
+        drops many of them, masking them otherwise)."""
+        settled = self.done | self.lone
+        keep = np.flatnonzero(~settled)
+        if keep.size < 0.75 * self.n:
+            self._take(*(col[keep] for col in (self.a, self.b, self.nx, self.ny, self.wa, self.wb, self.rest,
+                                               self.resting, self.lone, self.done)))
+        else:
+            self.done = settled
+            self.skipping = keep.size < self.n
+
+
+def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity, vx, vy, rows_a, rows_b, dt) -> np.ndarray:
     """Make a stack solid from the ground up (in place on ``ia``/``ib``).
 
     A dynamic body resting on something immovable has support level 1; one resting on a level-k
@@ -243,6 +361,7 @@ def _shock_propagation(n, ra, rb, nx, ny, ia, ib, gravity, vn, dt) -> np.ndarray
     if g == 0.0:
         return level
     ux, uy = -gx / g, -gy / g
+    vn = (vx[rows_b] - vx[rows_a]) * nx + (vy[rows_b] - vy[rows_a]) * ny
     up = nx * ux + ny * uy  # > 0: b sits on a
     up = np.where(vn > g * dt, 0.0, up)  # separating: not resting
     solid = (ia == 0.0) != (ib == 0.0)
@@ -323,7 +442,8 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
                      lone, dt, la, lb, L, stacked, rest, gn, resting_speed) -> None:
     """The passes of ``_velocities`` on the local velocities ``vx``/``vy`` (changed in place)."""
     done = np.zeros(resolved.size, dtype=bool)  # bounces are applied once per contact
-    act = np.flatnonzero(resolved)  # the contacts still to look at
+    act = np.flatnonzero(resolved & solid)  # the immovable contacts still to look at
+    dyn = _DynamicImpulses(np.flatnonzero(resolved & both), la, lb, nx, ny, ia, ib, rest, resting_speed, lone, L)
 
     def closing_speed(idx: np.ndarray) -> np.ndarray:
         """Normal speed of b relative to a, now (< 0: closing)."""
@@ -331,13 +451,8 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
         return (vx[b] - vx[a]) * nx[idx] + (vy[b] - vy[a]) * ny[idx]
 
     def pair_impulses(idx: np.ndarray, v: np.ndarray) -> None:
-        """Impulses between the dynamic bodies of the closing contacts ``idx`` (normal speeds ``v``).
-
-        Jacobi, made safe: a contact's impulse is divided by the larger number of these contacts
-        its two bodies are in. Each body's new velocity is then a convex combination of
-        single-contact updates, none of which gains energy, so the pass gains none. (Full
-        impulses summed let a box bouncing up into three bodies take three full bounces at once
-        and shoot down through the floor: the 200-body soak found it.)"""
+        """Impulses between the dynamic bodies of the closing contacts ``idx`` (normal speeds ``v``),
+        shared out as in :class:`_DynamicImpulses` (a stacked pair whose lower body came loose)."""
         a, b = la[idx], lb[idx]
         e = np.where(-v > resting_speed[idx], rest[idx], 0.0)
         per_body = np.bincount(np.concatenate([a, b]), minlength=L)
@@ -350,22 +465,20 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
         done[idx] = (e > 0.0) & (w == 1.0)  # a shared bounce is looked at again next pass
 
     for it in range(max(1, iterations)):
-        if act.size == 0:
+        if act.size == 0 and dyn.n == 0:
             return
         vn = closing_speed(act)
-        approaching = vn < 0.0
-        if not approaching.any():
+        s_appr = vn < 0.0
+        dyn_closing = dyn.closing(vx, vy)
+        if not (dyn_closing or s_appr.any()):
             return
-        s_act = solid[act]
-        s_appr = approaching & s_act
         if s_appr.any():
             lvl = mob_level[act]
             lowest = lvl[s_appr].min()
             # Ground up: each level sees the velocities below it settled, so a level whose bodies
             # all fell together (not approaching at first) is looked at again once those below stop.
-            cand = s_act & (lvl >= lowest)
-            for lv in np.unique(lvl[cand]).tolist():
-                sel = np.flatnonzero((s_appr if lv == lowest else cand) & (lvl == lv))
+            for lv in np.unique(lvl[lvl >= lowest]).tolist():
+                sel = np.flatnonzero((s_appr if lv == lowest else True) & (lvl == lv))
                 s_idx = act[sel]
                 if lv == lowest:
                     v_s = vn[sel]
@@ -393,13 +506,10 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
                 vx[m] += dv * nx[pick]
                 vy[m] += dv * ny[pick]
                 done[pick] = e > 0.0
-        d_idx = act[both[act]]
-        # The pass above changed velocities: measure after it.
-        v = closing_speed(d_idx) if d_idx.size and s_appr.any() else vn[both[act]]
-        closing = v < 0.0
-        d_idx, v = d_idx[closing], v[closing]
-        if d_idx.size:
-            pair_impulses(d_idx, v)
+            if dyn.n:
+                dyn.closing(vx, vy)  # the pass above changed velocities: measure after it
+        dyn.impulses(vx, vy)
         if it == 0:
             done |= lone  # a contact whose bodies touch nothing else is settled by one pass
+            dyn.drop_settled()
         act = act[~done[act]]
