@@ -19,6 +19,7 @@ from typing import Any, NamedTuple
 import esper
 import numpy as np
 
+from .arrays import distinct
 from .collision import batch
 from .collision.broad_phase import SpatialHash
 from .collision.grid import auto_cell_size
@@ -29,7 +30,7 @@ from .components import Body, Hitbox, Transform, Velocity, check_component
 from .events import CollisionEvent, PairTracker, StepContacts, pair_keys, sorted_member, to_events
 from .input import Input
 from .shapes import AABB, Circle
-from .store import KIND_POLYGON, STATIC, BodyStore
+from .store import STATIC, BodyStore
 from .systems.ccd import sweep_ccd_bodies
 from .systems.geometry import Geometry
 from .systems.internal_faces import InternalFaces
@@ -536,8 +537,7 @@ class Scene:
 
     def _rows_of(self, entities: np.ndarray) -> np.ndarray:
         store = self.store
-        if self._lookup_version != store.version or self._row_lookup.size <= (
-                int(store.entity.max()) if store.n else 0):
+        if self._lookup_version != store.version:  # (every spawn and despawn bumps the version)
             size = (int(store.entity.max()) + 1) if store.n else 1
             lut = np.full(size, -1, dtype=np.int64)
             lut[store.entity] = np.arange(store.n)
@@ -596,8 +596,8 @@ class Scene:
                                        geom.maxy[sleepers], store.entity[sleepers])
             self.counters["rehashed"] += int(sleepers.size)
             store.sleep_dirty = False
-        self.counters["asleep"] = int(store.asleep.sum())
-        if self.counters["asleep"]:
+        self.counters["asleep"] = n_asleep = int(np.count_nonzero(store.asleep[store.active_sel()[2]]))
+        if n_asleep:
             sa, sb = self.sleep_hash.pairs(*bounds, store.entity[moving], moving_pairs=False)
             if sa.size:
                 keys = np.concatenate([pair_keys(ea, eb), pair_keys(sa, sb)])
@@ -645,7 +645,7 @@ class Scene:
         contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
         crows = (ra[h], rb[h])
         store = self.store
-        if store.asleep.any():
+        if self.counters["asleep"]:
             # Pairs of sleeping (or sleeping and static) bodies are not tested: they keep the
             # contact they had, so their events stay "ongoing" while they sleep.
             prev = self.tracker.active
@@ -664,7 +664,7 @@ class Scene:
             solid = ~(store.sensor[a_] | store.sensor[b_])
             wake_b = solid & store.asleep[b_] & ~store.asleep[a_] & (store.body[a_] != STATIC)
             wake_a = solid & store.asleep[a_] & ~store.asleep[b_] & (store.body[b_] != STATIC)
-            woken = np.unique(np.concatenate([b_[wake_b], a_[wake_a]]))
+            woken = distinct(np.concatenate([b_[wake_b], a_[wake_a]]))
             if woken.size:
                 store.wake(woken)
                 contacts, crows = self._catch_up_woken(woken, dt, contacts, crows)
@@ -782,15 +782,13 @@ class Scene:
         if self._n_static:
             dd = idx[done]
             dd = dd[(store.inv_mass[ra[dd]] > 0) & (store.inv_mass[rb[dd]] > 0)]
-            flag = np.zeros(store.n, dtype=bool)
-            flag[ra[dd]] = flag[rb[dd]] = True
-            pushed_rows = np.flatnonzero(flag)
+            pushed_rows = distinct(np.concatenate([ra[dd], rb[dd]]))  # (not a flag per row: 100k tiles)
         else:
             pushed_rows = idx[:0]
         for _ in range(max(1, self.response_iterations)):
             if pushed_rows.size == 0 or self._n_static == 0:
                 break
-            extra = self._new_static_contacts(pushed_rows, np.concatenate([pair_keys(ea, eb), pair_keys(eb, ea)]))
+            extra = self._new_static_contacts(pushed_rows, ea, eb)
             if extra is None:
                 break
             xa, xb, xra, xrb, xr = extra
@@ -803,7 +801,7 @@ class Scene:
             snx, sny = np.concatenate([snx, xr.nx[xdone]]), np.concatenate([sny, xr.ny[xdone]])
             anx, any_ = np.concatenate([anx, xanx[xdone]]), np.concatenate([any_, xany[xdone]])
             pushed = np.concatenate([pushed, xpushed[xdone]])
-            pushed_rows = np.unique(np.where(store.inv_mass[xra] > 0, xra, xrb)[xdone])
+            pushed_rows = distinct(np.where(store.inv_mass[xra] > 0, xra, xrb)[xdone])
             self.counters["late_contacts"] += int(xdone.sum())
         self._moved += 1
         keys = pair_keys(ea, eb)
@@ -836,21 +834,21 @@ class Scene:
                + ((store.y[rb] - sy[rb]) - (store.y[ra] - sy[ra])) * ny)
         return np.minimum(-gap, 0.0)
 
-    def _new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
+    def _new_static_contacts(self, rows: np.ndarray, known_a: np.ndarray, known_b: np.ndarray):
         """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs
-        ``known`` (keys, either order): ``(ents_a, ents_b, rows_a, rows_b, contacts)`` or None."""
+        ``(known_a, known_b)`` (entities, either order): ``(ents_a, ents_b, rows_a, rows_b, contacts)``
+        or None."""
         store, geom = self.store, self.geometry
-        rows = rows[(store.kind[rows] >= 0) & ~store.asleep[rows] & ~store.sensor[rows]]
-        if rows.size == 0:
-            return None
-        # First a cheap look with bounds that hold the hitbox at any rotation: most bodies have
-        # no static in their cells, and their exact bounds are not needed.
-        reach = np.hypot(store.ox[rows], store.oy[rows])
-        ex = np.where(store.kind[rows] == KIND_POLYGON, store.bound[rows], store.hw[rows]) + reach
-        ey = np.where(store.kind[rows] == KIND_POLYGON, store.bound[rows], store.hh[rows]) + reach
+        # First a cheap look with bounds that hold the hitbox at any rotation (its bounding circle
+        # about the body's position): most bodies have no static in their cells, and their exact
+        # bounds are not needed; nor are any when all of them lie outside the statics' extent.
+        reach = store.bound[rows] + np.hypot(store.ox[rows], store.oy[rows]) if geom.has_offset else store.bound[rows]
         x, y = store.x[rows], store.y[rows]
-        near = self.hash.near_statics(np.nextafter(x - ex, -np.inf), np.nextafter(y - ey, -np.inf),
-                                      np.nextafter(x + ex, np.inf), np.nextafter(y + ey, np.inf))
+        box = (np.nextafter(x - reach, -np.inf), np.nextafter(y - reach, -np.inf),
+               np.nextafter(x + reach, np.inf), np.nextafter(y + reach, np.inf))
+        if self.hash.outside_statics(*(f(v) for f, v in zip((np.min, np.min, np.max, np.max), box))):
+            return None
+        near = self.hash.near_statics(*box) & (store.kind[rows] >= 0) & ~store.asleep[rows] & ~store.sensor[rows]
         rows = rows[near]
         if rows.size == 0:
             return None
@@ -862,7 +860,7 @@ class Scene:
         ra, rb = self._rows_of(ea), self._rows_of(eb)
         keep = filter_layers(store, ra, rb) & ~(store.sensor[ra] | store.sensor[rb])
         keep &= ~(store.one_way[ra] | store.one_way[rb])  # a platform is passed through from below
-        keep &= ~np.isin(pair_keys(ea, eb), known)
+        keep &= ~np.isin(pair_keys(ea, eb), np.concatenate([pair_keys(known_a, known_b), pair_keys(known_b, known_a)]))
         if not keep.any():
             return None
         ea, eb, ra, rb = ea[keep], eb[keep], ra[keep], rb[keep]

@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from ..arrays import distinct
 from ..validation import InvalidValue, finite, positive
 from . import grid
 from .grid import CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
@@ -208,6 +209,16 @@ class SpatialHash:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
 
+    def outside_statics(self, minx: float, miny: float, maxx: float, maxy: float) -> bool:
+        """Whether the box surely meets no static body: it lies outside the box around every static
+        (touching it counts as outside), or there are none. ``False`` when not sure."""
+        ext = self._static_extent
+        if self._static.n == 0:
+            return True
+        if ext is None or not all(math.isfinite(v) for v in (minx, miny, maxx, maxy)):
+            return False
+        return not (maxx > ext[0] and minx < ext[2] and maxy > ext[1] and miny < ext[3])
+
     def near_statics(self, minx, miny, maxx, maxy) -> np.ndarray:
         """Mask of the boxes that may strictly overlap a static body (a cheap superset test)."""
         b = as_bounds(minx, miny, maxx, maxy)
@@ -309,7 +320,7 @@ class SpatialHash:
             else:
                 ok = strict_overlap(*subset(bounds, c), *box)
                 found.append(ids[c[ok]])
-        return np.unique(np.concatenate(found)) if found else _EMPTY_I
+        return distinct(np.concatenate(found)) if found else _EMPTY_I
 
     def _box_candidates(self, index: CellIndex, box) -> np.ndarray | None:
         """Sorted numbers of the bodies in the cells under the box and of the large bodies; ``None``
@@ -324,7 +335,7 @@ class SpatialHash:
             return None
         cy = np.repeat(np.arange(gy0, gy0 + ny, dtype=_I64), nx)  # row-major order
         cx = np.tile(np.arange(gx0, gx0 + nx, dtype=_I64), ny)
-        return np.unique(np.concatenate([index.large, index.bodies_in_cells(cx, cy)]))
+        return distinct(np.concatenate([index.large, index.bodies_in_cells(cx, cy)]))
 
     def query_ray(self, ox, oy, dx, dy, max_distance=math.inf) -> np.ndarray:
         """Sorted ids of the bodies (static, and the last :meth:`pairs` call's moving ones) whose
@@ -349,7 +360,7 @@ class SpatialHash:
                 found.append(ids[_segment_touches(bounds, *ray)])
             else:
                 found.append(ids[c[_segment_touches(subset(bounds, c), *ray)]])
-        return np.unique(np.concatenate(found)) if found else _EMPTY_I
+        return distinct(np.concatenate(found)) if found else _EMPTY_I
 
     def _ray_candidates(self, index: CellIndex, ox, oy, ux, uy, length) -> np.ndarray | None:
         """Sorted numbers of the bodies in the cells near the segment (found column by column,
@@ -398,7 +409,7 @@ class SpatialHash:
                 return None  # a ray across most of the grid
             col, row = grid.expand_runs(cnt, r0)
             cand.append(index.bodies_in_cells(cols[col], row))
-        return np.unique(np.concatenate(cand))
+        return distinct(np.concatenate(cand))
 
     def cells_in_use(self) -> np.ndarray:
         """``(M, 2)`` int64 (column, row) of the cells holding a static body or a moving body of the

@@ -21,6 +21,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..arrays import distinct
 from ..collision.broad_phase import SpatialHash
 from ..store import KIND_AABB, STATIC, BodyStore
 from .geometry import Geometry
@@ -48,7 +49,7 @@ class InternalFaces:
         if key != self._key:
             self._key = key
             self._mask = np.full(store.n, _UNKNOWN, dtype=np.uint8)
-        todo = np.unique(rows[self._mask[rows] == _UNKNOWN])
+        todo = distinct(rows[self._mask[rows] == _UNKNOWN])
         if todo.size:
             self._mask[todo] = self._compute(store, geom, hash_, rows_of, todo)
         return self._mask[rows]

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import distinct
 from ..collision import batch
 from ..store import KIND_AABB, KIND_CIRCLE, BodyStore
 from .geometry import Geometry
@@ -45,15 +46,16 @@ def pair_contacts(
     kb = store.kind[rb].astype(np.int64)
     code = ka * 3 + kb
     if counts is not None:
-        for c, n in zip(*np.unique(code, return_counts=True), strict=True):
-            name = KIND_PAIR_NAMES[divmod(int(c), 3)]
-            counts[name] = counts.get(name, 0) + int(n)
+        n_of = np.bincount(code, minlength=9)
+        for c in np.flatnonzero(n_of).tolist():
+            name = KIND_PAIR_NAMES[divmod(c, 3)]
+            counts[name] = counts.get(name, 0) + int(n_of[c])
     # One kernel call per family of pairs, not per ordered pair of kinds: a box is a polygon to
     # the polygon kernels, and a circle may be either shape of a polygon-circle pair (the
     # kernel flips the normal per row). Per-call overhead dominates the response's small batches.
     ca, cb = ka == KIND_CIRCLE, kb == KIND_CIRCLE
     family = np.where(ca & cb, 1, np.where(ca | cb, 2, np.where((ka == KIND_AABB) & (kb == KIND_AABB), 0, 3)))
-    fams = [int(family[0])] if (family == family[0]).all() else np.unique(family).tolist()
+    fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
     hx, hy = geom.hx, geom.hy
     for f in fams:
         idx = np.flatnonzero(family == f) if len(fams) > 1 else np.arange(P)

@@ -32,7 +32,8 @@ Recompute = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.
 
 def _local_numbers(n: int, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(unique, local)``: the distinct rows (sorted) and each entry's number among them, like
-    ``np.unique(rows, return_inverse=True)`` but by a lookup table over the ``n`` rows (no sort)."""
+    ``np.unique(rows, return_inverse=True)`` but by a lookup table over the ``n`` rows (no sort:
+    faster even for a thousand rows among a hundred thousand)."""
     seen = np.zeros(n, dtype=bool)
     seen[rows] = True
     unique = np.flatnonzero(seen)
