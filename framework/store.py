@@ -78,6 +78,8 @@ class BodyStore:
         self.sleep_dirty = False  # a body fell asleep or woke: re-hash the sleepers
         self.written: set[int] = set()  # entities game code wrote to since the last check
         self._active_key: tuple[int, int, int] | None = None
+        self._layers_key = -1
+        self._layers_open = False
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
         self.writes = 0  # bumped by every write from game code (component views)
 
@@ -121,6 +123,19 @@ class BodyStore:
             self._active_sel = tuple(as_selector(rows) for rows in self._active)
             self._active_key = key
         return self._active
+
+    def layers_all_meet(self) -> bool:
+        """Whether every two hitboxes' layers and masks let them meet (the default: one layer, all
+        masks open), so the broad phase need not filter pairs; cached until a structural change
+        (layers and masks are hitbox fields: editing one is one)."""
+        if self._layers_key != self.version:
+            n = self.n
+            has = self.cols["kind"][:n] >= 0
+            layer, mask = self.cols["layer"][:n][has], self.cols["mask"][:n][has]
+            common = np.bitwise_and.reduce(mask) if mask.size else 0
+            self._layers_open = bool(mask.size == 0 or ((layer & common) != 0).all())
+            self._layers_key = self.version
+        return self._layers_open
 
     def active_sel(self) -> tuple[slice | np.ndarray, ...]:
         """:meth:`active` as selectors: a slice where the rows are one contiguous run (the usual

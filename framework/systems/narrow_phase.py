@@ -25,6 +25,8 @@ KIND_PAIR_NAMES = {
 
 def filter_layers(store: BodyStore, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
     """Mask of the pairs whose layers and masks let them meet."""
+    if store.layers_all_meet():
+        return np.ones(ra.size, dtype=bool)
     layer, mask = store.layer, store.mask
     return ((layer[ra] & mask[rb]) != 0) & ((layer[rb] & mask[ra]) != 0)
 
@@ -38,10 +40,8 @@ def pair_contacts(
     ``remeasure``: the response measuring pairs it has just pushed apart; pairs then count
     overlaps within rounding of touching as none, and box and polygon pairs skip their points."""
     P = ra.size
-    hit = np.zeros(P, dtype=bool)
-    nx, ny, depth, px, py = (np.zeros(P) for _ in range(5))
     if P == 0:
-        return batch.ContactArrays(hit, nx, ny, depth, px, py)
+        return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))
     ka = store.kind[ra].astype(np.int64)
     kb = store.kind[rb].astype(np.int64)
     code = ka * 3 + kb
@@ -57,9 +57,12 @@ def pair_contacts(
     family = np.where(ca & cb, 1, np.where(ca | cb, 2, np.where((ka == KIND_AABB) & (kb == KIND_AABB), 0, 3)))
     fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
     hx, hy = geom.hx, geom.hy
+    if len(fams) > 1:
+        hit = np.zeros(P, dtype=bool)
+        nx, ny, depth, px, py = (np.zeros(P) for _ in range(5))
     for f in fams:
-        idx = np.flatnonzero(family == f) if len(fams) > 1 else np.arange(P)
-        a, b = ra[idx], rb[idx]
+        idx = np.flatnonzero(family == f) if len(fams) > 1 else None
+        a, b = (ra[idx], rb[idx]) if idx is not None else (ra, rb)
         if f == 0:
             res = batch.aabb_aabb_fast(
                 hx[a], hy[a], store.hw[a], store.hh[a], hx[b], hy[b], store.hw[b], store.hh[b],
@@ -69,7 +72,7 @@ def pair_contacts(
             res = batch.circle_circle(hx[a], hy[a], store.radius[a], hx[b], hy[b], store.radius[b],
                                        exact=not remeasure)
         elif f == 2:
-            flip = ca[idx]  # the circle is shape A: normals from it to the polygon
+            flip = ca if idx is None else ca[idx]  # the circle is shape A: normals from it to the polygon
             poly, circ = np.where(flip, b, a), np.where(flip, a, b)
             vp, np_ = geom.outlines(store, poly)
             res = batch.polygon_circle(hx[poly], hy[poly], vp, np_, hx[circ], hy[circ], store.radius[circ],
@@ -79,5 +82,7 @@ def pair_contacts(
             vb, nb = geom.outlines(store, b)
             res = batch.polygon_polygon(hx[a], hy[a], va, na, hx[b], hy[b], vb, nb,
                                         exact=not remeasure, points=not remeasure)
+        if idx is None:  # one family: the kernel's rows are the pairs
+            return res
         hit[idx], nx[idx], ny[idx], depth[idx], px[idx], py[idx] = res
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
