@@ -337,7 +337,15 @@ class BodyStore:
         if self.written:
             extra = [self.row_of[e] for e in self.written if e in self.row_of]
             rows = sel = np.union1d(rows, np.array(extra, dtype=np.int64))
-        for col in ("x", "y", "rot", "vx", "vy", "w"):
+        cols = ("x", "y", "rot", "vx", "vy", "w")
+        # First all six at once: the sum of finite values is finite unless it overflows, which
+        # only sends us to the column-by-column look below.
+        with np.errstate(over="ignore", invalid="ignore"):
+            total = self.cols["x"][sel] + self.cols["y"][sel]
+            for col in cols[2:]:
+                total += self.cols[col][sel]
+        all_finite = bool(np.isfinite(total).all())
+        for col in () if all_finite else cols:
             values = self.cols[col][sel]
             ok = np.isfinite(values)
             if not ok.all():

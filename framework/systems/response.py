@@ -30,6 +30,13 @@ __all__ = ["resolve"]
 Recompute = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 
+def _complex(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``x + iy`` as one complex array (exactly: no arithmetic on the parts)."""
+    z = np.empty(x.shape, dtype=np.complex128)
+    z.real, z.imag = x, y
+    return z
+
+
 def _local_numbers(n: int, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(unique, local)``: the distinct rows (sorted) and each entry's number among them, like
     ``np.unique(rows, return_inverse=True)`` but by a lookup table over the ``n`` rows (no sort:
@@ -92,39 +99,44 @@ def resolve(
     ia0, ib0 = ia.copy(), ib.copy()  # the real inverse masses (the stack makes lower bodies 0)
     level = _shock_propagation(L, la, lb, nx, ny, ia, ib, gravity, c["vx"], c["vy"], ra, rb, dt)
     solid = (ia == 0.0) != (ib == 0.0)
-    mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
-    mobile_l = np.where(ib > 0.0, lb, la)
-    sgn = np.where(ib > 0.0, 1.0, -1.0)  # it moves along +n if it is b, along -n if it is a
     both = (ia > 0.0) & (ib > 0.0)
     applied_nx, applied_ny = nx.copy(), ny.copy()
     pushed = np.zeros(C)  # total push-out along the applied normal (for the energy correction)
     alive = np.ones(C, dtype=bool) if alive0 is None else alive0.copy()
-    cur_nx, cur_ny, cur_depth = nx.copy(), ny.copy(), depth.copy()
-    cur_rank = depth.copy() if rank0 is None else rank0.copy()
-    # Support level of each solid contact's mobile body: a stack is resolved from the ground up,
-    # each level measured again after the one below it moved (inf: not resting on anything).
-    mob_level = level[mobile_l]
-    levels = np.unique(mob_level[solid & np.isfinite(mob_level)])
-
     moved = np.zeros(L, dtype=bool)  # bodies moved since their contacts were last measured
     # A contact whose movable bodies are in no other contact is settled by its own push-out and
     # never needs measuring again (most contacts, in a sparse scene).
     per_row = np.bincount(local, minlength=L)
-    lone = np.where(solid, per_row[mobile_l] == 1, (per_row[la] == 1) & (per_row[lb] == 1))
+    lone = (per_row[la] == 1) & (per_row[lb] == 1)
+    if solid.any():  # (a scene of dynamic bodies alone needs none of this)
+        mobile = np.where(ib > 0.0, rb, ra)  # the dynamic body of a solid contact
+        mobile_l = np.where(ib > 0.0, lb, la)
+        sgn = np.where(ib > 0.0, 1.0, -1.0)  # it moves along +n if it is b, along -n if it is a
+        cur_nx, cur_ny, cur_depth = nx.copy(), ny.copy(), depth.copy()
+        cur_rank = depth.copy() if rank0 is None else rank0.copy()
+        # Support level of each solid contact's mobile body: a stack is resolved from the ground
+        # up, each level measured again after the one below it moved (inf: not resting on anything).
+        mob_level = level[mobile_l]
+        levels = np.unique(mob_level[solid & np.isfinite(mob_level)])
+        lone = np.where(solid, per_row[mobile_l] == 1, lone)
+    else:
+        mobile = mobile_l = sgn = cur_nx = cur_ny = cur_depth = cur_rank = mob_level = None
+        levels = np.zeros(0)
 
     # Where each row stood when the response began: contacts between two dynamic bodies are
     # re-measured along their normal from how far the bodies moved since (SAT depth is linear in
     # translation along a fixed axis, as in Box2D's solver); contacts with immovable bodies are
     # measured again from the geometry, because there the axis matters (tile seams).
-    x0, y0 = c["x"][rows_u], c["y"][rows_u]
-    # The passes move the bodies in these local copies (no scatter into the store per pass); the
-    # store is written before a geometric re-measure reads it, and at the end.
-    xl, yl = x0.copy(), y0.copy()
+    z0 = _complex(c["x"][rows_u], c["y"][rows_u])
+    # The passes move the bodies in this local copy, positions as complex numbers x + iy (one
+    # numpy call moves both coordinates; no scatter into the store per pass); the store is
+    # written before a geometric re-measure reads it, and at the end.
+    zl = z0.copy()
     dirty = [False]
 
     def flush() -> None:
         if dirty[0]:
-            c["x"][rows_u], c["y"][rows_u] = xl, yl
+            c["x"][rows_u], c["y"][rows_u] = zl.real, zl.imag
             dirty[0] = False
 
     def remeasure(idx: np.ndarray) -> None:
@@ -138,10 +150,9 @@ def resolve(
     def push_out_deepest(s_idx: np.ndarray) -> None:
         """Push each mobile body fully out of its deepest immovable contact among ``s_idx``."""
         pick = s_idx[_first_per_group(mobile[s_idx], -cur_rank[s_idx])]
-        m = mobile_l[pick]
+        m = mobile_l[pick]  # one contact per body: no repeats
         d = cur_depth[pick] * sgn[pick]
-        xl[m] += cur_nx[pick] * d
-        yl[m] += cur_ny[pick] * d
+        zl[m] += _complex(cur_nx[pick] * d, cur_ny[pick] * d)
         dirty[0] = True
         moved[m] = True
         applied_nx[pick], applied_ny[pick] = cur_nx[pick], cur_ny[pick]
@@ -162,7 +173,7 @@ def resolve(
 
     for it in range(max(1, iterations)):
         # Dynamic pairs: split by inverse mass, mean over each body's contacts.
-        if dyn.push(xl, yl, moved):
+        if dyn.push(zl, moved):
             dirty[0] = True
         # Immovable contacts: deepest one per dynamic body, level by level from the ground up,
         # each level measured again where the bodies under it moved.
@@ -178,7 +189,7 @@ def resolve(
         if stale.size == 0 and not dyn.shared_moved(moved):
             break
         remeasure(stale)
-        dyn.measure(xl - x0, yl - y0)
+        dyn.measure(zl - z0)
         moved[:] = False
         if not (dyn.any_alive() or alive[sol_all].any()):
             break
@@ -208,7 +219,8 @@ class _DynamicPairs:
     (Jacobi); the pairs are then measured again along their own normal: the depth of a fixed axis
     changes by exactly the relative displacement along it. Lone pairs (bodies in no other contact)
     are settled by the first pass and left alone. Masked arithmetic over all the pairs costs less
-    than gathering the overlapping ones every pass.
+    than gathering the overlapping ones every pass; positions and normals are complex numbers, so
+    one scatter moves both coordinates.
     """
 
     def __init__(self, idx, la, lb, nx, ny, depth, ia, ib, alive, lone, L) -> None:
@@ -218,14 +230,17 @@ class _DynamicPairs:
             cols = tuple(col[idx] for col in cols)
         self.a, self.b, self.nx, self.ny, self.depth0, wa, wb, self.alive, self.lone = cols
         w = 1.0 / (wa + wb)
-        self.fa, self.fb = wa * w, wb * w  # each body's share of a push
+        fa, fb = wa * w, wb * w  # each body's share of a push
+        self.move_a = _complex(-self.nx * fa, -self.ny * fa)  # a unit push, as a's and b's moves
+        self.move_b = _complex(self.nx * fb, self.ny * fb)
         self.cur = self.depth0
         self.any_lone = bool(self.lone.any())
         self.pushed = np.zeros(idx.size)
         self.resolved = np.zeros(idx.size, dtype=bool)
 
-    def push(self, xl, yl, moved) -> bool:
-        """One pass: push every overlapping pair apart. Returns whether anything moved."""
+    def push(self, zl, moved) -> bool:
+        """One pass: push every overlapping pair apart (positions ``zl``, complex). Returns whether
+        anything moved."""
         if not self.alive.any():
             return False
         a, b, L = self.a, self.b, self.L
@@ -234,13 +249,11 @@ class _DynamicPairs:
         count = np.zeros(L)
         np.add.at(count, a, on)
         np.add.at(count, b, on)
-        for pos, n in ((xl, self.nx), (yl, self.ny)):
-            pn = p * n
-            sums = np.zeros(L)
-            np.subtract.at(sums, a, pn * self.fa)
-            np.add.at(sums, b, pn * self.fb)
-            sums /= np.maximum(count, 1.0)
-            pos += sums
+        sums = np.zeros(L, dtype=np.complex128)
+        np.add.at(sums, a, p * self.move_a)
+        np.add.at(sums, b, p * self.move_b)
+        sums *= 1.0 / np.maximum(count, 1.0)
+        zl += sums
         moved |= count > 0.0
         self.pushed += p
         self.resolved |= self.alive
@@ -251,10 +264,10 @@ class _DynamicPairs:
     def shared_moved(self, moved) -> bool:
         return bool(moved[self.a].any() or moved[self.b].any())
 
-    def measure(self, dx, dy) -> None:
-        """Depths after the bodies moved by ``(dx, dy)`` since the start (lone pairs stay apart)."""
-        a, b = self.a, self.b
-        self.cur = self.depth0 - ((dx[b] - dx[a]) * self.nx + (dy[b] - dy[a]) * self.ny)
+    def measure(self, dz) -> None:
+        """Depths after the bodies moved by ``dz`` (complex) since the start (lone pairs stay apart)."""
+        d = dz[self.b] - dz[self.a]
+        self.cur = self.depth0 - (d.real * self.nx + d.imag * self.ny)
         self.alive = self.cur > 0.0
         if self.any_lone:
             self.alive &= ~self.lone
@@ -276,7 +289,7 @@ class _DynamicImpulses:
     single-contact updates, none of which gains energy, so the pass gains none. (Full impulses
     summed let a box bouncing up into three bodies take three full bounces at once and shoot down
     through the floor: the 200-body soak found it.) A bounce applied whole is not looked at again;
-    nor is a lone contact after the first pass.
+    nor is a lone contact after the first pass. Velocities are complex numbers ``vx + i vy``.
     """
 
     def __init__(self, idx, la, lb, nx, ny, ia, ib, rest, resting_speed, lone, L) -> None:
@@ -292,25 +305,29 @@ class _DynamicImpulses:
         self.bouncy = bool(rest.any())
         self.skipping = bool(done.any())  # whether ``done`` masks anything
         inv = 1.0 / (wa + wb)
-        # a unit impulse along the normal, as velocity changes of a and b
-        self.dva = (nx * wa * inv, ny * wa * inv)
-        self.dvb = (nx * wb * inv, ny * wb * inv)
+        # each body's share of the velocity change that stops the pair (see impulses)
+        fa, fb = wa * inv, wb * inv
+        self.dva = _complex(nx * fa, ny * fa)
+        self.dvb = _complex(nx * fb, ny * fb)
         self.n = a.size
         self.v = self.mask = np.zeros(0)
 
-    def closing(self, vx, vy) -> bool:
+    def closing(self, vz) -> bool:
         """Measure the normal speeds; whether any contact still to look at is closing."""
         if self.n == 0:
             return False
-        a, b = self.a, self.b
-        self.v = (vx[b] - vx[a]) * self.nx + (vy[b] - vy[a]) * self.ny
+        d = vz[self.b] - vz[self.a]
+        self.v = d.real * self.nx + d.imag * self.ny
         self.mask = self.v < 0.0
         if self.skipping:
             self.mask &= ~self.done
         return bool(self.mask.any())
 
-    def impulses(self, vx, vy) -> None:
-        """Apply the impulses of the closing contacts (as last measured) to ``vx``/``vy``."""
+    def impulses(self, vz) -> None:
+        """Apply the impulses of the closing contacts (as last measured) to the velocities ``vz``.
+
+        A contact closing at speed ``v < 0`` needs ``a`` to change by ``v * dva`` and ``b`` by
+        ``-v * dvb`` to stop (``(1 + e)`` times that to bounce), shared out by ``w``."""
         if self.n == 0 or not self.mask.any():
             return
         m, a, b = self.mask, self.a, self.b
@@ -319,16 +336,15 @@ class _DynamicImpulses:
         np.add.at(count, a, on)
         np.add.at(count, b, on)
         w = 1.0 / np.maximum(np.maximum(count[a], count[b]), 1.0)
-        j = self.v * w  # minus the impulse (in units of the pair's reduced mass) that stops them
+        j = self.v * w
         j *= on
         if self.bouncy:
             e = np.where(-self.v > self.resting, self.rest, 0.0)
             j *= 1.0 + e
             self.done |= m & (e > 0.0) & (w == 1.0)  # a shared bounce is looked at again next pass
             self.skipping = bool(self.done.any())
-        for vel, da, db in ((vx, self.dva[0], self.dvb[0]), (vy, self.dva[1], self.dvb[1])):
-            np.add.at(vel, a, j * da)
-            np.subtract.at(vel, b, j * db)
+        np.add.at(vz, a, j * self.dva)
+        np.subtract.at(vz, b, j * self.dvb)
 
     def drop_settled(self) -> None:
         """After the first pass: leave out the contacts settled (compacting the columns when that
@@ -423,33 +439,39 @@ def _velocities(store, ra, rb, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushe
     and keep its own speed, making energy.
     """
     c = store.cols
-    stacked = solid & (ia > 0.0) & (ib > 0.0)
     rest = np.maximum(c["restitution"][ra], c["restitution"][rb])
     gx, gy = gravity
-    # Gravity against the push-out direction of a solid contact's mobile body.
-    gn = -(gx * nx + gy * ny) * sgn
-    # Restitution threshold: an approach no faster than gravity gives in two steps along the
-    # normal is a body resting, not a bounce; without it a bouncy body on the floor hops by
-    # e*g*dt every step forever and never sleeps.
-    resting_speed = 2.0 * np.abs(gx * nx + gy * ny) * dt
+    if gx or gy:
+        # Restitution threshold: an approach no faster than gravity gives in two steps along the
+        # normal is a body resting, not a bounce; without it a bouncy body on the floor hops by
+        # e*g*dt every step forever and never sleeps.
+        g_n = gx * nx + gy * ny
+        resting_speed = 2.0 * np.abs(g_n) * dt
+    else:
+        g_n = resting_speed = np.zeros(ra.size)
+    if mobile_l is not None:
+        stacked = solid & (ia > 0.0) & (ib > 0.0)
+        gn = -g_n * sgn  # gravity against the push-out direction of a solid contact's mobile body
+    else:
+        stacked = gn = None
     L = rows_u.size
-    vx, vy = c["vx"][rows_u], c["vy"][rows_u]
-    _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, iterations, mob_level,
+    vz = _complex(c["vx"][rows_u], c["vy"][rows_u])
+    _velocity_passes(vz, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, iterations, mob_level,
                      lone, dt, la, lb, L, stacked, rest, gn, resting_speed)
-    c["vx"][rows_u], c["vy"][rows_u] = vx, vy
+    c["vx"][rows_u], c["vy"][rows_u] = vz.real, vz.imag
 
 
-def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, iterations, mob_level,
+def _velocity_passes(vz, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed, resolved, iterations, mob_level,
                      lone, dt, la, lb, L, stacked, rest, gn, resting_speed) -> None:
-    """The passes of ``_velocities`` on the local velocities ``vx``/``vy`` (changed in place)."""
+    """The passes of ``_velocities`` on the local velocities ``vz = vx + i vy`` (changed in place)."""
     done = np.zeros(resolved.size, dtype=bool)  # bounces are applied once per contact
     act = np.flatnonzero(resolved & solid)  # the immovable contacts still to look at
     dyn = _DynamicImpulses(np.flatnonzero(resolved & both), la, lb, nx, ny, ia, ib, rest, resting_speed, lone, L)
 
     def closing_speed(idx: np.ndarray) -> np.ndarray:
         """Normal speed of b relative to a, now (< 0: closing)."""
-        a, b = la[idx], lb[idx]
-        return (vx[b] - vx[a]) * nx[idx] + (vy[b] - vy[a]) * ny[idx]
+        d = vz[lb[idx]] - vz[la[idx]]
+        return d.real * nx[idx] + d.imag * ny[idx]
 
     def pair_impulses(idx: np.ndarray, v: np.ndarray) -> None:
         """Impulses between the dynamic bodies of the closing contacts ``idx`` (normal speeds ``v``),
@@ -460,9 +482,9 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
         w = 1.0 / np.maximum(per_body[a], per_body[b])
         wa, wb = ia[idx], ib[idx]
         j = -(1.0 + e) * v * w / (wa + wb)
-        jx, jy = j * nx[idx], j * ny[idx]
-        np.add(vx, np.bincount(b, jx * wb, L) - np.bincount(a, jx * wa, L), out=vx)
-        np.add(vy, np.bincount(b, jy * wb, L) - np.bincount(a, jy * wa, L), out=vy)
+        jz = _complex(j * nx[idx], j * ny[idx])
+        np.add.at(vz, b, jz * wb)
+        np.subtract.at(vz, a, jz * wa)
         done[idx] = (e > 0.0) & (w == 1.0)  # a shared bounce is looked at again next pass
 
     for it in range(max(1, iterations)):
@@ -470,7 +492,7 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
             return
         vn = closing_speed(act)
         s_appr = vn < 0.0
-        dyn_closing = dyn.closing(vx, vy)
+        dyn_closing = dyn.closing(vz)
         if not (dyn_closing or s_appr.any()):
             return
         if s_appr.any():
@@ -493,7 +515,7 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
                 pick, v = s_idx[first], v_s[first]
                 if stacked[pick].any():
                     low = np.where(sgn[pick] > 0.0, la[pick], lb[pick])
-                    v_low = sgn[pick] * (vx[low] * nx[pick] + vy[low] * ny[pick])
+                    v_low = sgn[pick] * (vz[low].real * nx[pick] + vz[low].imag * ny[pick])
                     loose = stacked[pick] & (v_low > resting_speed[pick])
                     if loose.any():
                         pair_impulses(pick[loose], v[loose])
@@ -503,13 +525,12 @@ def _velocity_passes(vx, vy, ia, ib, solid, both, mobile_l, sgn, nx, ny, pushed,
                 e = np.where(-v > resting_speed[pick], rest[pick], 0.0)
                 target = e * _bounce_speed(v, gn[pick], pushed[pick], dt)
                 dv = (target - v) * sgn[pick]
-                m = mobile_l[pick]
-                vx[m] += dv * nx[pick]
-                vy[m] += dv * ny[pick]
+                m = mobile_l[pick]  # one contact per body: no repeats
+                vz[m] += _complex(dv * nx[pick], dv * ny[pick])
                 done[pick] = e > 0.0
             if dyn.n:
-                dyn.closing(vx, vy)  # the pass above changed velocities: measure after it
-        dyn.impulses(vx, vy)
+                dyn.closing(vz)  # the pass above changed velocities: measure after it
+        dyn.impulses(vz)
         if it == 0:
             done |= lone  # a contact whose bodies touch nothing else is settled by one pass
             dyn.drop_settled()
