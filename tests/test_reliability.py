@@ -41,6 +41,7 @@ from framework import AABB, Circle, Hitbox, Polygon, Scene, SceneClosed, Transfo
 from framework.collision import collide
 from framework.collision.broad_phase import brute_force_pairs
 from framework.components import Body
+from framework.scene import SLEEP_STEPS
 from framework.store import STATIC
 
 DT = 1.0 / 64.0
@@ -960,6 +961,25 @@ def test_removing_an_edited_hitbox_does_not_break_later_steps():
         s.get(e, Hitbox).restitution = 0.5
         s.remove_component(e, Hitbox)
         s.step(DT)  # was: AssertionError in the store's check of edited hitboxes
+
+
+def test_despawning_while_a_shape_edit_waits_keeps_the_geometry_whole():
+    # Found by the state machine: a polygon's shape edited to a box (applied at the next step),
+    # then a despawn that wakes sleepers rebuilt the polygon tables from the edited shape and
+    # failed ("'AABB' object has no attribute 'points'"). The store keeps the applied shape.
+    with Scene(gravity=(0.0, -10.0)) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(64.0, 1.0), body="static"))
+        tri = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(Polygon([(-1, -0.5), (1, -0.5), (0, 0.5)])))
+        others = [s.spawn(Transform(x, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0))) for x in (5.0, 8.0)]
+        for _ in range(SLEEP_STEPS + 40):
+            s.step(DT)
+        assert s.store.asleep.sum() == 3  # all three asleep
+        s.get(tri, Hitbox).shape = AABB(2.0, 1.0)
+        for e in others:  # each wakes what slept near it, looking at the geometry (rebuilt after the first)
+            s.despawn(e)
+        s.step(DT)
+        assert s.store.kind[s.store.row_of[tri]] == 0  # the box now
+        assert np.isfinite(s.store.y).all()
 
 
 def test_coincident_boxes_stay_above_the_floor():

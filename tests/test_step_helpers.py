@@ -1,0 +1,84 @@
+"""The small array helpers the per-step stages use in place of slower numpy idioms, held to the
+idioms they replace (property tests)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+
+from framework import AABB, Hitbox, Scene, Transform, Velocity
+from framework.arrays import distinct
+from framework.events import sorted_members
+from framework.store import as_selector
+from framework.systems.geometry import widen_down, widen_up
+
+ints = st.lists(st.integers(-(2**40), 2**40), max_size=200)
+
+
+@given(ints)
+def test_distinct_is_np_unique(values):
+    a = np.array(values, dtype=np.int64)
+    assert np.array_equal(distinct(a), np.unique(a))
+
+
+@given(st.sets(st.integers(0, 300), max_size=120), st.sets(st.integers(0, 300), max_size=120))
+def test_sorted_members_is_isin_both_ways(a, b):
+    a = np.array(sorted(a), dtype=np.int64)
+    b = np.array(sorted(b), dtype=np.int64)
+    in_b, in_a = sorted_members(a, b)
+    assert np.array_equal(in_b, np.isin(a, b)) and np.array_equal(in_a, np.isin(b, a))
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+
+
+@given(st.lists(finite, min_size=1, max_size=50))
+def test_widening_moves_a_bound_out_by_one_or_two_ulps(values):
+    v = np.array(values + [0.0, -0.0, 5e-324, -5e-324, 1.0, 2.0, -2.0, 0.5, 2.0**-1022])
+    with np.errstate(over="ignore"):  # (at the largest floats, widening reaches inf, as nextafter does)
+        down, up = widen_down(v), widen_up(v)
+        once_down, once_up = np.nextafter(v, -np.inf), np.nextafter(v, np.inf)
+        assert (down <= once_down).all() and (down >= np.nextafter(once_down, -np.inf)).all()
+        assert (up >= once_up).all() and (up <= np.nextafter(once_up, np.inf)).all()
+
+
+def test_widening_keeps_infinite_bounds_infinite():
+    with np.errstate(invalid="ignore"):
+        assert widen_down(np.array([-np.inf]))[0] == -np.inf
+        assert widen_up(np.array([np.inf]))[0] == np.inf
+
+
+@given(st.sets(st.integers(0, 60), max_size=40))
+def test_a_selector_selects_the_same_rows(rows):
+    rows = np.array(sorted(rows), dtype=np.int64)
+    col = np.arange(100.0) * 3.0
+    sel = as_selector(rows)
+    contiguous = rows.size > 0 and rows[-1] - rows[0] + 1 == rows.size
+    assert isinstance(sel, slice) == contiguous
+    assert np.array_equal(col[sel], col[rows])
+
+
+@given(st.lists(st.tuples(st.integers(1, 15), st.integers(0, 15)), min_size=1, max_size=8))
+def test_layers_all_meet_only_when_every_pair_does(layers):
+    with Scene(effects=("detection",)) as s:
+        for k, (layer, mask) in enumerate(layers):
+            s.spawn(Transform(3.0 * k, 0.0), Velocity(), Hitbox(AABB(1, 1), layer=layer, mask=mask))
+        s.step(1 / 60)
+        every = all((la & mb) and (lb & ma) for la, ma in layers for lb, mb in layers)
+        if s.store.layers_all_meet():
+            assert every  # may say "not sure" (False) when every pair meets, never the opposite
+
+
+def test_default_layers_all_meet_and_an_edit_is_seen():
+    with Scene() as s:
+        a = s.spawn(Transform(0, 0), Velocity(), Hitbox(AABB(1, 1)))
+        s.spawn(Transform(0.5, 0), Velocity(), Hitbox(AABB(1, 1)))
+        s.step(1 / 60)
+        assert s.store.layers_all_meet() and s.counters["candidate_pairs"] == 1
+        s.get(a, Hitbox).mask = 0
+        s.step(1 / 60)
+        assert not s.store.layers_all_meet() and s.counters["candidate_pairs"] == 0
+        assert math.isfinite(s.get(a, Transform).x)
