@@ -79,6 +79,8 @@ class BodyStore:
         self.written: set[int] = set()  # entities game code wrote to since the last check
         self._active_key: tuple[int, int, int] | None = None
         self._layers_key = -1
+        self._kinds_key = -1
+        self._kinds: frozenset[int] = frozenset()
         self._layers_open = False
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
         self.writes = 0  # bumped by every write from game code (component views)
@@ -136,6 +138,15 @@ class BodyStore:
             self._layers_open = bool(mask.size == 0 or ((layer & common) != 0).all())
             self._layers_key = self.version
         return self._layers_open
+
+    def kinds_present(self) -> frozenset[int]:
+        """The shape kinds of the hitboxes (``KIND_AABB`` ...), cached until a structural change:
+        a scene of boxes alone skips sorting its pairs by kind."""
+        if self._kinds_key != self.version:
+            kind = self.cols["kind"][: self.n]
+            self._kinds = frozenset(int(k) for k in (KIND_AABB, KIND_CIRCLE, KIND_POLYGON) if (kind == k).any())
+            self._kinds_key = self.version
+        return self._kinds
 
     def active_sel(self) -> tuple[slice | np.ndarray, ...]:
         """:meth:`active` as selectors: a slice where the rows are one contiguous run (the usual

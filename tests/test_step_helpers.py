@@ -82,3 +82,19 @@ def test_default_layers_all_meet_and_an_edit_is_seen():
         s.step(1 / 60)
         assert not s.store.layers_all_meet() and s.counters["candidate_pairs"] == 0
         assert math.isfinite(s.get(a, Transform).x)
+
+
+def test_kinds_present_follow_the_hitboxes_and_the_narrow_phase_counts_stay_right():
+    from framework import Circle
+    from framework.store import KIND_AABB, KIND_CIRCLE
+
+    with Scene() as s:
+        s.spawn(Transform(0, 0), Velocity(), Hitbox(AABB(1, 1)))
+        s.spawn(Transform(0.5, 0), Velocity(), Hitbox(AABB(1, 1)))
+        s.step(1 / 60)
+        assert s.store.kinds_present() == {KIND_AABB}
+        assert s.counters["narrow_tests"] == {"aabb-aabb": 1}
+        s.spawn(Transform(0.25, 0.5), Velocity(), Hitbox(Circle(0.5)))
+        s.step(1 / 60)
+        assert s.store.kinds_present() == {KIND_AABB, KIND_CIRCLE}
+        assert sum(s.counters["narrow_tests"].values()) == s.counters["candidate_pairs"] == 3

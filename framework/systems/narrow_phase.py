@@ -11,7 +11,7 @@ import numpy as np
 
 from ..arrays import distinct
 from ..collision import batch
-from ..store import KIND_AABB, KIND_CIRCLE, BodyStore
+from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, BodyStore
 from .geometry import Geometry
 
 __all__ = ["filter_layers", "pair_contacts", "KIND_PAIR_NAMES"]
@@ -42,20 +42,27 @@ def pair_contacts(
     P = ra.size
     if P == 0:
         return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))
-    ka = store.kind[ra].astype(np.int64)
-    kb = store.kind[rb].astype(np.int64)
-    code = ka * 3 + kb
-    if counts is not None:
-        n_of = np.bincount(code, minlength=9)
-        for c in np.flatnonzero(n_of).tolist():
-            name = KIND_PAIR_NAMES[divmod(c, 3)]
-            counts[name] = counts.get(name, 0) + int(n_of[c])
-    # One kernel call per family of pairs, not per ordered pair of kinds: a box is a polygon to
-    # the polygon kernels, and a circle may be either shape of a polygon-circle pair (the
-    # kernel flips the normal per row). Per-call overhead dominates the response's small batches.
-    ca, cb = ka == KIND_CIRCLE, kb == KIND_CIRCLE
-    family = np.where(ca & cb, 1, np.where(ca | cb, 2, np.where((ka == KIND_AABB) & (kb == KIND_AABB), 0, 3)))
-    fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
+    kinds = store.kinds_present()
+    if len(kinds) == 1 and KIND_POLYGON not in kinds:  # boxes alone, or circles alone: one family
+        k = next(iter(kinds))
+        if counts is not None:
+            name = KIND_PAIR_NAMES[(k, k)]
+            counts[name] = counts.get(name, 0) + P
+        fams, ca = [0 if k == KIND_AABB else 1], None
+    else:
+        ka = store.kind[ra].astype(np.int64)
+        kb = store.kind[rb].astype(np.int64)
+        if counts is not None:
+            n_of = np.bincount(ka * 3 + kb, minlength=9)
+            for c in np.flatnonzero(n_of).tolist():
+                name = KIND_PAIR_NAMES[divmod(c, 3)]
+                counts[name] = counts.get(name, 0) + int(n_of[c])
+        # One kernel call per family of pairs, not per ordered pair of kinds: a box is a polygon
+        # to the polygon kernels, and a circle may be either shape of a polygon-circle pair (the
+        # kernel flips the normal per row). Per-call overhead dominates the response's small batches.
+        ca, cb = ka == KIND_CIRCLE, kb == KIND_CIRCLE
+        family = np.where(ca & cb, 1, np.where(ca | cb, 2, np.where((ka == KIND_AABB) & (kb == KIND_AABB), 0, 3)))
+        fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
     hx, hy = geom.hx, geom.hy
     if len(fams) > 1:
         hit = np.zeros(P, dtype=bool)
