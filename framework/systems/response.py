@@ -161,8 +161,7 @@ def resolve(
         alive[pick] = False  # touching now
 
     # The immovable contacts work on index sets: those of each support level, and those that may
-    # need measuring again (not lone). The dynamic pairs are two groups of columns (see
-    # _DynamicPairs): lone ones, settled by the first pass, and shared ones, passed over each time.
+    # need measuring again (not lone). The pairs of two dynamic bodies are columns (_DynamicPairs).
     sol_all = np.flatnonzero(solid)
     by_level = [sol_all[mob_level[sol_all] == lv] for lv in [*levels.tolist(), np.inf]] if sol_all.size else []
     sol_shared = sol_all[~lone[sol_all]]
@@ -211,7 +210,6 @@ def resolve(
     return resolved, applied_nx, applied_ny, pushed
 
 
-
 class _DynamicPairs:
     """The position passes over contacts between two dynamic bodies, as columns.
 
@@ -228,7 +226,8 @@ class _DynamicPairs:
         cols = (la, lb, nx, ny, depth, ia, ib, alive, lone)
         if idx.size != la.size:  # (all contacts dynamic: the columns as they are)
             cols = tuple(col[idx] for col in cols)
-        self.a, self.b, self.nx, self.ny, self.depth0, wa, wb, self.alive, self.lone = cols
+        self.a, self.b, self.nx, self.ny, self.depth0, wa, wb, alive, self.lone = cols
+        self.alive = alive.copy()  # (changed in place below: not the caller's)
         w = 1.0 / (wa + wb)
         fa, fb = wa * w, wb * w  # each body's share of a push
         self.move_a = _complex(-self.nx * fa, -self.ny * fa)  # a unit push, as a's and b's moves
