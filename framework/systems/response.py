@@ -21,7 +21,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..collision.batch_exact import BAND
 from ..store import BodyStore
 
 __all__ = ["resolve"]
@@ -120,14 +119,8 @@ def resolve(
         mob_level = level[mobile_l]
         levels = np.unique(mob_level[solid & np.isfinite(mob_level)])
         lone = np.where(solid, per_row[mobile_l] == 1, lone)
-        stacked = solid & (ia0 > 0.0) & (ib0 > 0.0)  # solid only because the lower body rests
-        if stacked.any():
-            # a depth this small after a push is rounding, as in the kernels' re-measure
-            settled = (8.0 * BAND) * (c["bound"][ra] + c["bound"][rb])
-        else:
-            stacked = settled = None
     else:
-        mobile = mobile_l = sgn = cur_nx = cur_ny = cur_depth = cur_rank = mob_level = stacked = settled = None
+        mobile = mobile_l = sgn = cur_nx = cur_ny = cur_depth = cur_rank = mob_level = None
         levels = np.zeros(0)
 
     # Where each row stood when the response began: contacts between two dynamic bodies are
@@ -147,18 +140,7 @@ def resolve(
             dirty[0] = False
 
     def remeasure(idx: np.ndarray) -> None:
-        """Measure the immovable contacts ``idx`` (indices) again: a stacked pair (two dynamic
-        bodies, the lower one immovable while it rests) along its normal, like the dynamic pairs,
-        the others (a static, kinematic or infinitely heavy body) from the geometry."""
-        if idx.size and stacked is not None:
-            lin = idx[stacked[idx]]
-            idx = idx[~stacked[idx]]
-            if lin.size:
-                a, b = la[lin], lb[lin]
-                d = (zl[b] - z0[b]) - (zl[a] - z0[a])
-                dep = depth[lin] - (d.real * nx[lin] + d.imag * ny[lin])
-                cur_depth[lin] = cur_rank[lin] = dep
-                alive[lin] = dep > settled[lin]  # within rounding of touching: apart, as the kernels say
+        """Measure the immovable contacts ``idx`` (indices) again."""
         if idx.size:
             flush()
             hit, rnx, rny, rdepth, rrank = recompute(ra[idx], rb[idx])
