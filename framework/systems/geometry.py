@@ -16,23 +16,26 @@ __all__ = ["Geometry", "widen_down", "widen_up"]
 _TINY = 5e-324  # the smallest subnormal: the step away from 0
 
 
-def widen_down(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-    """``v`` lowered by one or two ulps (at least to ``np.nextafter(v, -inf)``), by arithmetic:
-    several times faster than ``nextafter``. ``|v| * 2**-52`` lies between one and two ulps of
-    ``v``, so the rounded difference is one or two ulps below it; the tiny term moves 0 and
-    subnormals; -inf stays -inf (and a lower bound is never +inf: it is at most the position)."""
+def _ulp_step(v: np.ndarray) -> np.ndarray:
+    """``|v| * 2**-52`` (between one and two ulps of ``v``) plus the smallest subnormal (which
+    moves 0 and subnormals)."""
     step = np.abs(v)
     step *= 2.0**-52
     step += _TINY
-    return np.subtract(v, step, out=out)
+    return step
+
+
+def widen_down(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``v`` lowered by one or two ulps (at least to ``np.nextafter(v, -inf)``), by arithmetic:
+    several times faster than ``nextafter``. The rounded difference ``v - step`` lies one or two
+    ulps below ``v``; -inf stays -inf (and a lower bound is never +inf: it is at most the
+    position)."""
+    return np.subtract(v, _ulp_step(v), out=out)
 
 
 def widen_up(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """``v`` raised by one or two ulps (see :func:`widen_down`)."""
-    step = np.abs(v)
-    step *= 2.0**-52
-    step += _TINY
-    return np.add(v, step, out=out)
+    return np.add(v, _ulp_step(v), out=out)
 
 
 class Geometry:
