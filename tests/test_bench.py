@@ -16,6 +16,7 @@ import pytest
 from framework import AABB, Circle
 from framework.bench import accuracy as acc
 from framework.bench import perf
+from framework.bench import regimes as reg
 from framework.bench.__main__ import main
 from framework.bench.progress import Progress
 from framework.bench.report import format_table, replace_generated, to_json, write_csv
@@ -229,6 +230,133 @@ def test_accuracy_report_of_a_tiny_configuration(tmp_path):
 
         assert plot_accuracy(report, tmp_path / "a.png")
         assert (tmp_path / "a.png").read_bytes()[:4] == b"\x89PNG"
+
+
+# --- the regimes benchmark ----------------------------------------------------------------------------
+
+TINY_REGIMES = {"rounds": ((10**12, 2),), "platformer_rounds": 2, "crowd_steps": 4,
+                "settle": dict.fromkeys(reg.SETTLE, 3)}
+
+
+def test_pile_layout_knows_the_exact_resting_height():
+    x, y, top = reg.pile_layout(4, 3)
+    assert top == 2.5  # three unit boxes on a floor at y = 0: the top centre is 2.5 up
+    assert sorted(set(x.tolist())) == [0.5, 1.5, 2.5, 3.5]  # four columns filling a pit 4 wide
+    rows = np.repeat(np.arange(3), 4)
+    assert (y - (rows + 0.5) == (rows + 1) * reg.GAP).all()  # each row lifted by exactly its gaps
+    pile = reg.box_pile(4, 3)
+    assert pile.bodies == 12 and pile.statics == 3 and pile.exact_top == 2.5 and pile.height == 3.0
+    assert [pile.pieces[k].y for k in pile.top] == [2.5 + 3 * reg.GAP] * 4  # the top row, lifted
+    assert reg.stack(20).exact_top == 19.5 and reg.pyramid(20).exact_top == 19.5
+    assert reg.pyramid(20).bodies == 210
+
+
+class _Frozen(reg.Engine):
+    """An engine whose bodies stay where it is told (to check the figures' arithmetic)."""
+
+    def __init__(self, regime, y_shift=None):
+        super().__init__(regime)
+        self.x = np.array([p.x for p in regime.pieces])
+        self.y = np.array([p.y for p in regime.pieces])
+        for k, dy in (y_shift or {}).items():
+            self.y[k] += dy
+
+    def state(self):
+        z = np.zeros(self.x.size)
+        return self.x, self.y, z, z, np.ones(self.x.size, dtype=bool)
+
+
+def test_sink_is_the_top_rows_lowest_box_below_its_exact_height_over_the_pile_height():
+    pile = reg.box_pile(2, 4)  # pieces 0-2: the pit; 3-10: the boxes, two a row
+    at_rest = {k: -(i // 2 + 1) * reg.GAP for i, k in enumerate(range(3, 11))}  # every box at rest
+    assert reg.judge(pile, _Frozen(pile, at_rest))["sink"] == 0.0
+    sunk = {**at_rest, pile.top[1]: at_rest[pile.top[1]] - 0.5}
+    fig = reg.judge(pile, _Frozen(pile, sunk))
+    assert fig["sink"] == 0.125  # 0.5 below, over a pile 4 high
+    assert fig["pen"] == 0.5  # it sank into the box below by as much
+
+
+def test_penetration_oracle_measures_known_overlaps_exactly():
+    shapes = [AABB(1.0, 1.0), AABB(1.0, 1.0), Circle(0.5), Circle(0.5), AABB(2.0, 2.0), AABB(2.0, 2.0)]
+    x = [0.0, 0.75, 10.0, 10.625, 20.0, 20.5]
+    y = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    static = [False, False, False, False, True, True]
+    assert reg.max_penetration(shapes, x, y, static) == 0.375  # the circles; static pairs never count
+    assert reg.max_penetration(shapes[:2], x[:2], y[:2], static[:2]) == 0.25
+    assert reg.max_penetration(shapes[:2], [0.0, 1.0], [0.0, 0.0], [False, False]) == 0.0  # touching
+    assert reg.max_penetration(shapes[:2], x[:2], y[:2], [False, True]) == 0.25
+    assert reg.max_penetration(shapes[:4], x[:4], y[:4], static[:4], dynamic_pairs=False) == 0.0
+    hexagon = reg._hexagon(0.5)  # flat top and bottom, 2 * sin(60 deg) * 0.5 tall
+    assert reg.max_penetration([hexagon, AABB(1.0, 1.0)], [0.0, 0.0], [0.0, 0.5 + math.sqrt(3) / 4 - 0.125],
+                               [False, True]) == pytest.approx(0.125)
+
+
+def test_every_engine_builds_the_same_bodies():
+    pile = reg.shape_pile("mixed", 3, 2, seed=4)
+    engines = reg.make_engines(pile)
+    try:
+        for eng in engines:
+            x, y, vx, vy, alive = eng.state()
+            assert alive.all()
+            assert x == pytest.approx([p.x for p in pile.pieces], abs=1e-6)  # Box2D keeps float32
+            assert y == pytest.approx([p.y for p in pile.pieces], abs=1e-6)
+    finally:
+        for eng in engines:
+            eng.close()
+    assert {e.name for e in engines} == {"ours"} | {n for n, m in reg.peer_modules().items() if m}
+
+
+def test_regimes_report_of_a_tiny_configuration(tmp_path):
+    report = reg.run_regimes(TINY_REGIMES, scenes=("stack-20", "scattered-10", "platformer-1"), crowds=("boxes",),
+                             progress=False)
+    rows = report["rows"]
+    assert [r["scene"] for r in rows] == ["stack-20", "scattered-10", "platformer-1"]
+    peers = reg.peer_modules()
+    for r in rows:
+        assert list(r) == reg.ROW_KEYS
+        assert r["ours_ms"] > 0 and r["pen_ours"] >= 0.0
+        assert (r["pymunk_ms"] is not None) == (peers["pymunk"] is not None)
+        assert (r["box2d_ms"] is not None) == (peers["box2d"] is not None)
+    assert rows[0]["sink_ours"] is not None and rows[1]["sink_ours"] is None
+    crowd = report["crowds"]
+    assert [c["engine"] for c in crowd] == ["ours"] + [n for n in ("pymunk", "box2d") if peers[n]]
+    assert all(c["steps"] == 4 and c["pass"] is None for c in crowd)  # a 4-step cap decides nothing
+    data = json.loads(to_json(report))
+    assert set(reg.ROW_KEYS) <= set(data["rows"][0]) and set(reg.CROWD_KEYS) == set(data["crowds"][0])
+    assert {g["goal"].split(":")[0] for g in data["goals"]} >= {"every scene", "scattered-10000"}
+    text = reg.text_report(report)
+    assert "| stack-20" in text and "Platformer: of our" in text
+    assert "| scene" in reg.markdown(report, "python -m framework.bench regimes", "images/regimes.png")
+
+
+def test_regimes_without_peers_has_null_columns(monkeypatch, tmp_path):
+    monkeypatch.setenv("FRAMEWORK_BENCH_WITHOUT", "pymunk,pyb2d3,matplotlib")
+    report = reg.run_regimes(TINY_REGIMES, scenes=("scattered-10",), crowds=(), progress=False)
+    (row,) = report["rows"]
+    assert row["pymunk_ms"] is None and row["box2d_ms"] is None and row["ratio"] is None
+    assert row["time_pass"] is None and row["ours_ms"] > 0
+    assert "pyb2d3 is not installed" in reg.text_report(report)
+    from framework.bench.plots import plot_regimes
+
+    assert plot_regimes(report, tmp_path / "r.png") is False and not (tmp_path / "r.png").exists()
+
+
+def test_cli_regimes_quick_json_of_a_tiny_configuration(capsys, tmp_path):
+    plot = tmp_path / "regimes.png"
+    code = main(["regimes", "--quick", "--json", "--rounds", "2", "--crowd-steps", "3", "--scenes",
+                 "scattered-10,scattered-100", "--crowds", "balls", "--no-progress", "--out", str(tmp_path),
+                 "--plot", str(plot)])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [r["scene"] for r in data["rows"]] == ["scattered-10", "scattered-100"]
+    assert data["command"].startswith("python -m framework.bench regimes --quick")
+    assert json.loads((tmp_path / "regimes-quick.json").read_text())["rows"] == data["rows"]
+    assert (tmp_path / "regimes-quick.csv").read_text().startswith("scene,bodies,static,ours_ms")
+    assert (tmp_path / "regimes-quick-crowds.csv").read_text().startswith("crowd,engine")
+    if perf.optional_module("matplotlib") is not None:
+        assert plot.read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(SystemExit):
+        main(["regimes", "--scenes", "no-such-scene", "--no-save"])
 
 
 # --- plumbing -----------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Command line: ``python -m framework.bench {perf,accuracy} [--quick] [--json] [--plot PATH] [--docs]``."""
+"""Command line: ``python -m framework.bench {perf,accuracy,regimes} [--quick] [--json] [--plot PATH] [--docs]``."""
 
 from __future__ import annotations
 
@@ -11,16 +11,19 @@ from .report import DATA_DIR, REPO, command_line, replace_generated, to_json, wr
 
 __all__ = ["main"]
 
-DOCS = {"perf": REPO / "docs" / "performance.md", "accuracy": REPO / "docs" / "accuracy.md"}
+DOCS = {"perf": REPO / "docs" / "performance.md", "accuracy": REPO / "docs" / "accuracy.md",
+        "regimes": REPO / "docs" / "performance.md"}
+QUICK_HELP = {"perf": "perf < 2 min", "accuracy": "accuracy < 1 min", "regimes": "regimes ~2 min"}
 
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m framework.bench", description=__doc__)
     sub = p.add_subparsers(dest="benchmark", required=True)
     for name, help_ in (("perf", "cost of a step: ours vs pymunk vs the broad-phase floor"),
-                        ("accuracy", "accuracy knobs against exact answers")):
+                        ("accuracy", "accuracy knobs against exact answers"),
+                        ("regimes", "piles, stacks, scattered boxes, the platformer, crowds: ours vs pymunk vs Box2D")):
         s = sub.add_parser(name, help=help_)
-        s.add_argument("--quick", action="store_true", help="fewer sizes and rounds (perf < 2 min, accuracy < 1 min)")
+        s.add_argument("--quick", action="store_true", help=f"fewer sizes and rounds ({QUICK_HELP[name]})")
         s.add_argument("--json", action="store_true", help="print the report as JSON (an object with a 'rows' list)")
         s.add_argument("--plot", metavar="PATH", help="write a PNG plot (needs matplotlib)")
         s.add_argument("--docs", action="store_true",
@@ -35,10 +38,20 @@ def _parser() -> argparse.ArgumentParser:
             s.add_argument("--rounds", type=int, metavar="R", help="timed rounds per size (default: by size)")
             s.add_argument("--tiles", type=int, metavar="T", help="static tiles of the level (default 100,000)")
             s.add_argument("--tile-bodies", type=int, metavar="N", help="moving boxes over the level (default 1,000)")
+        elif name == "accuracy":
+            s.add_argument("--scenarios", type=_names, metavar="A,B,...", help="only these scenarios (default: all)")
         else:
-            s.add_argument("--scenarios", type=lambda v: tuple(v.split(",")), metavar="A,B,...",
-                           help="only these scenarios (default: all)")
+            s.add_argument("--scenes", type=_names, metavar="A,B,...", help="only these scenes (default: all)")
+            s.add_argument("--crowds", type=_names, metavar="A,B,...",
+                           help="only these crowds: balls, boxes, mixed ('' for none; default: all)")
+            s.add_argument("--rounds", type=int, metavar="R", help="timed rounds of every scene (default: by size)")
+            s.add_argument("--crowd-steps", type=int, metavar="S",
+                           help="cap on a crowd's steps (default 1,800, the issue's 30 s; quick: 600)")
     return p
+
+
+def _names(text: str) -> tuple[str, ...]:
+    return tuple(v for v in text.split(",") if v)
 
 
 def _ints(text: str) -> tuple[int, ...]:
@@ -47,7 +60,8 @@ def _ints(text: str) -> tuple[int, ...]:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
     progress = not args.no_progress
     if args.benchmark == "perf":
         from . import perf as mod
@@ -61,10 +75,22 @@ def main(argv: list[str] | None = None) -> int:
                               tile_bodies=tile_bodies, brute_sizes=cfg["brute_sizes"] if args.sizes is None else
                               (min(sizes),), check_up_to=max(small, default=min(sizes)), progress=progress,
                               quick=args.quick)
-    else:
+    elif args.benchmark == "accuracy":
         from . import accuracy as mod
 
         report = mod.run_accuracy(progress=progress, quick=args.quick, scenarios=args.scenarios)
+    else:
+        from . import regimes as mod
+
+        for given, known in ((args.scenes, mod.SCENES), (args.crowds, mod.CROWDS)):
+            if set(given or ()) - set(known):
+                parser.error(f"unknown {sorted(set(given) - set(known))}; known: {', '.join(known)}")
+        cfg: dict = {}
+        if args.rounds:
+            cfg.update(rounds=((10**12, args.rounds),), platformer_rounds=args.rounds)
+        if args.crowd_steps:
+            cfg.update(crowd_steps=args.crowd_steps)
+        report = mod.run_regimes(cfg, scenes=args.scenes, crowds=args.crowds, progress=progress, quick=args.quick)
     command = command_line(argv)
     report["command"] = command
     stem = args.benchmark + ("-quick" if args.quick else "")
@@ -72,12 +98,14 @@ def main(argv: list[str] | None = None) -> int:
         out = Path(args.out)
         write_json(out / f"{stem}.json", report)
         write_csv(out / f"{stem}.csv", report["rows"])
+        if report.get("crowds"):
+            write_csv(out / f"{stem}-crowds.csv", report["crowds"])
     plot_rel = None
     if args.plot:
-        from .plots import plot_accuracy, plot_perf
+        from .plots import plot_accuracy, plot_perf, plot_regimes
 
         plot = Path(args.plot)
-        drawn = (plot_perf if args.benchmark == "perf" else plot_accuracy)(report, plot)
+        drawn = {"perf": plot_perf, "accuracy": plot_accuracy, "regimes": plot_regimes}[args.benchmark](report, plot)
         if drawn:
             plot_rel = os.path.relpath(plot.resolve(), DOCS[args.benchmark].parent)
     if args.docs:

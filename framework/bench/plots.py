@@ -7,7 +7,7 @@ from typing import Any
 
 from .report import optional_module, stderr_note
 
-__all__ = ["plot_accuracy", "plot_perf"]
+__all__ = ["plot_accuracy", "plot_perf", "plot_regimes"]
 
 
 def _pyplot():
@@ -139,5 +139,45 @@ def plot_accuracy(report: dict[str, Any], path: Path) -> bool:
     a_crowd.set_title("Crowd of 64 overlapping boxes: accuracy against cost")
     a_ball.set_title("Elastic ball: energy against cost")
     fig.suptitle(f"python -m framework.bench accuracy, {report['machine']['date']}", fontsize=9)
+    _save(fig, plt, path)
+    return True
+
+
+def plot_regimes(report: dict[str, Any], path: Path) -> bool:
+    """Per scene: ms per step of the three engines (log scale, ours / faster peer written above), and
+    the deepest overlap each left (symlog: 0 stays visible)."""
+    plt = _pyplot()
+    if plt is None:
+        stderr_note(f"matplotlib is not installed: no plot written to {path} (pip install 'framework[bench]')")
+        return False
+    rows = report["rows"]
+    names = [r["scene"] for r in rows]
+    engines = (("ours", "ours"), ("pymunk", "pymunk"), ("box2d", "Box2D v3 (pyb2d3)"))
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(13, 8.5), sharex=True)
+    width = 0.27
+    xs = range(len(rows))
+    for k, (key, label) in enumerate(engines):
+        ms = [r[f"{key}_ms"] or 0.0 for r in rows]
+        pen = [r[f"pen_{key}"] if r[f"pen_{key}"] is not None else float("nan") for r in rows]
+        if any(ms):
+            ax.bar([x + (k - 1) * width for x in xs], ms, width, label=label)
+            bx.bar([x + (k - 1) * width for x in xs], pen, width, label=label)
+    for x, r in zip(xs, rows):
+        if r["ratio"] is not None:
+            top = max(r[f"{k}_ms"] or 0.0 for k, _ in engines)
+            label = f"{r['ratio']:.2f}x" if r["ratio"] < 10 else f"{r['ratio']:.0f}x"
+            ax.annotate(label, (x, top), xytext=(0, 3), textcoords="offset points", ha="center",
+                        fontsize=8, color="black" if r["time_pass"] else "firebrick")
+    ax.set_yscale("log")
+    ax.set_ylabel("ms per step (median, interleaved)")
+    ax.set_title("Cost of a step; label: ours / the faster peer (red: above the issue's goal)")
+    ax.grid(True, axis="y", which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    bx.set_yscale("symlog", linthresh=1e-3)
+    bx.set_ylabel("deepest overlap left (units)")
+    bx.set_title("Accuracy: deepest overlap at the end of the run, one oracle (our exact geometry) for all")
+    bx.grid(True, axis="y", alpha=0.3)
+    bx.set_xticks(list(xs), names, rotation=30, ha="right", fontsize=8)
+    fig.suptitle(f"python -m framework.bench regimes, {report['machine']['date']}", fontsize=9)
     _save(fig, plt, path)
     return True
