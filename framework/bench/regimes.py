@@ -395,14 +395,18 @@ def _outline(shape: Shape, ox: float, oy: float) -> list[tuple[float, float]]:
 
 class Peer(Engine):
     """What the two peers share: a handle per moving piece, and the platformer's game logic
-    (untimed, in :meth:`after_step`): enemies walk at their speed and turn when blocked; the platform
-    goes back and forth between its ends (ours also pauses at each end; this one does not)."""
+    (untimed, in :meth:`after_step`): enemies walk at their speed and turn when blocked or when the
+    cell ahead of their feet holds no tile (as ours turn at walls and ledges); the platform goes back
+    and forth between its ends (ours also pauses at each end; this one does not)."""
 
     def __init__(self, regime: Regime) -> None:
         super().__init__(regime)
         self.handles: list[Any] = []
         self.heading = {i: p.params[1] for i, p in enumerate(regime.pieces) if p.role == "enemy"}
         self.toward_end = {i: True for i, p in enumerate(regime.pieces) if p.role == "platform"}
+        # the cells (unit tiles) holding a solid static piece, for the enemies' ledge probe
+        self.ground = {(math.floor(p.x), math.floor(p.y)) for p in regime.pieces if p.kind == "static"
+                       and not p.sensor} if self.heading else set()
 
     def _pos(self, h) -> tuple[float, float]:
         raise NotImplementedError
@@ -422,8 +426,10 @@ class Peer(Engine):
         pieces, dt = self.regime.pieces, self.regime.dt
         for i, d in self.heading.items():
             h, speed = self.handles[i], pieces[i].params[0]
-            vx, vy = self._vel(h)
-            if abs(vx) < 0.5 * speed:  # blocked by a wall (or another body): turn
+            (x, y), (vx, vy) = self._pos(h), self._vel(h)
+            hw, hh = _half_extents(pieces[i].shape)
+            ledge = (math.floor(x + d * (hw + 0.1)), math.floor(y - hh - 0.5)) not in self.ground
+            if abs(vx) < 0.5 * speed or (ledge and abs(vy) < 0.5 * speed):  # blocked, or at a ledge: turn
                 d = self.heading[i] = -d
             self._set_vel(h, d * speed, vy)
         for i, toward in self.toward_end.items():
