@@ -42,6 +42,7 @@ from .report import (
     machine_info,
     median,
     optional_module,
+    provenance,
     time_call,
 )
 
@@ -546,10 +547,7 @@ def markdown(report: dict[str, Any], command: str, plot: str | None) -> str:
     """The generated part of docs/performance.md."""
     m = report["machine"]
     parts = [
-        f"Taken **{m['date']}** with `{command}` on {m['platform']} ({m['machine']}, {m['cpus']} cpus, "
-        f"load average {m.get('load_average', 'n/a')} at the start), Python {m['python']}, numpy {m['numpy']}, "
-        f"esper {m['esper']}, pymunk {m['pymunk'] or 'absent'}. Rerunning the command rewrites this section, "
-        "the plot and `docs/data/perf.json` / `perf.csv`.",
+        provenance(m, command, f"pymunk {m['pymunk'] or 'absent'}", "perf"),
         "",
         "### Steps (median ms per step; stage columns from `scene.stage_ms`)",
         "",

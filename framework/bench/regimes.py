@@ -58,21 +58,21 @@ from ..collision.batch import collide_many
 from ..collision.broad_phase import find_pairs
 from .perf import DT as PERF_DT
 from .perf import EFFECTS as PERF_EFFECTS
-from .perf import Task, make_boxes, run_interleaved
+from .perf import WARMUP, Task, make_boxes, run_interleaved
 from .progress import Progress
-from .report import Column, format_table, machine_info, median, optional_module
+from .report import Column, format_table, machine_info, median, optional_module, provenance
 
 __all__ = [
-    "COLUMNS", "CROWD_COLUMNS", "Piece", "Regime", "box_pile", "crowd", "goals", "make_engines", "markdown",
-    "max_penetration", "pile_layout", "platformer", "pyramid", "run_crowd", "run_regimes", "run_scene",
-    "scattered", "shape_pile", "stack", "text_report",
+    "COLUMNS", "CROWDS", "CROWD_COLUMNS", "CROWD_KEYS", "Box2DEngine", "Engine", "Ours", "Piece", "PymunkEngine",
+    "ROW_KEYS", "Regime", "SCENES", "box_pile", "crowd", "goals", "judge", "make_engines", "markdown",
+    "max_penetration", "peer_modules", "pile_layout", "platformer", "pyramid", "run_crowd", "run_regimes",
+    "run_scene", "scattered", "shape_pile", "stack", "text_report",
 ]
 
 DT = 1.0 / 60.0
 GRAVITY = (0.0, -10.0)
 GAP = 1.0 / 16.0  # spawn gap between rows of boxes: dyadic, so the exact heights are exact in floats
 SLEEP_TIME = 0.5  # s at rest before a peer body sleeps (Box2D's b2_timeToSleep; pymunk gets the same)
-WARMUP = 5
 CROWD = {"bodies": 120, "pit": 8.0, "gravity": (0.0, -20.0), "max_steps": 1_800, "overlap": 0.02}
 ENGINES = ("ours", "pymunk", "box2d")
 
@@ -82,7 +82,7 @@ SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer
 # timed rounds by the number of moving bodies (the first bound that is >= it); the crowds' step cap
 FULL = {"rounds": ((100, 500), (1_000, 200), (10**9, 80)), "platformer_rounds": 900,
         "crowd_steps": CROWD["max_steps"]}
-QUICK = {"rounds": ((100, 80), (1_000, 30), (10**9, 12)), "platformer_rounds": 240, "crowd_steps": 600}
+QUICK = {"rounds": ((100, 150), (1_000, 50), (10**9, 20)), "platformer_rounds": 300, "crowd_steps": 600}
 
 
 # --- the engine-neutral description ---------------------------------------------------------------
@@ -890,10 +890,8 @@ def markdown(report: dict[str, Any], command: str, plot: str | None) -> str:
     """The generated part of docs/performance.md."""
     m = report["machine"]
     parts = [
-        f"Taken **{m['date']}** with `{command}` on {m['platform']} ({m['machine']}, {m['cpus']} cpus, "
-        f"load average {m.get('load_average', 'n/a')} at the start), Python {m['python']}, numpy {m['numpy']}, "
-        f"esper {m['esper']}, pymunk {m['pymunk'] or 'absent'}, pyb2d3 {m['box2d'] or 'absent'}. Rerunning the "
-        "command rewrites this section, the plot and `docs/data/regimes.json` / `regimes.csv`.",
+        provenance(m, command, f"pymunk {m['pymunk'] or 'absent'}, pyb2d3 {m['box2d'] or 'absent'}", "regimes")
+        + " (and `regimes-crowds.csv`).",
         "",
     ]
     if plot:

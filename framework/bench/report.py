@@ -24,7 +24,7 @@ import numpy as np
 
 __all__ = [
     "Column", "REPO", "format_table", "fmt", "frozen_gc", "machine_info", "median", "optional_module",
-    "replace_generated", "write_csv", "write_json",
+    "provenance", "replace_generated", "write_csv", "write_json",
 ]
 
 REPO = Path(__file__).resolve().parents[2]
@@ -77,6 +77,15 @@ def machine_info() -> dict[str, Any]:
         mod = optional_module(name)
         info[name] = getattr(mod, "__version__", getattr(mod, "version", "installed")) if mod else None
     return info
+
+
+def provenance(m: dict[str, Any], command: str, peers: str, stem: str) -> str:
+    """The first line of a generated docs section: when, how and on what the numbers were taken
+    (``m``: :func:`machine_info`; ``peers``: e.g. ``"pymunk 7.3.1"``; ``stem``: the data files')."""
+    return (f"Taken **{m['date']}** with `{command}` on {m['platform']} ({m['machine']}, {m['cpus']} cpus, "
+            f"load average {m.get('load_average', 'n/a')} at the start), Python {m['python']}, numpy {m['numpy']}, "
+            f"esper {m['esper']}, {peers}. Rerunning the command rewrites this section, the plot and "
+            f"`docs/data/{stem}.json` / `{stem}.csv`.")
 
 
 def command_line(argv: Sequence[str]) -> str:
