@@ -890,8 +890,8 @@ def markdown(report: dict[str, Any], command: str, plot: str | None) -> str:
     """The generated part of docs/performance.md."""
     m = report["machine"]
     parts = [
-        provenance(m, command, f"pymunk {m['pymunk'] or 'absent'}, pyb2d3 {m['box2d'] or 'absent'}", "regimes")
-        + " (and `regimes-crowds.csv`).",
+        provenance(m, command, f"pymunk {m['pymunk'] or 'absent'}, pyb2d3 {m['box2d'] or 'absent'}", "regimes",
+                   ["regimes-crowds.csv"]),
         "",
     ]
     if plot:

@@ -79,13 +79,14 @@ def machine_info() -> dict[str, Any]:
     return info
 
 
-def provenance(m: dict[str, Any], command: str, peers: str, stem: str) -> str:
+def provenance(m: dict[str, Any], command: str, peers: str, stem: str, more: Sequence[str] = ()) -> str:
     """The first line of a generated docs section: when, how and on what the numbers were taken
-    (``m``: :func:`machine_info`; ``peers``: e.g. ``"pymunk 7.3.1"``; ``stem``: the data files')."""
+    (``m``: :func:`machine_info`; ``peers``: e.g. ``"pymunk 7.3.1"``; ``stem``: the data files' name,
+    ``more``: other files the command writes to ``docs/data``)."""
+    files = " / ".join(f"`{f}`" for f in (f"docs/data/{stem}.json", f"{stem}.csv", *more))
     return (f"Taken **{m['date']}** with `{command}` on {m['platform']} ({m['machine']}, {m['cpus']} cpus, "
             f"load average {m.get('load_average', 'n/a')} at the start), Python {m['python']}, numpy {m['numpy']}, "
-            f"esper {m['esper']}, {peers}. Rerunning the command rewrites this section, the plot and "
-            f"`docs/data/{stem}.json` / `{stem}.csv`.")
+            f"esper {m['esper']}, {peers}. Rerunning the command rewrites this section, the plot and {files}.")
 
 
 def command_line(argv: Sequence[str]) -> str:
