@@ -19,7 +19,7 @@ import numpy as np
 
 from .events import CollisionEvent, StepContacts, to_events
 
-__all__ = ["NO_RESOLVED", "NO_SUPPORT", "StepFrame", "new_counters"]
+__all__ = ["NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counters"]
 
 _INTS = np.zeros(0, dtype=np.int64)
 _FLOATS = np.zeros(0)
@@ -31,6 +31,18 @@ def new_counters() -> dict[str, Any]:
     """A sub-step's counters, before any stage ran (see ``Scene.counters``)."""
     return {"systems": [], "integrated": 0, "rehashed": 0, "candidate_pairs": 0, "narrow_tests": {}, "contacts": 0,
             "events": 0, "resolved": 0, "late_contacts": 0, "ccd_stopped": 0, "asleep": 0}
+
+
+def add_counters(total: dict[str, Any], step: dict[str, Any]) -> None:
+    """Sum one sub-step's counters into ``total`` (lists of systems: in order, once)."""
+    for key, value in step.items():
+        if isinstance(value, dict):
+            add_counters(total.setdefault(key, {}), value)
+        elif isinstance(value, list):
+            seen = total.setdefault(key, [])
+            seen.extend(v for v in value if v not in seen)
+        else:
+            total[key] = total.get(key, 0) + value
 
 
 def _pairs() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -21,16 +21,17 @@ import esper
 import numpy as np
 
 from .bodies import Bodies
-from .components import Body, Hitbox, Transform, Velocity, check_component
+from .components import Hitbox, Transform, Velocity
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
+from .entities import check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
-from .frame import StepFrame
+from .frame import StepFrame, add_counters
 from .input import Input
 from .queries import ALL_LAYERS, SceneHit, SpatialQueries
 from .systems import pipeline_stages
 from .systems.geometry import Geometry
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
-from .systems.stage import PRIORITY, STAGES, Pipeline
+from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister
 from .validation import InvalidValue, positive, vector2
 
 __all__ = ["DEFAULT_EFFECTS", "EFFECTS", "SLEEP_SPEED", "SLEEP_STEPS", "STAGES", "Scene", "SceneClosed", "SceneHit",
@@ -41,47 +42,14 @@ _scene_ids = itertools.count(1)
 System = Callable[["Scene", float], Any]
 
 
-def _add_counters(total: dict[str, Any], step: dict[str, Any]) -> None:
-    """Sum one sub-step's counters into ``total`` (lists of systems: in order, once)."""
-    for key, value in step.items():
-        if isinstance(value, dict):
-            _add_counters(total.setdefault(key, {}), value)
-        elif isinstance(value, list):
-            seen = total.setdefault(key, [])
-            seen.extend(v for v in value if v not in seen)
-        else:
-            total[key] = total.get(key, 0) + value
-
-
 def _iterations(value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise InvalidValue(f"Scene response_iterations must be an int >= 1, got {value!r}")
     return value
 
 
-def _unregister(processor: esper.Processor) -> None:
-    """Take one processor instance out of the current esper world (``esper.remove_processor``
-    removes by type, and a scene may hold several processors of one type)."""
-    esper._processors.remove(processor)
-    if esper._processors_dict.get(type(processor)) is processor:
-        del esper._processors_dict[type(processor)]
-
-
 class SceneClosed(RuntimeError, ValueError):
     """The scene was closed; it can no longer be stepped or changed."""
-
-
-class _SystemProcessor(esper.Processor):
-    """A plain ``system(scene, dt)`` function as a processor of the scene's world. One placed
-    around the render stage runs only when it does (the last sub-step of a step)."""
-
-    def __init__(self, system: System, scene: Scene, stage: str) -> None:
-        self.system, self.scene, self.stage = system, scene, stage
-
-    def process(self, dt: float) -> None:
-        if self.stage == "render" and not self.scene.step_frame.render:
-            return
-        self.system(self.scene, dt)
 
 
 class Scene:
@@ -126,7 +94,7 @@ class Scene:
         self.frame = 0
         self.time = 0.0
         self._totals: tuple[list[CollisionEvent], dict[str, Any]] | None = None  # a step of several sub-steps
-        self._systems: list[_SystemProcessor] = []
+        self._systems: list[SystemProcessor] = []
         self._stepping = False
         self._pending_despawn: list[int] = []
         esper.switch_world(self.world)
@@ -233,24 +201,7 @@ class Scene:
 
         A Hitbox needs a Transform; a static body has no Velocity. Nothing changes on error."""
         self._activate()
-        kinds: dict[type, Any] = {}
-        for comp in components:
-            if comp is None or isinstance(comp, type):
-                raise InvalidValue(f"spawn takes component instances, got {comp!r}")
-            check_component(comp)
-            if type(comp) in kinds:
-                raise InvalidValue(f"spawn got two {type(comp).__name__} components: {components!r}")
-            kinds[type(comp)] = comp
-        t, v, h = kinds.get(Transform), kinds.get(Velocity), kinds.get(Hitbox)
-        for comp in (t, v, h):
-            if comp is not None and comp._store is not None:
-                raise InvalidValue(f"{comp!r} already belongs to an entity; give each entity its own")
-        if h is not None and t is None:
-            raise InvalidValue("an entity with a Hitbox needs a Transform")
-        if h is not None and h.body is Body.STATIC and v is not None:
-            raise InvalidValue("a static body never moves: give it no Velocity (or make it kinematic)")
-        if v is not None and t is None:
-            raise InvalidValue("an entity with a Velocity needs a Transform")
+        t, v, h = spawn_components(components)
         entity = esper.create_entity(*components)
         if t is not None:
             self.bodies.store.add(entity, t, v, h)
@@ -294,21 +245,7 @@ class Scene:
         if component is None or isinstance(component, type):
             raise InvalidValue(f"add_component takes a component instance, got {component!r}")
         store = self.bodies.store
-        if isinstance(component, Transform):
-            raise InvalidValue("a Transform is given at spawn and edited in place; it cannot be replaced")
-        try:
-            check_component(component)
-        except InvalidValue as exc:
-            raise InvalidValue(f"entity {entity}: {exc}") from None
-        if isinstance(component, (Velocity, Hitbox)):
-            if entity not in store.row_of:
-                raise InvalidValue(f"entity {entity} has no Transform")
-            if component._store is not None:
-                raise InvalidValue(f"{component!r} already belongs to an entity")
-            hb = component if isinstance(component, Hitbox) else esper.try_component(entity, Hitbox)
-            has_v = isinstance(component, Velocity) or esper.has_component(entity, Velocity)
-            if hb is not None and hb.body is Body.STATIC and has_v:
-                raise InvalidValue("a static body never moves: give it no Velocity")
+        check_added_component(store, entity, component)
         old = esper.try_component(entity, type(component))
         esper.add_component(entity, component)
         if isinstance(component, Velocity):
@@ -360,25 +297,13 @@ class Scene:
 
     # --- systems, processors and handlers ------------------------------------------------------
 
-    @staticmethod
-    def _place(before: str | None, after: str | None) -> tuple[str, int]:
-        """``(stage, priority)`` of a processor placed ``before`` or ``after`` a stage (default:
-        after the response)."""
-        if before is not None and after is not None:
-            raise InvalidValue("give either before= or after=, not both")
-        stage = after if before is None else before
-        stage = "response" if stage is None else stage
-        if stage not in STAGES:
-            raise InvalidValue(f"unknown stage {stage!r}; stages are {STAGES}")
-        return stage, PRIORITY[stage] + (300 if before is not None else -300)
-
     def add_system(self, system: System, *, before: str | None = None, after: str | None = None) -> None:
         """Run ``system(scene, dt)`` every step, before or after a stage (default: after response)."""
-        stage, priority = self._place(before, after)
+        stage, priority = place(before, after)
         if not callable(system):
             raise InvalidValue(f"system must be callable as system(scene, dt), got {system!r}")
         self._activate()
-        proc = _SystemProcessor(system, self, stage)
+        proc = SystemProcessor(system, self, stage)
         self._systems.append(proc)
         esper.add_processor(proc, priority)
 
@@ -387,7 +312,7 @@ class Scene:
             if proc.system == system:
                 self._activate()
                 self._systems.remove(proc)
-                _unregister(proc)
+                unregister(proc)
                 return
         raise InvalidValue(f"system {system!r} is not in this scene")
 
@@ -395,7 +320,7 @@ class Scene:
                       after: str | None = None) -> None:
         """Add an esper processor to the scene's world, before or after a stage (default: after
         the response). ``esper.process`` passes it ``dt``: ``processor.process(dt)``."""
-        stage, priority = self._place(before, after)
+        _stage, priority = place(before, after)
         if not callable(getattr(processor, "process", None)):
             raise InvalidValue(f"processor must have a process(dt) method, got {processor!r}")
         self._activate()
@@ -406,7 +331,7 @@ class Scene:
         self._activate()
         if processor not in esper._processors or processor in self._stages.values():
             raise InvalidValue(f"processor {processor!r} is not a game processor of this scene")
-        _unregister(processor)
+        unregister(processor)
 
     def on_collision(
         self, type_a: type, type_b: type, handler: Callable[[Scene, CollisionEvent], Any],
@@ -447,7 +372,7 @@ class Scene:
             for k in range(n):
                 self._substep(dt / n, render=k == n - 1, checked=k == 0)
                 events.extend(self.events)
-                _add_counters(total, self.counters)
+                add_counters(total, self.counters)
             self._totals = (events, total)
         self.frame += 1
         self.time += dt

@@ -16,11 +16,12 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import esper
 
 from ..frame import StepFrame
+from ..validation import InvalidValue
 
 if TYPE_CHECKING:  # (bodies imports the geometry of this package)
     from ..bodies import Bodies
 
-__all__ = ["PRIORITY", "STAGES", "Pipeline", "Stage"]
+__all__ = ["PRIORITY", "STAGES", "Pipeline", "Stage", "SystemProcessor", "place", "unregister"]
 
 STAGES = ("movement", "ccd", "broad_phase", "narrow_phase", "response", "sleeping", "render")
 # esper runs higher priorities first; a game's processor goes 300 above ("before") or below
@@ -80,3 +81,36 @@ class Stage(esper.Processor):
 
     def run(self, frame: StepFrame) -> bool:
         raise NotImplementedError
+
+
+def place(before: str | None, after: str | None) -> tuple[str, int]:
+    """``(stage, priority)`` of a game processor placed ``before`` or ``after`` a stage (default:
+    after the response); ``ValueError`` for both or an unknown stage."""
+    if before is not None and after is not None:
+        raise InvalidValue("give either before= or after=, not both")
+    stage = after if before is None else before
+    stage = "response" if stage is None else stage
+    if stage not in STAGES:
+        raise InvalidValue(f"unknown stage {stage!r}; stages are {STAGES}")
+    return stage, PRIORITY[stage] + (300 if before is not None else -300)
+
+
+class SystemProcessor(esper.Processor):
+    """A plain ``system(scene, dt)`` function as a processor of the scene's world. One placed
+    around the render stage runs only when it does (the last sub-step of a step)."""
+
+    def __init__(self, system: Any, scene: Any, stage: str) -> None:
+        self.system, self.scene, self.stage = system, scene, stage
+
+    def process(self, dt: float) -> None:
+        if self.stage == "render" and not self.scene.step_frame.render:
+            return
+        self.system(self.scene, dt)
+
+
+def unregister(processor: esper.Processor) -> None:
+    """Take one processor instance out of the current esper world (``esper.remove_processor``
+    removes by type, and a scene may hold several processors of one type)."""
+    esper._processors.remove(processor)
+    if esper._processors_dict.get(type(processor)) is processor:
+        del esper._processors_dict[type(processor)]
