@@ -92,3 +92,11 @@ class Bodies:
         g = self.ensure_geometry()
         near = (g.minx < x + r) & (g.maxx > x - r) & (g.miny < y + r) & (g.maxy > y - r)
         store.wake(np.flatnonzero(near & store.asleep))
+
+    @property
+    def static_hash_current(self) -> bool:
+        """Whether :attr:`hash` holds the static bodies as they are now: it was built (it has a
+        cell size) and no static body was added, moved, changed or removed since (the broad phase
+        and the spatial queries build it again when one was). Read-only: the renderer culls the
+        statics through the hash only while this holds."""
+        return not self.store.static_dirty and self.hash.cell_size is not None
