@@ -41,7 +41,8 @@ def make_scene() -> tuple[Scene, list[int]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m examples.bounce", description=__doc__.splitlines()[0])
+    prog = f"python -m {__package__ or 'examples'}.bounce"  # framework.examples.bounce when installed
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     ap.add_argument("--headless", action="store_true", help="run without a window; print a JSON summary")
     ap.add_argument("--frames", type=int, default=None, metavar="N", help="stop after N steps (headless: 600)")
     args = ap.parse_args(argv)

@@ -61,7 +61,8 @@ def make_scene() -> tuple[Scene, dict[str, int]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m examples.line_of_sight", description=__doc__.splitlines()[0])
+    prog = f"python -m {__package__ or 'examples'}.line_of_sight"  # framework.examples.line_of_sight when installed
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     ap.add_argument("--headless", action="store_true", help="run without a window; print a JSON summary")
     ap.add_argument("--frames", type=int, default=None, metavar="N", help="stop after N steps (headless: 600)")
     args = ap.parse_args(argv)

@@ -55,7 +55,8 @@ def make_scene(seed: int = 7) -> tuple[Scene, dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m examples.shapes_overlay", description=__doc__.splitlines()[0])
+    prog = f"python -m {__package__ or 'examples'}.shapes_overlay"  # framework.examples.shapes_overlay when installed
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     ap.add_argument("--headless", action="store_true", help="run without a window; print a JSON summary")
     ap.add_argument("--frames", type=int, default=None, metavar="N", help="stop after N steps (headless: 300)")
     ap.add_argument("--screenshot", default=None, metavar="PATH", help="write a PNG of the last frame")

@@ -11,13 +11,18 @@ bookkeeping is a couple of vectorised set operations, whatever the number of pai
 
 from __future__ import annotations
 
-from typing import Literal, NamedTuple
+import inspect
+from collections.abc import Callable, Iterable
+from typing import Any, Literal, NamedTuple
 
+import esper
 import numpy as np
 
 from .collision.results import Vec2
+from .validation import InvalidValue
 
-__all__ = ["CollisionEvent", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_member", "sorted_members"]
+__all__ = ["CollisionEvent", "CollisionHandlers", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_member",
+           "sorted_members"]
 
 STARTED: Literal["started"] = "started"
 ONGOING: Literal["ongoing"] = "ongoing"
@@ -108,11 +113,6 @@ class PairTracker:
         self.active, self.keys = now, keys
         return ~was, was, ended
 
-    def forget(self) -> StepContacts:
-        """End every active pair (the scene is closing); return them."""
-        ended, self.active, self.keys = self.active, StepContacts.empty(), np.zeros(0, dtype=np.int64)
-        return ended
-
 
 def to_events(
     contacts: StepContacts, started: np.ndarray, ongoing: np.ndarray, ended: StepContacts
@@ -129,3 +129,86 @@ def to_events(
             out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py))))
     out.sort(key=lambda t: (t[0], t[1], t[2]))
     return [t[3] for t in out]
+
+
+Handler = Callable[[Any, CollisionEvent], Any]
+
+
+def _takes_one_argument(fn: Callable[..., Any]) -> bool:
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    if any(p.kind == p.VAR_POSITIONAL for p in params):
+        return False
+    return sum(p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) for p in params) == 1
+
+
+class CollisionHandlers:
+    """The scene's collision handlers (``scene.on_collision``) and their dispatch after each sub-step.
+
+    ``rows_of``: entity ids -> store rows (for :meth:`wanted`). Entities despawned during a step
+    are remembered by their component types until the dispatch, so their ``ended`` events still
+    reach the handlers of those types."""
+
+    def __init__(self, rows_of: Callable[[np.ndarray], np.ndarray]) -> None:
+        self._rows_of = rows_of
+        self._handlers: list[tuple[type, type, Handler, frozenset[str]]] = []
+        self._ghosts: dict[int, set[type]] = {}
+
+    def add(self, type_a: type, type_b: type, handler: Callable[..., Any], kinds: Iterable[str] | str) -> None:
+        """Register ``handler`` (see ``Scene.on_collision``); ``ValueError`` for unknown kinds."""
+        ks = frozenset([kinds] if isinstance(kinds, str) else kinds)
+        if not ks <= {STARTED, ONGOING, ENDED}:
+            raise InvalidValue(f"kinds must be among 'started', 'ongoing', 'ended', got {sorted(ks)!r}")
+        if not callable(handler):
+            raise InvalidValue(f"handler must be callable, got {handler!r}")
+        if _takes_one_argument(handler):
+            one = handler
+            handler = lambda scene, event: one(event)  # noqa: E731
+        self._handlers.append((type_a, type_b, handler, ks))
+
+    def remember(self, entity: int, types: set[type]) -> None:
+        """``entity`` is being despawned: keep its component types for this step's dispatch."""
+        self._ghosts[entity] = types
+
+    def wanted(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+        """Mask of the pairs (rows) that some handler's two component types could match."""
+        need = np.zeros(ra.size, dtype=bool)
+        for ta, tb, _handler, _kinds in self._handlers:
+            has_a, has_b = self._has_type(ta, ra, rb), self._has_type(tb, ra, rb)
+            need |= (has_a[ra] & has_b[rb]) | (has_a[rb] & has_b[ra])
+        return need
+
+    def _has_type(self, component_type: type, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+        """Per row: whether the entity has a ``component_type`` component (current esper world)."""
+        size = int(max(ra.max(), rb.max())) + 1 if ra.size else 0
+        mask = np.zeros(size, dtype=bool)
+        ents = [e for e, _ in esper.get_component(component_type)]
+        if ents:
+            rows = self._rows_of(np.array(ents, dtype=np.int64))
+            rows = rows[(rows >= 0) & (rows < size)]
+            mask[rows] = True
+        return mask
+
+    def dispatch(self, scene: Any, events: Callable[[], list[CollisionEvent]]) -> None:
+        """Call the handlers for ``events()`` (made only if some handler is registered), each event
+        turned so that ``event.a`` has the handler's first type; then forget the despawned."""
+        ghosts = self._ghosts
+        self._ghosts = {}
+        if not self._handlers:
+            return
+
+        def has(e: int, t: type) -> bool:
+            if e in ghosts:
+                return t in ghosts[e]
+            return esper.has_component(e, t)
+
+        for ev in events():
+            for ta, tb, handler, ks in self._handlers:
+                if ev.kind not in ks:
+                    continue
+                if has(ev.a, ta) and has(ev.b, tb):
+                    handler(scene, ev)
+                elif has(ev.b, ta) and has(ev.a, tb):
+                    handler(scene, ev.flipped())

@@ -71,7 +71,6 @@ class BodyStore:
         self.shapes: list[Any] = []
         self.bad: dict[tuple[int, str], object] = {}
         self.dirty_hitboxes: set[int] = set()
-        self.moved_static: set[int] = set()  # static entities whose transform game code changed
         self.static_epoch = 0  # bumped whenever static_dirty is set
         self.sleep_epoch = 0  # bumped whenever sleep_dirty is set
         self.static_dirty = True  # the static set or a static body changed: re-hash the statics
@@ -84,6 +83,9 @@ class BodyStore:
         self._layers_open = False
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
         self.writes = 0  # bumped by every write from game code (component views)
+        self.motion = 0  # bumped by every move the pipeline makes (move_by_velocity, place)
+        self._lookup = np.full(1, -1, dtype=np.int64)  # entity id -> row (rows_of)
+        self._lookup_version = -1
 
     # --- change flags and the rows that can move ---------------------------------------------
 
@@ -154,6 +156,42 @@ class BodyStore:
         self.active()
         return self._active_sel
 
+    def rows_of(self, entities: np.ndarray) -> np.ndarray:
+        """Rows of ``entities`` (-1 for an id without a row), through a table rebuilt after each
+        structural change: the one entity -> row lookup of the pipeline, the queries and the renderer."""
+        if self._lookup_version != self.version:  # (every spawn and despawn bumps the version)
+            size = (int(self.entity.max()) + 1) if self.n else 1
+            lut = np.full(size, -1, dtype=np.int64)
+            lut[self.entity] = np.arange(self.n)
+            self._lookup, self._lookup_version = lut, self.version
+        entities = np.asarray(entities, dtype=np.int64)
+        out = np.full(entities.size, -1, dtype=np.int64)
+        ok = entities < self._lookup.size
+        out[ok] = self._lookup[entities[ok]]
+        return out
+
+    # --- moves: the only ways the pipeline changes positions -----------------------------------
+    # Each bumps ``motion``, so whatever is derived from positions (hitbox bounds) knows it is stale
+    # without the mover having to say so.
+
+    def move_by_velocity(self, rows: np.ndarray, sel: slice | np.ndarray, dt: float) -> None:
+        """``x += vx dt``, ``y += vy dt`` and ``rot += w dt`` over ``rows`` (``sel``: the same rows,
+        as a slice where they are one run, so the column reads are views, not gathers)."""
+        c = self.cols
+        c["x"][sel] += c["vx"][sel] * dt
+        c["y"][sel] += c["vy"][sel] * dt
+        w = c["w"][sel]
+        spinning = w != 0.0
+        if spinning.any():
+            c["rot"][rows[spinning]] += w[spinning] * dt
+        self.motion += 1
+
+    def place(self, rows: np.ndarray | int, x: np.ndarray | float, y: np.ndarray | float) -> None:
+        """Put ``rows`` at ``(x, y)``."""
+        self.cols["x"][rows] = x
+        self.cols["y"][rows] = y
+        self.motion += 1
+
     # --- columns ---------------------------------------------------------------------------
 
     def __getattr__(self, name: str) -> np.ndarray:
@@ -212,7 +250,6 @@ class BodyStore:
         for key in [k for k in self.bad if k[0] == entity]:
             del self.bad[key]
         self.dirty_hitboxes.discard(entity)
-        self.moved_static.discard(entity)
         if row != last:
             for col in self.cols.values():
                 col[row] = col[last]
@@ -329,7 +366,6 @@ class BodyStore:
             self.bad[(entity, col)] = value
             self.cols[col][row] = math.nan
         if col in ("x", "y", "rot") and self.cols["body"][row] == STATIC and self.cols["kind"][row] >= 0:
-            self.moved_static.add(entity)
             self.static_dirty = True
 
     def hitbox_changed(self, entity: int) -> None:

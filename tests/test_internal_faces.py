@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
-from framework.systems.internal_faces import DOWN, LEFT, RIGHT, UP
+from framework.systems.internal_faces import DOWN, LEFT, RIGHT, UP, InternalFaces
 
 DT = 1.0 / 64.0
 
@@ -15,7 +15,8 @@ DT = 1.0 / 64.0
 def masks(s: Scene, ents) -> list[int]:
     s.step(DT)  # builds the static hash
     rows = np.array([s.store.row_of[e] for e in ents])
-    m = s._internal_faces.masks(s.store, s.geometry, s.hash, s._rows_of, rows)
+    faces = InternalFaces()
+    m = faces.masks(s.store, s.geometry, s.hash, s.store.rows_of, rows)
     return [int(v) for v in m]
 
 

@@ -66,7 +66,7 @@ def snapshot(scene: Scene) -> tuple:
         comps, repr(scene.events), tuple(a.tobytes() for a in scene.contacts),
         tuple(a.tobytes() for a in scene.tracker.active), scene.tracker.keys.tobytes(),
         scene.frame, scene.time, scene.gravity, sorted(scene._pending_despawn), repr(scene.counters),
-        tuple(a.tobytes() for a in scene._support),
+        tuple(a.tobytes() for a in scene.step_frame.support),
     )
 
 
@@ -313,7 +313,8 @@ class SceneMachine(RuleBasedStateMachine):
         ok = ((lay[ra] & msk[rb]) != 0) & ((lay[rb] & msk[ra]) != 0)
         ea, eb = store.entity[ra[ok]], store.entity[rb[ok]]
         want = {(min(a, b), max(a, b)) for a, b in zip(ea.tolist(), eb.tolist())}
-        got = set(zip(scene._pairs[0].tolist(), scene._pairs[1].tolist()))
+        pairs = scene.step_frame.pairs
+        got = set(zip(pairs[0].tolist(), pairs[1].tolist()))
         assert got == want, f"broad phase: missing {want - got}, extra {got - want}"
 
     def _check_narrow_phase(self, scene: Scene, dt: float) -> None:
@@ -521,7 +522,7 @@ class SceneMachine(RuleBasedStateMachine):
         touching: dict[int, set[int]] = {}
         # This step's contacts and the pairs the response resolved (which include last step's
         # resting contacts it kept as support).
-        sa, sb = s._support[0], s._support[1]
+        sa, sb = s.step_frame.support[0], s.step_frame.support[1]
         pressed_by_the_dead = set()  # pressed by a body despawned later in the step: not checked
         for a, b in zip(c.a.tolist() + sa.tolist(), c.b.tolist() + sb.tolist()):
             if a in bs and b in bs and not (bs[a][2].sensor or bs[b][2].sensor):

@@ -253,14 +253,15 @@ def test_culling_draws_only_what_the_view_meets(render, scene):
     renderer = render.Renderer(width=64, height=48, camera=camera)
     scene.renderer = renderer
     calls = []
-    query_box = scene.hash.query_box
-    scene.hash.query_box = lambda *box: calls.append(box) or query_box(*box)
+    static_hash = scene.bodies.hash
+    query_box = static_hash.query_box
+    static_hash.query_box = lambda *box: calls.append(box) or query_box(*box)
     scene.step(1 / 60)
     assert calls, "the statics are culled through the spatial hash"
 
     def expected() -> int:
         x0, y0, x1, y1 = camera.view_box()
-        g = scene.geometry
+        g = scene.bodies.ensure_geometry()
         on = (g.minx < x1 + 1) & (g.maxx > x0 - 1) & (g.miny < y1 + 1) & (g.maxy > y0 - 1)
         return int(on.sum())
 
@@ -274,6 +275,73 @@ def test_culling_draws_only_what_the_view_meets(render, scene):
     img = renderer.capture()
     assert px(img, 5, 5) == RED and px(img, 40, 30) == (0, 0, 0)
     renderer.close()
+
+
+class _Only:
+    """``target`` seen through the ``names`` given (and the ``replaced`` ones): reading anything else
+    fails, naming what was read."""
+
+    def __init__(self, target, names, **replaced):
+        self._target, self._names, self._replaced = target, frozenset(names), replaced
+
+    def __getattr__(self, name):
+        if name in self._replaced:
+            return self._replaced[name]
+        if name not in self._names:
+            raise AttributeError(f"read {name!r}, which is not in the renderer's surface (docs/rendering.md)")
+        return getattr(self._target, name)
+
+
+def test_the_renderer_reads_the_scene_only_through_its_surface(render, scene, tmp_path):
+    """The names of docs/rendering.md's "What the renderer reads", and no others: the same pixels,
+    overlay included, and the same bookkeeping as through the scene itself."""
+    sprite = tmp_path / "sprite.png"
+    render.write_png(sprite, np.full((4, 6, 4), 200, dtype=np.uint8))
+    for i in range(8):
+        scene.spawn(Transform(8.0 + 16.0 * i, 8.0), Hitbox(AABB(16.0, 16.0), body="static"), Visual(RED))
+    scene.spawn(Transform(40.0, 40.0), Velocity(30.0, 0.0), Hitbox(Circle(6.0)), Visual(GREEN))
+    gone = scene.spawn(Transform(80.0, 40.0, 0.3), Velocity(0.0, 0.0), Hitbox(Polygon.box(12.0, 8.0)), Visual(BLUE))
+    scene.spawn(Transform(10.0, 70.0), Velocity(900.0, 0.0), Hitbox(Circle(2.0), ccd=True))
+    scene.spawn(Transform(100.0, 70.0), Visual(image=str(sprite)))
+    scene.add_system(lambda s, dt: s.raycast((0.0, 60.0), (1.0, -0.5), 150.0), after="response")
+    scene.step(1 / 30)
+    assert scene.bodies.static_hash_current
+    bodies = _Only(scene.bodies, {"store", "ensure_geometry", "rows_of", "static_hash_current", "static_rows_in_box",
+                                  "hash"})
+    view = _Only(scene, {"step_frame", "try_get", "exists", "frame", "renderer"}, bodies=bodies)
+    for debug in (False, True):
+        expected = render.screenshot(scene, width=128, height=96, background=BG, debug=debug)
+        seen = render.screenshot(view, width=128, height=96, background=BG, debug=debug)
+        assert np.array_equal(seen, expected), debug
+    renderer = render.Renderer(width=128, height=96)
+    try:
+        renderer.draw(view)
+        assert renderer.stats["drawables"] == 11
+        scene.despawn(gone)
+        renderer.draw(view)  # the drawable of a despawned entity goes (found through bodies.rows_of)
+        assert renderer.stats["drawables"] == 10 and renderer.scene_entities == 11
+    finally:
+        renderer.close()
+
+
+def test_render_modules_import_one_way():
+    """No module of framework.render imports one that imports it back (at the top or in a function)."""
+    import ast
+    from pathlib import Path
+
+    package = Path(__file__).resolve().parents[1] / "framework" / "render"
+    imports = {}
+    for path in package.glob("*.py"):
+        tree = ast.parse(path.read_text())
+        imports[path.stem] = {node.module.split(".")[0] for node in ast.walk(tree)
+                              if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module}
+
+    def reaches(start, goal, seen=()):
+        return any(m == goal or (m not in seen and reaches(m, goal, (*seen, m))) for m in imports.get(start, ()))
+
+    cycles = sorted(m for m in imports if m != "__init__" and reaches(m, m))
+    assert cycles == [], f"import cycles through {cycles}"
+    assert "headless" not in imports["renderer"] and "renderer" not in imports["offscreen"]
 
 
 # --- camera -----------------------------------------------------------------------------------------

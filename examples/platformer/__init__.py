@@ -1,7 +1,8 @@
 """The example platformer: run, jump, stomp, collect, reach the goal.
 
 ``python -m examples.platformer`` plays it in a window; ``--headless --demo`` plays the first level
-by itself. See docs/platformer.md.
+by itself. Installed (``pip install framework``) it is ``framework.examples.platformer``, with its
+levels and images next to its modules. See docs/platformer.md.
 """
 
 from .components import GameState, Tuning

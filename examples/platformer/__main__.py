@@ -1,4 +1,4 @@
-"""Command line: ``python -m examples.platformer [options]``.
+"""Command line: ``python -m examples.platformer [options]`` (installed: ``framework.examples.platformer``).
 
 Plays in a window by default (arrows/WASD to run, space/up/W to jump, down+jump to drop through a
 one-way platform, R to restart the level, F1 for the debug overlay, Esc to quit).
@@ -29,7 +29,7 @@ BACKGROUND = (24, 26, 38)
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(prog="python -m examples.platformer", description="The example platformer.")
+    ap = argparse.ArgumentParser(prog=f"python -m {__package__}", description="The example platformer.")
     ap.add_argument("--headless", action="store_true", help="run without a window and print a JSON summary")
     ap.add_argument("--demo", action="store_true", help="scripted input that plays the first level")
     ap.add_argument("--frames", type=int, default=None, metavar="N", help="stop after N frames")

@@ -25,7 +25,8 @@ if "pyglet.window" not in sys.modules and "pyglet.gl" not in sys.modules:
         _pyglet.options["shadow_window"] = False
 
 from .camera import Camera  # noqa: E402
-from .headless import offscreen_window, screenshot, write_png  # noqa: E402
+from .headless import screenshot  # noqa: E402
+from .offscreen import offscreen_window, write_png  # noqa: E402
 from .overlay import OVERLAY_COLORS, DebugOverlay  # noqa: E402
 from .renderer import Renderer  # noqa: E402
 from .window import Runner, key_name, run  # noqa: E402

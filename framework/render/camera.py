@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ..components import Transform
 from ..validation import InvalidValue, finite, positive
 
 __all__ = ["Camera"]
@@ -112,8 +113,6 @@ class Camera:
         """Take the viewport size, move to the target (if it exists) and clamp to the bounds."""
         self.width, self.height = positive("viewport width", width), positive("viewport height", height)
         if self._target is not None and scene is not None and scene.exists(self._target):
-            from ..components import Transform
-
             t = scene.try_get(self._target, Transform)
             if t is not None:
                 x, y = t.x, t.y

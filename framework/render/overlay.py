@@ -2,11 +2,15 @@
 
 - every hitbox's outline in view (with a Visual or not), coloured by body type
   (:data:`OVERLAY_COLORS`), a circle with a radius showing its rotation;
-- this step's contacts (``scene.contacts``): a cross at each point and the normal (A toward B);
-- the swept paths of continuous-detection bodies (``scene.swept_paths``);
-- the spatial-hash cells in use (``scene.hash.cells_in_use()``);
-- this step's rays (``scene.ray_log``): to the hit, the rest of the ray dimmer, the hit normal;
-- a text line with FPS, entity count and milliseconds per pipeline stage (``scene.stage_ms``).
+- this step's contacts (``scene.step_frame.contacts``): a cross at each point and the normal (A
+  toward B);
+- the swept paths of continuous-detection bodies (``scene.step_frame.swept_paths``);
+- the spatial hash's cells in use, by the static bodies and the last step's moving ones
+  (``scene.bodies.hash.cells_in_use()``);
+- this step's rays (``scene.step_frame.ray_log``): to the hit, the rest of the ray dimmer, the hit
+  normal;
+- a text line with FPS, entity count and milliseconds per pipeline stage
+  (``scene.step_frame.stage_ms``).
 
 All lines go into one vertex buffer, rebuilt from numpy arrays each step and drawn with one
 ``GL_LINES`` call; marks whose size is in pixels (crosses, normals) keep it at any zoom. Lines
@@ -75,51 +79,137 @@ void main()
 _VERTEX_DTYPE = np.dtype([("p", "<f4", (2,)), ("c", "u1", (4,))])
 
 
-def _segs(a: np.ndarray, color: tuple[int, ...] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(m, 4)`` segments x0, y0, x1, y1 and their ``(m, 4)`` uint8 colours."""
-    a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
-    c = np.asarray(color, dtype=np.uint8)
-    if c.ndim == 1:
-        c = np.broadcast_to(c, (a.shape[0], 4))
-    return a, c
+Segments = tuple[np.ndarray, np.ndarray]  # (m, 4) float x0, y0, x1, y1 and their (m, 4) uint8 colours
 
 
-def _outline_segments(store: Any, geom: Any, rows: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The outlines of the hitboxes of ``rows``, coloured by body type."""
-    out: list[tuple[np.ndarray, np.ndarray]] = []
-    if rows.size == 0:
-        return out
+def _segments(ends: Any, color: tuple[int, ...] | np.ndarray) -> Segments:
+    """``(m, 4)`` segments x0, y0, x1, y1 and their ``(m, 4)`` uint8 colours (one colour for all,
+    or one per segment)."""
+    ends = np.asarray(ends, dtype=np.float64).reshape(-1, 4)
+    colors = np.asarray(color, dtype=np.uint8)
+    if colors.ndim == 1:
+        colors = np.broadcast_to(colors, (ends.shape[0], 4))
+    return ends, colors
+
+
+def _body_colors(store: Any, rows: np.ndarray) -> np.ndarray:
+    """``(len(rows), 4)`` uint8: each row's overlay colour (asleep, else sensor, else its body type)."""
     palette = np.array([OVERLAY_COLORS[k] for k in ("dynamic", "kinematic", "static", "sensor", "asleep")],
                        dtype=np.uint8)
     which = store.body[rows].astype(np.int64)  # 0 dynamic, 1 kinematic, 2 static
     which = np.where(store.sensor[rows], 3, which)
     which = np.where(store.asleep[rows], 4, which)
-    colors = palette[which]
+    return palette[which]
+
+
+def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segments]:
+    """The outlines of the hitboxes of ``rows`` (rows with a hitbox), coloured by body type: boxes
+    and polygons edge by edge, circles as :data:`CIRCLE_SEGMENTS` chords and a radius showing
+    their rotation."""
+    out: list[Segments] = []
+    if rows.size == 0:
+        return out
+    colors = _body_colors(store, rows)
     kind = store.kind[rows]
-    hx, hy = geom.hx[rows], geom.hy[rows]
-    pa = np.flatnonzero((kind == KIND_AABB) | (kind == KIND_POLYGON))
-    if pa.size:
-        verts, _count = geom.outlines(store, rows[pa])  # padded by repeating the last vertex
-        world = verts + np.stack([hx[pa], hy[pa]], axis=1)[:, None, :]
-        nxt = np.roll(world, -1, axis=1)
-        seg = np.concatenate([world, nxt], axis=2)  # (R, K, 4)
-        col = np.broadcast_to(colors[pa][:, None, :], seg.shape[:2] + (4,))
-        keep = (seg[..., 0] != seg[..., 2]) | (seg[..., 1] != seg[..., 3])  # padding repeats
-        out.append((seg[keep], col[keep]))
-    ci = np.flatnonzero(kind == KIND_CIRCLE)
-    if ci.size:
-        r = store.radius[rows[ci]][:, None]
-        ang = np.linspace(0.0, 2.0 * math.pi, CIRCLE_SEGMENTS + 1)[None, :]
-        px = hx[ci][:, None] + r * np.cos(ang)
-        py = hy[ci][:, None] + r * np.sin(ang)
-        seg = np.stack([px[:, :-1], py[:, :-1], px[:, 1:], py[:, 1:]], axis=2)
-        col = np.broadcast_to(colors[ci][:, None, :], seg.shape[:2] + (4,))
-        out.append((seg.reshape(-1, 4), col.reshape(-1, 4)))
-        rot = store.rot[rows[ci]]
-        rim = r[:, 0]
-        spoke = np.stack([hx[ci], hy[ci], hx[ci] + rim * np.cos(rot), hy[ci] + rim * np.sin(rot)], axis=1)
-        out.append((spoke, colors[ci]))
+    hx, hy = geometry.hx[rows], geometry.hy[rows]
+    polygons = np.flatnonzero((kind == KIND_AABB) | (kind == KIND_POLYGON))
+    if polygons.size:
+        local, _count = geometry.outlines(store, rows[polygons])  # padded by repeating the last vertex
+        corners = local + np.stack([hx[polygons], hy[polygons]], axis=1)[:, None, :]
+        edges = np.concatenate([corners, np.roll(corners, -1, axis=1)], axis=2)  # (R, K, 4)
+        edge_colors = np.broadcast_to(colors[polygons][:, None, :], edges.shape[:2] + (4,))
+        real = (edges[..., 0] != edges[..., 2]) | (edges[..., 1] != edges[..., 3])  # not padding
+        out.append((edges[real], edge_colors[real]))
+    circles = np.flatnonzero(kind == KIND_CIRCLE)
+    if circles.size:
+        cx, cy = hx[circles], hy[circles]
+        radius = store.radius[rows[circles]]
+        angles = np.linspace(0.0, 2.0 * math.pi, CIRCLE_SEGMENTS + 1)[None, :]
+        rim_x = cx[:, None] + radius[:, None] * np.cos(angles)
+        rim_y = cy[:, None] + radius[:, None] * np.sin(angles)
+        chords = np.stack([rim_x[:, :-1], rim_y[:, :-1], rim_x[:, 1:], rim_y[:, 1:]], axis=2)
+        chord_colors = np.broadcast_to(colors[circles][:, None, :], chords.shape[:2] + (4,))
+        out.append((chords.reshape(-1, 4), chord_colors.reshape(-1, 4)))
+        rot = store.rot[rows[circles]]
+        spokes = np.stack([cx, cy, cx + radius * np.cos(rot), cy + radius * np.sin(rot)], axis=1)
+        out.append((spokes, colors[circles]))
     return out
+
+
+def _cell_segments(static_hash: Any, box: tuple[float, float, float, float]) -> list[Segments]:
+    """The borders of the hash cells in use that meet ``box``."""
+    size = static_hash.cell_size
+    if not size:
+        return []
+    cells = np.asarray(static_hash.cells_in_use(), dtype=np.float64).reshape(-1, 2) * size
+    if cells.shape[0] == 0:
+        return []
+    x0, y0 = cells[:, 0], cells[:, 1]
+    x1, y1 = x0 + size, y0 + size
+    on = (x0 < box[2]) & (x1 > box[0]) & (y0 < box[3]) & (y1 > box[1])
+    x0, y0, x1, y1 = x0[on], y0[on], x1[on], y1[on]
+    borders = np.stack([
+        np.stack([x0, y0, x1, y0], axis=1), np.stack([x1, y0, x1, y1], axis=1),
+        np.stack([x1, y1, x0, y1], axis=1), np.stack([x0, y1, x0, y0], axis=1),
+    ], axis=1).reshape(-1, 4)
+    return [_segments(borders, OVERLAY_COLORS["cell"])]
+
+
+def _swept_path_segments(paths: list) -> list[Segments]:
+    """The swept paths ``((x0, y0), (x1, y1))`` of continuous-detection bodies."""
+    if not paths:
+        return []
+    ends = np.array([(a[0], a[1], b[0], b[1]) for a, b in paths], dtype=np.float64)
+    return [_segments(ends, OVERLAY_COLORS["swept"])]
+
+
+def _ray_segments(ray_log: list, normal_len: float) -> list[Segments]:
+    """Each ray ``(origin, end, first hit or None)``: to its hit, the rest, the hit's normal."""
+    if not ray_log:
+        return []
+    to_hit, rest, normals = [], [], []
+    for (ox, oy), (ex, ey), hit in ray_log:
+        if hit is None:
+            rest.append((ox, oy, ex, ey))
+        else:
+            hx, hy = hit.point
+            to_hit.append((ox, oy, hx, hy))
+            rest.append((hx, hy, ex, ey))
+            normals.append((hx, hy, hx + hit.normal[0] * normal_len, hy + hit.normal[1] * normal_len))
+    out = []
+    for ends, key in ((rest, "ray_rest"), (to_hit, "ray"), (normals, "ray_normal")):
+        if ends:
+            out.append(_segments(np.array(ends, dtype=np.float64), OVERLAY_COLORS[key]))
+    return out
+
+
+def _contact_segments(contacts: Any, cross: float, normal_len: float) -> list[Segments]:
+    """A cross of half size ``cross`` at each contact point, and its normal (A toward B)."""
+    if len(contacts.a) == 0:
+        return []
+    px, py = np.asarray(contacts.px, dtype=np.float64), np.asarray(contacts.py, dtype=np.float64)
+    nx, ny = np.asarray(contacts.nx, dtype=np.float64), np.asarray(contacts.ny, dtype=np.float64)
+    normals = np.stack([px, py, px + nx * normal_len, py + ny * normal_len], axis=1)
+    crosses = np.concatenate([
+        np.stack([px - cross, py - cross, px + cross, py + cross], axis=1),
+        np.stack([px - cross, py + cross, px + cross, py - cross], axis=1),
+    ])
+    return [_segments(normals, OVERLAY_COLORS["normal"]), _segments(crosses, OVERLAY_COLORS["contact"])]
+
+
+def _hud_text(scene: Any, renderer: Any) -> str:
+    """The overlay's two text lines: FPS, entities, drawn, contacts, frame; ms per stage."""
+    frame = scene.step_frame
+    fps = f"{renderer.fps:.0f}" if renderer.fps > 0 else "-"
+    head = (f"FPS {fps}  entities {scene.bodies.store.n}  drawn {renderer.stats.get('drawn', 0)}  "
+            f"contacts {len(frame.contacts.a)}  frame {scene.frame}")
+    ms = dict(frame.stage_ms)
+    if not ms:
+        return f"{head}\nms/step: (not stepped yet)"
+    if "render" not in ms and renderer.draw_ms > 0:  # this stage is running: the last one's time
+        ms["render"] = renderer.draw_ms
+    stages = "  ".join(f"{k} {v:.2f}" for k, v in ms.items())
+    return f"{head}\nms/step: {stages}  total {sum(ms.values()):.2f}"
 
 
 class DebugOverlay:
@@ -156,99 +246,34 @@ class DebugOverlay:
     # --- building ---------------------------------------------------------------------------
 
     def build(self, scene: Any, renderer: Any, rows: np.ndarray) -> None:
-        """Collect this step's overlay lines (in world coordinates) and the text line."""
-        store, geom = scene.store, scene.geometry
+        """Collect this step's overlay lines (in world coordinates) for the visible ``rows`` and
+        the text line. Reads ``scene.bodies`` and ``scene.step_frame`` (see docs/rendering.md)."""
+        bodies, frame = scene.bodies, scene.step_frame
+        store, geometry = bodies.store, bodies.ensure_geometry()
         zoom = renderer.camera.zoom
-        parts: list[tuple[np.ndarray, np.ndarray]] = []
-        parts += self._cells(scene, renderer.camera.view_box())
-        parts += _outline_segments(store, geom, rows[store.kind[rows] >= 0])
-        if scene.swept_paths:
-            paths = np.array([(a[0], a[1], b[0], b[1]) for a, b in scene.swept_paths], dtype=np.float64)
-            parts.append(_segs(paths, OVERLAY_COLORS["swept"]))
-        parts += self._rays(scene.ray_log, NORMAL_PX / zoom)
-        parts += self._contacts(scene.contacts, CROSS_PX / zoom, NORMAL_PX / zoom)
+        parts: list[Segments] = []
+        parts += _cell_segments(bodies.hash, renderer.camera.view_box())
+        parts += _outline_segments(store, geometry, rows[store.kind[rows] >= 0])
+        parts += _swept_path_segments(frame.swept_paths)
+        parts += _ray_segments(frame.ray_log, NORMAL_PX / zoom)
+        parts += _contact_segments(frame.contacts, CROSS_PX / zoom, NORMAL_PX / zoom)
         parts = [p for p in parts if p[0].shape[0]]
         if parts:
-            seg = np.concatenate([p[0] for p in parts])
-            col = np.concatenate([p[1] for p in parts])
-            ok = np.isfinite(seg).all(axis=1)
-            seg, col = seg[ok], col[ok]
+            ends = np.concatenate([p[0] for p in parts])
+            colors = np.concatenate([p[1] for p in parts])
+            finite = np.isfinite(ends).all(axis=1)
+            ends, colors = ends[finite], colors[finite]
         else:
-            seg, col = np.zeros((0, 4)), np.zeros((0, 4), dtype=np.uint8)
-        self._upload(seg, col)
-        self.text = self._hud_lines(scene, renderer)
+            ends, colors = np.zeros((0, 4)), np.zeros((0, 4), dtype=np.uint8)
+        self._upload(ends, colors)
+        self.text = _hud_text(scene, renderer)
 
-    @staticmethod
-    def _cells(scene: Any, box: tuple[float, float, float, float]) -> list[tuple[np.ndarray, np.ndarray]]:
-        hsh = scene.hash
-        size = getattr(hsh, "cell_size", None)
-        if not size or not hasattr(hsh, "cells_in_use"):
-            return []
-        cells = np.asarray(hsh.cells_in_use(), dtype=np.float64).reshape(-1, 2) * size
-        if cells.shape[0] == 0:
-            return []
-        x0, y0 = cells[:, 0], cells[:, 1]
-        x1, y1 = x0 + size, y0 + size
-        on = (x0 < box[2]) & (x1 > box[0]) & (y0 < box[3]) & (y1 > box[1])
-        x0, y0, x1, y1 = x0[on], y0[on], x1[on], y1[on]
-        seg = np.stack([
-            np.stack([x0, y0, x1, y0], axis=1), np.stack([x1, y0, x1, y1], axis=1),
-            np.stack([x1, y1, x0, y1], axis=1), np.stack([x0, y1, x0, y0], axis=1),
-        ], axis=1).reshape(-1, 4)
-        return [_segs(seg, OVERLAY_COLORS["cell"])]
-
-    @staticmethod
-    def _rays(log: list, normal_len: float) -> list[tuple[np.ndarray, np.ndarray]]:
-        if not log:
-            return []
-        hit_seg, rest_seg, normals = [], [], []
-        for (ox, oy), (ex, ey), hit in log:
-            if hit is None:
-                rest_seg.append((ox, oy, ex, ey))
-            else:
-                hx, hy = hit.point
-                hit_seg.append((ox, oy, hx, hy))
-                rest_seg.append((hx, hy, ex, ey))
-                normals.append((hx, hy, hx + hit.normal[0] * normal_len, hy + hit.normal[1] * normal_len))
-        out = []
-        for segs, key in ((rest_seg, "ray_rest"), (hit_seg, "ray"), (normals, "ray_normal")):
-            if segs:
-                out.append(_segs(np.array(segs, dtype=np.float64), OVERLAY_COLORS[key]))
-        return out
-
-    @staticmethod
-    def _contacts(c: Any, cross: float, normal_len: float) -> list[tuple[np.ndarray, np.ndarray]]:
-        if len(c.a) == 0:
-            return []
-        px, py = np.asarray(c.px, dtype=np.float64), np.asarray(c.py, dtype=np.float64)
-        nx, ny = np.asarray(c.nx, dtype=np.float64), np.asarray(c.ny, dtype=np.float64)
-        normals = np.stack([px, py, px + nx * normal_len, py + ny * normal_len], axis=1)
-        crosses = np.concatenate([
-            np.stack([px - cross, py - cross, px + cross, py + cross], axis=1),
-            np.stack([px - cross, py + cross, px + cross, py - cross], axis=1),
-        ])
-        return [_segs(normals, OVERLAY_COLORS["normal"]), _segs(crosses, OVERLAY_COLORS["contact"])]
-
-    @staticmethod
-    def _hud_lines(scene: Any, renderer: Any) -> str:
-        fps = f"{renderer.fps:.0f}" if renderer.fps > 0 else "-"
-        stats = renderer.stats
-        head = (f"FPS {fps}  entities {len(scene.store.row_of)}  drawn {stats.get('drawn', 0)}  "
-                f"contacts {len(scene.contacts.a)}  frame {scene.frame}")
-        ms = dict(scene.stage_ms)
-        if ms and "render" not in ms and renderer.draw_ms > 0:  # this stage is running: the last one's time
-            ms["render"] = renderer.draw_ms
-        stages = "  ".join(f"{k} {v:.2f}" for k, v in ms.items())
-        total = sum(ms.values())
-        if not ms:
-            return f"{head}\nms/step: (not stepped yet)"
-        return f"{head}\nms/step: {stages}  total {total:.2f}"
-
-    def _upload(self, seg: np.ndarray, col: np.ndarray) -> None:
-        m = seg.shape[0]
+    def _upload(self, ends: np.ndarray, colors: np.ndarray) -> None:
+        """Write the segments into the vertex buffer, two vertices each."""
+        m = ends.shape[0]
         data = np.empty(2 * m, dtype=_VERTEX_DTYPE)
-        data["p"] = seg.reshape(2 * m, 2)
-        data["c"] = np.repeat(col, 2, axis=0)
+        data["p"] = ends.reshape(2 * m, 2)
+        data["c"] = np.repeat(colors, 2, axis=0)
         self.count = 2 * m
         if m:
             self._vbo.size = data.nbytes

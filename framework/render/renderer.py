@@ -6,13 +6,18 @@ the GL draw calls happen when a frame is shown (:meth:`Renderer.render`, called 
 runner's ``on_draw`` or by :meth:`Renderer.capture`). So a frame that ran two steps draws once, and
 a frame that ran none shows the last state again.
 
-Culling: the camera's view box picks the rows to draw. Static bodies come from the scene's spatial
-hash (``scene.hash.query_box`` over the view), moving bodies (and bodies without a hitbox) from
-one vectorised test of their bounds; a sprite's reach beyond its hitbox is added to the bounds.
-Only the visible entities are then visited in Python: their Visual is looked up, their drawable
-made on first sight, moved only if their position changed since it was last drawn (a vectorised
-comparison), shown if it was hidden. Drawables that leave the view are hidden, not deleted, and
-deleted only after being out of view for a while (or when their entity goes).
+The renderer reads the scene only through the read-only surface written down in
+docs/rendering.md ("What the renderer reads"): ``scene.bodies`` (the store's columns, the current
+geometry, the one entity -> row lookup, the static spatial hash), ``scene.step_frame`` (for the
+overlay), ``scene.try_get``, ``scene.exists`` and ``scene.frame``.
+
+Culling: the camera's view box picks the rows to draw. Static bodies come from the static spatial
+hash while it is current (``bodies.static_rows_in_box`` over the view), moving bodies (and bodies
+without a hitbox) from one vectorised test of their bounds; a sprite's reach beyond its hitbox is
+added to the bounds. Only the visible entities are then visited in Python: their Visual is looked
+up, their drawable made on first sight, moved only if their position changed since it was last
+drawn (a vectorised comparison), shown if it was hidden. Drawables that leave the view are hidden,
+not deleted, and deleted only after being out of view for a while (or when their entity goes).
 
 Batching: every drawable lives in one :class:`pyglet.graphics.Batch`, under a
 :class:`pyglet.graphics.Group` per ``Visual.z`` (lower z first). pyglet draws a batch with one
@@ -35,12 +40,15 @@ from ..components import Visual
 from ..store import KIND_POLYGON, STATIC
 from .camera import Camera
 from .drawables import ConvexFill, Drawable, fill_triangles, load_image
+from .offscreen import OffscreenTarget, offscreen_window, write_png
 from .overlay import DebugOverlay
 
 __all__ = ["Renderer"]
 
-_HIDDEN_FRAMES = 300  # a drawable out of view this many frames is deleted (made again if it returns)
-_SWEEP_EVERY = 60
+DELETE_HIDDEN_AFTER = 300  # a drawable out of view for this many draws is deleted (made again if it returns)
+CHECK_HIDDEN_EVERY = 60  # draws between two looks for drawables to delete
+
+_NO_ROWS = np.zeros(0, dtype=np.int64)
 
 
 class Renderer:
@@ -77,252 +85,272 @@ class Renderer:
         #: what the last draw did: visible rows, drawables shown, made, moved, deleted
         self.stats: dict[str, int] = {}
         self._batch: Batch | None = None
-        self._groups: dict[int, Group] = {}
-        self._records: dict[int, Drawable] = {}
-        self._shown: set[int] = set()
-        self._images: dict[str, Any] = {}
+        self._z_groups: dict[int, Group] = {}
+        self._drawables: dict[int, Drawable] = {}  # entity -> its drawable (shown or hidden)
+        self._shown_entities: set[int] = set()  # entities whose drawable the last draw showed
+        self._textures: dict[str, Any] = {}  # image path -> texture
         self._overlay: DebugOverlay | None = None
-        self._frame = 0
-        self._store_version = -1
-        self._gone_version = -1
-        self._lut = np.zeros(1, dtype=np.int64)
-        # Per entity id: the last drawn (hx, hy, x, y, rot); the extra reach of its sprite beyond
-        # its bounds; whether it has been looked at once.
-        self._last = np.full((0, 5), np.nan)
-        self._pad = np.zeros(0)
-        self._seen = np.zeros(0, dtype=bool)
-        self._fbo: tuple[Any, Any, int, int] | None = None
+        self._target = OffscreenTarget()  # what capture() draws into
+        self._draws = 0  # render stages run (a drawable's last_seen counts in these)
+        self._store_version_seen = -1  # the store's version when despawned entities were last looked for
         self._scene_entities = 0
+        self._forget_entities()
+
+    def _forget_entities(self) -> None:
+        """Empty the per-entity-id tables (grown as ids grow, by :meth:`_grow`)."""
+        self._drawn_pose = np.full((0, 5), np.nan)  # hx, hy, x, y, rot when last placed
+        self._sprite_reach = np.zeros(0)  # how far a sprite reaches beyond its entity's bounds
+        self._looked_at = np.zeros(0, dtype=bool)  # whether the entity was looked at once
 
     # --- GL context ---------------------------------------------------------------------------
 
-    def _enter(self) -> Any:
+    def _make_current(self) -> Any:
         """Make the renderer's context current; return the one to restore afterwards."""
         if self.window is None:
-            from .headless import offscreen_window
-
             self.window = offscreen_window()
-        prev = gl.current_context
-        if prev is not self.window.context:
+        previous = gl.current_context
+        if previous is not self.window.context:
             self.window.switch_to()
         if self._batch is None:
             self._batch = Batch()
-        return prev
+        return previous
 
-    def _leave(self, prev: Any) -> None:
-        if prev is not None and prev is not gl.current_context:
-            prev.set_current()
+    @staticmethod
+    def _restore(previous: Any) -> None:
+        if previous is not None and previous is not gl.current_context:
+            previous.set_current()
 
     # --- the render stage -----------------------------------------------------------------
 
     def draw(self, scene: Any) -> None:
         """The render stage: follow the camera's target, cull, and bring the drawables (and the
         overlay, with ``debug``) up to date with the scene. No GL draw call happens here."""
-        prev = self._enter()
+        previous = self._make_current()
         t0 = time.perf_counter()
         try:
-            self._frame += 1
+            self._draws += 1
             self.camera.update(scene, self.width, self.height)
-            store = scene.store
-            scene.ensure_geometry()
-            if store.version != self._gone_version:
-                self._forget_gone(store)
-                self._gone_version = store.version
-            self._first_sight(scene)
+            bodies = scene.bodies
+            bodies.ensure_geometry()
+            if bodies.store.version != self._store_version_seen:
+                self._forget_despawned(bodies)
+                self._store_version_seen = bodies.store.version
+            self._look_at_new_entities(scene)
             rows = self.visible_rows(scene)
             self._sync(scene, rows)
-            if self._frame % _SWEEP_EVERY == 0:
-                self._sweep()
+            if self._draws % CHECK_HIDDEN_EVERY == 0:
+                self._delete_long_hidden()
             if self.debug:
                 if self._overlay is None:
                     self._overlay = DebugOverlay()
                 self._overlay.build(scene, self, rows)
-            self._scene_entities = len(store.row_of)
+            self._scene_entities = bodies.store.n
         finally:
             self.draw_ms = (time.perf_counter() - t0) * 1e3
-            self._leave(prev)
+            self._restore(previous)
 
     def visible_rows(self, scene: Any) -> np.ndarray:
-        """Store rows whose bounds (grown by their sprite's reach) meet the camera's view box.
+        """Sorted store rows whose bounds (grown by their sprite's reach) meet the camera's view box
+        plus a pixel of margin.
 
-        Statics come from the spatial hash when it is current; everything else (and the statics
-        when the hash is stale: a static changed since the last step, or detection is off) from
-        one vectorised test of the bounds. Call after ``scene.geometry.update``."""
-        store, geom = scene.store, scene.geometry
-        n = store.n
-        if n == 0:
-            return np.zeros(0, dtype=np.int64)
+        Statics come from the static spatial hash while it is current; everything else (and the
+        statics when the hash is not current: a static changed since it was built, or it never
+        was) from one vectorised test of the bounds."""
+        bodies = scene.bodies
+        store, geometry = bodies.store, bodies.ensure_geometry()
+        if store.n == 0:
+            return _NO_ROWS
+        margin = 1.0 / self.camera.zoom  # a pixel
         x0, y0, x1, y1 = self.camera.view_box()
-        m = 1.0 / self.camera.zoom  # a pixel of margin
-        x0, y0, x1, y1 = x0 - m, y0 - m, x1 + m, y1 + m
-        ents = store.entity
-        self._grow(int(ents.max()) + 1)
-        pad = self._pad[ents]
+        x0, y0, x1, y1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
+        entities = store.entity
+        self._grow(int(entities.max()) + 1)
+        reach = self._sprite_reach[entities]
         static = (store.kind >= 0) & (store.body == STATIC)
-        hsh = scene.hash
-        if "detection" in scene.effects and not store.static_dirty and hsh.cell_size is not None:
-            reach = float(pad[static].max()) if static.any() else 0.0
-            ids = hsh.query_box(x0 - reach, y0 - reach, x1 + reach, y1 + reach)
-            srows = self._rows_of(store, ids)
-            srows = srows[srows >= 0]
-            cand = np.concatenate([srows[static[srows]], np.flatnonzero(~static)])
+        if bodies.static_hash_current:
+            r = float(reach[static].max()) if static.any() else 0.0
+            near = np.asarray(bodies.static_rows_in_box(x0 - r, y0 - r, x1 + r, y1 + r), dtype=np.int64)
+            candidates = np.concatenate([near, np.flatnonzero(~static)])
         else:
-            cand = np.arange(n)
-        x, y, p = store.x[cand], store.y[cand], pad[cand]
-        minx = np.minimum(geom.minx[cand], x - p)
-        maxx = np.maximum(geom.maxx[cand], x + p)
-        miny = np.minimum(geom.miny[cand], y - p)
-        maxy = np.maximum(geom.maxy[cand], y + p)
+            candidates = np.arange(store.n)
+        x, y, r = store.x[candidates], store.y[candidates], reach[candidates]
+        minx = np.minimum(geometry.minx[candidates], x - r)
+        maxx = np.maximum(geometry.maxx[candidates], x + r)
+        miny = np.minimum(geometry.miny[candidates], y - r)
+        maxy = np.maximum(geometry.maxy[candidates], y + r)
         inside = (minx < x1) & (maxx > x0) & (miny < y1) & (maxy > y0)
-        return np.sort(cand[inside])
+        return np.sort(candidates[inside])
 
     # --- bookkeeping ------------------------------------------------------------------------
 
-    def _first_sight(self, scene: Any) -> None:
+    def _look_at_new_entities(self, scene: Any) -> None:
         """Look once at each entity not seen before: a sprite's reach beyond the entity's bounds
         must be known before culling can keep a sprite that hangs into the view."""
-        store = scene.store
+        store = scene.bodies.store
         if store.n == 0:
             return
-        ents = store.entity
-        self._grow(int(ents.max()) + 1)
-        new = ents[~self._seen[ents]]
+        entities = store.entity
+        self._grow(int(entities.max()) + 1)
+        new = entities[~self._looked_at[entities]]
         if new.size:
-            for e in new.tolist():
-                vis = scene.try_get(e, Visual)
-                if vis is not None and vis.image is not None:
-                    tex = self._image(vis.image, e)
-                    self._pad[e] = 0.5 * math.hypot(tex.width, tex.height)
-            self._seen[new] = True
+            for entity in new.tolist():
+                visual = scene.try_get(entity, Visual)
+                if visual is not None and visual.image is not None:
+                    self._note_sprite_reach(entity, self._texture(visual.image, entity))
+            self._looked_at[new] = True
+
+    def _note_sprite_reach(self, entity: int, texture: Any) -> None:
+        self._sprite_reach[entity] = 0.5 * math.hypot(texture.width, texture.height)
 
     def _grow(self, size: int) -> None:
-        have = self._pad.shape[0]
+        """Make the per-entity-id tables hold ids below ``size``."""
+        have = self._sprite_reach.shape[0]
         if size <= have:
             return
         new = max(size, 2 * have, 64)
-        last = np.full((new, 5), np.nan)
-        last[:have] = self._last
-        pad = np.zeros(new)
-        pad[:have] = self._pad
-        seen = np.zeros(new, dtype=bool)
-        seen[:have] = self._seen
-        self._last, self._pad, self._seen = last, pad, seen
+        drawn_pose = np.full((new, 5), np.nan)
+        drawn_pose[:have] = self._drawn_pose
+        sprite_reach = np.zeros(new)
+        sprite_reach[:have] = self._sprite_reach
+        looked_at = np.zeros(new, dtype=bool)
+        looked_at[:have] = self._looked_at
+        self._drawn_pose, self._sprite_reach, self._looked_at = drawn_pose, sprite_reach, looked_at
 
-    def _rows_of(self, store: Any, ids: np.ndarray) -> np.ndarray:
-        if self._lut.shape[0] <= (int(store.entity.max()) if store.n else 0) or \
-                self._store_version != store.version:
-            lut = np.full((int(store.entity.max()) + 1) if store.n else 1, -1, dtype=np.int64)
-            lut[store.entity] = np.arange(store.n)
-            self._lut = lut
-            self._store_version = store.version
-        ids = np.asarray(ids, dtype=np.int64)
-        out = np.full(ids.shape[0], -1, dtype=np.int64)
-        ok = ids < self._lut.shape[0]
-        out[ok] = self._lut[ids[ok]]
-        return out
+    def _forget_despawned(self, bodies: Any) -> None:
+        """Delete the drawables of entities that left the scene (no row in the store)."""
+        if not self._drawables:
+            return
+        entities = np.fromiter(self._drawables, dtype=np.int64, count=len(self._drawables))
+        for entity in entities[bodies.rows_of(entities) < 0].tolist():
+            self._drawables.pop(entity).delete()
+            self._shown_entities.discard(entity)
 
-    def _forget_gone(self, store: Any) -> None:
-        """Delete the drawables of entities that left the scene."""
-        row_of = store.row_of
-        for e in [e for e in self._records if e not in row_of]:
-            self._records.pop(e).delete()
-            self._shown.discard(e)
-
-    def _sweep(self) -> None:
+    def _delete_long_hidden(self) -> None:
         """Delete drawables that have been out of view for a long time."""
-        old = self._frame - _HIDDEN_FRAMES
-        for e in [e for e, r in self._records.items() if not r.shown and r.last_seen < old]:
-            self._records.pop(e).delete()
+        oldest = self._draws - DELETE_HIDDEN_AFTER
+        long_hidden = [e for e, d in self._drawables.items() if not d.shown and d.last_seen < oldest]
+        for entity in long_hidden:
+            self._drawables.pop(entity).delete()
             self.stats["deleted"] = self.stats.get("deleted", 0) + 1
 
-    def _group(self, z: int) -> Group:
-        g = self._groups.get(z)
-        if g is None:
-            g = self._groups[z] = Group(order=z)
-        return g
+    def _z_group(self, z: int) -> Group:
+        group = self._z_groups.get(z)
+        if group is None:
+            group = self._z_groups[z] = Group(order=z)
+        return group
 
-    def _image(self, path: str, entity: int) -> Any:
-        tex = self._images.get(path)
-        if tex is None:
+    def _texture(self, path: str, entity: int) -> Any:
+        texture = self._textures.get(path)
+        if texture is None:
             try:
-                tex = load_image(path)
+                texture = load_image(path)
             except Exception as exc:  # a missing or unreadable file: say which entity and path
                 raise ValueError(
                     f"entity {entity}: Visual image {path!r} could not be loaded: {exc}"
                 ) from exc
-            self._images[path] = tex
-        return tex
+            self._textures[path] = texture
+        return texture
 
     # --- drawables ------------------------------------------------------------------------
 
-    def _make(self, entity: int, vis: Visual, shape: Any, kind: int) -> Drawable | None:
-        group = self._group(vis.z)
-        color = tuple(vis.color)
-        if vis.image is not None:
-            tex = self._image(vis.image, entity)
-            sprite = pyglet.sprite.Sprite(tex, 0.0, 0.0, batch=self._batch, group=group)
+    def _make(self, entity: int, visual: Visual, shape: Any, kind: int) -> Drawable | None:
+        """A new drawable for ``entity``: its image as a sprite, else its hitbox ``shape`` filled
+        (``None`` when it has neither)."""
+        group = self._z_group(visual.z)
+        color = tuple(visual.color)
+        if visual.image is not None:
+            texture = self._texture(visual.image, entity)
+            sprite = pyglet.sprite.Sprite(texture, 0.0, 0.0, batch=self._batch, group=group)
             if color != (255, 255, 255, 255):
                 sprite.color = color
             self._grow(entity + 1)
-            self._pad[entity] = 0.5 * math.hypot(tex.width, tex.height)
-            return Drawable(sprite, "sprite", shape, vis.image, vis.z, color, True)
+            self._note_sprite_reach(entity, texture)
+            return Drawable(sprite, "sprite", shape, visual.image, visual.z, color, True)
         if shape is None:
             return None  # a Visual without an image needs a hitbox to take its shape from
         fill = ConvexFill(fill_triangles(shape, self.camera.zoom), 0.0, 0.0, 0.0, color,
                           batch=self._batch, group=group)
-        return Drawable(fill, "fill", shape, None, vis.z, color, kind == KIND_POLYGON)
+        return Drawable(fill, "fill", shape, None, visual.z, color, kind == KIND_POLYGON)
+
+    def _remake(self, entity: int, visual: Visual, shape: Any, kind: int) -> Drawable | None:
+        """Replace ``entity``'s drawable (if any) by a new one (``None``: nothing to draw)."""
+        old = self._drawables.pop(entity, None)
+        if old is not None:
+            old.delete()
+        drawable = self._make(entity, visual, shape, kind)
+        if drawable is not None:
+            self._drawables[entity] = drawable
+        return drawable
+
+    def _refresh(self, drawable: Drawable, visual: Visual) -> bool:
+        """Take ``visual``'s z and colour; show the drawable if it was hidden. Return whether it
+        was (it must then be placed: it has not followed its entity while hidden)."""
+        if drawable.z != visual.z:
+            drawable.set_group(visual.z, self._z_group(visual.z))
+        if drawable.color != visual.color:
+            drawable.set_color(tuple(visual.color))
+        if drawable.shown:
+            return False
+        drawable.show()
+        return True
+
+    def _poses(self, bodies: Any, rows: np.ndarray, entities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(poses, moved)``: each row's ``(hx, hy, x, y, rot)`` (hitbox origin, Transform,
+        rotation) and whether it differs from the pose its entity was last drawn at (which
+        becomes this one)."""
+        store, geometry = bodies.store, bodies.ensure_geometry()
+        if rows.size == 0:
+            return np.zeros((0, 5)), np.zeros(0, dtype=bool)
+        self._grow(int(entities.max()) + 1)
+        poses = np.stack([geometry.hx[rows], geometry.hy[rows], store.x[rows], store.y[rows], store.rot[rows]],
+                         axis=1)
+        moved = (poses != self._drawn_pose[entities]).any(axis=1)
+        self._drawn_pose[entities] = poses
+        return poses, moved
 
     def _sync(self, scene: Any, rows: np.ndarray) -> None:
-        store, geom = scene.store, scene.geometry
-        ents = store.entity[rows]
-        made = moved_n = 0
-        if rows.size:
-            self._grow(int(ents.max()) + 1)
-        cur = np.stack([geom.hx[rows], geom.hy[rows], store.x[rows], store.y[rows], store.rot[rows]], axis=1)
-        moved = (cur != self._last[ents]).any(axis=1) if rows.size else np.zeros(0, dtype=bool)
-        self._last[ents] = cur
-        records, frame = self._records, self._frame
-        hitboxes = store.hitboxes
-        kinds = store.kind[rows].tolist()
+        """Bring the drawables of the visible ``rows`` up to date with their entities' Visual,
+        hitbox and pose; hide the drawables of entities no longer visible."""
+        store = scene.bodies.store
+        entities = store.entity[rows]
+        poses, moved = self._poses(scene.bodies, rows, entities)
+        hitboxes, kinds = store.hitboxes, store.kind[rows].tolist()
+        drawables, draws, try_get = self._drawables, self._draws, scene.try_get
         shown: set[int] = set()
-        try_get = scene.try_get
-        for i, (e, r, mv) in enumerate(zip(ents.tolist(), rows.tolist(), moved.tolist())):
-            vis = try_get(e, Visual)
-            rec = records.get(e)
-            if vis is None or not vis.visible:
+        made = placed = 0
+        for i, (entity, row, must_place) in enumerate(zip(entities.tolist(), rows.tolist(), moved.tolist())):
+            visual = try_get(entity, Visual)
+            if visual is None or not visual.visible:
                 continue
-            hb = hitboxes[r]
-            shape = None if hb is None else hb.shape
-            if rec is None or rec.image != vis.image or (vis.image is None and rec.shape is not shape):
-                if rec is not None:
-                    records.pop(e).delete()
-                rec = self._make(e, vis, shape, kinds[i])
-                if rec is None:
+            hitbox = hitboxes[row]
+            shape = None if hitbox is None else hitbox.shape
+            drawable = drawables.get(entity)
+            if drawable is None or drawable.image != visual.image or (
+                    visual.image is None and drawable.shape is not shape):
+                drawable = self._remake(entity, visual, shape, kinds[i])
+                if drawable is None:
                     continue
-                records[e] = rec
                 made += 1
-                mv = True
-            else:
-                if rec.z != vis.z:
-                    rec.set_group(vis.z, self._group(vis.z))
-                if rec.color != vis.color:
-                    rec.set_color(tuple(vis.color))
-                if not rec.shown:
-                    rec.show()
-                    mv = True
-            if mv:
-                c = cur[i]
-                rec.place(float(c[0]), float(c[1]), float(c[2]), float(c[3]), float(c[4]))
-                moved_n += 1
-            rec.last_seen = frame
-            shown.add(e)
-        for e in self._shown - shown:
-            rec = records.get(e)
-            if rec is not None and rec.shown:
-                rec.hide()
-        self._shown = shown
-        self.stats = {"visible_rows": int(rows.size), "drawn": len(shown), "made": made, "moved": moved_n,
-                      "drawables": len(records)}
+                must_place = True
+            elif self._refresh(drawable, visual):
+                must_place = True
+            if must_place:
+                hx, hy, x, y, rot = poses[i].tolist()
+                drawable.place(hx, hy, x, y, rot)
+                placed += 1
+            drawable.last_seen = draws
+            shown.add(entity)
+        self._hide_all_but(shown)
+        self.stats = {"visible_rows": int(rows.size), "drawn": len(shown), "made": made, "moved": placed,
+                      "drawables": len(drawables)}
+
+    def _hide_all_but(self, shown: set[int]) -> None:
+        """Hide the drawables shown by the last draw whose entities are not in ``shown``."""
+        for entity in self._shown_entities - shown:
+            drawable = self._drawables.get(entity)
+            if drawable is not None and drawable.shown:
+                drawable.hide()
+        self._shown_entities = shown
 
     # --- GL: showing a frame ------------------------------------------------------------------
 
@@ -332,7 +360,7 @@ class Renderer:
 
         ``window``: whose ``projection`` / ``view`` (pyglet's WindowBlock) to set; default the
         renderer's own window."""
-        prev = self._enter()
+        previous = self._make_current()
         win = window if window is not None else self.window
         try:
             win.projection = Mat4.orthogonal_projection(0.0, float(self.width), 0.0, float(self.height),
@@ -346,37 +374,17 @@ class Renderer:
                 self._overlay.draw_hud(self)
             win.view = Mat4()
         finally:
-            self._leave(prev)
+            self._restore(previous)
 
     def capture(self, path: str | None = None) -> np.ndarray:
         """Render the last :meth:`draw` offscreen into an RGBA8 texture (pixel-exact) and return
         it as a ``(height, width, 4)`` uint8 array, top row first, alpha 255; also written as a
         PNG when ``path`` is given."""
-        from .headless import read_pixels, write_png
-
-        prev = self._enter()
+        previous = self._make_current()
         try:
-            w, h = self.width, self.height
-            if self._fbo is None or self._fbo[2:] != (w, h):
-                tex = pyglet.image.Texture.create(w, h, internalformat=gl.GL_RGBA8)
-                fbo = pyglet.image.Framebuffer()
-                fbo.attach_texture(tex)
-                self._fbo = (fbo, tex, w, h)
-            fbo = self._fbo[0]
-            fbo.bind()
-            try:
-                if not fbo.is_complete:
-                    raise RuntimeError(f"offscreen framebuffer incomplete: {fbo.get_status()}")
-                gl.glViewport(0, 0, w, h)
-                r, g, b = (c / 255.0 for c in self.background[:3])
-                gl.glClearColor(r, g, b, 1.0)
-                gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
-                self.render()
-                pixels = read_pixels(w, h)
-            finally:
-                fbo.unbind()
+            pixels = self._target.capture(self.width, self.height, self.background, self.render)
         finally:
-            self._leave(prev)
+            self._restore(previous)
         if path is not None:
             write_png(path, pixels)
         return pixels
@@ -385,39 +393,32 @@ class Renderer:
 
     def reset(self) -> None:
         """Forget every drawable (e.g. before drawing another scene, whose entity ids differ)."""
-        if self._records or self._overlay is not None:
-            prev = self._enter()
+        if self._drawables or self._overlay is not None:
+            previous = self._make_current()
             try:
-                for rec in self._records.values():
-                    rec.delete()
+                for drawable in self._drawables.values():
+                    drawable.delete()
             finally:
-                self._leave(prev)
-        self._records.clear()
-        self._shown = set()
-        self._last = np.full((0, 5), np.nan)
-        self._pad = np.zeros(0)
-        self._seen = np.zeros(0, dtype=bool)
-        self._store_version = -1
-        self._gone_version = -1
-        self._lut = np.zeros(1, dtype=np.int64)
+                self._restore(previous)
+        self._drawables.clear()
+        self._shown_entities = set()
+        self._forget_entities()
+        self._store_version_seen = -1
 
     def close(self) -> None:
         """Delete the renderer's GL objects (drawables, overlay buffers, offscreen target)."""
         if self.window is None:
             return
         self.reset()
-        prev = self._enter()
+        previous = self._make_current()
         try:
             if self._overlay is not None:
                 self._overlay.delete()
                 self._overlay = None
-            if self._fbo is not None:
-                self._fbo[0].delete()
-                self._fbo[1].delete()
-                self._fbo = None
+            self._target.delete()
             self._batch = None
         finally:
-            self._leave(prev)
+            self._restore(previous)
 
     @property
     def scene_entities(self) -> int:

@@ -1,2 +1,26 @@
-"""The pipeline's stages, one module each: movement, continuous detection, broad phase, narrow
-phase (with collision events) and response. Each reads what the previous one wrote."""
+"""The pipeline's stages, one module each, each an esper processor: movement, continuous detection,
+broad phase, narrow phase (contacts and their events), response, sleeping and render. Each reads
+the step's frame that the stages before it wrote (see :mod:`framework.frame`)."""
+
+from __future__ import annotations
+
+from .broad_phase import BroadPhase
+from .ccd import ContinuousDetection
+from .movement import Movement
+from .narrow_phase import NarrowPhase
+from .render import Render
+from .response import Response
+from .sleeping import Sleeping
+from .stage import STAGES, Pipeline, Stage
+
+__all__ = ["BroadPhase", "ContinuousDetection", "Movement", "NarrowPhase", "Pipeline", "Render", "Response",
+           "STAGES", "Sleeping", "Stage", "pipeline_stages"]
+
+_ORDER = (Movement, ContinuousDetection, BroadPhase, NarrowPhase, Response, Sleeping, Render)
+
+
+def pipeline_stages(pipeline: Pipeline) -> list[Stage]:
+    """One instance of every stage, in pipeline order, sharing ``pipeline``."""
+    stages = [cls(pipeline) for cls in _ORDER]
+    assert tuple(s.name for s in stages) == STAGES
+    return stages

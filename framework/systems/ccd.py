@@ -16,10 +16,34 @@ import math
 import numpy as np
 
 from ..collision.sweep import time_of_impact
+from ..frame import StepFrame
 from ..store import STATIC, BodyStore
 from .geometry import Geometry
+from .stage import Stage
 
-__all__ = ["sweep_ccd_bodies"]
+__all__ = ["ContinuousDetection", "sweep_ccd_bodies"]
+
+
+class ContinuousDetection(Stage):
+    """Sweep the bodies that asked for it (``Hitbox(ccd=True)``) over the step's motion."""
+
+    name = "ccd"
+    needs = frozenset({"continuous", "movement"})
+
+    def run(self, frame: StepFrame) -> bool:
+        rows = frame.ccd_rows
+        bodies = self.bodies
+        store = bodies.store
+        if rows.size == 0 or rows.max() >= store.n:
+            return False
+        geom = bodies.ensure_geometry()
+        frame.counters["rehashed"] += bodies.sync_static()
+        stopped = sweep_ccd_bodies(store, geom, rows, *frame.ccd_start, bodies.static_rows_in_box, frame.counters)
+        frame.counters["ccd_stopped"] = stopped
+        x0, y0 = frame.ccd_start
+        frame.swept_paths = list(zip(zip(x0.tolist(), y0.tolist()),
+                                     zip(store.x[rows].tolist(), store.y[rows].tolist())))
+        return True
 
 
 def sweep_ccd_bodies(
@@ -87,7 +111,6 @@ def sweep_ccd_bodies(
         slop = 1e-6 * float(store.bound[r])
         extra = slop / toward if toward > 0.0 else 0.0
         f = min(1.0, f + extra)
-        c["x"][r] = x0 + mx * f
-        c["y"][r] = y0 + my * f
+        store.place(r, x0 + mx * f, y0 + my * f)
         stopped += 1
     return stopped

@@ -1,16 +1,20 @@
 """Movement: integrate velocities (semi-implicit Euler), with optional gravity.
 
 Only rows with a Velocity are touched; static and sleeping bodies never move. Gravity accelerates dynamic
-bodies only (kinematic ones move exactly as game code tells them).
+bodies only (kinematic ones move exactly as game code tells them). The stage also records where
+every row started the step (for one-way platforms and sleeping) and which bodies continuous
+detection will sweep.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..frame import StepFrame
 from ..store import DYNAMIC, STATIC, BodyStore
+from .stage import Stage
 
-__all__ = ["integrate", "integrate_rows"]
+__all__ = ["Movement", "integrate", "integrate_rows"]
 
 
 def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> np.ndarray:
@@ -30,8 +34,7 @@ def integrate_rows(store: BodyStore, rows: np.ndarray, dt: float, gravity: tuple
 
 def _advance(store: BodyStore, rows: np.ndarray, sel: slice | np.ndarray, dt: float,
              gravity: tuple[float, float]) -> None:
-    """Semi-implicit Euler on ``rows`` (``sel``: the same rows, as a slice where they are one run,
-    so the column reads are views, not gathers)."""
+    """Semi-implicit Euler on ``rows`` (``sel``: the same rows, as a slice where they are one run)."""
     if rows.size == 0:
         return
     c = store.cols
@@ -42,9 +45,36 @@ def _advance(store: BodyStore, rows: np.ndarray, sel: slice | np.ndarray, dt: fl
             c["vx"][dyn] += gx * dt
         if gy:
             c["vy"][dyn] += gy * dt
-    c["x"][sel] += c["vx"][sel] * dt
-    c["y"][sel] += c["vy"][sel] * dt
-    w = c["w"][sel]
-    spinning = w != 0.0
-    if spinning.any():
-        c["rot"][rows[spinning]] += w[spinning] * dt
+    store.move_by_velocity(rows, sel, dt)
+
+
+class Movement(Stage):
+    """Integrate the moving bodies; record the step's start positions and the bodies to sweep."""
+
+    name = "movement"
+    needs = frozenset({"movement"})
+
+    def __init__(self, pipeline) -> None:
+        super().__init__(pipeline)
+        self._start_key: tuple[int, ...] | None = None
+        self._start_buf = (np.zeros(0), np.zeros(0))
+
+    def run(self, frame: StepFrame) -> bool:
+        store = self.bodies.store
+        # Where every row starts the step (for one-way platforms and sleeping); static rows are
+        # copied again only when the static set changed.
+        key = (store.version, store.static_epoch, store.n)
+        if key != self._start_key:
+            self._start_buf = (store.x.copy(), store.y.copy())
+            self._start_key = key
+        else:
+            sel = store.active_sel()[2]
+            self._start_buf[0][sel], self._start_buf[1][sel] = store.x[sel], store.y[sel]
+        frame.start_x, frame.start_y = self._start_buf
+        movers = store.active()[0]
+        ccd = movers[store.ccd[store.active_sel()[0]]]
+        frame.ccd_rows = ccd
+        frame.ccd_start = (store.x[ccd].copy(), store.y[ccd].copy())
+        rows = integrate(store, frame.dt, self.pipeline.active_gravity())
+        frame.counters["integrated"] = int(rows.size)
+        return True

@@ -11,10 +11,14 @@ import numpy as np
 
 from ..arrays import distinct
 from ..collision import batch
-from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, BodyStore
+from ..events import PairTracker, StepContacts
+from ..frame import StepFrame
+from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, STATIC, BodyStore
 from .geometry import Geometry
+from .movement import integrate_rows
+from .stage import Stage
 
-__all__ = ["filter_layers", "pair_contacts", "KIND_PAIR_NAMES"]
+__all__ = ["NarrowPhase", "filter_layers", "pair_contacts", "KIND_PAIR_NAMES"]
 
 KIND_PAIR_NAMES = {
     (0, 0): "aabb-aabb", (0, 1): "aabb-circle", (0, 2): "aabb-polygon",
@@ -93,3 +97,90 @@ def pair_contacts(
             return res
         hit[idx], nx[idx], ny[idx], depth[idx], px[idx], py[idx] = res
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
+class NarrowPhase(Stage):
+    """Measure the candidate pairs; fill ``frame.contacts`` (entities a < b, normal from a to b),
+    ``frame.contact_rows`` and, through the pair tracker, ``frame.started`` and ``frame.ended``.
+
+    Pairs of sleeping (or sleeping and static) bodies are not measured: they keep last step's
+    contact, so their events stay ``ongoing`` while they sleep. A touch by an awake solid body wakes
+    a sleeper, which then catches up on the step it slept through (see :meth:`_catch_up_woken`)."""
+
+    name = "narrow_phase"
+    needs = frozenset({"detection"})
+
+    def __init__(self, pipeline) -> None:
+        super().__init__(pipeline)
+        self.tracker = PairTracker()
+
+    def run(self, frame: StepFrame) -> bool:
+        bodies = self.bodies
+        store, geom = bodies.store, bodies.geometry
+        ea, eb, ra, rb = frame.pairs
+        if geom.version != store.version:
+            # A system changed hitboxes after the broad phase: measure the pairs as they are now.
+            live = (store.kind[ra] >= 0) & (store.kind[rb] >= 0)
+            ea, eb, ra, rb = ea[live], eb[live], ra[live], rb[live]
+            geom.update(store)
+        res = pair_contacts(store, geom, ra, rb, frame.counters["narrow_tests"])
+        h = np.flatnonzero(res.hit)
+        contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
+        rows = (ra[h], rb[h])
+        if frame.n_asleep:
+            contacts, rows = self._keep_sleepers(frame, contacts, rows)
+        frame.contacts, frame.contact_rows = contacts, rows
+        frame.started, _ongoing, frame.ended = self.tracker.update(contacts)
+        frame._events = None
+        frame.counters["contacts"] = int(contacts.a.size)
+        frame.counters["events"] = int(h.size + frame.ended.a.size)
+        return True
+
+    def _keep_sleepers(self, frame: StepFrame, contacts: StepContacts, rows: tuple[np.ndarray, np.ndarray]):
+        """Add last step's contacts between idle bodies (asleep or static); wake sleepers touched by
+        an awake solid body, and bring them up to date."""
+        store = self.bodies.store
+        prev = self.tracker.active
+        pa, pb = self.bodies.rows_of(prev.a), self.bodies.rows_of(prev.b)
+        ok = (pa >= 0) & (pb >= 0)
+        idle = store.asleep | (store.body == STATIC)
+        frozen = np.flatnonzero(ok & idle[np.maximum(pa, 0)] & idle[np.maximum(pb, 0)])
+        if frozen.size:
+            merged = [np.concatenate([x, y[frozen]]) for x, y in zip(contacts, prev)]
+            order = np.lexsort((merged[1], merged[0]))
+            contacts = StepContacts(*(m[order] for m in merged))
+            rows = (np.concatenate([rows[0], pa[frozen]])[order], np.concatenate([rows[1], pb[frozen]])[order])
+        a_, b_ = rows
+        solid = ~(store.sensor[a_] | store.sensor[b_])
+        wake_b = solid & store.asleep[b_] & ~store.asleep[a_] & (store.body[a_] != STATIC)
+        wake_a = solid & store.asleep[a_] & ~store.asleep[b_] & (store.body[b_] != STATIC)
+        woken = distinct(np.concatenate([b_[wake_b], a_[wake_a]]))
+        if woken.size:
+            store.wake(woken)
+            contacts, rows = self._catch_up_woken(woken, frame.dt, contacts, rows)
+        return contacts, rows
+
+    def _catch_up_woken(self, woken: np.ndarray, dt: float, contacts: StepContacts,
+                        rows: tuple[np.ndarray, np.ndarray]):
+        """Bodies woken by a touch in this narrow phase slept through the movement stage: move them
+        now as it would have (a body resting on the floor sinks into it by gravity's step, as an
+        awake one does, and the response pushes it out), then measure their contacts again: those
+        kept from last step are as the narrow phase found them before that step's response moved
+        the body. A contact now apart is dropped. So a woken body's contacts are real ones, and a
+        resting body bumped awake keeps its floor contact (``ongoing``) rather than ending it."""
+        store, geom = self.bodies.store, self.bodies.geometry
+        if "movement" in self.pipeline.effects:
+            integrate_rows(store, woken, dt, self.pipeline.active_gravity())
+            geom.update_rows(store, woken)
+        flag = np.zeros(store.n, dtype=bool)
+        flag[woken] = True
+        stale = np.flatnonzero(flag[rows[0]] | flag[rows[1]])
+        if stale.size == 0:
+            return contacts, rows
+        r = pair_contacts(store, geom, rows[0][stale], rows[1][stale])
+        cols = [c.copy() for c in contacts]
+        for col, new in zip(cols[2:], (r.nx, r.ny, r.depth, r.px, r.py)):
+            col[stale] = new
+        keep = np.ones(contacts.a.size, dtype=bool)
+        keep[stale[~r.hit]] = False
+        return StepContacts(*(c[keep] for c in cols)), (rows[0][keep], rows[1][keep])

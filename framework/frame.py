@@ -1,0 +1,98 @@
+"""The frame: what one step (one pass of the pipeline) computed, handed from stage to stage.
+
+Every stage reads what the stages before it wrote here (and the store), and writes its own results
+here; nothing passes between stages any other way. A new frame starts each sub-step; the scene
+keeps the last one, which is what ``scene.events``, ``scene.contacts``, ``scene.resolved``,
+``scene.counters`` and the debug overlay read between steps.
+
+Data flow (one way): movement -> ``start_x/start_y, ccd_rows, ccd_start`` -> continuous detection
+-> ``swept_paths`` -> broad phase -> ``pairs, n_asleep`` -> narrow phase -> ``contacts,
+contact_rows, started, ended`` -> response -> ``resolved, support`` -> sleeping -> render.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .events import CollisionEvent, StepContacts, to_events
+
+__all__ = ["NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counters"]
+
+_INTS = np.zeros(0, dtype=np.int64)
+_FLOATS = np.zeros(0)
+NO_SUPPORT = (_INTS, _INTS, _FLOATS, _FLOATS)
+NO_RESOLVED = (*NO_SUPPORT, _FLOATS)
+
+
+def new_counters() -> dict[str, Any]:
+    """A sub-step's counters, before any stage ran (see ``Scene.counters``)."""
+    return {"systems": [], "integrated": 0, "rehashed": 0, "candidate_pairs": 0, "narrow_tests": {}, "contacts": 0,
+            "events": 0, "resolved": 0, "late_contacts": 0, "ccd_stopped": 0, "asleep": 0}
+
+
+def add_counters(total: dict[str, Any], step: dict[str, Any]) -> None:
+    """Sum one sub-step's counters into ``total`` (lists of systems: in order, once)."""
+    for key, value in step.items():
+        if isinstance(value, dict):
+            add_counters(total.setdefault(key, {}), value)
+        elif isinstance(value, list):
+            seen = total.setdefault(key, [])
+            seen.extend(v for v in value if v not in seen)
+        else:
+            total[key] = total.get(key, 0) + value
+
+
+def _pairs() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    return (_INTS, _INTS, _INTS, _INTS)
+
+
+@dataclass(eq=False)
+class StepFrame:
+    """One sub-step's data. ``dt``: its length; ``render``: whether the render stage runs in it
+    (the last sub-step of a step)."""
+
+    dt: float = 0.0
+    render: bool = False
+    counters: dict[str, Any] = field(default_factory=new_counters)
+    stage_ms: dict[str, float] = field(default_factory=dict)
+    # movement: where every row started the step (rows spawned during it: none), the swept bodies
+    start_x: np.ndarray = field(default_factory=lambda: _FLOATS)
+    start_y: np.ndarray = field(default_factory=lambda: _FLOATS)
+    ccd_rows: np.ndarray = field(default_factory=lambda: _INTS)
+    ccd_start: tuple[np.ndarray, np.ndarray] = (_FLOATS, _FLOATS)
+    # continuous detection: each swept body's path ((x0, y0), (x1, y1)), for the overlay
+    swept_paths: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)
+    # broad phase: candidate pairs (entities a < b, their rows) and how many bodies sleep
+    pairs: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = field(default_factory=_pairs)
+    n_asleep: int = 0
+    # narrow phase: the overlapping pairs, their rows, which started, which ended
+    contacts: StepContacts = field(default_factory=StepContacts.empty)
+    contact_rows: tuple[np.ndarray, np.ndarray] = (_INTS, _INTS)
+    started: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    ended: StepContacts = field(default_factory=StepContacts.empty)
+    # response: the contacts applied (a, b, nx, ny, pushed) and the resting pairs kept for next step
+    resolved: tuple[np.ndarray, ...] = NO_RESOLVED
+    support: tuple[np.ndarray, ...] = NO_SUPPORT
+    # queries during the step: (origin, end, first hit or None), for the overlay
+    ray_log: list[tuple[tuple[float, float], tuple[float, float], Any]] = field(default_factory=list)
+    _events: list[CollisionEvent] | None = None
+
+    def next(self, dt: float, render: bool) -> StepFrame:
+        """The frame of the next sub-step. Until its stages replace them, it shows this frame's
+        contacts, events, resolved and resting pairs: what a game system that runs before the
+        narrow phase (or the response) reads, and what the response starts from (last step's
+        resting pairs)."""
+        return StepFrame(dt=dt, render=render, pairs=self.pairs, contacts=self.contacts,
+                         contact_rows=self.contact_rows, started=self.started, ended=self.ended,
+                         resolved=self.resolved, support=self.support, _events=self._events)
+
+    @property
+    def events(self) -> list[CollisionEvent]:
+        """The frame's collision events (made on first use), sorted by pair: ended, then started
+        or ongoing."""
+        if self._events is None:
+            self._events = to_events(self.contacts, self.started, ~self.started, self.ended)
+        return self._events

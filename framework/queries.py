@@ -1,0 +1,138 @@
+"""Spatial queries over a scene's hitboxes: rays, boxes, points and shapes.
+
+Candidates come from the static hash (static bodies) and one vectorised bounds test (everything
+that moves); the exact answer from the collision functions of :mod:`framework.collision`. Rays
+cast during a step are logged in the step's frame for the debug overlay.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from .collision import batch
+from .collision.placement import check_shape
+from .collision.ray import raycast as _raycast
+from .collision.results import Vec2
+from .shapes import AABB, Circle
+from .store import STATIC
+from .systems.stage import Pipeline
+from .validation import InvalidValue, finite, vector2
+
+__all__ = ["ALL_LAYERS", "SceneHit", "SpatialQueries"]
+
+ALL_LAYERS = 0xFFFFFFFF
+
+
+class SceneHit(NamedTuple):
+    """A scene raycast hit: the entity, and where and how the ray entered its hitbox."""
+
+    entity: int
+    distance: float
+    point: Vec2
+    normal: Vec2
+
+
+class SpatialQueries:
+    """The queries of one scene (``Scene.raycast``, ``query_box``...), over its pipeline's bodies."""
+
+    def __init__(self, pipeline: Pipeline) -> None:
+        self.pipeline = pipeline
+        self.bodies = pipeline.bodies
+
+    def _candidate_rows(self, minx: float, miny: float, maxx: float, maxy: float) -> np.ndarray:
+        """Rows whose current bounds strictly meet the box: statics via the hash, moving bodies by
+        one vectorised test over their current bounds."""
+        bodies = self.bodies
+        store = bodies.store
+        geom = bodies.ensure_geometry()
+        self.pipeline.frame.counters["rehashed"] = (self.pipeline.frame.counters.get("rehashed", 0)
+                                                    + bodies.sync_static())
+        st = bodies.rows_of(bodies.hash.query_box(minx, miny, maxx, maxy))
+        st = st[(st >= 0)]
+        st = st[store.body[st] == STATIC]
+        mv = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
+        hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)
+        return np.concatenate([st, mv[hit]])
+
+    def _mask_ok(self, rows: np.ndarray, mask: int) -> np.ndarray:
+        return rows[(self.bodies.store.layer[rows] & mask) != 0]
+
+    def raycast_all(self, origin: tuple[float, float], direction: tuple[float, float],
+                    max_distance: float = math.inf, mask: int = ALL_LAYERS) -> list[SceneHit]:
+        """Every hitbox the ray enters within ``max_distance``, nearest first (ties by entity)."""
+        ox, oy = vector2("origin", origin)
+        dx, dy = vector2("direction", direction)
+        if dx == 0.0 and dy == 0.0:
+            raise InvalidValue(f"direction must not be zero, got {direction!r}")
+        md = float(max_distance) if not isinstance(max_distance, bool) else math.nan
+        if not md >= 0.0:
+            raise InvalidValue(f"max_distance must be >= 0, got {max_distance!r}")
+        ln = math.hypot(dx, dy)
+        reach = md if math.isfinite(md) else self._world_extent(ox, oy)
+        ex, ey = ox + dx / ln * reach, oy + dy / ln * reach
+        rows = self._candidate_rows(min(ox, ex) - 1e-9, min(oy, ey) - 1e-9, max(ox, ex) + 1e-9,
+                                    max(oy, ey) + 1e-9)
+        rows = self._mask_ok(rows, mask)
+        hits = []
+        geom, store = self.bodies.geometry, self.bodies.store
+        for r in rows.tolist():
+            hb = store.hitboxes[r]
+            hit = _raycast(hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
+                           (ox, oy), (dx, dy), md)
+            if hit is not None:
+                hits.append(SceneHit(int(store.entity[r]), *hit))
+        hits.sort(key=lambda h: (h.distance, h.entity))
+        self.pipeline.frame.ray_log.append(((ox, oy), (ex, ey), hits[0] if hits else None))
+        return hits
+
+    def _world_extent(self, ox: float, oy: float) -> float:
+        g = self.bodies.ensure_geometry()
+        if self.bodies.store.n == 0:
+            return 1.0
+        far = max(abs(float(g.minx.min()) - ox), abs(float(g.maxx.max()) - ox),
+                  abs(float(g.miny.min()) - oy), abs(float(g.maxy.max()) - oy))
+        return 2.0 * far + 1.0
+
+    def query_box(self, minx: float, miny: float, maxx: float, maxy: float, mask: int = ALL_LAYERS) -> list[int]:
+        """Entities whose hitbox interiors overlap the box's interior, sorted."""
+        x0, y0, x1, y1 = (finite(n, v) for n, v in zip(("minx", "miny", "maxx", "maxy"), (minx, miny, maxx, maxy)))
+        if not (x1 > x0 and y1 > y0):
+            raise InvalidValue(f"query_box needs maxx > minx and maxy > miny, got {(minx, miny, maxx, maxy)!r}")
+        box = AABB(x1 - x0, y1 - y0)
+        return self._overlapping(box, ((x0 + x1) * 0.5, (y0 + y1) * 0.5), mask, (x0, y0, x1, y1))
+
+    def query_point(self, x: float, y: float, mask: int = ALL_LAYERS) -> list[int]:
+        """Entities whose hitbox contains the point (closed: a point on the boundary counts)."""
+        px, py = finite("x", x), finite("y", y)
+        rows = self._mask_ok(self._candidate_rows(px - 1e-9, py - 1e-9, px + 1e-9, py + 1e-9), mask)
+        return sorted(int(self.bodies.store.entity[r]) for r in rows.tolist() if self._contains(r, px, py))
+
+    def _contains(self, r: int, px: float, py: float) -> bool:
+        store, geom = self.bodies.store, self.bodies.geometry
+        hb = store.hitboxes[r]
+        dx, dy = px - float(geom.hx[r]), py - float(geom.hy[r])
+        shape = hb.shape
+        if isinstance(shape, Circle):
+            return dx * dx + dy * dy <= shape.radius * shape.radius
+        verts, count = geom.outlines(store, np.array([r]))
+        pts = verts[0, : int(count[0])]
+        for i in range(len(pts)):
+            x0, y0 = pts[i]
+            x1, y1 = pts[(i + 1) % len(pts)]
+            if (x1 - x0) * (dy - y0) - (y1 - y0) * (dx - x0) < 0.0:
+                return False
+        return True
+
+    def _overlapping(self, shape: Any, center: tuple[float, float], mask: int, box: tuple) -> list[int]:
+        rows = self._mask_ok(self._candidate_rows(*box), mask)
+        store, geom = self.bodies.store, self.bodies.geometry
+        check_shape("shape", shape)
+        if rows.size == 0:
+            return []
+        shapes_b = [store.hitboxes[r].shape for r in rows.tolist()]
+        poses_b = list(zip(geom.hx[rows].tolist(), geom.hy[rows].tolist(), store.rot[rows].tolist()))
+        res = batch.collide_many([shape] * rows.size, [center] * rows.size, shapes_b, poses_b)
+        return sorted(int(e) for e in store.entity[rows[res.hit]])

@@ -1,0 +1,73 @@
+"""Sleeping: bodies at rest stop costing anything until something wakes them.
+
+A dynamic body sleeps after :data:`SLEEP_STEPS` steps at rest: moving less than
+:data:`SLEEP_SPEED` (relative to 1 + its size, per second) with a speed below that. A stack sleeps
+as one: a body touching an awake, restless dynamic body stays awake, and so, in turn, does
+whatever touches it. Game code writing its Transform or Velocity, a contact with an awake body, a
+change to the static level or a despawn nearby wake it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..frame import StepFrame
+from .stage import Stage
+
+__all__ = ["SLEEP_SPEED", "SLEEP_STEPS", "Sleeping"]
+
+SLEEP_STEPS = 30
+SLEEP_SPEED = 1e-3
+
+
+class Sleeping(Stage):
+    """Count the steps each awake dynamic body has been at rest; put the restful to sleep."""
+
+    name = "sleeping"
+    needs = frozenset({"sleeping"})
+
+    def run(self, frame: StepFrame) -> bool:
+        store = self.bodies.store
+        n0 = frame.start_x.size
+        if n0 == 0:  # (nothing moved this step: the movement stage did not run)
+            return False
+        c = store.cols
+        rows = np.flatnonzero((store.body[:n0] == 0) & (store.kind[:n0] >= 0) & ~store.asleep[:n0])
+        if rows.size == 0:
+            return True
+        dt = frame.dt
+        tol = SLEEP_SPEED * (1.0 + store.bound[rows])
+        moved = np.abs(store.x[rows] - frame.start_x[rows]) + np.abs(store.y[rows] - frame.start_y[rows])
+        speed = np.abs(store.vx[rows]) + np.abs(store.vy[rows]) + np.abs(store.w[rows]) * store.bound[rows]
+        rest = (moved <= tol * dt) & (speed <= tol)
+        still = c["still"]
+        still[rows] = np.where(rest, still[rows] + 1, 0)
+        sleepy = rows[still[rows] >= SLEEP_STEPS]
+        if sleepy.size:
+            sleepy = self._whole_islands(frame, sleepy)
+        if sleepy.size:
+            c["asleep"][sleepy] = True
+            c["vx"][sleepy] = c["vy"][sleepy] = c["w"][sleepy] = 0.0
+            store.sleep_dirty = True
+        return True
+
+    def _whole_islands(self, frame: StepFrame, ready_rows: np.ndarray) -> np.ndarray:
+        """The ready rows whose whole group of touching dynamic bodies is ready (or asleep)."""
+        store = self.bodies.store
+        ready = np.zeros(store.n, dtype=bool)
+        ready[ready_rows] = True
+        ra, rb = frame.contact_rows
+        sa, sb = self.bodies.rows_of(frame.support[0]), self.bodies.rows_of(frame.support[1])
+        ea = np.concatenate([ra, sa])
+        eb = np.concatenate([rb, sb])
+        ok = (ea >= 0) & (eb >= 0) & (ea < store.n) & (eb < store.n)
+        ea, eb = ea[ok], eb[ok]
+        restless = (store.body == 0) & ~store.asleep
+        for _ in range(store.n):
+            blocked_a = ready[ea] & restless[eb] & ~ready[eb]
+            blocked_b = ready[eb] & restless[ea] & ~ready[ea]
+            if not (blocked_a.any() or blocked_b.any()):
+                break
+            ready[ea[blocked_a]] = False
+            ready[eb[blocked_b]] = False
+        return ready_rows[ready[ready_rows]]
