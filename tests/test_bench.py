@@ -352,7 +352,7 @@ def test_cli_regimes_quick_json_of_a_tiny_configuration(capsys, tmp_path):
     assert data["command"].startswith("python -m framework.bench regimes --quick")
     assert json.loads((tmp_path / "regimes-quick.json").read_text())["rows"] == data["rows"]
     assert (tmp_path / "regimes-quick.csv").read_text().startswith("scene,bodies,static,ours_ms")
-    assert (tmp_path / "regimes-quick-crowds.csv").read_text().startswith("crowd,engine")
+    assert (tmp_path / "regimes-crowds-quick.csv").read_text().startswith("crowd,engine")
     if perf.optional_module("matplotlib") is not None:
         assert plot.read_bytes()[:4] == b"\x89PNG"
     with pytest.raises(SystemExit):

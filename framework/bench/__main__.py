@@ -98,8 +98,8 @@ def main(argv: list[str] | None = None) -> int:
         out = Path(args.out)
         write_json(out / f"{stem}.json", report)
         write_csv(out / f"{stem}.csv", report["rows"])
-        if report.get("crowds"):
-            write_csv(out / f"{stem}-crowds.csv", report["crowds"])
+        if report.get("crowds"):  # regimes-crowds.csv, regimes-crowds-quick.csv
+            write_csv(out / (stem.replace(args.benchmark, args.benchmark + "-crowds", 1) + ".csv"), report["crowds"])
     plot_rel = None
     if args.plot:
         from .plots import plot_accuracy, plot_perf, plot_regimes
