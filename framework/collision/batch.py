@@ -38,12 +38,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..shapes import AABB, Circle, Polygon, Shape
+from ..shapes import AABB, Polygon, Shape
 from ..validation import InvalidValue
 from .batch_box import aabb_aabb, aabb_aabb_fast, overlap_aabb_aabb
 from .batch_circle import circle_circle, overlap_circle_circle, overlap_polygon_circle, polygon_circle
 from .batch_common import F64, ContactArrays, no_contacts
 from .batch_polygon import overlap_polygon_polygon, polygon_polygon
+from .kinds import BOXES, CIRCLES, PAIRS, POLYGON_CIRCLE, POLYGONS, kind_of, pair_code
 from .placement import check_shape, pose
 
 __all__ = [
@@ -117,11 +118,9 @@ def outlines(shapes: Sequence[AABB | Polygon], rotations: object) -> tuple[np.nd
     return verts, counts
 
 
-_AABB, _CIRCLE, _POLYGON = 0, 1, 2
-
-
-def _kind(shape: Shape) -> int:
-    return _AABB if isinstance(shape, AABB) else _CIRCLE if isinstance(shape, Circle) else _POLYGON
+# The shape-pair table as columns indexed by pair code: kernel family, flipped (the circle is A).
+_PAIR_FAMILY = np.array([rule.family for rule in PAIRS.values()], dtype=np.int64)
+_PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
 
 
 def collide_many(
@@ -144,8 +143,8 @@ def collide_many(
     out = no_contacts(n)
     if n == 0:
         return out
-    ka = np.array([_kind(s) for s in sa])
-    kb = np.array([_kind(s) for s in sb])
+    code = pair_code(np.array([kind_of(s) for s in sa]), np.array([kind_of(s) for s in sb]))
+    family, flip = _PAIR_FAMILY[code], _PAIR_FLIP[code]
     ra = np.array([s.bounding_radius for s in sa])
     rb = np.array([s.bounding_radius for s in sb])
 
@@ -165,19 +164,18 @@ def collide_many(
     def shape_outlines(shapes: list[Shape], rot: np.ndarray, rows: np.ndarray):
         return outlines([shapes[i] for i in rows], rot[rows])  # type: ignore[misc]
 
-    a_circle, b_circle = ka == _CIRCLE, kb == _CIRCLE
-    run(a_circle & b_circle, lambda r: circle_circle(
+    run(family == CIRCLES, lambda r: circle_circle(
         pa[r, 0], pa[r, 1], radius(sa, r), pb[r, 0], pb[r, 1], radius(sb, r)))
-    run((ka == _AABB) & (kb == _AABB), lambda r: aabb_aabb(
+    run(family == BOXES, lambda r: aabb_aabb(
         pa[r, 0], pa[r, 1], half(sa, r, "width"), half(sa, r, "height"),
         pb[r, 0], pb[r, 1], half(sb, r, "width"), half(sb, r, "height")))
-    run(~a_circle & b_circle, lambda r: polygon_circle(
+    run((family == POLYGON_CIRCLE) & ~flip, lambda r: polygon_circle(
         pa[r, 0], pa[r, 1], *shape_outlines(sa, pa[:, 2], r),
         pb[r, 0], pb[r, 1], radius(sb, r), size=ra[r] + rb[r]))
-    run(a_circle & ~b_circle, lambda r: polygon_circle(
+    run((family == POLYGON_CIRCLE) & flip, lambda r: polygon_circle(
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r),
         pa[r, 0], pa[r, 1], radius(sa, r), flip=True, size=ra[r] + rb[r]))
-    run(~a_circle & ~b_circle & ~((ka == _AABB) & (kb == _AABB)), lambda r: polygon_polygon(
+    run(family == POLYGONS, lambda r: polygon_polygon(
         pa[r, 0], pa[r, 1], *shape_outlines(sa, pa[:, 2], r),
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r), size=ra[r] + rb[r]))
     return out

@@ -29,6 +29,7 @@ import math
 
 from ..shapes import Circle, Shape
 from ..validation import InvalidValue
+from .kinds import CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
 from .placement import check_shape, local_outline, pose
 from .results import Contact, Vec2
 from .tiebreak import pick
@@ -61,13 +62,14 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
     check_shape("shape_b", shape_b)
     ax, ay, ar = pose("transform_a", transform_a)
     bx, by, br = pose("transform_b", transform_b)
-    if isinstance(shape_a, Circle) and not isinstance(shape_b, Circle):
+    rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
+    if rule.flip:
         # Polygon-circle pairs are worked in the polygon's frame whichever comes first.
         ox, oy = bx, by
-        found = _pair(shape_b, bx, by, br, shape_a, ax, ay, flip=True)
+        found = _pair(rule.family, shape_b, bx, by, br, shape_a, ax, ay, flip=True)
     else:
         ox, oy = ax, ay
-        found = _pair(shape_a, ax, ay, ar, shape_b, bx, by, br)
+        found = _pair(rule.family, shape_a, ax, ay, ar, shape_b, bx, by, br)
     if found is None:
         return None
     (nx, ny, depth, px, py), k = found
@@ -88,10 +90,11 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
 
 
 def _pair(
-    sa: Shape, ox: float, oy: float, rot_a: float, sb: Shape, qx: float, qy: float, rot_b: float = 0.0,
-    flip: bool = False,
+    family: int, sa: Shape, ox: float, oy: float, rot_a: float, sb: Shape, qx: float, qy: float,
+    rot_b: float = 0.0, flip: bool = False,
 ) -> tuple[Res, int] | None:
-    """``sa`` at (ox, oy) against ``sb`` at (qx, qy): the result in ``sa``'s frame scaled by 2**-k.
+    """``sa`` at (ox, oy) against ``sb`` at (qx, qy), computed by ``family``
+    (:data:`~framework.collision.kinds.PAIRS`): the result in ``sa``'s frame scaled by 2**-k.
 
     With ``flip`` the caller's A is ``sb`` (a circle): normals are turned to point from it.
     """
@@ -103,13 +106,14 @@ def _pair(
     # The exact offset (q - o) * 2**-k, as (value, exponent) terms for the exact fallback.
     off = ((qx, -k), (ox, -k), (qy, -k), (oy, -k))
     size = math.ldexp(ra, -k) + math.ldexp(rb, -k)
-    if isinstance(sa, Circle):
-        assert isinstance(sb, Circle)
+    if family == CIRCLES:
+        assert isinstance(sa, Circle) and isinstance(sb, Circle)
         res = circle_circle(math.ldexp(sa.radius, -k), math.ldexp(sb.radius, -k), dx, dy, off)
-    elif isinstance(sb, Circle):
+    elif family == POLYGON_CIRCLE:
+        assert isinstance(sb, Circle)
         res = polygon_circle(local_outline(sa, rot_a, k), dx, dy, math.ldexp(sb.radius, -k), off, size,
                              flip)
-    else:
+    else:  # BOXES or POLYGONS: boxes are polygons here
         res = polygon_polygon(local_outline(sa, rot_a, k), local_outline(sb, rot_b, k), dx, dy, off, size)
     return None if res is None else (res, k)
 
