@@ -25,7 +25,7 @@ Numerics, as in the scalar code (whose module docstring explains them): each pai
 local frame (A's hitbox origin; the polygon's for a polygon / circle pair) scaled by a power of two,
 so a scene at x = 1e9 gives the answers of the scene at the origin and radii of 1e-200 or 1e300
 neither underflow nor overflow; floats decide wherever the answer is clear of rounding, exact
-arithmetic inside a thin band around touching (:mod:`~framework.collision.batch_exact`).
+arithmetic inside a thin band around touching (:mod:`~framework.collision.exact`).
 
 Inputs must be finite (the systems check components); kernels never return NaN or inf.
 :func:`collide_many` groups arbitrary shape pairs by kind and is the convenient (validated) entry.

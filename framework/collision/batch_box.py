@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 
 from .batch_common import F64, ContactArrays, columns, finish, frame
-from .batch_exact import BAND, TINY
 from .batch_point import POINT_TOL, overlap_point
+from .exact import BAND, TINY
 from .tiebreak import DEPTH_TOL
 
 __all__ = ["aabb_aabb", "aabb_aabb_fast", "overlap_aabb_aabb"]

@@ -2,10 +2,12 @@
 
 Each step mirrors :mod:`framework.collision.collide` operation for operation (same scaled local
 frame, same expressions in the same order, same band around touching); the rows inside the band
-are decided exactly by :mod:`framework.collision.batch_exact`.
+are decided exactly by :mod:`framework.collision.exact`.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -28,7 +30,8 @@ from .batch_common import (
     pick,
     take,
 )
-from .batch_exact import BAND, TINY, circle_circle_exact, polygon_circle_exact
+from .exact import BAND, TINY, Offset, circle_circle_exact, float_rounded, polygon_circle_exact
+from .tiebreak import pick as pick_one
 
 __all__ = ["circle_circle", "overlap_circle_circle", "overlap_polygon_circle", "polygon_circle"]
 
@@ -50,7 +53,7 @@ def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True)
         exact = circle_circle_exact((ax[i], ay[i], bx[i], by[i], int(k[i])), ra[i], rb[i])
         if exact is not None:
             hit[i] = True
-            num[j] = exact
+            num[j] = float_rounded(*exact)
     if not details:
         return hit
     exact_rows = np.zeros(hit.shape, dtype=bool)
@@ -129,7 +132,7 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: boo
     for i in np.flatnonzero(exact) if fallback else ():
         n = int(count[i])
         poly = list(zip(vx[:n, i].tolist(), vy[:n, i].tolist(), strict=True))
-        res = polygon_circle_exact(
+        res = _polygon_circle_exact(
             poly, (ax[i], ay[i], bx[i], by[i], int(k[i])), r[i], cx[i], cy[i], size[i], float(f[i])
         )
         if res is not None:
@@ -161,6 +164,46 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: boo
     for i, res in results.items():
         nx[i], ny[i], depth[i], px[i], py[i] = res
     return finish(hit, nx[hit], ny[hit], depth[hit], px[hit], py[hit], k[hit], ax[hit], ay[hit])
+
+
+def _polygon_circle_exact(
+    poly: list[tuple[float, float]], offset: Offset, r: float, cx: float, cy: float, size: float, f: float
+) -> tuple[float, float, float, float, float] | None:
+    """One row of :func:`polygon_circle` decided on exact integers (a convex CCW outline at the
+    origin, the circle at the exact offset, float (cx, cy)): ``(nx, ny, depth, px, py)`` with the
+    normal times ``f``, or ``None``."""
+    found = polygon_circle_exact(poly, offset, r)
+    if found is None:
+        return None
+    n, e = len(poly), found.e
+    if found.case == "inside":
+        # An overlap (r > 0), depth r + distance to the nearest face.
+        cands = []
+        for i in range(n):
+            (x0, y0), (x1, y1) = poly[i], poly[(i + 1) % n]
+            ex, ey = x1 - x0, y1 - y0
+            ln = math.hypot(ex, ey)
+            if ln > 0.0:
+                cands.append((r - float_rounded(found.seps[i], 2 * e) / ln, f * ey / ln, -f * ex / ln))
+        depth, nx, ny = pick_one(cands, size)
+        return nx, ny, max(depth, TINY), cx, cy
+    if found.case == "face":
+        # depth = (r^2 |e|^2 - s^2) / (|e| (r |e| + s)).
+        i = found.index
+        (fx0, fy0), (fx1, fy1) = poly[i], poly[(i + 1) % n]
+        fex, fey = fx1 - fx0, fy1 - fy0
+        ln = math.hypot(fex, fey)
+        fs = float_rounded(found.seps[i], 2 * e)
+        depth = max(float_rounded(found.num, 4 * e) / (ln * (r * ln + fs)), TINY)
+        nx, ny = fey / ln, -fex / ln
+        dist = fs / ln
+        return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
+    j = found.index
+    ddx, ddy = float_rounded(found.dx, e), float_rounded(found.dy, e)
+    dist = math.hypot(ddx, ddy)
+    depth = max(float_rounded(found.num, 2 * e) / (r + dist), TINY)
+    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
+    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
 
 def overlap_polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False) -> np.ndarray:

@@ -4,7 +4,7 @@ Separating axes, vectorised over pairs: the axes are the unnormalised outward ed
 and of B, ``[C, P]`` with ``C = Ka + Kb``; every vertex of both outlines is projected on every
 axis (a loop over the few vertices, each step on ``[C, P]``), with B about its own origin and
 ``u . d`` added, exactly the scalar code's products and comparisons. Rows within the band of
-touching on some axis are decided exactly (:mod:`framework.collision.batch_exact`). Only the
+touching on some axis are decided exactly (:mod:`framework.collision.exact`). Only the
 overlapping rows go on to normalise their axes, build the ``2 C`` push-out candidates and apply
 the tie-break rule.
 
@@ -37,8 +37,8 @@ from .batch_common import (
     outline_rows,
     pick,
 )
-from .batch_exact import BAND, TINY, polygon_polygon_exact
 from .batch_point import overlap_point
+from .exact import BAND, TINY, float_rounded, polygon_polygon_exact
 
 __all__ = ["overlap_polygon_polygon", "polygon_polygon"]
 
@@ -120,9 +120,11 @@ def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, fa
         lb = list(zip(bvx[: bcount[i], i].tolist(), bvy[: bcount[i], i].tolist(), strict=True))
         exact = polygon_polygon_exact(pa, lb, (ax[i], ay[i], bx[i], by[i], int(k[i])))
         if exact is not None:
+            found, u = exact
             hit[i] = True
             slots = np.flatnonzero(valid[:, i])
-            fwd[slots, i], bwd[slots, i] = np.array(exact).T
+            fwd[slots, i], bwd[slots, i] = np.array([(float_rounded(fw, u), float_rounded(bw, u))
+                                                     for fw, bw in found.values()]).T
     return hit, (ux, uy, valid, fwd, bwd)
 
 
