@@ -1,16 +1,18 @@
 """Batch (numpy) collision kernels: the contacts of :func:`~framework.collision.collide` for
-arrays of pairs at once, one kernel per pair of shape kinds.
+arrays of pairs at once, one kernel per family of shape pairs (which pair goes to which kernel:
+:data:`framework.collision.kinds.PAIRS`).
 
 Every kernel takes ``[P]`` arrays (scalars broadcast) and returns a :class:`ContactArrays` whose
 row ``i`` is what ``collide`` gives for pair ``i``: the same overlap decision on every input
 (touching is never a collision and an overlap of one ulp always is), the same normal and depth up
-to rounding (the same tie-break rule) and the same point up to rounding. Each has a cheaper
-``overlap_*`` twin that returns only ``hit``. No Python loop runs over the pairs, except over the
-rare ones within rounding of touching that need exact integer arithmetic (none for AABB pairs).
+to rounding (the same tie-break rule) and the same point up to rounding. No Python loop runs over
+the pairs, except over the rare ones within rounding of touching that need exact integer
+arithmetic (none for AABB pairs).
 
 =============================  ===============================================================
 ``circle_circle``              circles A and B
 ``aabb_aabb``                  axis-aligned boxes, by centre and half extents
+``aabb_aabb_fast``             the same, for the pipeline: the overlap rectangle's centre as point
 ``polygon_circle``             polygon (or any box, via :func:`outlines`) A, circle B; with
                                ``flip=True`` the circle is shape A of the pair
 ``polygon_polygon``            polygons and boxes in any mix but AABB / AABB
@@ -40,10 +42,10 @@ import numpy as np
 
 from ..shapes import AABB, Polygon, Shape
 from ..validation import InvalidValue
-from .batch_box import aabb_aabb, aabb_aabb_fast, overlap_aabb_aabb
-from .batch_circle import circle_circle, overlap_circle_circle, overlap_polygon_circle, polygon_circle
+from .batch_box import aabb_aabb, aabb_aabb_fast
+from .batch_circle import circle_circle, polygon_circle
 from .batch_common import F64, ContactArrays, no_contacts
-from .batch_polygon import overlap_polygon_polygon, polygon_polygon
+from .batch_polygon import polygon_polygon
 from .kinds import BOXES, CIRCLES, PAIRS, POLYGON_CIRCLE, POLYGONS, kind_of, pair_code
 from .placement import check_shape, pose
 
@@ -54,10 +56,6 @@ __all__ = [
     "circle_circle",
     "collide_many",
     "outlines",
-    "overlap_aabb_aabb",
-    "overlap_circle_circle",
-    "overlap_polygon_circle",
-    "overlap_polygon_polygon",
     "polygon_circle",
     "polygon_polygon",
 ]

@@ -22,11 +22,12 @@ from __future__ import annotations
 import numpy as np
 
 from .batch_common import F64, ContactArrays, columns, finish, frame
-from .batch_point import POINT_TOL, overlap_point
+from .batch_point import overlap_point
+from .collide import POINT_TOL
 from .exact import BAND, TINY
 from .tiebreak import DEPTH_TOL
 
-__all__ = ["aabb_aabb", "aabb_aabb_fast", "overlap_aabb_aabb"]
+__all__ = ["aabb_aabb", "aabb_aabb_fast"]
 
 
 def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -51,12 +52,6 @@ def _less(dh, dl, rh, rl) -> np.ndarray:
     """``|dh + dl| < rh + rl`` exactly (``dh``, ``rh`` the rounded leading parts, ``rh >= 0``)."""
     adh = np.abs(dh)
     return (adh < rh) | ((adh == rh) & (np.sign(dh) * dl < rl))
-
-
-def overlap_aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh) -> np.ndarray:
-    """``hit`` of :func:`aabb_aabb` only."""
-    ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
-    return _less(*_reach(ax, bx, ahw, bhw)) & _less(*_reach(ay, by, ahh, bhh))
 
 
 def _overlaps(hwa, hha, hwb, hhb, dx, dy):
@@ -208,7 +203,7 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
     ``collide``) average except where corners coincide; it lies in the overlap region either way.
     Rows are decided with plain floats where the answer is clear; those within the rounding band
     around touching (boxes just pushed apart, common) are decided exactly on double-doubles, as
-    :func:`overlap_aabb_aabb`, with double-double push-outs; extreme magnitudes go through
+    :func:`aabb_aabb` decides them, with double-double push-outs; extreme magnitudes go through
     :func:`aabb_aabb`. With ``exact=False`` rows within about 1e-12 of the sizes of touching count
     as not overlapping (the response re-measuring pairs it has just pushed apart: such an overlap
     is not worth resolving), and with ``points=False`` the points are left at 0.

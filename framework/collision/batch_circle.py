@@ -33,12 +33,14 @@ from .batch_common import (
 from .exact import BAND, TINY, Offset, circle_circle_exact, float_rounded, polygon_circle_exact
 from .tiebreak import pick as pick_one
 
-__all__ = ["circle_circle", "overlap_circle_circle", "overlap_polygon_circle", "polygon_circle"]
+__all__ = ["circle_circle", "polygon_circle"]
 
 
 # --- circle / circle -------------------------------------------------------------------------
 
-def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True):
+def circle_circle(ax, ay, ar, bx, by, br, exact: bool = True) -> ContactArrays:
+    """Circles of radius ``ar`` at (ax, ay) (A) and ``br`` at (bx, by) (B), all ``[P]``.
+    ``exact=False``: pairs within rounding of touching count as apart (for the response)."""
     ax, ay, ar, bx, by, br = columns(ax, ay, ar, bx, by, br)
     dx, dy, k = frame(ax, ay, bx, by, np.maximum(ar, br))
     ra, rb = np.ldexp(ar, -k), np.ldexp(br, -k)
@@ -47,15 +49,13 @@ def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True)
     band = BAND * (d2 + r2)
     hit = d2 <= r2 - band
     # Too close to touching for floats: decide on the exact |d|^2 < (ra + rb)^2.
-    near = np.flatnonzero((d2 > r2 - band) & (d2 < r2 + band)) if fallback else np.zeros(0, dtype=np.int64)
+    near = np.flatnonzero((d2 > r2 - band) & (d2 < r2 + band)) if exact else np.zeros(0, dtype=np.int64)
     num = np.zeros(near.size, dtype=F64)
     for j, i in enumerate(near):
-        exact = circle_circle_exact((ax[i], ay[i], bx[i], by[i], int(k[i])), ra[i], rb[i])
-        if exact is not None:
+        excess = circle_circle_exact((ax[i], ay[i], bx[i], by[i], int(k[i])), ra[i], rb[i])
+        if excess is not None:
             hit[i] = True
-            num[j] = float_rounded(*exact)
-    if not details:
-        return hit
+            num[j] = float_rounded(*excess)
     exact_rows = np.zeros(hit.shape, dtype=bool)
     exact_rows[near] = True
     exact_num = np.zeros(hit.shape, dtype=F64)
@@ -75,26 +75,14 @@ def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True)
     return finish(hit, nx, ny, depth, nx * mid, ny * mid, k, ax[hit], ay[hit])
 
 
-def overlap_circle_circle(ax, ay, ar, bx, by, br) -> np.ndarray:
-    """``hit`` of :func:`circle_circle` only."""
-    return _circle_circle(ax, ay, ar, bx, by, br, details=False)
-
-
-def circle_circle(ax, ay, ar, bx, by, br, exact: bool = True) -> ContactArrays:
-    """Circles of radius ``ar`` at (ax, ay) (A) and ``br`` at (bx, by) (B), all ``[P]``.
-    ``exact=False``: pairs within rounding of touching count as apart (for the response)."""
-    return _circle_circle(ax, ay, ar, bx, by, br, details=True, fallback=exact)
-
-
 # --- polygon / circle ------------------------------------------------------------------------
 
-def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: bool, fallback: bool = True):
+def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, fallback: bool):
     vx, vy, count = outline_rows(averts, acount, "polygon vertices")
     p = vx.shape[1]
     ax, ay, bx, by, r = columns_of(p, ax, ay, bx, by, br)
     if p == 0:
-        return np.zeros(0, dtype=bool) if not details else finish(
-            np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
+        return finish(np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
     f = np.where(np.broadcast_to(np.asarray(flip, dtype=bool), (p,)), -1.0, 1.0)  # per row
     # The polygon's frame, whichever shape of the pair it is.
     cx, cy, k = frame(ax, ay, bx, by, np.maximum(extent(vx, vy), r))
@@ -138,9 +126,6 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: boo
         if res is not None:
             hit[i] = True
             results[i] = res
-    if not details:
-        return hit
-
     nx, ny, depth, px, py = (np.zeros(p, dtype=F64) for _ in range(5))
     m = np.flatnonzero(inside_clear)
     if m.size:
@@ -206,11 +191,6 @@ def _polygon_circle_exact(
     return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
 
-def overlap_polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False) -> np.ndarray:
-    """``hit`` of :func:`polygon_circle` only."""
-    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, None, details=False)
-
-
 def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None, exact: bool = True) -> ContactArrays:
     """Convex polygons (hitbox origins (ax, ay) ``[P]``, outlines ``averts [P, K, 2]`` with
     ``acount`` vertices, as :func:`~framework.collision.batch.outlines` gives them) against circles
@@ -223,4 +203,4 @@ def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None, ex
     tolerance; by default it is measured from the outlines. ``exact=False``: pairs within rounding
     of touching count as apart (the response re-measuring pairs it has just pushed apart).
     """
-    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details=True, fallback=exact)
+    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, fallback=exact)

@@ -33,7 +33,7 @@ from ..validation import InvalidValue, finite, positive
 from . import grid
 from .grid import CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
 
-__all__ = ["SpatialHash", "brute_force_pairs", "find_pairs"]
+__all__ = ["SpatialHash", "brute_force_pairs"]
 
 _I64 = np.int64
 _EMPTY_I = np.zeros(0, dtype=_I64)
@@ -54,22 +54,6 @@ def brute_force_pairs(minx, miny, maxx, maxy, static=None) -> tuple[np.ndarray, 
     i, j = overlap_pairs(b, b, upper=True)
     keep = ~(st[i] & st[j])
     return i[keep], j[keep]
-
-
-def find_pairs(minx, miny, maxx, maxy, static=None, cell_size: float | None = None):
-    """The broad-phase pairs ``(i, j)`` of bodies numbered by position; same answer as
-    :func:`brute_force_pairs`, in O(N) for scenes of similar-sized bodies."""
-    b = as_bounds(minx, miny, maxx, maxy)
-    n = b[0].shape[0]
-    st = np.zeros(n, dtype=bool) if static is None else np.asarray(static, dtype=bool).reshape(-1)
-    if st.shape[0] != n:
-        raise InvalidValue(f"static must have {n} entries, got {st.shape[0]}")
-    ids = np.arange(n, dtype=_I64)
-    h = SpatialHash(cell_size)
-    if cell_size is None:
-        h._choose_cell(b)  # from all bodies, not only the statics
-    h.set_static(*subset(b, st), ids[st])
-    return h.pairs(*subset(b, ~st), ids[~st])
 
 
 def _as_ids(ids, n: int) -> np.ndarray:

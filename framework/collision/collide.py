@@ -361,6 +361,11 @@ def _polygon_polygon_exact(
             for edge, k in zip(edges, ks, strict=True)]
 
 
+# Relative tolerance (times the pair's size) of the inside tests of the contact point: a vertex
+# within rounding of the other outline counts as inside it.
+POINT_TOL = 1e-12
+
+
 def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:
     """(x, y) in the closed convex CCW polygon, allowing ``tol`` (relative) of rounding."""
     n = len(poly)
@@ -379,7 +384,7 @@ def overlap_point(pa: Pts, pb: Pts, nx: float, ny: float, depth: float, size: fl
     The vertices of A ∩ B are A's vertices inside B, B's vertices inside A and the crossings of
     their edges; their mean is a convex combination, so it lies in A ∩ B.
     """
-    tol = 1e-12 * size
+    tol = POINT_TOL * size
     sx = sy = 0.0
     count = 0
     for x, y in pa:
