@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .collision.kinds import KIND_AABB, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field
 from .shapes import AABB, Circle
@@ -25,7 +26,6 @@ from .validation import InvalidValue
 
 __all__ = ["BodyStore", "KIND_AABB", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "as_selector"]
 
-KIND_NONE, KIND_AABB, KIND_CIRCLE, KIND_POLYGON = -1, 0, 1, 2
 BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
 DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
 

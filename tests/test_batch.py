@@ -5,7 +5,7 @@ thousands of random pairs, about half overlapping, plus exact touching on dyadic
 identical and concentric shapes, containment, and all of it again at coordinates near 1e9. The
 kernels must make the same overlap decision as ``collide`` on every pair, give the same depth and
 normal to 1e-12 (relative to the pair's size) and the same point to 1e-9 (or else a point of the
-overlap), and the ``overlap_*`` twins must agree with ``hit``.
+overlap).
 """
 
 from __future__ import annotations
@@ -23,10 +23,6 @@ from framework.collision.batch import (
     circle_circle,
     collide_many,
     outlines,
-    overlap_aabb_aabb,
-    overlap_circle_circle,
-    overlap_polygon_circle,
-    overlap_polygon_polygon,
     polygon_circle,
     polygon_polygon,
 )
@@ -194,8 +190,8 @@ def _kind(shape: object) -> str:
     return "circle" if isinstance(shape, Circle) else "polygon"
 
 
-def kernel_results(pairs: list[Pair], fallback: bool = True) -> tuple[ContactArrays, np.ndarray]:
-    """The kernel of this (single) kind combination on the pairs, and its ``overlap_*`` twin.
+def kernel_results(pairs: list[Pair], fallback: bool = True) -> ContactArrays:
+    """The kernel of this (single) kind combination on the pairs.
     ``fallback=False``: the kernels as the response calls them (no exact fallback, no points)."""
     sa = [p[0] for p in pairs]
     sb = [p[2] for p in pairs]
@@ -207,21 +203,21 @@ def kernel_results(pairs: list[Pair], fallback: bool = True) -> tuple[ContactArr
     ax, ay, bx, by = ta[:, 0], ta[:, 1], tb[:, 0], tb[:, 1]
     if ka_ == kb_ == "circle":
         args = (ax, ay, [s.radius for s in sa], bx, by, [s.radius for s in sb])
-        return circle_circle(*args, exact=fallback), overlap_circle_circle(*args)
+        return circle_circle(*args, exact=fallback)
     if ka_ == kb_ == "aabb":
         args = (ax, ay, [s.width / 2 for s in sa], [s.height / 2 for s in sa],
                 bx, by, [s.width / 2 for s in sb], [s.height / 2 for s in sb])
         if not fallback:
-            return aabb_aabb_fast(*args, exact=False, points=False), overlap_aabb_aabb(*args)
-        return aabb_aabb(*args), overlap_aabb_aabb(*args)
+            return aabb_aabb_fast(*args, exact=False, points=False)
+        return aabb_aabb(*args)
     if kb_ == "circle":
         args = (ax, ay, *outlines(sa, ta[:, 2]), bx, by, [s.radius for s in sb])
-        return polygon_circle(*args, exact=fallback), overlap_polygon_circle(*args)
+        return polygon_circle(*args, exact=fallback)
     if ka_ == "circle":
         args = (bx, by, *outlines(sb, tb[:, 2]), ax, ay, [s.radius for s in sa])
-        return polygon_circle(*args, flip=True, exact=fallback), overlap_polygon_circle(*args, flip=True)
+        return polygon_circle(*args, flip=True, exact=fallback)
     args = (ax, ay, *outlines(sa, ta[:, 2]), bx, by, *outlines(sb, tb[:, 2]))
-    return polygon_polygon(*args, exact=fallback, points=fallback), overlap_polygon_polygon(*args)
+    return polygon_polygon(*args, exact=fallback, points=fallback)
 
 
 # --- comparison ------------------------------------------------------------------------------
@@ -280,9 +276,9 @@ def assert_matches(pairs: list[Pair], res: ContactArrays, label: str) -> None:
 @pytest.mark.parametrize(("ka", "kb"), COMBOS, ids=[f"{a}-{b}" for a, b in COMBOS])
 def test_kernels_match_collide(ka: str, kb: str) -> None:
     pairs = all_pairs(ka, kb)
-    res, hit = kernel_results(pairs)
+    res = kernel_results(pairs)
     assert_matches(pairs, res, "kernel")
-    assert hit.dtype == bool and (hit == res.hit).all()
+    assert res.hit.dtype == bool
     frac = res.hit[:N_RANDOM].mean()
     assert 0.3 < frac < 0.8, f"random pairs should overlap about half the time, got {frac}"
 
@@ -341,9 +337,6 @@ def test_empty_inputs() -> None:
     ]
     for r in results:
         assert all(a.shape == (0,) for a in r)
-    for h in (overlap_circle_circle(e, e, e, e, e, e), overlap_aabb_aabb(e, e, e, e, e, e, e, e),
-              overlap_polygon_circle(e, e, v, c, e, e, e), overlap_polygon_polygon(e, e, v, c, e, e, v, c)):
-        assert h.shape == (0,) and h.dtype == bool
 
 
 def test_outlines_rotate_polygons_not_aabbs_and_pad() -> None:
@@ -491,8 +484,8 @@ def test_kernels_without_the_exact_fallback_drop_only_touching_rows(ka: str, kb:
     """As the response re-measures (``exact=False``): a pair within rounding of touching counts
     as apart; every other row is the exact kernel's answer (same normal, same depth)."""
     pairs = all_pairs(ka, kb)
-    ref, _ = kernel_results(pairs)
-    fast, _ = kernel_results(pairs, fallback=False)
+    ref = kernel_results(pairs)
+    fast = kernel_results(pairs, fallback=False)
     assert not (fast.hit & ~ref.hit).any()
     dropped = np.flatnonzero(ref.hit & ~fast.hit)
     for i in dropped.tolist():

@@ -18,7 +18,23 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from framework.collision import grid
-from framework.collision.broad_phase import SpatialHash, brute_force_pairs, find_pairs
+from framework.collision.broad_phase import SpatialHash, brute_force_pairs
+
+
+def find_pairs(minx, miny, maxx, maxy, static=None, cell_size=None):
+    """The broad-phase pairs ``(i, j)`` of bodies numbered by position, through a SpatialHash: the
+    static ones hashed, then the others paired with them and among themselves; without a
+    ``cell_size`` the hash chooses one from all bodies (not only the statics)."""
+    b = grid.as_bounds(minx, miny, maxx, maxy)
+    n = b[0].shape[0]
+    st = np.zeros(n, dtype=bool) if static is None else np.asarray(static, dtype=bool).reshape(-1)
+    assert st.shape[0] == n
+    ids = np.arange(n, dtype=np.int64)
+    h = SpatialHash(cell_size)
+    if cell_size is None:
+        h._choose_cell(b)
+    h.set_static(*grid.subset(b, st), ids[st])
+    return h.pairs(*grid.subset(b, ~st), ids[~st])
 
 
 def as_set(pairs) -> set[tuple[int, int]]:
@@ -85,7 +101,6 @@ def test_empty_hash_queries():
     h = SpatialHash()
     assert h.cell_size is None
     assert h.query_box(0, 0, 1, 1).shape == (0,)
-    assert h.query_ray(0, 0, 1, 0, 10).shape == (0,)
     assert h.cells_in_use().shape == (0, 2)
     e = np.zeros(0)
     a, b = h.pairs(e, e, e, e, np.zeros(0, dtype=np.int64))
@@ -249,25 +264,18 @@ def test_scene_spread_over_an_astronomical_span():
     for cell in (1.0, 1e-3, None):
         got = assert_exact(*b, static, cell)
         assert len(got[0]) >= 6
-    # rays and boxes over that span
+    # boxes over that span
     ids = np.arange(len(rows))
     for cell in (1.0, None):
         h, _ = hashed_pairs(*b, static, ids, cell)
         for k, (cx, cy) in enumerate(corners):
             at = ids[4 * k: 4 * k + 4]
-            got = set(h.query_ray(cx - 10, cy + 1.5, 1, 0).tolist())  # endless, along +x
-            assert {int(at[0]), int(at[1])} <= got
-            got = set(h.query_ray(cx + 1.5, cy + 100, 0, -1, 1000).tolist())
-            assert {int(at[0]), int(at[1])} <= got
             assert h.query_box(cx + 0.5, cy + 0.5, cx + 1.5, cy + 1.5).tolist() == at[:2].tolist()
     # the extremes of float64: spans overflow to inf
     big = boxes((-1.7e308, 0, -1.6e308, 1), (-1.65e308, 0.5, -1e308, 2), (1e308, 0, 1.7e308, 1),
                 (1.6e308, 0, 1.7e308, 3), (0, 0, 1, 1), (0.5, 0.5, 1e308, 0.75))
     for cell in (1.0, None, 1e300, 1e307):
         assert len(assert_exact(*big, None, cell)[0]) == 3
-        h, _ = hashed_pairs(*big, np.array([1, 0, 1, 0, 1, 0], bool), np.arange(6), cell)
-        assert {0, 1} <= set(h.query_ray(-1.69e308, 0.75, 1, 0).tolist())
-        assert {2, 3} <= set(h.query_ray(1.65e308, -1e300, 0, 1, math.inf).tolist())
 
 
 def test_points_and_zero_width_bounds():
@@ -454,71 +462,6 @@ def test_query_box_hand_cases():
         h.query_box(0, 0, math.nan, 1)
 
 
-def segment_samples_hit(b, o, u, length, samples=4001):
-    """Bodies whose closed bounds contain one of many points sampled along the segment."""
-    t = np.linspace(0.0, length, samples)
-    px, py = o[0] + u[0] * t, o[1] + u[1] * t
-    minx, miny, maxx, maxy = (v[:, None] for v in b)
-    inside = (minx <= px) & (px <= maxx) & (miny <= py) & (py <= maxy)
-    return set(np.flatnonzero(inside.any(axis=1)).tolist())
-
-
-def segment_near(b, o, u, length, tol):
-    """Bodies whose bounds, grown by ``tol``, the segment meets (a loose float slab test)."""
-    out = set()
-    for i, (x0, y0, x1, y1) in enumerate(zip(*b, strict=True)):
-        t0, t1 = 0.0, length
-        ok = True
-        for oo, uu, lo, hi in ((o[0], u[0], x0 - tol, x1 + tol), (o[1], u[1], y0 - tol, y1 + tol)):
-            if uu == 0.0:
-                ok &= lo <= oo <= hi
-            else:
-                a, c = (lo - oo) / uu, (hi - oo) / uu
-                t0, t1 = max(t0, min(a, c)), min(t1, max(a, c))
-        if ok and t0 <= t1:
-            out.add(i)
-    return out
-
-
-def test_query_ray_hand_cases():
-    b = boxes((0, 0, 1, 1), (1, 0, 2, 1), (2, 0, 3, 1), (0, 2, 1, 3), (5, 5, 6, 6), (-3, -3, -2, -2))
-    static = np.array([True, True, True, True, False, False])
-    ids = np.arange(6)
-    h, _ = hashed_pairs(*b, static, ids, cell_size=1.0)
-    # along the top edge of the row of tiles (grazing: a superset may include them)
-    r = set(h.query_ray(-1, 1, 1, 0, 10).tolist())
-    assert {0, 1, 2} <= r and 4 not in r and 5 not in r
-    # through a corner, diagonal: (1, 1) is the corner of 0 and 1, the ray goes on to (5, 5)
-    r = set(h.query_ray(0.5, 0.5, 2, 2).tolist())  # endless
-    assert {0, 4} <= r and 5 not in r
-    # the direction need not be unit length: max_distance is in world units
-    assert 4 not in set(h.query_ray(0.5, 0.5, 2, 2, 1.0).tolist())
-    assert 5 in set(h.query_ray(0.5, 0.5, -7, -7, 3.6).tolist())
-    # vertical, down a column border
-    r = set(h.query_ray(1, 4, 0, -1, 10).tolist())
-    assert {0, 1, 3} <= r and 4 not in r
-    # zero length
-    assert 0 in set(h.query_ray(0.5, 0.5, 1, 0, 0.0).tolist())
-    with pytest.raises(ValueError):
-        h.query_ray(0, 0, 0, 0, 1)
-    with pytest.raises(ValueError):
-        h.query_ray(0, 0, 1, 0, -1)
-    with pytest.raises(ValueError):
-        h.query_ray(0, 0, 1, 0, math.nan)
-
-
-def test_query_ray_does_not_visit_everything():
-    k = 200
-    gx, gy = np.meshgrid(np.arange(k, dtype=float), np.arange(k, dtype=float))
-    sx, sy = gx.ravel(), gy.ravel()
-    h = SpatialHash(1.0)
-    h.set_static(sx, sy, sx + 0.5, sy + 0.5, np.arange(k * k))
-    r = h.query_ray(0.25, 0.25, 1, 1, 10)  # to (7.32, 7.32): meets the tiles (k, k), k = 0..7
-    assert r.tolist() == [201 * k for k in range(8)]
-    r = h.query_ray(-5, 100.25, 1, 0)  # endless, along one row
-    assert k <= len(r) < 4 * k
-
-
 def test_queries_over_many_moving_bodies():
     # after a few queries the moving bodies get cells of their own; answers must not change
     rng = np.random.default_rng(12)
@@ -532,10 +475,6 @@ def test_queries_over_many_moving_bodies():
         bx, by = rng.uniform(-220, 200, 2).round()
         bw = [0.0, 3.0, 40.0, 500.0][q % 4]
         assert np.array_equal(h.query_box(bx, by, bx + bw, by + bw), brute_box(b, (bx, by, bx + bw, by + bw)))
-        ang = rng.uniform(0, 2 * math.pi)
-        u = (math.cos(ang), math.sin(ang))
-        got = set(h.query_ray(bx, by, *u, 150.0).tolist())
-        assert segment_samples_hit(b, (bx, by), u, 150.0) <= got <= segment_near(b, (bx, by), u, 150.0, 1e-6)
     assert h._moving_cells is not None
     # a new step drops them
     m = ~static
@@ -552,12 +491,9 @@ def test_the_caller_may_overwrite_its_arrays():
     assert h.query_box(0.5, 0.5, 0.75, 0.75).tolist() == [1]
     assert h.query_box(5.5, 5.5, 7, 7).tolist() == [2]
     assert h.query_box(0, 3.5, 0, 3.5).tolist() == [3]
-    assert set(h.query_ray(-1, 0.5, 1, 0, 2).tolist()) == {1}
 
 
 def test_argument_checks():
-    with pytest.raises(ValueError, match="static"):
-        find_pairs([0.0], [0.0], [1.0], [1.0], [True, False])
     with pytest.raises(ValueError, match="static"):
         brute_force_pairs([0.0], [0.0], [1.0], [1.0], [True, False])
     with pytest.raises(ValueError, match="integers"):
@@ -619,26 +555,6 @@ def test_random_query_box_matches_brute_force(scene, cell, x, y, w, hh, repeat):
     exp = ids[brute_box(b, box)]
     for _ in range(repeat):  # later queries may use the moving bodies' cells
         assert np.array_equal(h.query_box(*box), exp)
-
-
-@settings(max_examples=150, deadline=None)
-@given(scenes(), cells, quarter, quarter, st.integers(-8, 8), st.integers(-8, 8),
-       st.one_of(st.just(math.inf), st.integers(0, 60).map(lambda i: i / 2)), st.integers(1, 5))
-def test_random_query_ray_is_a_tight_superset(scene, cell, ox, oy, dx, dy, length, repeat):
-    if dx == 0 and dy == 0:
-        dx = 1
-    b, static = scene
-    n = len(static)
-    h, _ = hashed_pairs(*b, static, np.arange(n), cell)
-    norm = math.hypot(dx, dy)
-    u = (dx / norm, dy / norm)
-    finite_len = length if math.isfinite(length) else 400.0  # beyond every body
-    must = segment_samples_hit(b, (ox, oy), u, finite_len) if n else set()
-    may = segment_near(b, (ox, oy), u, finite_len, 1e-6)
-    for _ in range(repeat):
-        got = h.query_ray(ox, oy, dx, dy, length)
-        assert np.array_equal(got, np.unique(got))
-        assert must <= set(got.tolist()) <= may
 
 
 def test_moving_pairs_false_gives_only_moving_static_pairs():

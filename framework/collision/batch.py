@@ -1,16 +1,18 @@
 """Batch (numpy) collision kernels: the contacts of :func:`~framework.collision.collide` for
-arrays of pairs at once, one kernel per pair of shape kinds.
+arrays of pairs at once, one kernel per family of shape pairs (which pair goes to which kernel:
+:data:`framework.collision.kinds.PAIRS`).
 
 Every kernel takes ``[P]`` arrays (scalars broadcast) and returns a :class:`ContactArrays` whose
 row ``i`` is what ``collide`` gives for pair ``i``: the same overlap decision on every input
 (touching is never a collision and an overlap of one ulp always is), the same normal and depth up
-to rounding (the same tie-break rule) and the same point up to rounding. Each has a cheaper
-``overlap_*`` twin that returns only ``hit``. No Python loop runs over the pairs, except over the
-rare ones within rounding of touching that need exact integer arithmetic (none for AABB pairs).
+to rounding (the same tie-break rule) and the same point up to rounding. No Python loop runs over
+the pairs, except over the rare ones within rounding of touching that need exact integer
+arithmetic (none for AABB pairs).
 
 =============================  ===============================================================
 ``circle_circle``              circles A and B
 ``aabb_aabb``                  axis-aligned boxes, by centre and half extents
+``aabb_aabb_fast``             the same, for the pipeline: the overlap rectangle's centre as point
 ``polygon_circle``             polygon (or any box, via :func:`outlines`) A, circle B; with
                                ``flip=True`` the circle is shape A of the pair
 ``polygon_polygon``            polygons and boxes in any mix but AABB / AABB
@@ -25,7 +27,7 @@ Numerics, as in the scalar code (whose module docstring explains them): each pai
 local frame (A's hitbox origin; the polygon's for a polygon / circle pair) scaled by a power of two,
 so a scene at x = 1e9 gives the answers of the scene at the origin and radii of 1e-200 or 1e300
 neither underflow nor overflow; floats decide wherever the answer is clear of rounding, exact
-arithmetic inside a thin band around touching (:mod:`~framework.collision.batch_exact`).
+arithmetic inside a thin band around touching (:mod:`~framework.collision.exact`).
 
 Inputs must be finite (the systems check components); kernels never return NaN or inf.
 :func:`collide_many` groups arbitrary shape pairs by kind and is the convenient (validated) entry.
@@ -38,12 +40,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..shapes import AABB, Circle, Polygon, Shape
+from ..shapes import AABB, Polygon, Shape
 from ..validation import InvalidValue
-from .batch_box import aabb_aabb, aabb_aabb_fast, overlap_aabb_aabb
-from .batch_circle import circle_circle, overlap_circle_circle, overlap_polygon_circle, polygon_circle
+from .batch_box import aabb_aabb, aabb_aabb_fast
+from .batch_circle import circle_circle, polygon_circle
 from .batch_common import F64, ContactArrays, no_contacts
-from .batch_polygon import overlap_polygon_polygon, polygon_polygon
+from .batch_polygon import polygon_polygon
+from .kinds import BOXES, CIRCLES, PAIRS, POLYGON_CIRCLE, POLYGONS, kind_of, pair_code
 from .placement import check_shape, pose
 
 __all__ = [
@@ -53,10 +56,6 @@ __all__ = [
     "circle_circle",
     "collide_many",
     "outlines",
-    "overlap_aabb_aabb",
-    "overlap_circle_circle",
-    "overlap_polygon_circle",
-    "overlap_polygon_polygon",
     "polygon_circle",
     "polygon_polygon",
 ]
@@ -117,11 +116,9 @@ def outlines(shapes: Sequence[AABB | Polygon], rotations: object) -> tuple[np.nd
     return verts, counts
 
 
-_AABB, _CIRCLE, _POLYGON = 0, 1, 2
-
-
-def _kind(shape: Shape) -> int:
-    return _AABB if isinstance(shape, AABB) else _CIRCLE if isinstance(shape, Circle) else _POLYGON
+# The shape-pair table as columns indexed by pair code: kernel family, flipped (the circle is A).
+_PAIR_FAMILY = np.array([rule.family for rule in PAIRS.values()], dtype=np.int64)
+_PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
 
 
 def collide_many(
@@ -144,8 +141,8 @@ def collide_many(
     out = no_contacts(n)
     if n == 0:
         return out
-    ka = np.array([_kind(s) for s in sa])
-    kb = np.array([_kind(s) for s in sb])
+    code = pair_code(np.array([kind_of(s) for s in sa]), np.array([kind_of(s) for s in sb]))
+    family, flip = _PAIR_FAMILY[code], _PAIR_FLIP[code]
     ra = np.array([s.bounding_radius for s in sa])
     rb = np.array([s.bounding_radius for s in sb])
 
@@ -165,19 +162,18 @@ def collide_many(
     def shape_outlines(shapes: list[Shape], rot: np.ndarray, rows: np.ndarray):
         return outlines([shapes[i] for i in rows], rot[rows])  # type: ignore[misc]
 
-    a_circle, b_circle = ka == _CIRCLE, kb == _CIRCLE
-    run(a_circle & b_circle, lambda r: circle_circle(
+    run(family == CIRCLES, lambda r: circle_circle(
         pa[r, 0], pa[r, 1], radius(sa, r), pb[r, 0], pb[r, 1], radius(sb, r)))
-    run((ka == _AABB) & (kb == _AABB), lambda r: aabb_aabb(
+    run(family == BOXES, lambda r: aabb_aabb(
         pa[r, 0], pa[r, 1], half(sa, r, "width"), half(sa, r, "height"),
         pb[r, 0], pb[r, 1], half(sb, r, "width"), half(sb, r, "height")))
-    run(~a_circle & b_circle, lambda r: polygon_circle(
+    run((family == POLYGON_CIRCLE) & ~flip, lambda r: polygon_circle(
         pa[r, 0], pa[r, 1], *shape_outlines(sa, pa[:, 2], r),
         pb[r, 0], pb[r, 1], radius(sb, r), size=ra[r] + rb[r]))
-    run(a_circle & ~b_circle, lambda r: polygon_circle(
+    run((family == POLYGON_CIRCLE) & flip, lambda r: polygon_circle(
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r),
         pa[r, 0], pa[r, 1], radius(sa, r), flip=True, size=ra[r] + rb[r]))
-    run(~a_circle & ~b_circle & ~((ka == _AABB) & (kb == _AABB)), lambda r: polygon_polygon(
+    run(family == POLYGONS, lambda r: polygon_polygon(
         pa[r, 0], pa[r, 1], *shape_outlines(sa, pa[:, 2], r),
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r), size=ra[r] + rb[r]))
     return out

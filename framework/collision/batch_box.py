@@ -22,11 +22,12 @@ from __future__ import annotations
 import numpy as np
 
 from .batch_common import F64, ContactArrays, columns, finish, frame
-from .batch_exact import BAND, TINY
-from .batch_point import POINT_TOL, overlap_point
+from .batch_point import overlap_point
+from .collide import POINT_TOL
+from .exact import BAND, TINY
 from .tiebreak import DEPTH_TOL
 
-__all__ = ["aabb_aabb", "aabb_aabb_fast", "overlap_aabb_aabb"]
+__all__ = ["aabb_aabb", "aabb_aabb_fast"]
 
 
 def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -51,12 +52,6 @@ def _less(dh, dl, rh, rl) -> np.ndarray:
     """``|dh + dl| < rh + rl`` exactly (``dh``, ``rh`` the rounded leading parts, ``rh >= 0``)."""
     adh = np.abs(dh)
     return (adh < rh) | ((adh == rh) & (np.sign(dh) * dl < rl))
-
-
-def overlap_aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh) -> np.ndarray:
-    """``hit`` of :func:`aabb_aabb` only."""
-    ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
-    return _less(*_reach(ax, bx, ahw, bhw)) & _less(*_reach(ay, by, ahh, bhh))
 
 
 def _overlaps(hwa, hha, hwb, hhb, dx, dy):
@@ -120,17 +115,9 @@ def _crossing(t: np.ndarray, u: np.ndarray, gone: np.ndarray) -> np.ndarray:
     return ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~gone).astype(F64)
 
 
-def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
-    """``collide.overlap_point`` of two boxes, with B at its offset: the mean of A's corners in B,
-    B's corners in A and the crossings of their edges, each counted by the scalar code's tests.
-
-    For boxes those tests separate: an edge's cross product ``ex (y - y0) - ey (x - x0)`` has one
-    term ``0 * (...)``, a signed zero that changes no comparison, so a corner is inside when its x
-    passes the two side edges and its y the bottom and top edges; and only the 8 perpendicular
-    edge pairs can cross (parallel ones have ``den == 0`` exactly and are skipped).
-    """
-    tol = POINT_TOL * size
-    xb0, xb1, yb0, yb1 = -hwb + dx, hwb + dx, -hhb + dy, hhb + dy
+def _corners_inside(hwa, hha, xb0, xb1, yb0, yb1, tol):
+    """Sums of the x and y of A's corners inside B and B's corners inside A (B's outline
+    ``[xb0, xb1] x [yb0, yb1]`` at its offset, A's ``(±hwa, ±hha)``), and their number."""
     wa, ha = hwa + hwa, hha + hha  # A's edge lengths; B's as the scalar code gets them:
     wb, hb = xb1 - xb0, yb1 - yb0
 
@@ -157,10 +144,20 @@ def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
         sx += (xs[0] * mx[0] + xs[1] * mx[1]) * nyin
         sy += (ys[0] * my[0] + ys[1] * my[1]) * nxin
         count += nxin * nyin
-    # Crossings: A's bottom / top edges with B's right / left ones, and A's right / left edges
-    # with B's bottom / top ones. With the zero components of the edge vectors written out, the
-    # scalar code's den = rx sy - ry sx, t = (wx sy - wy sx) / den and u = (wx ry - wy rx) / den
-    # lose terms that are signed zeros (changing no comparison and no sum).
+    return sx, sy, count
+
+
+def _edge_crossings(hwa, hha, xb0, xb1, yb0, yb1):
+    """Sums of the x and y of the crossings of A's edges with B's, and their number.
+
+    A's bottom / top edges cross B's right / left ones, and A's right / left edges B's bottom /
+    top ones. With the zero components of the edge vectors written out, the scalar code's
+    den = rx sy - ry sx, t = (wx sy - wy sx) / den and u = (wx ry - wy rx) / den lose terms that
+    are signed zeros (changing no comparison and no sum).
+    """
+    wa, ha = hwa + hwa, hha + hha
+    wb, hb = xb1 - xb0, yb1 - yb0
+
     def stack(*v):
         return np.stack(v)
 
@@ -182,9 +179,26 @@ def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
     t = (-((q_y - p_y) * s_)) / den
     u = ((q_x - p_x) * r) / den
     vx, vy, vcross = p_x, p_y + np.minimum(np.maximum(t, 0.0), 1.0) * r, _crossing(t, u, gone)
-    sx += (hx * hcross).sum(axis=0) + (vx * vcross).sum(axis=0)
-    sy += (hy * hcross).sum(axis=0) + (vy * vcross).sum(axis=0)
-    count += hcross.sum(axis=0) + vcross.sum(axis=0)
+    return ((hx * hcross).sum(axis=0) + (vx * vcross).sum(axis=0),
+            (hy * hcross).sum(axis=0) + (vy * vcross).sum(axis=0),
+            hcross.sum(axis=0) + vcross.sum(axis=0))
+
+
+def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):
+    """``collide.overlap_point`` of two boxes, with B at its offset: the mean of A's corners in B,
+    B's corners in A and the crossings of their edges, each counted by the scalar code's tests.
+
+    For boxes those tests separate: an edge's cross product ``ex (y - y0) - ey (x - x0)`` has one
+    term ``0 * (...)``, a signed zero that changes no comparison, so a corner is inside when its x
+    passes the two side edges and its y the bottom and top edges; and only the 8 perpendicular
+    edge pairs can cross (parallel ones have ``den == 0`` exactly and are skipped).
+    """
+    xb0, xb1, yb0, yb1 = -hwb + dx, hwb + dx, -hhb + dy, hhb + dy
+    sx, sy, count = _corners_inside(hwa, hha, xb0, xb1, yb0, yb1, POINT_TOL * size)
+    cross_x, cross_y, crossings = _edge_crossings(hwa, hha, xb0, xb1, yb0, yb1)
+    sx += cross_x
+    sy += cross_y
+    count += crossings
     found = count > 0
     c = np.maximum(count, 1.0)
     px, py = sx / c, sy / c
@@ -208,7 +222,7 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
     ``collide``) average except where corners coincide; it lies in the overlap region either way.
     Rows are decided with plain floats where the answer is clear; those within the rounding band
     around touching (boxes just pushed apart, common) are decided exactly on double-doubles, as
-    :func:`overlap_aabb_aabb`, with double-double push-outs; extreme magnitudes go through
+    :func:`aabb_aabb` decides them, with double-double push-outs; extreme magnitudes go through
     :func:`aabb_aabb`. With ``exact=False`` rows within about 1e-12 of the sizes of touching count
     as not overlapping (the response re-measuring pairs it has just pushed apart: such an overlap
     is not worth resolving), and with ``points=False`` the points are left at 0.

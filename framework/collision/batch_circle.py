@@ -2,10 +2,12 @@
 
 Each step mirrors :mod:`framework.collision.collide` operation for operation (same scaled local
 frame, same expressions in the same order, same band around touching); the rows inside the band
-are decided exactly by :mod:`framework.collision.batch_exact`.
+are decided exactly by :mod:`framework.collision.exact`.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -28,14 +30,17 @@ from .batch_common import (
     pick,
     take,
 )
-from .batch_exact import BAND, TINY, circle_circle_exact, polygon_circle_exact
+from .exact import BAND, TINY, Offset, circle_circle_exact, float_rounded, polygon_circle_exact
+from .tiebreak import pick as pick_one
 
-__all__ = ["circle_circle", "overlap_circle_circle", "overlap_polygon_circle", "polygon_circle"]
+__all__ = ["circle_circle", "polygon_circle"]
 
 
 # --- circle / circle -------------------------------------------------------------------------
 
-def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True):
+def circle_circle(ax, ay, ar, bx, by, br, exact: bool = True) -> ContactArrays:
+    """Circles of radius ``ar`` at (ax, ay) (A) and ``br`` at (bx, by) (B), all ``[P]``.
+    ``exact=False``: pairs within rounding of touching count as apart (for the response)."""
     ax, ay, ar, bx, by, br = columns(ax, ay, ar, bx, by, br)
     dx, dy, k = frame(ax, ay, bx, by, np.maximum(ar, br))
     ra, rb = np.ldexp(ar, -k), np.ldexp(br, -k)
@@ -44,15 +49,13 @@ def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True)
     band = BAND * (d2 + r2)
     hit = d2 <= r2 - band
     # Too close to touching for floats: decide on the exact |d|^2 < (ra + rb)^2.
-    near = np.flatnonzero((d2 > r2 - band) & (d2 < r2 + band)) if fallback else np.zeros(0, dtype=np.int64)
+    near = np.flatnonzero((d2 > r2 - band) & (d2 < r2 + band)) if exact else np.zeros(0, dtype=np.int64)
     num = np.zeros(near.size, dtype=F64)
     for j, i in enumerate(near):
-        exact = circle_circle_exact((ax[i], ay[i], bx[i], by[i], int(k[i])), ra[i], rb[i])
-        if exact is not None:
+        excess = circle_circle_exact((ax[i], ay[i], bx[i], by[i], int(k[i])), ra[i], rb[i])
+        if excess is not None:
             hit[i] = True
-            num[j] = exact
-    if not details:
-        return hit
+            num[j] = float_rounded(*excess)
     exact_rows = np.zeros(hit.shape, dtype=bool)
     exact_rows[near] = True
     exact_num = np.zeros(hit.shape, dtype=F64)
@@ -72,26 +75,14 @@ def _circle_circle(ax, ay, ar, bx, by, br, details: bool, fallback: bool = True)
     return finish(hit, nx, ny, depth, nx * mid, ny * mid, k, ax[hit], ay[hit])
 
 
-def overlap_circle_circle(ax, ay, ar, bx, by, br) -> np.ndarray:
-    """``hit`` of :func:`circle_circle` only."""
-    return _circle_circle(ax, ay, ar, bx, by, br, details=False)
-
-
-def circle_circle(ax, ay, ar, bx, by, br, exact: bool = True) -> ContactArrays:
-    """Circles of radius ``ar`` at (ax, ay) (A) and ``br`` at (bx, by) (B), all ``[P]``.
-    ``exact=False``: pairs within rounding of touching count as apart (for the response)."""
-    return _circle_circle(ax, ay, ar, bx, by, br, details=True, fallback=exact)
-
-
 # --- polygon / circle ------------------------------------------------------------------------
 
-def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: bool, fallback: bool = True):
+def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, fallback: bool):
     vx, vy, count = outline_rows(averts, acount, "polygon vertices")
     p = vx.shape[1]
     ax, ay, bx, by, r = columns_of(p, ax, ay, bx, by, br)
     if p == 0:
-        return np.zeros(0, dtype=bool) if not details else finish(
-            np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
+        return finish(np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
     f = np.where(np.broadcast_to(np.asarray(flip, dtype=bool), (p,)), -1.0, 1.0)  # per row
     # The polygon's frame, whichever shape of the pair it is.
     cx, cy, k = frame(ax, ay, bx, by, np.maximum(extent(vx, vy), r))
@@ -129,15 +120,12 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: boo
     for i in np.flatnonzero(exact) if fallback else ():
         n = int(count[i])
         poly = list(zip(vx[:n, i].tolist(), vy[:n, i].tolist(), strict=True))
-        res = polygon_circle_exact(
+        res = _polygon_circle_exact(
             poly, (ax[i], ay[i], bx[i], by[i], int(k[i])), r[i], cx[i], cy[i], size[i], float(f[i])
         )
         if res is not None:
             hit[i] = True
             results[i] = res
-    if not details:
-        return hit
-
     nx, ny, depth, px, py = (np.zeros(p, dtype=F64) for _ in range(5))
     m = np.flatnonzero(inside_clear)
     if m.size:
@@ -163,9 +151,44 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details: boo
     return finish(hit, nx[hit], ny[hit], depth[hit], px[hit], py[hit], k[hit], ax[hit], ay[hit])
 
 
-def overlap_polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False) -> np.ndarray:
-    """``hit`` of :func:`polygon_circle` only."""
-    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, None, details=False)
+def _polygon_circle_exact(
+    poly: list[tuple[float, float]], offset: Offset, r: float, cx: float, cy: float, size: float, f: float
+) -> tuple[float, float, float, float, float] | None:
+    """One row of :func:`polygon_circle` decided on exact integers (a convex CCW outline at the
+    origin, the circle at the exact offset, float (cx, cy)): ``(nx, ny, depth, px, py)`` with the
+    normal times ``f``, or ``None``."""
+    found = polygon_circle_exact(poly, offset, r)
+    if found is None:
+        return None
+    n, e = len(poly), found.e
+    if found.case == "inside":
+        # An overlap (r > 0), depth r + distance to the nearest face.
+        cands = []
+        for i in range(n):
+            (x0, y0), (x1, y1) = poly[i], poly[(i + 1) % n]
+            ex, ey = x1 - x0, y1 - y0
+            ln = math.hypot(ex, ey)
+            if ln > 0.0:
+                cands.append((r - float_rounded(found.seps[i], 2 * e) / ln, f * ey / ln, -f * ex / ln))
+        depth, nx, ny = pick_one(cands, size)
+        return nx, ny, max(depth, TINY), cx, cy
+    if found.case == "face":
+        # depth = (r^2 |e|^2 - s^2) / (|e| (r |e| + s)).
+        i = found.index
+        (fx0, fy0), (fx1, fy1) = poly[i], poly[(i + 1) % n]
+        fex, fey = fx1 - fx0, fy1 - fy0
+        ln = math.hypot(fex, fey)
+        fs = float_rounded(found.seps[i], 2 * e)
+        depth = max(float_rounded(found.num, 4 * e) / (ln * (r * ln + fs)), TINY)
+        nx, ny = fey / ln, -fex / ln
+        dist = fs / ln
+        return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
+    j = found.index
+    ddx, ddy = float_rounded(found.dx, e), float_rounded(found.dy, e)
+    dist = math.hypot(ddx, ddy)
+    depth = max(float_rounded(found.num, 2 * e) / (r + dist), TINY)
+    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
+    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
 
 def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None, exact: bool = True) -> ContactArrays:
@@ -180,4 +203,4 @@ def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None, ex
     tolerance; by default it is measured from the outlines. ``exact=False``: pairs within rounding
     of touching count as apart (the response re-measuring pairs it has just pushed apart).
     """
-    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, details=True, fallback=exact)
+    return _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, fallback=exact)

@@ -3,7 +3,8 @@
 The result record, input coercion, frames, padded-outline helpers and the tie-break rule of
 :mod:`framework.collision.tiebreak` on arrays. The kernels live in ``batch_circle``, ``batch_box``
 and ``batch_polygon``, the contact point of polygons in ``batch_point``, the exact fallback near
-touching in ``batch_exact``; :mod:`framework.collision.batch` is the public face.
+touching in :mod:`~framework.collision.exact` (shared with the scalar code);
+:mod:`framework.collision.batch` is the public face.
 
 Padded outlines: a batch of convex counter-clockwise outlines is an array ``[P, K, 2]`` plus a
 count per row; slots at and past the count repeat the last real vertex. Edge ``i`` runs from slot
@@ -24,10 +25,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..validation import InvalidValue
+from .exact import TINY
 from .tiebreak import DEPTH_TOL, DIR_TOL
-
-# Smallest positive float: the floor of every depth, so "depth > 0" holds even where it underflows.
-TINY = 5e-324
 
 __all__ = ["ContactArrays"]
 

@@ -11,12 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from .batch_common import F64, cols, edges, first_min, norm, take, vertex_mask
+from .collide import POINT_TOL
 
-__all__ = ["POINT_TOL", "overlap_point"]
-
-# Relative tolerance of the inside test of the contact point (times the pair's size), as in
-# ``collide.overlap_point``.
-POINT_TOL = 1e-12
+__all__ = ["overlap_point"]
 
 
 def _inside(x, y, ox, oy, ex, ey, tol):

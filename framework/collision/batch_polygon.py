@@ -4,7 +4,7 @@ Separating axes, vectorised over pairs: the axes are the unnormalised outward ed
 and of B, ``[C, P]`` with ``C = Ka + Kb``; every vertex of both outlines is projected on every
 axis (a loop over the few vertices, each step on ``[C, P]``), with B about its own origin and
 ``u . d`` added, exactly the scalar code's products and comparisons. Rows within the band of
-touching on some axis are decided exactly (:mod:`framework.collision.batch_exact`). Only the
+touching on some axis are decided exactly (:mod:`framework.collision.exact`). Only the
 overlapping rows go on to normalise their axes, build the ``2 C`` push-out candidates and apply
 the tie-break rule.
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..validation import InvalidValue
-from .batch_box import aabb_aabb, aabb_aabb_fast, overlap_aabb_aabb
+from .batch_box import aabb_aabb, aabb_aabb_fast
 from .batch_common import (
     BIG,
     F64,
@@ -37,10 +37,10 @@ from .batch_common import (
     outline_rows,
     pick,
 )
-from .batch_exact import BAND, TINY, polygon_polygon_exact
 from .batch_point import overlap_point
+from .exact import BAND, TINY, float_rounded, polygon_polygon_exact
 
-__all__ = ["overlap_polygon_polygon", "polygon_polygon"]
+__all__ = ["polygon_polygon"]
 
 
 def _frame(avx, avy, bvx, bvy, ax, ay, bx, by):
@@ -120,26 +120,12 @@ def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, fa
         lb = list(zip(bvx[: bcount[i], i].tolist(), bvy[: bcount[i], i].tolist(), strict=True))
         exact = polygon_polygon_exact(pa, lb, (ax[i], ay[i], bx[i], by[i], int(k[i])))
         if exact is not None:
+            found, u = exact
             hit[i] = True
             slots = np.flatnonzero(valid[:, i])
-            fwd[slots, i], bwd[slots, i] = np.array(exact).T
+            fwd[slots, i], bwd[slots, i] = np.array([(float_rounded(fw, u), float_rounded(bw, u))
+                                                     for fw, bw in found.values()]).T
     return hit, (ux, uy, valid, fwd, bwd)
-
-
-def overlap_polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount) -> np.ndarray:
-    """``hit`` of :func:`polygon_polygon` only."""
-    avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, boxes, rest, box_args = _rows(
-        ax, ay, averts, acount, bx, by, bverts, bcount
-    )
-    hit = np.zeros(ax.shape, dtype=bool)
-    if boxes.size:
-        hit[boxes] = overlap_aabb_aabb(*box_args)
-    if rest.size:
-        avx, avy, bvx, bvy = (cols(v, rest) for v in (avx, avy, bvx, bvy))
-        ax, ay, bx, by, acount, bcount = (v[rest] for v in (ax, ay, bx, by, acount, bcount))
-        avx, avy, bvx, bvy, dx, dy, k, size = _frame(avx, avy, bvx, bvy, ax, ay, bx, by)
-        hit[rest] = _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size)[0]
-    return hit
 
 
 def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None, exact: bool = True,

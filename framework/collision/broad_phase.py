@@ -33,7 +33,7 @@ from ..validation import InvalidValue, finite, positive
 from . import grid
 from .grid import CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
 
-__all__ = ["SpatialHash", "brute_force_pairs", "find_pairs"]
+__all__ = ["SpatialHash", "brute_force_pairs"]
 
 _I64 = np.int64
 _EMPTY_I = np.zeros(0, dtype=_I64)
@@ -54,22 +54,6 @@ def brute_force_pairs(minx, miny, maxx, maxy, static=None) -> tuple[np.ndarray, 
     i, j = overlap_pairs(b, b, upper=True)
     keep = ~(st[i] & st[j])
     return i[keep], j[keep]
-
-
-def find_pairs(minx, miny, maxx, maxy, static=None, cell_size: float | None = None):
-    """The broad-phase pairs ``(i, j)`` of bodies numbered by position; same answer as
-    :func:`brute_force_pairs`, in O(N) for scenes of similar-sized bodies."""
-    b = as_bounds(minx, miny, maxx, maxy)
-    n = b[0].shape[0]
-    st = np.zeros(n, dtype=bool) if static is None else np.asarray(static, dtype=bool).reshape(-1)
-    if st.shape[0] != n:
-        raise InvalidValue(f"static must have {n} entries, got {st.shape[0]}")
-    ids = np.arange(n, dtype=_I64)
-    h = SpatialHash(cell_size)
-    if cell_size is None:
-        h._choose_cell(b)  # from all bodies, not only the statics
-    h.set_static(*subset(b, st), ids[st])
-    return h.pairs(*subset(b, ~st), ids[~st])
 
 
 def _as_ids(ids, n: int) -> np.ndarray:
@@ -337,80 +321,6 @@ class SpatialHash:
         cx = np.tile(np.arange(gx0, gx0 + nx, dtype=_I64), ny)
         return distinct(np.concatenate([index.large, index.bodies_in_cells(cx, cy)]))
 
-    def query_ray(self, ox, oy, dx, dy, max_distance=math.inf) -> np.ndarray:
-        """Sorted ids of the bodies (static, and the last :meth:`pairs` call's moving ones) whose
-        closed bounds the segment from ``(ox, oy)`` along ``(dx, dy)`` for ``max_distance`` world
-        units may touch: a conservative superset (bounds padded by a tiny relative margin) for a
-        narrow-phase raycast to decide. ``(dx, dy)`` need not be unit length."""
-        ox, oy = finite("ox", ox), finite("oy", oy)
-        dx, dy = finite("dx", dx), finite("dy", dy)
-        if dx == 0.0 and dy == 0.0:
-            raise InvalidValue("ray direction (dx, dy) must not be zero")
-        if not (max_distance >= 0.0):  # also refuses NaN
-            raise InvalidValue(f"max_distance must be >= 0, got {max_distance!r}")
-        norm = math.hypot(dx, dy)
-        ray = (ox, oy, dx / norm, dy / norm, float(max_distance))
-        found = []
-        for index, bounds, ids in self._sets():
-            if bounds[0].shape[0] == 0:
-                continue
-            with np.errstate(over="ignore", invalid="ignore"):
-                c = None if index is None else self._ray_candidates(index, *ray)
-            if c is None:
-                found.append(ids[_segment_touches(bounds, *ray)])
-            else:
-                found.append(ids[c[_segment_touches(subset(bounds, c), *ray)]])
-        return distinct(np.concatenate(found)) if found else _EMPTY_I
-
-    def _ray_candidates(self, index: CellIndex, ox, oy, ux, uy, length) -> np.ndarray | None:
-        """Sorted numbers of the bodies in the cells near the segment (found column by column,
-        padded by a cell each way) and of the large bodies; ``None``: test every body."""
-        lim = grid.CELL_LIMIT
-        if min(index.x0, index.y0) <= -lim or max(index.x0 + index.wx, index.y0 + index.wy) > lim:
-            return None  # clipped cell indices: the grid's cells are not where the geometry says
-        cand = [index.large]
-        cell = self._cell
-        # clip the segment to the grid's box, padded by a cell, so that an endless ray ends
-        gx0, gx1 = (index.x0 - 1) * cell, (index.x0 + index.wx + 1) * cell
-        gy0, gy1 = (index.y0 - 1) * cell, (index.y0 + index.wy + 1) * cell
-        t0, t1 = 0.0, length
-        for o, u, lo, hi in ((ox, ux, gx0, gx1), (oy, uy, gy0, gy1)):
-            if u == 0.0:
-                if not (lo <= o <= hi):
-                    t1 = -1.0
-            else:
-                a, b = (lo - o) / u, (hi - o) / u
-                t0, t1 = max(t0, min(a, b)), min(t1, max(a, b))
-        if index.entries and t0 <= t1:
-            t0, t1 = max(0.0, t0 - cell), min(length, t1 + cell)
-            xs, xe = sorted((ox + ux * t0, ox + ux * t1))
-            ys, ye = oy + uy * t0, oy + uy * t1
-            c0, c1 = (int(v) for v in grid.cell_index(np.array([xs, xe]), cell))
-            k0, k1 = max(c0 - 1, index.x0), min(c1 + 1, index.x0 + index.wx - 1)
-            if k1 - k0 >= index.entries:
-                return None  # a ray across more columns than there are entries
-            cols = np.arange(k0, k1 + 1)
-            # the segment's y range over each column's x range
-            xa = np.maximum(cols * cell, xs)
-            xb = np.minimum((cols + 1) * cell, xe)
-            if abs(ux) < 1e-9:  # (nearly) vertical: the whole y range in each of the few columns
-                ya = np.full(cols.shape[0], min(ys, ye))
-                yb = np.full(cols.shape[0], max(ys, ye))
-            else:
-                ya = oy + (xa - ox) * (uy / ux)
-                yb = oy + (xb - ox) * (uy / ux)
-                ya, yb = np.minimum(ya, yb), np.maximum(ya, yb)
-            if not (np.isfinite(ya).all() and np.isfinite(yb).all()):
-                return None  # coordinates near the float limit
-            r0 = np.maximum(grid.cell_index(ya, cell) - 1, index.y0)
-            r1 = np.minimum(grid.cell_index(yb, cell) + 1, index.y0 + index.wy - 1)
-            cnt = np.maximum(r1 - r0 + 1, 0)
-            if int(cnt.sum()) > index.entries:
-                return None  # a ray across most of the grid
-            col, row = grid.expand_runs(cnt, r0)
-            cand.append(index.bodies_in_cells(cols[col], row))
-        return distinct(np.concatenate(cand))
-
     def cells_in_use(self) -> np.ndarray:
         """``(M, 2)`` int64 (column, row) of the cells holding a static body or a moving body of the
         last :meth:`pairs` call, sorted; cell ``(c, r)`` spans ``[c, c+1] x [r, r+1]`` times
@@ -423,24 +333,3 @@ class SpatialHash:
         cells = np.stack([np.concatenate(cols), np.concatenate(rows)], axis=1)
         return np.unique(cells, axis=0) if cells.shape[0] else cells.reshape(0, 2)
 
-
-def _segment_touches(bounds: tuple, ox, oy, ux, uy, length) -> np.ndarray:
-    """Elementwise, conservatively: the segment ``o + u t, 0 <= t <= length`` meets the closed
-    bounds padded by a small relative margin (slab test)."""
-    minx, miny, maxx, maxy = bounds
-    scale = 1.0 + abs(ox) + abs(oy) + (length if math.isfinite(length) else 0.0)
-    pad = 1e-9 * scale
-    t0 = np.zeros(minx.shape[0])
-    t1 = np.full(minx.shape[0], length)
-    ok = np.ones(minx.shape[0], dtype=bool)
-    with np.errstate(invalid="ignore", over="ignore"):
-        for o, u, lo, hi in ((ox, ux, minx, maxx), (oy, uy, miny, maxy)):
-            lo = lo - (pad + 1e-12 * np.abs(lo))
-            hi = hi + (pad + 1e-12 * np.abs(hi))
-            if u == 0.0:
-                ok &= (lo <= o) & (o <= hi)
-            else:
-                a, b = (lo - o) / u, (hi - o) / u
-                t0 = np.maximum(t0, np.minimum(a, b))
-                t1 = np.minimum(t1, np.maximum(a, b))
-    return ok & (t0 <= t1)

@@ -18,9 +18,10 @@ Numerics, in three layers:
    unscaled answers bit for bit, while radii of 1e-200 or 1e300 neither underflow nor overflow.
 3. **Exact arithmetic near touching.** Floats decide wherever the answer is clear by far more than
    their rounding error. Inside a thin band around "touching" the decision is redone with exact
-   integers (every float is an integer times a power of two), so touching is never a collision and
-   an overlap of one ulp always is; the depth is then computed from the exact overlap, so it is
-   > 0 whenever a contact is returned.
+   integers (every float is an integer times a power of two; :mod:`~framework.collision.exact`,
+   shared with the batch kernels), so touching is never a collision and an overlap of one ulp
+   always is; the depth is then computed from the exact overlap, so it is > 0 whenever a contact
+   is returned.
 """
 
 from __future__ import annotations
@@ -29,6 +30,17 @@ import math
 
 from ..shapes import Circle, Shape
 from ..validation import InvalidValue
+from .exact import (
+    BAND,
+    TINY,
+    Offset,
+    circle_circle_exact,
+    float_approx,
+    polygon_circle_exact,
+    polygon_polygon_exact,
+    ratio_approx,
+)
+from .kinds import CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
 from .placement import check_shape, local_outline, pose
 from .results import Contact, Vec2
 from .tiebreak import pick
@@ -38,16 +50,6 @@ __all__ = ["collide"]
 Pts = list[tuple[float, float]]
 # (nx, ny, depth, px, py) in the scaled local frame; the normal already points from A toward B.
 Res = tuple[float, float, float, float, float]
-# Exact values as (float, exponent) terms: each stands for float * 2**exponent.
-Terms = tuple[tuple[float, int], ...]
-
-# Half-width of the band, relative to the magnitudes involved, inside which the float result is not
-# trusted and the overlap is decided exactly. Float rounding is below 1e-15 of those magnitudes;
-# the band only has to be wider than that, and narrow enough to be rare.
-_BAND = 1e-13
-# Smallest positive float: the floor of an exactly-decided depth, so "depth > 0" holds even in
-# cases (an overlap far below the scene's resolution) where the division underflows.
-_TINY = 5e-324
 
 
 def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: object) -> Contact | None:
@@ -61,20 +63,21 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
     check_shape("shape_b", shape_b)
     ax, ay, ar = pose("transform_a", transform_a)
     bx, by, br = pose("transform_b", transform_b)
-    if isinstance(shape_a, Circle) and not isinstance(shape_b, Circle):
+    rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
+    if rule.flip:
         # Polygon-circle pairs are worked in the polygon's frame whichever comes first.
         ox, oy = bx, by
-        found = _pair(shape_b, bx, by, br, shape_a, ax, ay, flip=True)
+        found = _pair(rule.family, shape_b, bx, by, br, shape_a, ax, ay, flip=True)
     else:
         ox, oy = ax, ay
-        found = _pair(shape_a, ax, ay, ar, shape_b, bx, by, br)
+        found = _pair(rule.family, shape_a, ax, ay, ar, shape_b, bx, by, br)
     if found is None:
         return None
     (nx, ny, depth, px, py), k = found
     try:
         # An overlap below the smallest float (only between shapes 1e300 times smaller than the
         # scene) is still an overlap: depth > 0.
-        depth = max(math.ldexp(depth, k), _TINY)
+        depth = max(math.ldexp(depth, k), TINY)
         px, py = ox + math.ldexp(px, k), oy + math.ldexp(py, k)
     except OverflowError:
         px = math.inf
@@ -88,10 +91,11 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
 
 
 def _pair(
-    sa: Shape, ox: float, oy: float, rot_a: float, sb: Shape, qx: float, qy: float, rot_b: float = 0.0,
-    flip: bool = False,
+    family: int, sa: Shape, ox: float, oy: float, rot_a: float, sb: Shape, qx: float, qy: float,
+    rot_b: float = 0.0, flip: bool = False,
 ) -> tuple[Res, int] | None:
-    """``sa`` at (ox, oy) against ``sb`` at (qx, qy): the result in ``sa``'s frame scaled by 2**-k.
+    """``sa`` at (ox, oy) against ``sb`` at (qx, qy), computed by ``family``
+    (:data:`~framework.collision.kinds.PAIRS`): the result in ``sa``'s frame scaled by 2**-k.
 
     With ``flip`` the caller's A is ``sb`` (a circle): normals are turned to point from it.
     """
@@ -100,65 +104,40 @@ def _pair(
     hx, hy = 0.5 * qx - 0.5 * ox, 0.5 * qy - 0.5 * oy
     k = math.frexp(max(abs(hx), abs(hy), 0.5 * ra, 0.5 * rb))[1]
     dx, dy = math.ldexp(hx, 1 - k), math.ldexp(hy, 1 - k)
-    # The exact offset (q - o) * 2**-k, as (value, exponent) terms for the exact fallback.
-    off = ((qx, -k), (ox, -k), (qy, -k), (oy, -k))
+    # The exact offset (q - o) * 2**-k, for the exact fallback.
+    off = (ox, oy, qx, qy, k)
     size = math.ldexp(ra, -k) + math.ldexp(rb, -k)
-    if isinstance(sa, Circle):
-        assert isinstance(sb, Circle)
+    if family == CIRCLES:
+        assert isinstance(sa, Circle) and isinstance(sb, Circle)
         res = circle_circle(math.ldexp(sa.radius, -k), math.ldexp(sb.radius, -k), dx, dy, off)
-    elif isinstance(sb, Circle):
+    elif family == POLYGON_CIRCLE:
+        assert isinstance(sb, Circle)
         res = polygon_circle(local_outline(sa, rot_a, k), dx, dy, math.ldexp(sb.radius, -k), off, size,
                              flip)
-    else:
+    else:  # BOXES or POLYGONS: boxes are polygons here
         res = polygon_polygon(local_outline(sa, rot_a, k), local_outline(sb, rot_b, k), dx, dy, off, size)
     return None if res is None else (res, k)
-
-
-# --- exact arithmetic -------------------------------------------------------------------------
-
-def _ints(*terms: tuple[float, int]) -> tuple[list[int], int]:
-    """Integers ``n_i`` and one exponent ``e`` with ``value_i * 2**shift_i == n_i * 2**e`` exactly."""
-    parts = []
-    for v, shift in terms:
-        num, den = v.as_integer_ratio()  # den is a power of two
-        parts.append((num, shift - den.bit_length() + 1))
-    e = min(p[1] for p in parts)
-    return [num << (q - e) for num, q in parts], e
-
-
-def _to_float(n: int, e: int) -> float:
-    """``n * 2**e`` as a float, to within 2**-63 relative; nonzero stays nonzero (bar underflow)."""
-    s = max(0, n.bit_length() - 64)
-    m = float(n >> s) if n >= 0 else -float((-n) >> s)
-    return math.ldexp(m, e + s)
-
-
-def _exact_offset(off: Terms, *more: tuple[float, int]) -> tuple[int, int, list[int], int]:
-    """The exact offset (as integers) and the extra terms ``more``, all over one exponent."""
-    n, e = _ints(*off, *more)
-    return n[0] - n[1], n[2] - n[3], n[4:], e
 
 
 # --- circle / circle -------------------------------------------------------------------------
 
 def circle_circle(
-    ra: float, rb: float, dx: float, dy: float, off: Terms
+    ra: float, rb: float, dx: float, dy: float, off: Offset
 ) -> Res | None:
     """Circle A (radius ``ra``) at the origin, circle B (``rb``) at (dx, dy)."""
     rsum = ra + rb
     d2, r2 = dx * dx + dy * dy, rsum * rsum
-    band = _BAND * (d2 + r2)
+    band = BAND * (d2 + r2)
     if d2 >= r2 + band:
         return None
     dist = math.hypot(dx, dy)
     if d2 > r2 - band:
         # Too close to touching for floats: decide on the exact |d|^2 < (ra + rb)^2, and take the
         # depth from the exact (ra + rb)^2 - |d|^2 = depth * (ra + rb + |d|).
-        ex, ey, (era, erb), e = _exact_offset(off, (ra, 0), (rb, 0))
-        num = (era + erb) ** 2 - ex * ex - ey * ey
-        if num <= 0:
+        excess = circle_circle_exact(off, ra, rb)
+        if excess is None:
             return None
-        depth = max(_to_float(num, 2 * e) / (rsum + dist), _TINY)
+        depth = max(float_approx(*excess) / (rsum + dist), TINY)
     else:
         depth = rsum - dist
     if dist > 0.0:
@@ -175,7 +154,7 @@ def circle_circle(
 # --- polygon / circle ------------------------------------------------------------------------
 
 def polygon_circle(
-    poly: Pts, cx: float, cy: float, r: float, off: Terms, size: float,
+    poly: Pts, cx: float, cy: float, r: float, off: Offset, size: float,
     flip: bool = False,
 ) -> Res | None:
     """Convex CCW polygon A at the origin against circle B (radius ``r``) at (cx, cy).
@@ -184,7 +163,7 @@ def polygon_circle(
     """
     f = -1.0 if flip else 1.0
     rp = max(math.hypot(x, y) for x, y in poly)
-    tol = _BAND * (abs(cx) + abs(cy) + rp + r)  # on distances
+    tol = BAND * (abs(cx) + abs(cy) + rp + r)  # on distances
     faces = _faces(poly)
     # Unnormalised signed distances of the centre outside each face (outward normal (ey, -ex)).
     seps = [ey * (cx - x0) - ex * (cy - y0) for x0, y0, ex, ey, _, _ in faces]
@@ -249,58 +228,38 @@ def _inside_candidates(faces: list[Face], seps: list[float], r: float, f: float)
     return cands or [(r, 0.0, 1.0)]  # a polygon shrunk to a point at the centre: undefined, up
 
 
-def _ratio(num: int, den: int, e: int) -> float:
-    """``num / den * 2**e`` (``den > 0``) as a float, to within 2**-60 relative."""
-    shift = 64 - (num.bit_length() - den.bit_length())
-    q = (num << shift) // den if shift >= 0 else num // (den << -shift)
-    return _to_float(q, e - shift)
-
-
 def _polygon_circle_exact(
-    poly: Pts, cx: float, cy: float, r: float, off: Terms, size: float, f: float
+    poly: Pts, cx: float, cy: float, r: float, off: Offset, size: float, f: float
 ) -> Res | None:
     """:func:`polygon_circle` decided on exact integers (for centres within rounding of touching)."""
-    n = len(poly)
-    ecx, ecy, rest, e = _exact_offset(off, (r, 0), *((c, 0) for p in poly for c in p))
-    er, pts = rest[0], [(rest[1 + 2 * i], rest[2 + 2 * i]) for i in range(n)]
-    edges = []  # (index, ex, ey, s) of the edges of nonzero length
-    for i in range(n):
-        x0, y0 = pts[i]
-        x1, y1 = pts[(i + 1) % n]
-        ex, ey = x1 - x0, y1 - y0
-        if ex or ey:
-            edges.append((i, ex, ey, ey * (ecx - x0) - ex * (ecy - y0)))
-    if edges and all(s <= 0 for *_, s in edges):
-        # Inside or on the boundary: always an overlap (r > 0), depth r + distance to the face.
+    found = polygon_circle_exact(poly, off, r)
+    if found is None:
+        return None
+    n, e = len(poly), found.e
+    if found.case == "inside":
+        # Always an overlap (r > 0), depth r + distance to the face.
         faces = _faces(poly)  # the same edges: a float edge is zero exactly when the exact one is
-        seps = [_to_float(s, 2 * e - face[5]) for (*_, s), face in zip(edges, faces, strict=True)]
+        exact_seps = [s for i, s in enumerate(found.seps) if poly[i] != poly[(i + 1) % n]]
+        seps = [float_approx(s, 2 * e - face[5]) for s, face in zip(exact_seps, faces, strict=True)]
         cands = _inside_candidates(faces, seps, r, f)
         depth, nx, ny = pick(cands, size)
-        return nx, ny, max(depth, _TINY), cx, cy
-    for i, ex, ey, s in edges:
-        x0, y0 = pts[i]
-        e2 = ex * ex + ey * ey
-        if s > 0 and 0 <= (ecx - x0) * ex + (ecy - y0) * ey <= e2:
-            # distance s / |e| < r  <=>  s^2 < r^2 |e|^2; then depth = r - dist, computed as
-            # (r^2 - dist^2) / (r + dist) with r^2 - dist^2 = (r^2 |e|^2 - s^2) / |e|^2 exact.
-            num = er * er * e2 - s * s
-            if num <= 0:
-                return None
-            (fx0, fy0), (fx1, fy1) = poly[i], poly[(i + 1) % n]
-            k = math.frexp(max(abs(fx1 - fx0), abs(fy1 - fy0)))[1]
-            fex, fey = math.ldexp(fx1 - fx0, -k), math.ldexp(fy1 - fy0, -k)
-            ln = math.hypot(fex, fey)
-            dist = _to_float(s, 2 * e - k) / ln
-            depth = max(_ratio(num, e2, 2 * e) / (r + dist), _TINY)
-            nx, ny = fey / ln, -fex / ln
-            return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
-    j = min(range(n), key=lambda i: (ecx - pts[i][0]) ** 2 + (ecy - pts[i][1]) ** 2)
-    num = er * er - (ecx - pts[j][0]) ** 2 - (ecy - pts[j][1]) ** 2
-    if num <= 0:
-        return None
-    ddx, ddy = _to_float(ecx - pts[j][0], e), _to_float(ecy - pts[j][1], e)
+        return nx, ny, max(depth, TINY), cx, cy
+    if found.case == "face":
+        # depth = r - dist, computed as (r^2 - dist^2) / (r + dist) with r^2 - dist^2 =
+        # (r^2 |e|^2 - s^2) / |e|^2 exact.
+        i = found.index
+        (fx0, fy0), (fx1, fy1) = poly[i], poly[(i + 1) % n]
+        k = math.frexp(max(abs(fx1 - fx0), abs(fy1 - fy0)))[1]
+        fex, fey = math.ldexp(fx1 - fx0, -k), math.ldexp(fy1 - fy0, -k)
+        ln = math.hypot(fex, fey)
+        dist = float_approx(found.seps[i], 2 * e - k) / ln
+        depth = max(ratio_approx(found.num, found.edge2, 2 * e) / (r + dist), TINY)
+        nx, ny = fey / ln, -fex / ln
+        return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
+    j = found.index
+    ddx, ddy = float_approx(found.dx, e), float_approx(found.dy, e)
     dist = math.hypot(ddx, ddy)
-    depth = max(_to_float(num, 2 * e) / (r + dist), _TINY)
+    depth = max(float_approx(found.num, 2 * e) / (r + dist), TINY)
     nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
     return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
@@ -344,7 +303,7 @@ def _extent(poly: Pts, ux: float, uy: float) -> tuple[float, float]:
 
 
 def polygon_polygon(
-    pa: Pts, lb: Pts, dx: float, dy: float, off: Terms, size: float
+    pa: Pts, lb: Pts, dx: float, dy: float, off: Offset, size: float
 ) -> Res | None:
     """Convex CCW outline A at the origin and B (outline ``lb`` about its own origin) at (dx, dy)."""
     edges = _axes(pa, lb)
@@ -362,7 +321,7 @@ def polygon_polygon(
         ud = ux * dx + uy * dy
         fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
         least = min(fwd, bwd)
-        tol = _BAND * (abs(ux) + abs(uy)) * mag
+        tol = BAND * (abs(ux) + abs(uy)) * mag
         if least < -tol:
             return None  # a separating axis, clear of rounding
         if least <= tol:
@@ -379,8 +338,8 @@ def polygon_polygon(
     for (ux, uy), (fwd, bwd) in zip(axes, overlaps, strict=True):
         ln = math.hypot(ux, uy)
         nx, ny = ux / ln, uy / ln
-        cands.append((max(fwd / ln, _TINY), nx, ny))
-        cands.append((max(bwd / ln, _TINY), -nx, -ny))
+        cands.append((max(fwd / ln, TINY), nx, ny))
+        cands.append((max(bwd / ln, TINY), -nx, -ny))
     depth, nx, ny = pick(cands, size)
     pb = [(x + dx, y + dy) for x, y in lb]
     px, py = overlap_point(pa, pb, nx, ny, depth, size)
@@ -388,30 +347,23 @@ def polygon_polygon(
 
 
 def _polygon_polygon_exact(
-    pa: Pts, lb: Pts, off: Terms, edges: list[tuple[int, int]], ks: list[int]
+    pa: Pts, lb: Pts, off: Offset, edges: list[tuple[int, int]], ks: list[int]
 ) -> list[tuple[float, float]] | None:
     """The SAT on exact integers: ``None`` if separated or touching, else the overlaps along the
     axes of ``edges``, in the units of those axes scaled by ``2**-ks``. Every edge is tested, also
     those whose float axis was dropped as a repeat (rounding can make nearly parallel edges look
     exactly parallel)."""
-    ex, ey, rest, e = _exact_offset(off, *((c, 0) for p in pa + lb for c in p))
-    pts = [(rest[2 * i], rest[2 * i + 1]) for i in range(len(rest) // 2)]
-    ia, ib = pts[: len(pa)], pts[len(pa):]
-    found = {}
-    for which, poly in enumerate((ia, ib)):
-        for i in range(len(poly)):
-            ux, uy = _edge(poly, i)  # type: ignore[arg-type]
-            if not (ux or uy):
-                continue
-            amin, amax = _extent(ia, ux, uy)  # type: ignore[arg-type]
-            bmin, bmax = _extent(ib, ux, uy)  # type: ignore[arg-type]
-            ud = ux * ex + uy * ey
-            fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
-            if fwd <= 0 or bwd <= 0:
-                return None
-            found[which, i] = (fwd, bwd)
-    return [(_to_float(found[edge][0], 2 * e - k), _to_float(found[edge][1], 2 * e - k))
+    exact = polygon_polygon_exact(pa, lb, off)
+    if exact is None:
+        return None
+    found, u = exact
+    return [(float_approx(found[edge][0], u - k), float_approx(found[edge][1], u - k))
             for edge, k in zip(edges, ks, strict=True)]
+
+
+# Relative tolerance (times the pair's size) of the inside tests of the contact point: a vertex
+# within rounding of the other outline counts as inside it.
+POINT_TOL = 1e-12
 
 
 def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:
@@ -432,7 +384,7 @@ def overlap_point(pa: Pts, pb: Pts, nx: float, ny: float, depth: float, size: fl
     The vertices of A ∩ B are A's vertices inside B, B's vertices inside A and the crossings of
     their edges; their mean is a convex combination, so it lies in A ∩ B.
     """
-    tol = 1e-12 * size
+    tol = POINT_TOL * size
     sx = sy = 0.0
     count = 0
     for x, y in pa:

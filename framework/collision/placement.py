@@ -11,7 +11,7 @@ import math
 from ..shapes import AABB, Circle, Polygon, Shape
 from ..validation import InvalidValue, finite
 
-__all__ = ["pose", "outline", "local_outline", "check_shape"]
+__all__ = ["pose", "local_outline", "check_shape"]
 
 
 def check_shape(name: str, shape: object) -> Shape:
@@ -38,20 +38,6 @@ def pose(name: str, transform: object) -> tuple[float, float, float]:
     rot = seq[2] if n == 3 else 0.0  # type: ignore[index]
     return (finite(f"{name}[0]", seq[0]), finite(f"{name}[1]", seq[1]),  # type: ignore[index]
             finite(f"{name}[2]", rot))
-
-
-def outline(shape: AABB | Polygon, x: float, y: float, rotation: float) -> list[tuple[float, float]]:
-    """World outline (counter-clockwise) of a box or polygon whose hitbox origin is at (x, y).
-
-    (x, y) is already relative to the query's local origin. AABBs ignore ``rotation``.
-    """
-    if isinstance(shape, AABB):
-        hw, hh = shape.width * 0.5, shape.height * 0.5
-        return [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)]
-    if rotation == 0.0:
-        return [(px + x, py + y) for px, py in shape.points]
-    c, s = math.cos(rotation), math.sin(rotation)
-    return [(c * px - s * py + x, s * px + c * py + y) for px, py in shape.points]
 
 
 def local_outline(shape: AABB | Polygon, rotation: float, k: int = 0) -> list[tuple[float, float]]:

@@ -192,8 +192,8 @@ def local_exponent(sizes: list[float], offsets: list[tuple[float, int]]) -> int:
 
 
 def scaled_outline(shape: AABB | Polygon, x: float, y: float, rotation: float, k: int) -> Pts:
-    """``placement.outline`` of the shape scaled by ``2**-k`` (exactly: the same operations on
-    scaled operands), its hitbox origin at the already scaled (x, y). Counter-clockwise."""
+    """World outline (counter-clockwise) of a box or polygon scaled by ``2**-k`` (exactly: scaled
+    operands), its hitbox origin at the already scaled (x, y). AABBs ignore ``rotation``."""
     if isinstance(shape, AABB):
         hw, hh = math.ldexp(shape.width, -k - 1), math.ldexp(shape.height, -k - 1)
         return [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)]

@@ -25,6 +25,7 @@ import math
 from ..shapes import AABB, Circle, Shape
 from ..validation import vector2
 from .collide import collide
+from .kinds import CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
 from .placement import check_shape, pose
 from .ray import TIE, disc_interval, extent, local_exponent, relative, scale_exponent, scaled_outline
 from .results import Impact, Vec2
@@ -76,31 +77,7 @@ def time_of_impact(
     # With tau = t * 2**(j - k), B's offset is delta + tau * v; the step ends at tau = T.
     end = math.inf if j - k > 1023 else math.ldexp(1.0, j - k)
 
-    a_circle, b_circle = isinstance(shape_a, Circle), isinstance(shape_b, Circle)
-    if a_circle and b_circle:
-        res = _circle_circle(dx, dy, math.ldexp(shape_a.radius, -k) + math.ldexp(shape_b.radius, -k),
-                             vx, vy)
-    elif b_circle:
-        res = _polygon_circle(scaled_outline(shape_a, 0.0, 0.0, ar, k), dx, dy,
-                              math.ldexp(shape_b.radius, -k), vx, vy)
-    elif a_circle:
-        # A circle against B: in B's frame (as when B comes first, so that both orders do the same
-        # arithmetic), cast A's centre at -delta, moving by -v; then turn the normals round.
-        res = _polygon_circle(scaled_outline(shape_b, 0.0, 0.0, br, k), -dx, -dy,
-                              math.ldexp(shape_a.radius, -k), -vx, -vy)
-        if res is not None:
-            res = res[0], res[1], [(t, -nx, -ny) for t, nx, ny in res[2]]
-    elif _order_key(shape_b, bx, by, br) < _order_key(shape_a, ax, ay, ar):
-        # Work in the frame of whichever shape sorts first, so that swapping A and B repeats the
-        # very same arithmetic: the same fraction and the exactly negated normal. (Two circles'
-        # numbers only change sign when swapped; a circle and a polygon work in the polygon's frame.)
-        res = _polygon_polygon(scaled_outline(shape_b, 0.0, 0.0, br, k),
-                               scaled_outline(shape_a, -dx, -dy, ar, k), -vx, -vy)
-        if res is not None:
-            res = res[0], res[1], [(t, -nx, -ny) for t, nx, ny in res[2]]
-    else:
-        res = _polygon_polygon(scaled_outline(shape_a, 0.0, 0.0, ar, k),
-                               scaled_outline(shape_b, dx, dy, br, k), vx, vy)
+    res = _sweep_pair(shape_a, (ax, ay, ar), shape_b, (bx, by, br), dx, dy, vx, vy, k)
     if res is None:
         return None
     t_in, t_out, cands = res
@@ -115,10 +92,52 @@ def time_of_impact(
     return Impact(fraction + 0.0, Vec2(nx + 0.0, ny + 0.0))
 
 
+def _sweep_pair(
+    shape_a: Shape, pose_a: tuple[float, float, float], shape_b: Shape, pose_b: tuple[float, float, float],
+    dx: float, dy: float, vx: float, vy: float, k: int,
+) -> _Sweep | None:
+    """The sweep of the pair in the scaled local frame (B's offset (dx, dy), relative motion
+    (vx, vy), sizes scaled by ``2**-k``), computed as :data:`~framework.collision.kinds.PAIRS` says."""
+    (ax, ay, ar), (bx, by, br) = pose_a, pose_b
+    rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
+    if rule.family == CIRCLES:
+        assert isinstance(shape_a, Circle) and isinstance(shape_b, Circle)
+        return _circle_circle(dx, dy, math.ldexp(shape_a.radius, -k) + math.ldexp(shape_b.radius, -k),
+                              vx, vy)
+    if rule.family == POLYGON_CIRCLE and not rule.flip:
+        assert isinstance(shape_b, Circle)
+        return _polygon_circle(scaled_outline(shape_a, 0.0, 0.0, ar, k), dx, dy,
+                               math.ldexp(shape_b.radius, -k), vx, vy)
+    if rule.family == POLYGON_CIRCLE:
+        # A circle against B: in B's frame (as when B comes first, so that both orders do the same
+        # arithmetic), cast A's centre at -delta, moving by -v; then turn the normals round.
+        assert isinstance(shape_a, Circle)
+        res = _polygon_circle(scaled_outline(shape_b, 0.0, 0.0, br, k), -dx, -dy,
+                              math.ldexp(shape_a.radius, -k), -vx, -vy)
+        return _turned_round(res)
+    # BOXES or POLYGONS: the swept SAT.
+    if _order_key(shape_b, bx, by, br) < _order_key(shape_a, ax, ay, ar):
+        # Work in the frame of whichever shape sorts first, so that swapping A and B repeats the
+        # very same arithmetic: the same fraction and the exactly negated normal. (Two circles'
+        # numbers only change sign when swapped; a circle and a polygon work in the polygon's frame.)
+        res = _polygon_polygon(scaled_outline(shape_b, 0.0, 0.0, br, k),
+                               scaled_outline(shape_a, -dx, -dy, ar, k), -vx, -vy)
+        return _turned_round(res)
+    return _polygon_polygon(scaled_outline(shape_a, 0.0, 0.0, ar, k),
+                            scaled_outline(shape_b, dx, dy, br, k), vx, vy)
+
+
+def _turned_round(res: _Sweep | None) -> _Sweep | None:
+    """A sweep worked with A and B swapped, its normals turned to point from A toward B again."""
+    if res is None:
+        return None
+    return res[0], res[1], [(t, -nx, -ny) for t, nx, ny in res[2]]
+
+
 def _order_key(shape: Shape, x: float, y: float, rotation: float) -> tuple:
     """A total order on placed boxes and polygons (equal keys: the same outline at the same place)."""
     params = (shape.width, shape.height) if isinstance(shape, AABB) else shape.points  # type: ignore[union-attr]
-    return (x, y, rotation, shape.kind, params)
+    return (x, y, rotation, kind_of(shape), params)
 
 
 # --- pairs of kinds, in the scaled local frame --------------------------------------------------

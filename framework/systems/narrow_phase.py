@@ -11,20 +11,20 @@ import numpy as np
 
 from ..arrays import distinct
 from ..collision import batch
+from ..collision.kinds import BOXES, CIRCLES, KIND_POLYGON, PAIRS, POLYGON_CIRCLE, pair_code
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
-from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, STATIC, BodyStore
+from ..store import STATIC, BodyStore
 from .geometry import Geometry
 from .movement import integrate_rows
 from .stage import Stage
 
-__all__ = ["NarrowPhase", "filter_layers", "pair_contacts", "KIND_PAIR_NAMES"]
+__all__ = ["NarrowPhase", "filter_layers", "pair_contacts"]
 
-KIND_PAIR_NAMES = {
-    (0, 0): "aabb-aabb", (0, 1): "aabb-circle", (0, 2): "aabb-polygon",
-    (1, 0): "circle-aabb", (1, 1): "circle-circle", (1, 2): "circle-polygon",
-    (2, 0): "polygon-aabb", (2, 1): "polygon-circle", (2, 2): "polygon-polygon",
-}
+# The shape-pair table as columns indexed by pair code: counter name, kernel family, flipped.
+_PAIR_NAME = [rule.name for rule in PAIRS.values()]
+_PAIR_FAMILY = np.array([rule.family for rule in PAIRS.values()], dtype=np.int64)
+_PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
 
 
 def filter_layers(store: BodyStore, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
@@ -49,23 +49,21 @@ def pair_contacts(
     kinds = store.kinds_present()
     if len(kinds) == 1 and KIND_POLYGON not in kinds:  # boxes alone, or circles alone: one family
         k = next(iter(kinds))
+        rule = PAIRS[k, k]
         if counts is not None:
-            name = KIND_PAIR_NAMES[(k, k)]
-            counts[name] = counts.get(name, 0) + P
-        fams, ca = [0 if k == KIND_AABB else 1], None
+            counts[rule.name] = counts.get(rule.name, 0) + P
+        fams = [rule.family]
     else:
-        ka = store.kind[ra].astype(np.int64)
-        kb = store.kind[rb].astype(np.int64)
+        code = pair_code(store.kind[ra].astype(np.int64), store.kind[rb].astype(np.int64))
         if counts is not None:
-            n_of = np.bincount(ka * 3 + kb, minlength=9)
+            n_of = np.bincount(code, minlength=len(PAIRS))
             for c in np.flatnonzero(n_of).tolist():
-                name = KIND_PAIR_NAMES[divmod(c, 3)]
+                name = _PAIR_NAME[c]
                 counts[name] = counts.get(name, 0) + int(n_of[c])
         # One kernel call per family of pairs, not per ordered pair of kinds: a box is a polygon
         # to the polygon kernels, and a circle may be either shape of a polygon-circle pair (the
         # kernel flips the normal per row). Per-call overhead dominates the response's small batches.
-        ca, cb = ka == KIND_CIRCLE, kb == KIND_CIRCLE
-        family = np.where(ca & cb, 1, np.where(ca | cb, 2, np.where((ka == KIND_AABB) & (kb == KIND_AABB), 0, 3)))
+        family = _PAIR_FAMILY[code]
         fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
     hx, hy = geom.hx, geom.hy
     if len(fams) > 1:
@@ -74,16 +72,16 @@ def pair_contacts(
     for f in fams:
         idx = np.flatnonzero(family == f) if len(fams) > 1 else None
         a, b = (ra[idx], rb[idx]) if idx is not None else (ra, rb)
-        if f == 0:
+        if f == BOXES:
             res = batch.aabb_aabb_fast(
                 hx[a], hy[a], store.hw[a], store.hh[a], hx[b], hy[b], store.hw[b], store.hh[b],
                 exact=not remeasure, points=not remeasure,
             )
-        elif f == 1:
+        elif f == CIRCLES:
             res = batch.circle_circle(hx[a], hy[a], store.radius[a], hx[b], hy[b], store.radius[b],
                                        exact=not remeasure)
-        elif f == 2:
-            flip = ca if idx is None else ca[idx]  # the circle is shape A: normals from it to the polygon
+        elif f == POLYGON_CIRCLE:
+            flip = _PAIR_FLIP[code if idx is None else code[idx]]  # the circle is A: normals from it
             poly, circ = np.where(flip, b, a), np.where(flip, a, b)
             vp, np_ = geom.outlines(store, poly)
             res = batch.polygon_circle(hx[poly], hy[poly], vp, np_, hx[circ], hy[circ], store.radius[circ],

@@ -1,0 +1,163 @@
+"""Exact decisions near touching: the one numeric core of the scalar queries and the batch kernels.
+
+Floats decide every pair whose answer is clear by far more than their rounding error. Inside a thin
+band around "touching" (``BAND`` relative to the magnitudes involved) the decision is redone here
+on exact integers: every float is an integer times a power of two, so the offset between the two
+shapes and their sizes become integers over one common power of two ``2**e``, and sums, products
+and comparisons of them are exact. Touching is then never a collision and an overlap of one ulp
+always is, whichever code path the floats took.
+
+Everything is in a query's scaled local frame: shapes in their own local coordinates times
+``2**-k``, and the offset between the two hitbox origins ``(q - o) * 2**-k``, passed as an
+:data:`Offset` ``(ox, oy, qx, qy, k)`` so that it stays exact.
+
+The functions below decide and return integers; each caller turns them into the float depth,
+normal and point of its own arithmetic: :mod:`~framework.collision.collide` with
+:func:`float_approx` and :func:`ratio_approx`, the batch kernels with :func:`float_rounded`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import NamedTuple
+
+__all__ = [
+    "BAND", "TINY", "Offset", "PolygonCircleExact", "circle_circle_exact", "exact_ints", "float_approx",
+    "float_rounded", "polygon_circle_exact", "polygon_polygon_exact", "ratio_approx",
+]
+
+# Half-width of the band, relative to the magnitudes involved, inside which a float decision is not
+# trusted and the overlap is decided exactly. Float rounding is below 1e-15 of those magnitudes; the
+# band only has to be wider than that, and narrow enough to be rare.
+BAND = 1e-13
+# Smallest positive float: the floor of every depth, so "depth > 0" holds even in cases (an overlap
+# far below the scene's resolution) where the division underflows.
+TINY = 5e-324
+
+Offset = tuple[float, float, float, float, int]  # ox, oy, qx, qy, k: the offset is (q - o) * 2**-k
+Pts = Sequence[tuple[float, float]]
+
+
+# --- integers and back --------------------------------------------------------------------------
+
+def exact_ints(offset: Offset, values: Sequence[float]) -> tuple[int, int, list[int], int]:
+    """``(ex, ey, ints, e)``: the exact offset and ``values`` as integers over one power of two,
+    each standing for ``n * 2**e``."""
+    ox, oy, qx, qy, k = offset
+    parts = []
+    for v, shift in ((qx, -k), (ox, -k), (qy, -k), (oy, -k), *((v, 0) for v in values)):
+        num, den = float(v).as_integer_ratio()  # den is a power of two
+        parts.append((num, shift - den.bit_length() + 1))
+    e = min(p[1] for p in parts)
+    n = [num << (q - e) for num, q in parts]
+    return n[0] - n[1], n[2] - n[3], n[4:], e
+
+
+def float_rounded(n: int, e: int) -> float:
+    """``n * 2**e``, correctly rounded (the batch kernels' conversion)."""
+    return float(n << e) if e >= 0 else n / (1 << -e)
+
+
+def float_approx(n: int, e: int) -> float:
+    """``n * 2**e`` from the leading 64 bits of ``n``: to within 2**-63 relative, and nonzero stays
+    nonzero (bar underflow) (the scalar queries' conversion)."""
+    s = max(0, n.bit_length() - 64)
+    m = float(n >> s) if n >= 0 else -float((-n) >> s)
+    return math.ldexp(m, e + s)
+
+
+def ratio_approx(num: int, den: int, e: int) -> float:
+    """``num / den * 2**e`` (``den > 0``) as a float, to within 2**-60 relative."""
+    shift = 64 - (num.bit_length() - den.bit_length())
+    q = (num << shift) // den if shift >= 0 else num // (den << -shift)
+    return float_approx(q, e - shift)
+
+
+# --- the decisions ------------------------------------------------------------------------------
+
+def circle_circle_exact(offset: Offset, ra: float, rb: float) -> tuple[int, int] | None:
+    """Circles of radius ``ra`` at the origin and ``rb`` at the offset: ``(num, u)`` with
+    ``num * 2**u = (ra + rb)^2 - |d|^2 > 0`` where they overlap, else ``None``."""
+    ex, ey, (era, erb), e = exact_ints(offset, (ra, rb))
+    num = (era + erb) ** 2 - ex * ex - ey * ey
+    return None if num <= 0 else (num, 2 * e)
+
+
+class PolygonCircleExact(NamedTuple):
+    """An exact polygon / circle overlap: where the circle's centre lies and the integers its
+    contact is made of, each standing for ``n * 2**u`` with the unit ``u`` given (``e`` below)."""
+
+    case: str  # "inside" (or on the boundary), "face" (nearest a face) or "vertex" (nearest a vertex)
+    index: int  # "face": the edge from vertex ``index`` to the next; "vertex": the vertex
+    seps: list[int]  # per edge: the centre's distance outside its line, times the edge's length (2e)
+    num: int  # "face": r^2 |edge|^2 - seps[index]^2 (4e); "vertex": r^2 - |centre - vertex|^2 (2e)
+    edge2: int  # "face": |edge|^2 (2e)
+    dx: int  # "vertex": centre - vertex (e)
+    dy: int
+    e: int
+
+
+def polygon_circle_exact(poly: Pts, offset: Offset, r: float) -> PolygonCircleExact | None:
+    """Convex CCW outline at the origin against the circle of radius ``r`` at the offset, on exact
+    integers: ``None`` if they do not overlap (touching is no overlap)."""
+    n = len(poly)
+    ecx, ecy, rest, e = exact_ints(offset, [r, *(c for p in poly for c in p)])
+    er, pts = rest[0], [(rest[1 + 2 * i], rest[2 + 2 * i]) for i in range(n)]
+    seps = []
+    for i in range(n):
+        (x0, y0), (x1, y1) = pts[i], pts[(i + 1) % n]
+        seps.append((y1 - y0) * (ecx - x0) - (x1 - x0) * (ecy - y0))
+    if any(pts[i] != pts[(i + 1) % n] for i in range(n)) and all(s <= 0 for s in seps):
+        # Inside or on the boundary: always an overlap (r > 0).
+        return PolygonCircleExact("inside", -1, seps, 0, 0, 0, 0, e)
+    # Outside: the nearest point is on the first face whose region holds the centre, or a vertex.
+    for i in range(n):
+        s = seps[i]
+        if s <= 0:
+            continue  # (also every edge of length zero)
+        (x0, y0), (x1, y1) = pts[i], pts[(i + 1) % n]
+        ex, ey = x1 - x0, y1 - y0
+        edge2 = ex * ex + ey * ey
+        if 0 <= (ecx - x0) * ex + (ecy - y0) * ey <= edge2:
+            # distance s / |e| < r  <=>  s^2 < r^2 |e|^2
+            num = er * er * edge2 - s * s
+            return None if num <= 0 else PolygonCircleExact("face", i, seps, num, edge2, 0, 0, e)
+    j = min(range(n), key=lambda i: (ecx - pts[i][0]) ** 2 + (ecy - pts[i][1]) ** 2)
+    dx, dy = ecx - pts[j][0], ecy - pts[j][1]
+    num = er * er - dx**2 - dy**2
+    return None if num <= 0 else PolygonCircleExact("vertex", j, seps, num, 0, dx, dy, e)
+
+
+def _extent(pts: list[tuple[int, int]], ux: int, uy: int) -> tuple[int, int]:
+    proj = [ux * x + uy * y for x, y in pts]
+    return min(proj), max(proj)
+
+
+def polygon_polygon_exact(
+    pa: Pts, lb: Pts, offset: Offset
+) -> tuple[dict[tuple[int, int], tuple[int, int]], int] | None:
+    """Separating axes on exact integers for convex CCW outlines A at the origin and B (``lb``,
+    about its own origin) at the offset: ``None`` if separated or touching, else ``(found, u)``:
+    per axis, keyed ``(0 for A / 1 for B, edge index)`` for every edge of nonzero length in order,
+    how far B must move forward (+axis) and backward, times the axis's length, in units of ``2**u``.
+    The axes are the unnormalised outward edge normals ``(ey, -ex)``."""
+    ex, ey, rest, e = exact_ints(offset, [c for p in (*pa, *lb) for c in p])
+    pts = [(rest[2 * i], rest[2 * i + 1]) for i in range(len(rest) // 2)]
+    ia, ib = pts[: len(pa)], pts[len(pa):]
+    found = {}
+    for which, poly in enumerate((ia, ib)):
+        n = len(poly)
+        for i in range(n):
+            (x0, y0), (x1, y1) = poly[i], poly[(i + 1) % n]
+            if (x0, y0) == (x1, y1):
+                continue
+            ux, uy = y1 - y0, x0 - x1
+            amin, amax = _extent(ia, ux, uy)
+            bmin, bmax = _extent(ib, ux, uy)
+            ud = ux * ex + uy * ey
+            fwd, bwd = (amax - bmin) - ud, (bmax - amin) + ud
+            if fwd <= 0 or bwd <= 0:
+                return None
+            found[which, i] = (fwd, bwd)
+    return found, 2 * e

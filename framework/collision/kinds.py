@@ -1,0 +1,80 @@
+"""Shape kinds and shape pairs: the one table of kind codes and the one shape-pair dispatch table.
+
+Every place that dispatches on shapes reads these: the body store's ``kind`` column holds the kind
+codes; :func:`~framework.collision.collide`, :func:`~framework.collision.batch.collide_many`, the
+narrow phase (:func:`framework.systems.narrow_phase.pair_contacts`) and
+:func:`~framework.collision.time_of_impact` look up :data:`PAIRS` to learn how an ordered pair of
+kinds is computed.
+
+Families: a pair of kinds is computed by one of four families of functions. Each dispatcher maps a
+family to its own function (its column of this table):
+
+===================  ==========================  =============================  ====================
+family               ``collide``                 batch kernel                   ``time_of_impact``
+===================  ==========================  =============================  ====================
+``BOXES``            ``polygon_polygon``         ``aabb_aabb`` (the pipeline:   ``_polygon_polygon``
+                     (boxes are polygons)        ``aabb_aabb_fast``)
+``CIRCLES``          ``circle_circle``           ``circle_circle``              ``_circle_circle``
+``POLYGON_CIRCLE``   ``polygon_circle``          ``polygon_circle``             ``_polygon_circle``
+``POLYGONS``         ``polygon_polygon``         ``polygon_polygon``            ``_polygon_polygon``
+===================  ==========================  =============================  ====================
+
+``flip``: the family's functions take the polygon first, so a circle-first pair is computed with
+the shapes swapped (in the polygon's frame) and its normals turned round to point from A to B.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+from ..shapes import AABB, Circle, Polygon, Shape
+
+__all__ = [
+    "BOXES", "CIRCLES", "KINDS", "KIND_AABB", "KIND_CIRCLE", "KIND_NAMES", "KIND_NONE", "KIND_POLYGON",
+    "PAIRS", "POLYGONS", "POLYGON_CIRCLE", "PairRule", "kind_of", "pair_code",
+]
+
+# Kind codes, as the store's int8 ``kind`` column holds them; KIND_NONE: a row without a hitbox.
+KIND_NONE, KIND_AABB, KIND_CIRCLE, KIND_POLYGON = -1, 0, 1, 2
+KINDS = (KIND_AABB, KIND_CIRCLE, KIND_POLYGON)
+# The shapes' own names for their kinds (``Shape.kind``), by code.
+KIND_NAMES = {KIND_AABB: AABB.kind, KIND_CIRCLE: Circle.kind, KIND_POLYGON: Polygon.kind}
+
+
+def kind_of(shape: Shape) -> int:
+    """The kind code of a shape (any shape that is neither an AABB nor a circle is a polygon)."""
+    if isinstance(shape, AABB):
+        return KIND_AABB
+    return KIND_CIRCLE if isinstance(shape, Circle) else KIND_POLYGON
+
+
+def pair_code(kind_a, kind_b):
+    """One code per ordered pair of kinds, ``0 .. 8`` (ints or integer arrays): the position of
+    the pair in :data:`PAIRS`."""
+    return kind_a * len(KINDS) + kind_b
+
+
+# Families of functions that compute a pair (module docstring).
+BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS = 0, 1, 2, 3
+
+
+class PairRule(NamedTuple):
+    """How an ordered pair of kinds (A, B) is computed."""
+
+    name: str  # "circle-polygon": the narrow phase's pair counters
+    family: int  # BOXES, CIRCLES, POLYGON_CIRCLE or POLYGONS
+    flip: bool  # computed as (B, A), normals turned round: the circle of a polygon-circle pair is A
+
+
+# (kind_a, kind_b) -> how the pair is computed, in pair_code order.
+PAIRS: dict[tuple[int, int], PairRule] = {
+    (KIND_AABB, KIND_AABB): PairRule("aabb-aabb", BOXES, False),
+    (KIND_AABB, KIND_CIRCLE): PairRule("aabb-circle", POLYGON_CIRCLE, False),
+    (KIND_AABB, KIND_POLYGON): PairRule("aabb-polygon", POLYGONS, False),
+    (KIND_CIRCLE, KIND_AABB): PairRule("circle-aabb", POLYGON_CIRCLE, True),
+    (KIND_CIRCLE, KIND_CIRCLE): PairRule("circle-circle", CIRCLES, False),
+    (KIND_CIRCLE, KIND_POLYGON): PairRule("circle-polygon", POLYGON_CIRCLE, True),
+    (KIND_POLYGON, KIND_AABB): PairRule("polygon-aabb", POLYGONS, False),
+    (KIND_POLYGON, KIND_CIRCLE): PairRule("polygon-circle", POLYGON_CIRCLE, False),
+    (KIND_POLYGON, KIND_POLYGON): PairRule("polygon-polygon", POLYGONS, False),
+}
