@@ -32,9 +32,10 @@ round, in rotating order, after ``gc.freeze()``; the figures are medians. Ratio 
 faster peer.
 
 Accuracy, judged by one oracle for all three (:func:`max_penetration`: our exact geometry,
-``collide_many`` over the pairs that :func:`~framework.collision.broad_phase.find_pairs` finds,
-on the final positions): ``pen`` is the deepest overlap left; ``sink`` (piles, stack, pyramid) is
-how far the top row's lowest box lies below its exact resting height, over the pile's height.
+``collide_many`` over the pairs whose bounds overlap, found by
+:func:`~framework.collision.broad_phase.brute_force_pairs`, on the final positions): ``pen`` is
+the deepest overlap left; ``sink`` (piles, stack, pyramid) is how far the top row's lowest box
+lies below its exact resting height, over the pile's height.
 
 **Crowds** (the issue's rest criterion, :func:`run_crowd`): 120 balls (radius 0.25-0.5), 120 boxes
 (sides 0.5-1) or half of each, dropped into a pit 8 units wide, gravity 20, sleeping on in every
@@ -55,7 +56,7 @@ import numpy as np
 
 from .. import AABB, Circle, Hitbox, Polygon, Shape, Transform, Velocity
 from ..collision.batch import collide_many
-from ..collision.broad_phase import find_pairs
+from ..collision.broad_phase import brute_force_pairs
 from .perf import DT as PERF_DT
 from .perf import EFFECTS as PERF_EFFECTS
 from .perf import WARMUP, Task, make_boxes, run_interleaved
@@ -579,16 +580,17 @@ def _half_extents(shape: Shape) -> tuple[float, float]:
 
 def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool = True) -> float:
     """The deepest overlap among the shapes at ``(x, y)`` (no rotation), by our exact geometry: the
-    pairs whose bounds overlap (:func:`~framework.collision.broad_phase.find_pairs`, the same pairs
-    as brute force, never two static ones), then ``collide_many`` (the same answers as
-    :func:`~framework.collision.collide`). ``dynamic_pairs=False``: only pairs with a static one.
-    The same oracle judges all three engines, from their final positions."""
+    pairs whose bounds overlap (:func:`~framework.collision.broad_phase.brute_force_pairs`, numpy in
+    row blocks, never two static ones: once per scene, so its O(N^2) does not matter), then
+    ``collide_many`` (the same answers as :func:`~framework.collision.collide`).
+    ``dynamic_pairs=False``: only pairs with a static one. The same oracle judges all three
+    engines, from their final positions."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     static = np.asarray(static, dtype=bool)
     if x.size < 2:
         return 0.0
     hw, hh = (np.array(v) for v in zip(*(_half_extents(s) for s in shapes)))
-    i, j = find_pairs(x - hw, y - hh, x + hw, y + hh, static)
+    i, j = brute_force_pairs(x - hw, y - hh, x + hw, y + hh, static)
     if not dynamic_pairs:
         keep = static[i] | static[j]
         i, j = i[keep], j[keep]
