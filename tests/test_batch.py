@@ -544,7 +544,7 @@ def test_the_pipeline_measures_a_mixed_batch_as_it_measures_each_pair() -> None:
             kind = KINDS[i % len(KINDS)]
             t = Transform(dyadic(rng, -4, 4), dyadic(rng, -4, 4), random_rotation(rng, kind))
             ents.append(s.spawn(t, Hitbox(random_shape(rng, kind), body="static" if i % 5 == 0 else "dynamic")))
-        s.step(0.0625)
+        s.ensure_geometry()  # (where they were spawned: a mix of overlaps and misses)
         rows = np.array([s.store.row_of[e] for e in ents])
         ra, rb = (g.ravel() for g in np.meshgrid(rows, rows, indexing="ij"))
         keep = ra != rb

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .batch_common import F64, ContactArrays, columns, finish, frame
+from .batch_common import F64, ContactArrays, columns, finish, frame, sum_leading
 from .batch_point import overlap_point
 from .collide import POINT_TOL
 from .exact import BAND, TINY
@@ -179,9 +179,9 @@ def _edge_crossings(hwa, hha, xb0, xb1, yb0, yb1):
     t = (-((q_y - p_y) * s_)) / den
     u = ((q_x - p_x) * r) / den
     vx, vy, vcross = p_x, p_y + np.minimum(np.maximum(t, 0.0), 1.0) * r, _crossing(t, u, gone)
-    return ((hx * hcross).sum(axis=0) + (vx * vcross).sum(axis=0),
-            (hy * hcross).sum(axis=0) + (vy * vcross).sum(axis=0),
-            hcross.sum(axis=0) + vcross.sum(axis=0))
+    return (sum_leading(hx * hcross) + sum_leading(vx * vcross),
+            sum_leading(hy * hcross) + sum_leading(vy * vcross),
+            sum_leading(hcross) + sum_leading(vcross))
 
 
 def _box_point(hwa, hha, hwb, hhb, dx, dy, nx, ny, depth, size):

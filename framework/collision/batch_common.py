@@ -28,9 +28,22 @@ from ..validation import InvalidValue
 from .exact import TINY
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
-__all__ = ["ContactArrays"]
+__all__ = ["ContactArrays", "sum_leading"]
 
 F64 = np.float64
+
+
+def sum_leading(values: np.ndarray) -> np.ndarray:
+    """The sum over every axis but the last (the pairs, ``[..., P]``), in one fixed order (first
+    index first), so a pair's sum does not depend on how many pairs share the batch. (numpy sums
+    a 1-D run pairwise: a batch of one pair would add its terms in another order than a batch of
+    several, and differ in the last bit.)"""
+    if values.shape[-1] == 0 or values.size == 0:
+        return np.zeros(values.shape[-1], dtype=values.dtype)
+    flat = values.reshape(-1, values.shape[-1])
+    if flat.shape[1] == 1:
+        return np.cumsum(flat[:, 0])[-1:] if flat.shape[0] else np.zeros(1, dtype=flat.dtype)
+    return np.add.reduce(flat, axis=0)
 
 
 class ContactArrays(NamedTuple):

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .batch_common import F64, cols, edges, first_min, norm, take, vertex_mask
+from .batch_common import F64, cols, edges, first_min, norm, sum_leading, take, vertex_mask
 from .collide import POINT_TOL
 
 __all__ = ["overlap_point"]
@@ -31,9 +31,9 @@ def overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, size):
     ina = _inside(avx, avy, bvx, bvy, exb, eyb, tol) & vertex_mask(acount, avx.shape[0])
     inb = _inside(bvx, bvy, avx, avy, exa, eya, tol) & vertex_mask(bcount, bvx.shape[0])
     ina, inb = ina.astype(F64), inb.astype(F64)
-    sx = (avx * ina).sum(axis=0) + (bvx * inb).sum(axis=0)
-    sy = (avy * ina).sum(axis=0) + (bvy * inb).sum(axis=0)
-    count = ina.sum(axis=0) + inb.sum(axis=0)
+    sx = sum_leading(avx * ina) + sum_leading(bvx * inb)
+    sy = sum_leading(avy * ina) + sum_leading(bvy * inb)
+    count = sum_leading(ina) + sum_leading(inb)
     # Crossings of A's edge i (p + t r) with B's edge j (q + u s), t and u in [0, 1]: [Ka, Kb, P].
     # Parallel and padding (zero) edges have den == 0 exactly and are skipped, as in the scalar code.
     rx, ry = exa[:, None], eya[:, None]
@@ -47,9 +47,9 @@ def overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, size):
     u = (wx * ry - wy * rx) / den
     crossing = ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~parallel).astype(F64)
     t = np.minimum(np.maximum(t, 0.0), 1.0)  # unchanged where crossing; finite elsewhere
-    sx += ((avx[:, None] + t * rx) * crossing).sum(axis=(0, 1))
-    sy += ((avy[:, None] + t * ry) * crossing).sum(axis=(0, 1))
-    count += crossing.sum(axis=(0, 1))
+    sx += sum_leading((avx[:, None] + t * rx) * crossing)
+    sy += sum_leading((avy[:, None] + t * ry) * crossing)
+    count += sum_leading(crossing)
     found = count > 0
     c = np.maximum(count, 1.0)
     px, py = sx / c, sy / c
