@@ -23,8 +23,8 @@ __all__ = ["NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counte
 
 _INTS = np.zeros(0, dtype=np.int64)
 _FLOATS = np.zeros(0)
-NO_SUPPORT = (_INTS, _INTS, _FLOATS, _FLOATS)
-NO_RESOLVED = (*NO_SUPPORT, _FLOATS)
+NO_RESOLVED = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS)
+NO_SUPPORT = (*NO_RESOLVED, _FLOATS, _FLOATS)
 
 
 def new_counters() -> dict[str, Any]:
@@ -73,7 +73,8 @@ class StepFrame:
     contact_rows: tuple[np.ndarray, np.ndarray] = (_INTS, _INTS)
     started: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     ended: StepContacts = field(default_factory=StepContacts.empty)
-    # response: the contacts applied (a, b, nx, ny, pushed) and the resting pairs kept for next step
+    # response: the contacts applied (a, b, nx, ny, pushed) and the pairs acted on, kept for the next
+    # step with their push, impulse and the gap they ended with (a, b, nx, ny, push, impulse, gap)
     resolved: tuple[np.ndarray, ...] = NO_RESOLVED
     support: tuple[np.ndarray, ...] = NO_SUPPORT
     # queries during the step: (origin, end, first hit or None), for the overlay

@@ -143,7 +143,10 @@ def test_resting_stack_metrics_have_the_documented_keys():
 def test_perf_pipeline_pairs_equal_brute_force():
     wl = perf.make_boxes(300, seed=5)
     out = perf.check_pairs(wl)
-    assert out["ok"] and min(out["pairs"]) > 100  # about one pair per box
+    # About one pair per box at the start; the response then pushes them apart (the contact solver
+    # leaves fewer overlapping after each step than the old push-out passes did, so the later steps
+    # have fewer pairs to check, but still dozens).
+    assert out["ok"] and out["pairs"][0] > 250 and min(out["pairs"]) > 50
     tiled = perf.check_pairs(perf.with_tiles(wl, count=600, overlapping=True))
     assert tiled["ok"] and tiled["pairs"][0] > out["pairs"][0]  # the moving-static pairs are found too
 

@@ -1,0 +1,123 @@
+"""The contact solver's inner loops: projected Gauss-Seidel over contacts, compiled with numba.
+
+Two problems are solved over the same contacts, each as sequential impulses with accumulated,
+clamped values (so a pass may take back part of an earlier push, never pull bodies together) and
+warm started from the last step (so a resting pile is solved in its first pass):
+
+- **positions** (:func:`solve_positions`): push-outs ``p_i >= 0`` (relative displacement along the
+  contact normal) such that every contact's separation ``s_i = s0_i + (d_b - d_a) . n_i >= 0``,
+  with ``p_i = 0`` wherever ``s_i > 0``. The separation along a fixed normal is exactly linear in
+  the bodies' displacements (``s0`` is the separation where the bodies stand), as in Box2D's
+  solver, so no geometry is measured inside the loop.
+- **velocities** (:func:`solve_velocities`): velocity changes ``l_i >= 0`` along the normals such that
+  every active contact stops closing, ``u_i = (v_b - v_a) . n_i >= target_i`` (0 for a contact at
+  rest, the bounce speed for one that bounces).
+
+A push or an impulse is shared between the two bodies by inverse mass: ``share_a = w_a / (w_a + w_b)``
+and ``share_b = w_b / (w_a + w_b)``, so a unit of ``p`` or ``l`` changes the relative displacement
+or velocity along the normal by exactly one unit; an immovable body has share 0 and the other
+share 1 (exactly: a body pushed out of the floor lands exactly on it). Bodies are numbered
+locally (``a``, ``b`` index the per-body arrays). Contacts are visited in the order ``order``
+(bottom of a pile first), which propagates a push up a stack in one pass.
+
+One code path: these loops are the solver; numba compiles them on first use (``cache=True``: once
+per installation) and they run as plain Python where numba is missing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+try:  # numba is a run-time dependency; without it (e.g. an exotic platform) the same loops run slowly
+    from numba import njit
+except ImportError:  # pragma: no cover
+    def njit(*args, **kwargs):
+        return (lambda f: f) if not args or not callable(args[0]) else args[0]
+
+__all__ = ["solve_positions", "solve_velocities", "supported", "warm_start"]
+
+
+@njit(cache=True)
+def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, iterations, tolerance):
+    """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
+    exit) and the per-body displacements ``dx, dy`` (which must already hold the warm start's
+    displacement) are updated in place. Stops early once no push changes by more than
+    ``tolerance``; returns the passes made."""
+    for it in range(iterations):
+        largest = 0.0
+        for k in range(order.size):
+            i = order[k]
+            ia, ib = a[i], b[i]
+            s = sep0[i] + (dx[ib] - dx[ia]) * nx[i] + (dy[ib] - dy[ia]) * ny[i]
+            new = push[i] - s
+            if new < 0.0:
+                new = 0.0
+            change = new - push[i]
+            if change == 0.0:
+                continue
+            push[i] = new
+            dx[ia] -= share_a[i] * change * nx[i]
+            dy[ia] -= share_a[i] * change * ny[i]
+            dx[ib] += share_b[i] * change * nx[i]
+            dy[ib] += share_b[i] * change * ny[i]
+            if abs(change) > largest:
+                largest = abs(change)
+        if largest <= tolerance:
+            return it + 1
+    return iterations
+
+
+@njit(cache=True)
+def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, iterations, tolerance):
+    """Projected Gauss-Seidel on the normal velocities: ``impulse`` (warm start on entry; the
+    velocities ``vx, vy`` must already include it) and the velocities are updated in place.
+    Returns the passes made."""
+    for it in range(iterations):
+        largest = 0.0
+        for k in range(order.size):
+            i = order[k]
+            ia, ib = a[i], b[i]
+            u = (vx[ib] - vx[ia]) * nx[i] + (vy[ib] - vy[ia]) * ny[i]
+            new = impulse[i] + (target[i] - u)
+            if new < 0.0:
+                new = 0.0
+            change = new - impulse[i]
+            if change == 0.0:
+                continue
+            impulse[i] = new
+            vx[ia] -= share_a[i] * change * nx[i]
+            vy[ia] -= share_a[i] * change * ny[i]
+            vx[ib] += share_b[i] * change * nx[i]
+            vy[ib] += share_b[i] * change * ny[i]
+            if abs(change) > largest:
+                largest = abs(change)
+        if largest <= tolerance:
+            return it + 1
+    return iterations
+
+
+@njit(cache=True)
+def supported(order, a, b, up, fixed_a, fixed_b, n_bodies):
+    """Which bodies rest on something immovable, directly or through a chain of bodies resting on
+    each other: ``up[i] > 0.5`` says b rests on a, ``< -0.5`` a on b; ``fixed_*`` whether a
+    contact's body is immovable. One pass in ``order`` (from the bottom up) follows the chains."""
+    out = np.zeros(n_bodies, dtype=np.bool_)
+    for k in range(order.size):
+        i = order[k]
+        if up[i] > 0.5:
+            if fixed_a[i] or out[a[i]]:
+                out[b[i]] = True
+        elif up[i] < -0.5:
+            if fixed_b[i] or out[b[i]]:
+                out[a[i]] = True
+    return out
+
+
+def warm_start(a, b, nx, ny, share_a, share_b, value, n_bodies):
+    """Per-body ``(x, y)`` sums of the warm-start values (pushes or impulses) over the contacts."""
+    ox, oy = np.zeros(n_bodies), np.zeros(n_bodies)
+    np.subtract.at(ox, a, share_a * value * nx)
+    np.subtract.at(oy, a, share_a * value * ny)
+    np.add.at(ox, b, share_b * value * nx)
+    np.add.at(oy, b, share_b * value * ny)
+    return ox, oy
