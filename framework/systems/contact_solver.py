@@ -10,43 +10,82 @@ warm started from the last step (so a resting pile is solved in its first pass):
   the bodies' displacements (``s0`` is the separation where the bodies stand), as in Box2D's
   solver, so no geometry is measured inside the loop.
 - **velocities** (:func:`solve_velocities`): velocity changes ``l_i >= 0`` along the normals such that
-  every active contact stops closing, ``u_i = (v_b - v_a) . n_i >= target_i`` (0 for a contact at
-  rest, the bounce speed for one that bounces).
+  every contact stops closing, ``u_i = (v_b - v_a) . n_i >= target_i`` (0 for a contact at rest,
+  the bounce speed for one that bounces).
 
-A push or an impulse is shared between the two bodies by inverse mass: ``share_a = w_a / (w_a + w_b)``
-and ``share_b = w_b / (w_a + w_b)``, so a unit of ``p`` or ``l`` changes the relative displacement
-or velocity along the normal by exactly one unit; an immovable body has share 0 and the other
-share 1 (exactly: a body pushed out of the floor lands exactly on it). Bodies are numbered
-locally (``a``, ``b`` index the per-body arrays). Contacts are visited in the order ``order``
-(bottom of a pile first), which propagates a push up a stack in one pass.
+A push or an impulse is shared between the two bodies (``share_a + share_b = 1``; by inverse mass,
+or 0 and 1 where one body keeps still), so a unit of ``p`` or ``l`` changes the relative
+displacement or velocity along the normal by exactly one unit; an immovable body has share 0 and
+the other share 1 (exactly: a body pushed out of the floor lands exactly on it). Bodies are
+numbered locally (``a``, ``b`` index the per-body arrays). Contacts are visited in the order
+``order`` (bottom of a pile first), which propagates a push up a stack in one pass.
+
+Only contacts that may still change are visited: a pass looks at the contacts marked ``dirty``
+(all of them at first), and a contact whose value changes by more than ``tolerance`` marks every
+contact of its two bodies for the next pass. An isolated pair costs one pass; a settled pile
+warm started from the last step costs one pass; work follows what moves.
 
 One code path: these loops are the solver; numba compiles them on first use (``cache=True``: once
-per installation) and they run as plain Python where numba is missing.
+per installation).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-try:  # numba is a run-time dependency; without it (e.g. an exotic platform) the same loops run slowly
-    from numba import njit
-except ImportError:  # pragma: no cover
-    def njit(*args, **kwargs):
-        return (lambda f: f) if not args or not callable(args[0]) else args[0]
-
-__all__ = ["solve_positions", "solve_velocities", "supported", "warm_start"]
+__all__ = ["adjacency", "solve_positions", "solve_velocities", "supported", "warm_start"]
 
 
 @njit(cache=True)
-def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, iterations, tolerance):
+def adjacency(a, b, n_bodies):
+    """``(start, items)``: the contacts of body ``k`` are ``items[start[k]:start[k + 1]]``."""
+    count = np.zeros(n_bodies + 1, dtype=np.int64)
+    for i in range(a.size):
+        count[a[i] + 1] += 1
+        count[b[i] + 1] += 1
+    start = np.cumsum(count)
+    fill = start[:-1].copy()
+    items = np.empty(2 * a.size, dtype=np.int64)
+    for i in range(a.size):
+        items[fill[a[i]]] = i
+        fill[a[i]] += 1
+        items[fill[b[i]]] = i
+        fill[b[i]] += 1
+    return start, items
+
+
+@njit(cache=True)
+def _mark(body, start, items, flags):
+    for k in range(start[body], start[body + 1]):
+        flags[items[k]] = True
+
+
+@njit(cache=True)
+def _take(dirty, marked):
+    """The contacts marked in a pass become the next pass's (``marked`` is cleared)."""
+    for i in range(dirty.size):
+        if marked[i]:
+            dirty[i] = True
+            marked[i] = False
+
+
+@njit(cache=True)
+def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, start,
+                    items):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
     exit) and the per-body displacements ``dx, dy`` (which must already hold the warm start's
-    displacement) are updated in place. Stops early once no push changes by more than
-    ``tolerance``; returns the passes made."""
-    for it in range(iterations):
-        largest = 0.0
+    displacement) are updated in place. ``dirty``: the contacts to look at; on return, those still
+    to look at (none once converged; contacts outside ``order`` keep their marks). Returns the
+    passes made."""
+    nxt = np.zeros(dirty.size, dtype=np.bool_)
+    for it in range(passes):
+        any_dirty = False
         for k in range(order.size):
             i = order[k]
+            if not dirty[i]:
+                continue
+            dirty[i] = False
             ia, ib = a[i], b[i]
             s = sep0[i] + (dx[ib] - dx[ia]) * nx[i] + (dy[ib] - dy[ia]) * ny[i]
             new = push[i] - s
@@ -60,22 +99,30 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, i
             dy[ia] -= share_a[i] * change * ny[i]
             dx[ib] += share_b[i] * change * nx[i]
             dy[ib] += share_b[i] * change * ny[i]
-            if abs(change) > largest:
-                largest = abs(change)
-        if largest <= tolerance:
+            if abs(change) > tolerance:
+                _mark(ia, start, items, nxt)
+                _mark(ib, start, items, nxt)
+                any_dirty = True
+        if not any_dirty:
             return it + 1
-    return iterations
+        _take(dirty, nxt)
+    return passes
 
 
 @njit(cache=True)
-def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, iterations, tolerance):
+def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty, start,
+                     items):
     """Projected Gauss-Seidel on the normal velocities: ``impulse`` (warm start on entry; the
-    velocities ``vx, vy`` must already include it) and the velocities are updated in place.
-    Returns the passes made."""
-    for it in range(iterations):
-        largest = 0.0
+    velocities ``vx, vy`` must already include it) and the velocities are updated in place;
+    ``dirty`` as in :func:`solve_positions`. Returns the passes made."""
+    nxt = np.zeros(dirty.size, dtype=np.bool_)
+    for it in range(passes):
+        any_dirty = False
         for k in range(order.size):
             i = order[k]
+            if not dirty[i]:
+                continue
+            dirty[i] = False
             ia, ib = a[i], b[i]
             u = (vx[ib] - vx[ia]) * nx[i] + (vy[ib] - vy[ia]) * ny[i]
             new = impulse[i] + (target[i] - u)
@@ -89,11 +136,14 @@ def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx,
             vy[ia] -= share_a[i] * change * ny[i]
             vx[ib] += share_b[i] * change * nx[i]
             vy[ib] += share_b[i] * change * ny[i]
-            if abs(change) > largest:
-                largest = abs(change)
-        if largest <= tolerance:
+            if abs(change) > tolerance:
+                _mark(ia, start, items, nxt)
+                _mark(ib, start, items, nxt)
+                any_dirty = True
+        if not any_dirty:
             return it + 1
-    return iterations
+        _take(dirty, nxt)
+    return passes
 
 
 @njit(cache=True)

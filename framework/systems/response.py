@@ -46,7 +46,7 @@ __all__ = ["Response"]
 # the last step needs one or two, a fresh one dozens.
 SOLVER_PASSES = 25
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
-TOLERANCE = 1e-13
+TOLERANCE = 1e-12
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
@@ -285,6 +285,7 @@ class _Solve:
         self.cs = cs = cs.take(np.flatnonzero(~dropped)) if dropped.any() else cs
         self.rows, self.local = _local_numbers(store.n, np.concatenate([cs.ra, cs.rb]))
         self.tolerance = TOLERANCE * float(store.bound[self.rows].max())
+        self.dirty = np.ones(cs.size, dtype=bool)  # the contacts the position solver is to look at
         self._columns()
 
     def _columns(self) -> None:
@@ -301,6 +302,7 @@ class _Solve:
         w = 1.0 / (wa + wb)
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
+        self.adjacency = solver.adjacency(self.a, self.b, rows.size)
         self.order = self._order()
         self.position_shares = self._shock_shares()
 
@@ -383,14 +385,15 @@ class _Solve:
         cs = self.cs
         dx0, dy0 = self.dx.copy(), self.dy.copy()
         share_a, share_b = self.position_shares
-        solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
-                               self.push, self.dx, self.dy, self.iterations, self.tolerance)
+        solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b, self.push, self.dx,
+                               self.dy, self.iterations, self.tolerance, self.dirty, *self.adjacency)
         over = np.zeros(0, dtype=bool)
         if self.stage.bodies.n_static:
             far = np.hypot(self.dx - dx0, self.dy - dy0)
             over = far > self.reach
         if over.any():
             self.capped |= over
+            self.dirty |= over[self.a] | over[self.b]  # held back: not where the solve left them
             k = self.reach[over] / far[over]
             self.dx[over] = dx0[over] + (self.dx[over] - dx0[over]) * k
             self.dy[over] = dy0[over] + (self.dy[over] - dy0[over]) * k
@@ -427,6 +430,7 @@ class _Solve:
         hit = check[r.hit]
         cs.nx[hit], cs.ny[hit] = r.nx[r.hit], r.ny[r.hit]
         cs.depth[hit] = r.depth[r.hit] + self._shift(hit)
+        self.dirty[hit] = True
         return True
 
     def _moved_rows(self) -> np.ndarray:
@@ -517,6 +521,7 @@ class _Solve:
         self.capped, self.far_done = capped, far_done
         self.local = cat([remap[self.a], new_a, remap[self.b], new_b])
         self.push = cat([self.push, zeros])
+        self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
         self._columns()
 
     # --- velocities --------------------------------------------------------------------------
@@ -538,13 +543,13 @@ class _Solve:
         gx, gy = self.gravity
         tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
         solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, self.share_a, self.share_b, self.impulse, vx, vy,
-                                self.iterations, tol)
+                                self.iterations, tol, np.ones(cs.size, dtype=bool), *self.adjacency)
         bounce = self._bounce_targets(u, act)
         movable = ~((store.inv_mass[self.rows] == 0.0) | store.asleep[self.rows])
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, self.share_a, self.share_b, self.impulse,
-                                    vx, vy, self.iterations, tol)
+                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool), *self.adjacency)
             if not self.solo[bounce > 0.0].all():
                 self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy)
         rows = self.rows[movable]
@@ -572,6 +577,7 @@ class _Solve:
         c2 = float(np.sum(mass * (dx * dx + dy * dy)))
         if c0 + c1 + c2 <= before or c2 <= 0.0:
             return
+        before -= 16.0 * np.finfo(float).eps * before  # (scaled: a margin for the rounding of any way of summing)
         disc = max(c1 * c1 - 4.0 * c2 * (c0 - before), 0.0)
         t = max(0.0, min(1.0, (-c1 + math.sqrt(disc)) / (2.0 * c2)))
         t = math.nextafter(t, 0.0)  # (rounding: stay on the safe side)
