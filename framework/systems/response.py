@@ -41,12 +41,14 @@ from .stage import Stage
 
 __all__ = ["Response"]
 
-# Solver passes at most per response iteration (Scene.response_iterations): Gauss-Seidel passes are
-# cheap (compiled loops over the contacts) and stop once nothing changes; a pile warm started from
-# the last step needs one or two, a fresh one dozens.
-SOLVER_PASSES = 25
+# Solver passes at most per response iteration (Scene.response_iterations): passes stop once
+# nothing changes (a pile warm started from the last step needs one or two, a fresh one dozens);
+# a small solve may take up to MAX_PASSES, within PASS_BUDGET contact visits (nanoseconds each).
+SOLVER_PASSES = 4
+PASS_BUDGET = 25_000
+MAX_PASSES = 16
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
-TOLERANCE = 1e-12
+TOLERANCE = 1e-9
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
@@ -277,7 +279,8 @@ class _Solve:
         self.stage, self.frame = stage, frame
         self.store = store = stage.bodies.store
         self.gravity = stage.pipeline.active_gravity()
-        self.iterations = SOLVER_PASSES * stage.pipeline.response_iterations
+        its = stage.pipeline.response_iterations
+        self.iterations = max(SOLVER_PASSES * its, min(MAX_PASSES * its, PASS_BUDGET * its // cs.size))
         self.dt = frame.dt
         overlapping = cs.alive0.copy()
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
