@@ -20,10 +20,10 @@ the other share 1 (exactly: a body pushed out of the floor lands exactly on it).
 numbered locally (``a``, ``b`` index the per-body arrays). Contacts are visited in the order
 ``order`` (bottom of a pile first), which propagates a push up a stack in one pass.
 
-Only contacts that may still change are visited: a pass looks at the contacts marked ``dirty``
-(all of them at first), and a contact whose value changes by more than ``tolerance`` marks every
-contact of its two bodies for the next pass. An isolated pair costs one pass; a settled pile
-warm started from the last step costs one pass; work follows what moves.
+Only contacts that may still change are visited: the first pass looks at the contacts marked
+``dirty`` (all of them, at first), and later passes at the contacts of the bodies that moved (by
+more than ``tolerance``) in the pass before or in this one. An isolated pair costs one pass; a
+settled pile warm started from the last step costs one pass; work follows what moves.
 
 One code path: these loops are the solver; numba compiles them on first use (``cache=True``: once
 per installation).
@@ -34,59 +34,24 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["adjacency", "solve_positions", "solve_velocities", "supported", "warm_start"]
+__all__ = ["solve_positions", "solve_velocities", "supported", "warm_start"]
 
 
 @njit(cache=True)
-def adjacency(a, b, n_bodies):
-    """``(start, items)``: the contacts of body ``k`` are ``items[start[k]:start[k + 1]]``."""
-    count = np.zeros(n_bodies + 1, dtype=np.int64)
-    for i in range(a.size):
-        count[a[i] + 1] += 1
-        count[b[i] + 1] += 1
-    start = np.cumsum(count)
-    fill = start[:-1].copy()
-    items = np.empty(2 * a.size, dtype=np.int64)
-    for i in range(a.size):
-        items[fill[a[i]]] = i
-        fill[a[i]] += 1
-        items[fill[b[i]]] = i
-        fill[b[i]] += 1
-    return start, items
-
-
-@njit(cache=True)
-def _mark(body, start, items, flags):
-    for k in range(start[body], start[body + 1]):
-        flags[items[k]] = True
-
-
-@njit(cache=True)
-def _take(dirty, marked):
-    """The contacts marked in a pass become the next pass's (``marked`` is cleared)."""
-    for i in range(dirty.size):
-        if marked[i]:
-            dirty[i] = True
-            marked[i] = False
-
-
-@njit(cache=True)
-def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, start,
-                    items):
+def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
     exit) and the per-body displacements ``dx, dy`` (which must already hold the warm start's
-    displacement) are updated in place. ``dirty``: the contacts to look at; on return, those still
-    to look at (none once converged; contacts outside ``order`` keep their marks). Returns the
-    passes made."""
-    nxt = np.zeros(dirty.size, dtype=np.bool_)
+    displacement) are updated in place. ``dirty``: the contacts to look at first; on return, those
+    still to look at (none once converged). Returns the passes made."""
+    moved = np.full(dx.size, -1, dtype=np.int64)  # the last pass in which each body moved
     for it in range(passes):
-        any_dirty = False
+        any_moved = False
         for k in range(order.size):
             i = order[k]
-            if not dirty[i]:
+            ia, ib = a[i], b[i]
+            if not (dirty[i] or moved[ia] >= it - 1 or moved[ib] >= it - 1):
                 continue
             dirty[i] = False
-            ia, ib = a[i], b[i]
             s = sep0[i] + (dx[ib] - dx[ia]) * nx[i] + (dy[ib] - dy[ia]) * ny[i]
             new = push[i] - s
             if new < 0.0:
@@ -100,30 +65,28 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
             dx[ib] += share_b[i] * change * nx[i]
             dy[ib] += share_b[i] * change * ny[i]
             if abs(change) > tolerance:
-                _mark(ia, start, items, nxt)
-                _mark(ib, start, items, nxt)
-                any_dirty = True
-        if not any_dirty:
+                moved[ia] = moved[ib] = it
+                any_moved = True
+        if not any_moved:
             return it + 1
-        _take(dirty, nxt)
+    _left(order, a, b, moved, passes - 1, dirty)
     return passes
 
 
 @njit(cache=True)
-def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty, start,
-                     items):
+def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty):
     """Projected Gauss-Seidel on the normal velocities: ``impulse`` (warm start on entry; the
     velocities ``vx, vy`` must already include it) and the velocities are updated in place;
     ``dirty`` as in :func:`solve_positions`. Returns the passes made."""
-    nxt = np.zeros(dirty.size, dtype=np.bool_)
+    moved = np.full(vx.size, -1, dtype=np.int64)
     for it in range(passes):
-        any_dirty = False
+        any_moved = False
         for k in range(order.size):
             i = order[k]
-            if not dirty[i]:
+            ia, ib = a[i], b[i]
+            if not (dirty[i] or moved[ia] >= it - 1 or moved[ib] >= it - 1):
                 continue
             dirty[i] = False
-            ia, ib = a[i], b[i]
             u = (vx[ib] - vx[ia]) * nx[i] + (vy[ib] - vy[ia]) * ny[i]
             new = impulse[i] + (target[i] - u)
             if new < 0.0:
@@ -137,13 +100,21 @@ def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx,
             vx[ib] += share_b[i] * change * nx[i]
             vy[ib] += share_b[i] * change * ny[i]
             if abs(change) > tolerance:
-                _mark(ia, start, items, nxt)
-                _mark(ib, start, items, nxt)
-                any_dirty = True
-        if not any_dirty:
+                moved[ia] = moved[ib] = it
+                any_moved = True
+        if not any_moved:
             return it + 1
-        _take(dirty, nxt)
+    _left(order, a, b, moved, passes - 1, dirty)
     return passes
+
+
+@njit(cache=True)
+def _left(order, a, b, moved, last, dirty):
+    """After the last pass: the contacts of bodies that moved in it are still to look at."""
+    for k in range(order.size):
+        i = order[k]
+        if moved[a[i]] >= last or moved[b[i]] >= last:
+            dirty[i] = True
 
 
 @njit(cache=True)

@@ -305,7 +305,6 @@ class _Solve:
         w = 1.0 / (wa + wb)
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
-        self.adjacency = solver.adjacency(self.a, self.b, rows.size)
         self.order = self._order()
         self.position_shares = self._shock_shares()
 
@@ -389,7 +388,7 @@ class _Solve:
         dx0, dy0 = self.dx.copy(), self.dy.copy()
         share_a, share_b = self.position_shares
         solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b, self.push, self.dx,
-                               self.dy, self.iterations, self.tolerance, self.dirty, *self.adjacency)
+                               self.dy, self.iterations, self.tolerance, self.dirty)
         over = np.zeros(0, dtype=bool)
         if self.stage.bodies.n_static:
             far = np.hypot(self.dx - dx0, self.dy - dy0)
@@ -546,13 +545,13 @@ class _Solve:
         gx, gy = self.gravity
         tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
         solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, self.share_a, self.share_b, self.impulse, vx, vy,
-                                self.iterations, tol, np.ones(cs.size, dtype=bool), *self.adjacency)
+                                self.iterations, tol, np.ones(cs.size, dtype=bool))
         bounce = self._bounce_targets(u, act)
         movable = ~((store.inv_mass[self.rows] == 0.0) | store.asleep[self.rows])
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, self.share_a, self.share_b, self.impulse,
-                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool), *self.adjacency)
+                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool))
             if not self.solo[bounce > 0.0].all():
                 self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy)
         rows = self.rows[movable]
