@@ -38,12 +38,36 @@ __all__ = ["solve_positions", "solve_velocities", "supported", "warm_start"]
 
 
 @njit(cache=True)
-def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty):
+def _within(change, share, sign, ex, ey, nx, ny, reach):
+    """``change`` limited so that a body now ``(ex, ey)`` from where the call began, moving by
+    ``sign * share * change`` along ``(nx, ny)``, stays within ``reach`` of it."""
+    if share == 0.0:
+        return change
+    en = ex * nx + ey * ny
+    disc = en * en - (ex * ex + ey * ey) + reach * reach
+    if disc < 0.0:
+        return 0.0
+    root = disc ** 0.5
+    t = sign * share * change  # the move along n; allowed in [-en - root, -en + root]
+    lo, hi = -en - root, -en + root
+    if t > hi:
+        t = hi
+    elif t < lo:
+        t = lo
+    return t / (sign * share)
+
+
+@njit(cache=True)
+def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, reach):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
     exit) and the per-body displacements ``dx, dy`` (which must already hold the warm start's
     displacement) are updated in place. ``dirty``: the contacts to look at first; on return, those
-    still to look at (none once converged). Returns the passes made."""
+    still to look at (none once converged). ``reach``: how far each body may move in this call
+    (a push that would take it farther is held back). Returns ``(passes made, whether a push was
+    held back)``."""
     moved = np.full(dx.size, -1, dtype=np.int64)  # the last pass in which each body moved
+    x0, y0 = dx.copy(), dy.copy()
+    held = False
     for it in range(passes):
         any_moved = False
         for k in range(order.size):
@@ -59,7 +83,14 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
             change = new - push[i]
             if change == 0.0:
                 continue
-            push[i] = new
+            wanted = change
+            change = _within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
+            change = _within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
+            if change != wanted:
+                held = True
+                if change == 0.0:
+                    continue
+            push[i] += change
             dx[ia] -= share_a[i] * change * nx[i]
             dy[ia] -= share_a[i] * change * ny[i]
             dx[ib] += share_b[i] * change * nx[i]
@@ -68,9 +99,9 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
                 moved[ia] = moved[ib] = it
                 any_moved = True
         if not any_moved:
-            return it + 1
+            return it + 1, held
     _left(order, a, b, moved, passes - 1, dirty)
-    return passes
+    return passes, held
 
 
 @njit(cache=True)

@@ -296,8 +296,11 @@ class _Solve:
         position solver (after the contact set changed)."""
         store, cs = self.store, self.cs
         rows = self.rows
-        half = np.where(store.hw[rows] > 0.0, np.minimum(store.hw[rows], store.hh[rows]), 0.5 * store.bound[rows])
-        self.reach = 0.5 * half
+        if self.stage.bodies.n_static:
+            half = np.where(store.hw[rows] > 0.0, np.minimum(store.hw[rows], store.hh[rows]), 0.5 * store.bound[rows])
+            self.reach = 0.5 * half
+        else:  # (nothing to be pushed through)
+            self.reach = np.full(rows.size, np.inf)
         C = cs.size
         self.a, self.b = self.local[:C], self.local[C:]
         wa = np.where(store.asleep[cs.ra], 0.0, store.inv_mass[cs.ra])  # a sleeper keeps still
@@ -314,19 +317,24 @@ class _Solve:
         (the floor, or a body resting on it...), the lower body keeps still and the push lifts the
         upper one: a stack is pushed out from the ground up, each body exactly onto the one below
         (Gauss-Seidel alone converges on a stack only geometrically, and a body on top would press
-        the one below into it). Elsewhere the push is shared by inverse mass. (Velocities are
-        always shared by inverse mass.)"""
+        the one below into it). Elsewhere the push is shared by inverse mass. (Velocities: see
+        :meth:`_velocity_shares`.)"""
         gx, gy = self.gravity
         g = math.hypot(gx, gy)
         both = ~self.immovable
         if g == 0.0 or not both.any():
+            self.b_on_a = self.a_on_b = None
             return self.share_a, self.share_b
         cs = self.cs
         up = -(cs.nx * gx + cs.ny * gy) / g  # > 0.5: b rests on a
         fixed_a, fixed_b = self.share_a == 0.0, self.share_b == 0.0
         held = solver.supported(self.order, self.a, self.b, up, fixed_a, fixed_b, self.rows.size)
-        b_on_a = both & (up > 0.5) & held[self.a]
-        a_on_b = both & (up < -0.5) & held[self.b]
+        self.b_on_a = b_on_a = both & (up > 0.5) & held[self.a]
+        self.a_on_b = a_on_b = both & (up < -0.5) & held[self.b]
+        return self._lower_stays(b_on_a, a_on_b)
+
+    def _lower_stays(self, b_on_a: np.ndarray, a_on_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still."""
         share_a = np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, self.share_a))
         share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
         return share_a, share_b
@@ -356,10 +364,9 @@ class _Solve:
         next step)."""
         store, cs = self.store, self.cs
         self.x0, self.y0 = store.x[self.rows].copy(), store.y[self.rows].copy()
-        self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, self.share_a, self.share_b, cs.push0,
-                                             self.rows.size)
-        self.push = cs.push0.copy()
-        self.capped = np.zeros(self.rows.size, dtype=bool)
+        self.push = self._warm_pushes(cs.push0)
+        share_a, share_b = self.position_shares
+        self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
         self.far_done = np.zeros(self.rows.size, dtype=bool)
         self.candidates = self.stage.candidate_pairs(self.frame, cs)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
@@ -376,6 +383,18 @@ class _Solve:
             if not self._measure_immovable():
                 return
 
+    def _warm_pushes(self, push0: np.ndarray) -> np.ndarray:
+        """Last step's pushes as this step's first guess, scaled down where they would move a body
+        farther than its reach (see :meth:`_solve`) before the solver has looked at anything."""
+        if np.isfinite(self.reach).all() and push0.any():
+            share_a, share_b = self.position_shares
+            cs = self.cs
+            wx, wy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.rows.size)
+            far = np.hypot(wx, wy)
+            scale = np.minimum(1.0, self.reach / np.maximum(far, 1e-300))
+            return push0 * np.minimum(scale[self.a], scale[self.b])
+        return push0.copy()
+
     def _solve(self, order: np.ndarray) -> bool:
         """One run of the position solver over the contacts ``order``; the bodies are then placed.
         Whether a push was held back.
@@ -385,22 +404,12 @@ class _Solve:
         into while that static is still nearer the face it entered by, so the next round pushes it
         back out the way it came rather than on through."""
         cs = self.cs
-        dx0, dy0 = self.dx.copy(), self.dy.copy()
         share_a, share_b = self.position_shares
-        solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b, self.push, self.dx,
-                               self.dy, self.iterations, self.tolerance, self.dirty)
-        over = np.zeros(0, dtype=bool)
-        if self.stage.bodies.n_static:
-            far = np.hypot(self.dx - dx0, self.dy - dy0)
-            over = far > self.reach
-        if over.any():
-            self.capped |= over
-            self.dirty |= over[self.a] | over[self.b]  # held back: not where the solve left them
-            k = self.reach[over] / far[over]
-            self.dx[over] = dx0[over] + (self.dx[over] - dx0[over]) * k
-            self.dy[over] = dy0[over] + (self.dy[over] - dy0[over]) * k
+        _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
+                                               self.push, self.dx, self.dy, self.iterations, self.tolerance,
+                                               self.dirty, self.reach)
         self._place()
-        return bool(over.any())
+        return bool(held)
 
     def _place(self) -> None:
         moved = np.flatnonzero((self.dx != 0.0) | (self.dy != 0.0))
@@ -517,10 +526,9 @@ class _Solve:
                             cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
                             cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
                             cat([cs.impulse0, zeros]))
-        capped, far_done = np.zeros(rows.size, dtype=bool), np.zeros(rows.size, dtype=bool)
-        capped[remap], far_done[remap] = self.capped, self.far_done
-        self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
-        self.capped, self.far_done = capped, far_done
+        far_done = np.zeros(rows.size, dtype=bool)
+        far_done[remap] = self.far_done
+        self.rows, self.dx, self.dy, self.x0, self.y0, self.far_done = rows, dx, dy, x0, y0, far_done
         self.local = cat([remap[self.a], new_a, remap[self.b], new_b])
         self.push = cat([self.push, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
@@ -537,25 +545,45 @@ class _Solve:
         u = (vx[b] - vx[a]) * cs.nx + (vy[b] - vy[a]) * cs.ny  # closing speed before the solve
         act = np.flatnonzero(self.touching)
         order = self.order[self.touching[self.order]]
+        share_a, share_b = self._velocity_shares(vx, vy)
         self.impulse = np.where(self.touching, cs.impulse0, 0.0)
-        wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, self.share_a, self.share_b, self.impulse, self.rows.size)
+        wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, self.rows.size)
         vx += wx
         vy += wy
         target = np.zeros(cs.size)
         gx, gy = self.gravity
         tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
-        solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, self.share_a, self.share_b, self.impulse, vx, vy,
+        solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
                                 self.iterations, tol, np.ones(cs.size, dtype=bool))
         bounce = self._bounce_targets(u, act)
         movable = ~((store.inv_mass[self.rows] == 0.0) | store.asleep[self.rows])
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
-            solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, self.share_a, self.share_b, self.impulse,
+            solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, share_a, share_b, self.impulse,
                                     vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool))
             if not self.solo[bounce > 0.0].all():
                 self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy)
         rows = self.rows[movable]
         store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
+
+    def _velocity_shares(self, vx: np.ndarray, vy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Shares of the velocity impulses. As for the pushes, the lower body of a supported resting
+        pair keeps still (a pile's weight goes straight down to the ground within one pass; a body
+        high in a pile cannot keep a falling speed that only the pushes hide), except where the
+        lower body moves into the upper one faster than a body at rest does (it bounced): an
+        immovable body moving up would hand the upper one a bounce off a moving wall and keep its
+        own speed, making energy; those pairs meet as the dynamic bodies they are."""
+        if self.b_on_a is None or not (self.b_on_a.any() or self.a_on_b.any()):
+            return self.share_a, self.share_b
+        cs, a, b = self.cs, self.a, self.b
+        gx, gy = self.gravity
+        resting_speed = 2.0 * np.abs(gx * cs.nx + gy * cs.ny) * self.dt
+        # the lower body's speed toward the upper one
+        a_up = vx[a] * cs.nx + vy[a] * cs.ny
+        b_down = -(vx[b] * cs.nx + vy[b] * cs.ny)
+        b_on_a = self.b_on_a & (a_up <= resting_speed)
+        a_on_b = self.a_on_b & (b_down <= resting_speed)
+        return self._lower_stays(b_on_a, a_on_b)
 
     def _no_energy_made(self, bounce, movable, vx_in, vy_in, vx, vy) -> None:
         """Bounces hand back (some of) the energy the stopping took, never more than the bodies had
@@ -625,9 +653,7 @@ class _Solve:
         ea, eb, nx, ny = cs.ea[acted], cs.eb[acted], cs.nx[acted], cs.ny[acted]
         frame.resolved = (ea, eb, nx, ny, self.push[acted])
         gap = np.maximum(self._separations()[acted], 0.0)
-        # A push held back by the solver's reach is not the pair's push: no warm start from it.
-        push = np.where(self.capped[self.a[acted]] | self.capped[self.b[acted]], 0.0, self.push[acted])
-        frame.support = (ea, eb, nx, ny, push, self.impulse[acted], gap)
+        frame.support = (ea, eb, nx, ny, self.push[acted], self.impulse[acted], gap)
         frame.counters["resolved"] = int(acted.size)
 
 
