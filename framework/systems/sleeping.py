@@ -17,7 +17,10 @@ from .stage import Stage
 __all__ = ["SLEEP_SPEED", "SLEEP_STEPS", "Sleeping"]
 
 SLEEP_STEPS = 30
-SLEEP_SPEED = 1e-3
+# World units per second, per unit of (1 + size): about Box2D's 5 cm/s sleep threshold for a body a
+# metre across. Slower than this, a body counts as at rest (without friction, a box creeping along
+# a flat top would otherwise never sleep).
+SLEEP_SPEED = 0.03
 
 
 class Sleeping(Stage):
