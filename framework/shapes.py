@@ -167,6 +167,21 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
     tiny coordinates overflow or underflow, and in an order that does not depend on where the
     outline starts or which way it winds: equal outlines give the same Polygon bit for bit.
     """
+    pts, shown = _read_points(points)
+    out = _distinct(pts, shown)
+    q, thr = _scaled(out)
+    _not_collinear(q, thr, shown)
+    idx = _corners(out, q, thr, shown)
+    turns = _convex_turns(out, q, idx, shown)
+    res = [out[i] for i in idx]
+    if turns[0] < 0:
+        res.reverse()
+    start = min(range(len(res)), key=lambda i: (res[i][1], res[i][0]))
+    return tuple(res[start:] + res[:start])
+
+
+def _read_points(points: Iterable[Sequence[float]]) -> tuple[list[tuple[float, float]], str]:
+    """The points as finite float pairs (-0.0 made 0.0), and how to show the argument in errors."""
     if isinstance(points, (str, bytes)):
         raise InvalidValue(f"Polygon points must be a sequence of (x, y) pairs, got {points!r}")
     try:
@@ -194,8 +209,11 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
                 f"Polygon point {i} {p!r} is too far from the origin: its distance overflows float64"
             )
         pts.append((x, y))
+    return pts, shown
 
-    # Drop repeated points (consecutive ones, including the closing repeat of the first point).
+
+def _distinct(pts: list[tuple[float, float]], shown: str) -> list[tuple[float, float]]:
+    """The points without repeats (consecutive ones, including the closing repeat of the first)."""
     out: list[tuple[float, float]] = []
     for p in pts:
         if not out or p != out[-1]:
@@ -206,27 +224,37 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
         raise InvalidValue(f"Polygon outline visits a point twice, so it is not convex: {shown}")
     if len(out) < 3:
         raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {shown}")
+    return out
 
-    # Scale by a power of two so the largest coordinate is in [0.5, 1): exact, and no product
-    # below can overflow or lose a tiny polygon to underflow.
+
+def _scaled(out: list[tuple[float, float]]) -> tuple[list[tuple[float, float]], float]:
+    """The points scaled by a power of two so the largest coordinate is in [0.5, 1) (exact, and no
+    product below can overflow or lose a tiny polygon to underflow), and the thinness threshold."""
     k = math.frexp(max(max(abs(x), abs(y)) for x, y in out))[1]
     q = [(math.ldexp(x, -k), math.ldexp(y, -k)) for x, y in out]
     xs, ys = [p[0] for p in q], [p[1] for p in q]
     ext = max(max(xs) - min(xs), max(ys) - min(ys))
     thr = _COLLINEAR_REL * ext + _ROUNDING * max(max(map(abs, xs)), max(map(abs, ys)))
+    return q, thr
 
-    # All points on one line (within thr of the line through the lexicographic extremes, which are
-    # the two ends when they are collinear). Not a signed-area test: a bow-tie's area cancels.
+
+def _not_collinear(q: list[tuple[float, float]], thr: float, shown: str) -> None:
+    """All points on one line (within thr of the line through the lexicographic extremes, which are
+    the two ends when they are collinear) is an error. Not a signed-area test: a bow-tie's area
+    cancels."""
     lo, hi = min(q), max(q)
     lx, ly = hi[0] - lo[0], hi[1] - lo[1]
     span = math.hypot(lx, ly)
     if max(abs(_cross(lx, ly, x - lo[0], y - lo[1])) for x, y in q) <= thr * span:
         raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {shown}")
 
-    # Drop vertices where the outline runs straight on; a vertex where it doubles back is a spike.
-    # A vertex is degenerate when its triangle with its two neighbours is thinner than thr (the
-    # triangle's least height: twice its area over its longest side). The thinnest goes first, so
-    # the result does not depend on the starting point or the winding.
+
+def _corners(out: list[tuple[float, float]], q: list[tuple[float, float]], thr: float, shown: str) -> list[int]:
+    """Indices of the vertices kept: those where the outline runs straight on are dropped; one where
+    it doubles back is a spike (an error). A vertex is degenerate when its triangle with its two
+    neighbours is thinner than thr (the triangle's least height: twice its area over its longest
+    side). The thinnest goes first, so the result does not depend on the starting point or the
+    winding."""
     idx = list(range(len(out)))
     while len(idx) >= 3:
         best = None
@@ -252,8 +280,13 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
         del idx[j]
     if len(idx) < 3:
         raise InvalidValue(f"Polygon needs at least 3 non-collinear points, got {shown}")
+    return idx
 
-    # Convex: every turn has the same sign, and the outline turns once around (not a star).
+
+def _convex_turns(out: list[tuple[float, float]], q: list[tuple[float, float]], idx: list[int],
+                  shown: str) -> list[float]:
+    """The turn at each kept vertex; an error unless every turn has the same sign and the outline
+    turns once around (not a star)."""
     n = len(idx)
     turns = []
     for j in range(n):
@@ -270,8 +303,4 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
             )
         bad = next((out[idx[j]] for j, t in enumerate(turns) if (t > 0) != (sum(turns) > 0)), out[idx[0]])
         raise InvalidValue(f"Polygon is not convex (the outline turns the other way at {bad!r}): {shown}")
-    res = [out[i] for i in idx]
-    if turns[0] < 0:
-        res.reverse()
-    start = min(range(len(res)), key=lambda i: (res[i][1], res[i][0]))
-    return tuple(res[start:] + res[:start])
+    return turns

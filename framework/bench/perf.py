@@ -360,6 +360,18 @@ def _label(n: int) -> str:
     return f"{n // 1000}k" if n % 1000 == 0 else str(n)
 
 
+def _brute_row(label: str, n: int, brute: Task, hash_row: dict[str, Any]) -> dict[str, Any]:
+    """The brute-force baseline's row, beside the hashed scene's row of the same size."""
+    return {
+        "scene": f"brute-force-{label}", "bodies": n, "static": 0, "ms_per_step": median(brute.ms),
+        "pymunk_ms_per_step": None, "ratio": None, "pairs": hash_row["pairs"],
+        "movement_ms": None, "broad_ms": None, "narrow_ms": None, "response_ms": None, "other_ms": None,
+        "floor_ms": hash_row["floor_ms"],
+        "floor_ratio": median(brute.ms) / hash_row["floor_ms"] if hash_row["floor_ms"] else None,
+        "pairs_per_body": hash_row["pairs_per_body"], "cell_size": None, "rounds": len(brute.ms),
+    }
+
+
 def run_perf(
     sizes: tuple[int, ...] = FULL["sizes"],
     rounds: dict[int, int] | None = None,
@@ -414,15 +426,7 @@ def run_perf(
             if ctx_t is not None:
                 rows.append(_row(f"boxes-{label}+tiles-{_label(tiles)}", wlt, by, label + "+tiles", ctx_t))
             if brute is not None:
-                hash_row = rows[-1 if ctx_t is None else -2]
-                rows.append({
-                    "scene": f"brute-force-{label}", "bodies": n, "static": 0, "ms_per_step": median(brute.ms),
-                    "pymunk_ms_per_step": None, "ratio": None, "pairs": hash_row["pairs"],
-                    "movement_ms": None, "broad_ms": None, "narrow_ms": None, "response_ms": None, "other_ms": None,
-                    "floor_ms": hash_row["floor_ms"],
-                    "floor_ratio": median(brute.ms) / hash_row["floor_ms"] if hash_row["floor_ms"] else None,
-                    "pairs_per_body": hash_row["pairs_per_body"], "cell_size": None, "rounds": len(brute.ms),
-                })
+                rows.append(_brute_row(label, n, brute, rows[-1 if ctx_t is None else -2]))
             for c in (ctx, ctx_t):
                 if c is not None:
                     c["scene"].close()
