@@ -37,6 +37,7 @@ among small ones costs O(N), not a huge number of cells.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from ..validation import InvalidValue
 
@@ -68,7 +69,6 @@ _EMPTY_I = np.zeros(0, dtype=_I64)
 _BLOCK = 1 << 21
 # The strip sweep steps all entries forward together while more than this many are still active,
 # then finishes the few long sweeps with a binary search each.
-_SWEEP_TAIL = 256
 
 
 # --- small helpers --------------------------------------------------------------------------------
@@ -464,35 +464,9 @@ class StripSweep:
 
     def self_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """``(a, b)`` body numbers of the strictly overlapping pairs of small bodies, each once."""
-        e = self.entries
-        if e < 2:
+        if self.entries < 2:
             return _EMPTY_I, _EMPTY_I
-        x0, y0, x1, y1 = self.ex0, self.ey0, self.ex1, self.ey1
-        first, skey, slim = self.first, self.skey, self.slim
-        out_a, out_b = [], []
-        # entry p meets p+1, p+2, ... while their sweep key is within its limit: step all entries
-        # forward together while many are active, then finish the few long sweeps by binary search
-        act = np.flatnonzero(skey[1:] <= slim)
-        step = 1
-        while True:
-            nb = act + step
-            ok = (x1[nb] > x0[act]) & (x1[act] > x0[nb]) & (y1[nb] > y0[act]) & (y1[act] > y0[nb])
-            ok &= (first[act] | first[nb]) != 0
-            out_a.append(act[ok])
-            out_b.append(nb[ok])
-            step += 1
-            if act.shape[0] <= _SWEEP_TAIL:
-                break
-            act = act[skey[act + step] <= slim[act]]
-        if act.shape[0]:
-            end = np.searchsorted(skey, slim[act], "right")
-            own, nb = expand_runs(np.maximum(end - act - step, 0), act + step)
-            act = act[own]
-            ok = (x1[nb] > x0[act]) & (x1[act] > x0[nb]) & (y1[nb] > y0[act]) & (y1[act] > y0[nb])
-            ok &= (first[act] | first[nb]) != 0
-            out_a.append(act[ok])
-            out_b.append(nb[ok])
-        pa, pb = np.concatenate(out_a), np.concatenate(out_b)
+        pa, pb = sweep_pairs(self.skey, self.slim, self.ex0, self.ey0, self.ex1, self.ey1, self.first)
         return self.body[pa], self.body[pb]
 
     def cross_pairs(self, stat: CellIndex) -> tuple[np.ndarray, np.ndarray]:
@@ -511,3 +485,32 @@ class StripSweep:
         ok = strict_overlap(*(v[q] for v in (self.ex0, self.ey0, self.ex1, self.ey1)),
                             *(v[ps] for v in stat.ebounds))
         return body[q[ok]], stat.body[ps[ok]]
+
+
+@njit(cache=True)
+def sweep_pairs(skey, slim, x0, y0, x1, y1, first):
+    """The sweep of :meth:`StripSweep.self_pairs` (compiled): entry ``p`` meets ``p + 1, p + 2, ...``
+    while their sweep key is within its limit; a pair counts once (in the first row either of its
+    bodies has) and only if the bounds strictly overlap. Returns entry numbers ``(a, b)``."""
+    n = slim.shape[0]
+    count = 0
+    for p in range(n):
+        q = p + 1
+        while skey[q] <= slim[p]:
+            if (x1[q] > x0[p] and x1[p] > x0[q] and y1[q] > y0[p] and y1[p] > y0[q]
+                    and (first[p] | first[q]) != 0):
+                count += 1
+            q += 1
+    pa = np.empty(count, dtype=np.int64)
+    pb = np.empty(count, dtype=np.int64)
+    k = 0
+    for p in range(n):
+        q = p + 1
+        while skey[q] <= slim[p]:
+            if (x1[q] > x0[p] and x1[p] > x0[q] and y1[q] > y0[p] and y1[p] > y0[q]
+                    and (first[p] | first[q]) != 0):
+                pa[k] = p
+                pb[k] = q
+                k += 1
+            q += 1
+    return pa, pb
