@@ -29,7 +29,6 @@ import math
 
 import numpy as np
 
-from ..arrays import distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
 from ..events import pair_keys, sorted_member
@@ -49,6 +48,9 @@ PASS_BUDGET = 25_000
 MAX_PASSES = 16
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
 TOLERANCE = 1e-9
+# A body pushed farther than this fraction of its size within a step is looked at again with the
+# static hash (late contacts); nearer statics are among the broad phase's pairs.
+FAR = 0.01
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
@@ -497,11 +499,21 @@ class _Solve:
 
     def _late_contacts(self) -> bool:
         """Add the contacts with statics that bodies pushed by dynamic bodies were shoved into (they
-        were not touching them when the step's contacts were found). Whether there were any."""
+        were not touching them when the step's contacts were found). Whether there were any.
+
+        Statics the broad phase found touching or near a body are candidates already (see
+        :meth:`_new_dynamic_contacts`); the static hash is asked again only about bodies pushed
+        farther than a hundredth of their size (a crowd spawned in a heap), which is what could
+        reach a static that was not near. (A resting pile's bodies move by a step of gravity.)"""
         cs = self.cs
         both = ~self.immovable & (self.push > 0.0)
-        pushed = distinct(np.concatenate([cs.ra[both], cs.rb[both]]))
-        extra = self.stage.new_static_contacts(pushed, np.sort(pair_keys(cs.ea, cs.eb)))
+        pushed = np.zeros(self.rows.size, dtype=bool)
+        pushed[self.a[both]] = pushed[self.b[both]] = True
+        bound = self.store.bound[self.rows]
+        pushed &= np.hypot(self.dx, self.dy) > FAR * bound
+        if not pushed.any():
+            return False
+        extra = self.stage.new_static_contacts(self.rows[pushed], np.sort(pair_keys(cs.ea, cs.eb)))
         if extra is None:
             return False
         ea, eb, ra, rb, r = extra
