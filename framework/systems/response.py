@@ -444,7 +444,8 @@ class _Solve:
         cs.nx[hit], cs.ny[hit] = r.nx[r.hit], r.ny[r.hit]
         cs.depth[hit] = r.depth[r.hit] + self._shift(hit)
         self.dirty[hit] = True
-        return True
+        # Another round only for an overlap the solver would act on (not one within its tolerance).
+        return bool((r.depth[r.hit] > self.tolerance).any())
 
     def _moved_rows(self) -> np.ndarray:
         """Store rows (sorted) the solve has moved."""
@@ -487,9 +488,9 @@ class _Solve:
         if look.size == 0:
             return False
         r = self.stage.remeasure(ra[look], rb[look])
-        if not r.hit.any():
+        h = np.flatnonzero(r.hit & (r.depth > self.tolerance))  # (a sliver is left to the next step)
+        if h.size == 0:
             return False
-        h = np.flatnonzero(r.hit)
         new = look[h]
         keep = np.ones(ra.size, dtype=bool)
         keep[new] = False
