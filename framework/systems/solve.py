@@ -37,7 +37,7 @@ __all__ = ["Contacts", "Solve", "bounce_speed"]
 # nothing changes (a pile warm started from the last step needs one or two, a fresh one dozens);
 # a small solve may take up to MAX_PASSES, within PASS_BUDGET contact visits (nanoseconds each).
 SOLVER_PASSES = 4
-PASS_BUDGET = 25_000
+PASS_BUDGET = 8_000
 MAX_PASSES = 16
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
 TOLERANCE = 1e-9
@@ -165,7 +165,7 @@ class Solve:
         share_a, share_b = self.position_shares
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
         self.far_done = np.zeros(self.rows.size, dtype=bool)
-        self.candidates = self.stage.candidate_pairs(self.frame, cs)
+        self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
         for _round in range(rounds):
             held_back = self._solve(self.order)
@@ -242,9 +242,15 @@ class Solve:
         # Another round only for an overlap the solver would act on (not one within its tolerance).
         return bool((r.depth[r.hit] > self.tolerance).any())
 
-    def _moved_rows(self) -> np.ndarray:
-        """Store rows (sorted) the solve has moved."""
-        return self.rows[(self.dx != 0.0) | (self.dy != 0.0)]
+    def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
+        self.candidates = candidates
+        self._candidate_local = None  # (their bodies' local numbers, made when first needed)
+
+    def _local_of(self, rows: np.ndarray) -> np.ndarray:
+        """Local numbers of store ``rows`` (``len(self.rows)`` for a row not in the solve)."""
+        at = np.searchsorted(self.rows, rows)
+        found = self.rows[np.minimum(at, self.rows.size - 1)] == rows
+        return np.where(found, at, self.rows.size)
 
     def _far_candidates(self) -> bool:
         """Pushes that moved a body more than its solver reach (a heap spawned on one spot) may
@@ -269,7 +275,7 @@ class Solve:
             return False
         ea, eb = ea[keep], eb[keep]
         new = self.stage.solid_pairs(bodies.rows_of(ea), bodies.rows_of(eb), ea, eb)
-        self.candidates = tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, new))
+        self._set_candidates(tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, new)))
         return bool(new[0].size)
 
     def _new_dynamic_contacts(self) -> bool:
@@ -278,8 +284,12 @@ class Solve:
         ra, rb, ea, eb = self.candidates
         if ra.size == 0:
             return False
-        moved = self._moved_rows()
-        look = np.flatnonzero(sorted_member(ra, moved) | sorted_member(rb, moved))
+        # each candidate body's local number, or the extra last slot (never moved) if it has none
+        if self._candidate_local is None or self._candidate_local[0] != self.rows.size:
+            self._candidate_local = (self.rows.size, self._local_of(ra), self._local_of(rb))
+        _n, la, lb = self._candidate_local
+        moved = np.append((self.dx != 0.0) | (self.dy != 0.0), False)
+        look = np.flatnonzero(moved[la] | moved[lb])
         if look.size == 0:
             return False
         r = self.stage.remeasure(ra[look], rb[look])
@@ -289,7 +299,7 @@ class Solve:
         new = look[h]
         keep = np.ones(ra.size, dtype=bool)
         keep[new] = False
-        self.candidates = (ra[keep], rb[keep], ea[keep], eb[keep])
+        self._set_candidates((ra[keep], rb[keep], ea[keep], eb[keep]))
         self._add(ra[new], rb[new], ea[new], eb[new], batch.ContactArrays(*(v[h] for v in r)))
         return True
 
@@ -302,6 +312,8 @@ class Solve:
         farther than a hundredth of their size (a crowd spawned in a heap), which is what could
         reach a static that was not near. (A resting pile's bodies move by a step of gravity.)"""
         cs = self.cs
+        if self.stage.bodies.n_static == 0:
+            return False
         both = ~self.immovable & (self.push > 0.0)
         pushed = np.zeros(self.rows.size, dtype=bool)
         pushed[self.a[both]] = pushed[self.b[both]] = True

@@ -165,11 +165,16 @@ def supported(order, a, b, up, fixed_a, fixed_b, n_bodies):
     return out
 
 
+@njit(cache=True)
 def warm_start(a, b, nx, ny, share_a, share_b, value, n_bodies):
     """Per-body ``(x, y)`` sums of the warm-start values (pushes or impulses) over the contacts."""
     ox, oy = np.zeros(n_bodies), np.zeros(n_bodies)
-    np.subtract.at(ox, a, share_a * value * nx)
-    np.subtract.at(oy, a, share_a * value * ny)
-    np.add.at(ox, b, share_b * value * nx)
-    np.add.at(oy, b, share_b * value * ny)
+    for i in range(a.size):
+        v = value[i]
+        if v == 0.0:
+            continue
+        ox[a[i]] -= share_a[i] * v * nx[i]
+        oy[a[i]] -= share_a[i] * v * ny[i]
+        ox[b[i]] += share_b[i] * v * nx[i]
+        oy[b[i]] += share_b[i] * v * ny[i]
     return ox, oy
