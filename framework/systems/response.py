@@ -184,6 +184,22 @@ class Response(Stage):
         self.redirect(ra, rb, r.nx, r.ny, r.depth, r.hit)
         return r
 
+    def near_statics(self, rows: np.ndarray, margin: np.ndarray) -> np.ndarray:
+        """Mask of ``rows`` that may come within ``margin`` (per row) of a static body: their
+        bounding circles, grown by it, share a cell with one (a cheap superset test)."""
+        bodies = self.bodies
+        store, hsh = bodies.store, bodies.hash
+        if rows.size == 0 or bodies.n_static == 0:
+            return np.zeros(rows.size, dtype=bool)
+        off = np.hypot(store.ox[rows], store.oy[rows]) if bodies.geometry.has_offset else 0.0
+        reach = store.bound[rows] + off + np.where(np.isfinite(margin), margin, 0.0)
+        x, y = store.x[rows], store.y[rows]
+        box = (np.nextafter(x - reach, -np.inf), np.nextafter(y - reach, -np.inf),
+               np.nextafter(x + reach, np.inf), np.nextafter(y + reach, np.inf))
+        if hsh.outside_statics(*(f(v) for f, v in zip((np.min, np.min, np.max, np.max), box))):
+            return np.zeros(rows.size, dtype=bool)
+        return hsh.near_statics(*box)
+
     def new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
         """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs whose
         keys are in ``known`` (sorted): ``(ents_a, ents_b, rows_a, rows_b, contacts)`` or None."""

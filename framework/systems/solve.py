@@ -41,9 +41,6 @@ PASS_BUDGET = 8_000
 MAX_PASSES = 16
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
 TOLERANCE = 1e-9
-# A body pushed farther than this fraction of its size within a step is looked at again with the
-# static hash (late contacts); nearer statics are among the broad phase's pairs.
-FAR = 0.01
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
@@ -155,10 +152,8 @@ class Solve:
         """Push every solid contact out of overlap, in rounds: after each, the contacts with
         immovable bodies are measured again with the geometry, and the pairs the pushes made
         overlap are added (dynamic pairs the broad phase found touching, statics the pushed
-        bodies were shoved into), until nothing changes. If a contact with an immovable body still
-        overlaps after them (a crowd spawned in a heap), rounds over those contacts alone, so no
-        body ends the step inside static geometry (overlaps between dynamic bodies are left to the
-        next step)."""
+        bodies were shoved into), until nothing changes (to the solver's tolerance, a billionth of
+        the bodies' size), or the rounds run out (then :meth:`_clear_of_statics`)."""
         store, cs = self.store, self.cs
         self.x0, self.y0 = store.x[self.rows].copy(), store.y[self.rows].copy()
         self.push = self._warm_pushes(cs.push0)
@@ -166,6 +161,7 @@ class Solve:
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
         self.far_done = np.zeros(self.rows.size, dtype=bool)
         self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
+        self.near_static = self.stage.near_statics(self.rows, self.reach)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
         for _round in range(rounds):
             held_back = self._solve(self.order)
@@ -175,9 +171,23 @@ class Solve:
             grew = self._late_contacts() or grew
             if not (held_back or overlapping or grew):
                 return
+        self._clear_of_statics(rounds)
+
+    def _clear_of_statics(self, rounds: int) -> None:
+        """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
+        the contacts with immovable bodies alone, while one still overlaps: each pushes its body
+        exactly out, so no body ends the step inside static geometry; overlaps between dynamic
+        bodies are left to the next step."""
         for _round in range(rounds):
-            self._solve(self.order[self.immovable[self.order]])
-            if not self._measure_immovable():
+            order = self.order[self.immovable[self.order]]
+            if not (self._separations()[order] < 0.0).any():
+                return
+            self.dirty[order] = True
+            self._solve(order, tolerance=0.0)
+            overlapping = self._measure_immovable()
+            grew = self._new_dynamic_contacts(immovable_only=True)
+            grew = self._late_contacts() or grew
+            if not (overlapping or grew):
                 return
 
     def _warm_pushes(self, push0: np.ndarray) -> np.ndarray:
@@ -192,7 +202,7 @@ class Solve:
             return push0 * np.minimum(scale[self.a], scale[self.b])
         return push0.copy()
 
-    def _solve(self, order: np.ndarray) -> bool:
+    def _solve(self, order: np.ndarray, tolerance: float | None = None) -> bool:
         """One run of the position solver over the contacts ``order``; the bodies are then placed.
         Whether a push was held back.
 
@@ -203,8 +213,9 @@ class Solve:
         cs = self.cs
         share_a, share_b = self.position_shares
         _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
-                                               self.push, self.dx, self.dy, self.iterations, self.tolerance,
-                                               self.dirty, self.reach)
+                                               self.push, self.dx, self.dy, self.iterations,
+                                               self.tolerance if tolerance is None else tolerance, self.dirty,
+                                               self.reach)
         self._place()
         return bool(held)
 
@@ -278,9 +289,10 @@ class Solve:
         self._set_candidates(tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, new)))
         return bool(new[0].size)
 
-    def _new_dynamic_contacts(self) -> bool:
+    def _new_dynamic_contacts(self, immovable_only: bool = False) -> bool:
         """Add the candidate pairs (touching or near when the step's contacts were found) that the
-        pushes made overlap. Whether there were any."""
+        pushes made overlap (``immovable_only``: only those with an immovable body). Whether there
+        were any."""
         ra, rb, ea, eb = self.candidates
         if ra.size == 0:
             return False
@@ -289,7 +301,11 @@ class Solve:
             self._candidate_local = (self.rows.size, self._local_of(ra), self._local_of(rb))
         _n, la, lb = self._candidate_local
         moved = np.append((self.dx != 0.0) | (self.dy != 0.0), False)
-        look = np.flatnonzero(moved[la] | moved[lb])
+        near = moved[la] | moved[lb]
+        if immovable_only:
+            store = self.store
+            near &= ((store.inv_mass[ra] == 0.0) | store.asleep[ra]) | ((store.inv_mass[rb] == 0.0) | store.asleep[rb])
+        look = np.flatnonzero(near)
         if look.size == 0:
             return False
         r = self.stage.remeasure(ra[look], rb[look])
@@ -307,18 +323,17 @@ class Solve:
         """Add the contacts with statics that bodies pushed by dynamic bodies were shoved into (they
         were not touching them when the step's contacts were found). Whether there were any.
 
-        Statics the broad phase found touching or near a body are candidates already (see
-        :meth:`_new_dynamic_contacts`); the static hash is asked again only about bodies pushed
-        farther than a hundredth of their size (a crowd spawned in a heap), which is what could
-        reach a static that was not near. (A resting pile's bodies move by a step of gravity.)"""
+        Only bodies that were within their reach of a static when the solve began (most of a pile
+        is not), or that have been pushed farther than that (a crowd spawned in a heap), are looked
+        up in the static hash."""
         cs = self.cs
         if self.stage.bodies.n_static == 0:
             return False
         both = ~self.immovable & (self.push > 0.0)
         pushed = np.zeros(self.rows.size, dtype=bool)
         pushed[self.a[both]] = pushed[self.b[both]] = True
-        bound = self.store.bound[self.rows]
-        pushed &= np.hypot(self.dx, self.dy) > FAR * bound
+        # near a static when the solve began, or pushed farther than the reach that was looked at
+        pushed &= self.near_static | (np.hypot(self.dx, self.dy) > self.reach)
         if not pushed.any():
             return False
         extra = self.stage.new_static_contacts(self.rows[pushed], np.sort(pair_keys(cs.ea, cs.eb)))
@@ -346,9 +361,10 @@ class Solve:
                             cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
                             cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
                             cat([cs.impulse0, zeros]))
-        far_done = np.zeros(rows.size, dtype=bool)
-        far_done[remap] = self.far_done
+        far_done, near = np.zeros(rows.size, dtype=bool), np.ones(rows.size, dtype=bool)
+        far_done[remap], near[remap] = self.far_done, self.near_static
         self.rows, self.dx, self.dy, self.x0, self.y0, self.far_done = rows, dx, dy, x0, y0, far_done
+        self.near_static = near  # (new bodies: looked at)
         self.local = cat([remap[self.a], new_a, remap[self.b], new_b])
         self.push = cat([self.push, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
