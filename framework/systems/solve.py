@@ -90,11 +90,11 @@ class Solve:
         position solver (after the contact set changed)."""
         store, cs = self.store, self.cs
         rows = self.rows
-        if self.stage.bodies.n_static:
-            half = np.where(store.hw[rows] > 0.0, np.minimum(store.hw[rows], store.hh[rows]), 0.5 * store.bound[rows])
-            self.reach = 0.5 * half
-        else:  # (nothing to be pushed through)
-            self.reach = np.full(rows.size, np.inf)
+        half = np.where(store.hw[rows] > 0.0, np.minimum(store.hw[rows], store.hh[rows]), 0.5 * store.bound[rows])
+        self.span = 0.5 * half  # a move this long may bring a body to bodies it was not paired with
+        # how far a body may move in one run of the position solver (nothing to be pushed through
+        # without statics)
+        self.reach = self.span if self.stage.bodies.n_static else np.full(rows.size, np.inf)
         C = cs.size
         self.a, self.b = self.local[:C], self.local[C:]
         wa = np.where(store.asleep[cs.ra], 0.0, store.inv_mass[cs.ra])  # a sleeper keeps still
@@ -159,7 +159,7 @@ class Solve:
         self.push = self._warm_pushes(cs.push0)
         share_a, share_b = self.position_shares
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
-        self.far_done = np.zeros(self.rows.size, dtype=bool)
+        self.looked_x, self.looked_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _far_candidates)
         self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
         self.near_static = self.stage.near_statics(self.rows, self.reach)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
@@ -264,13 +264,14 @@ class Solve:
         return np.where(found, at, self.rows.size)
 
     def _far_candidates(self) -> bool:
-        """Pushes that moved a body more than its solver reach (a heap spawned on one spot) may
-        bring it to bodies the broad phase did not pair it with: the pairs of those bodies where
-        everything now stands become candidates. Whether any did."""
-        far = (np.hypot(self.dx, self.dy) > self.reach) & ~self.far_done
+        """Pushes that moved a body farther than its span (a quarter of its half-thickness) since it
+        was last looked at (a heap spawned on one spot) may bring it to bodies the broad phase did
+        not pair it with: the pairs of those bodies where everything now stands become candidates.
+        Whether any did."""
+        far = np.hypot(self.dx - self.looked_x, self.dy - self.looked_y) > self.span
         if not far.any():
             return False
-        self.far_done |= far
+        self.looked_x[far], self.looked_y[far] = self.dx[far], self.dy[far]
         bodies = self.stage.bodies
         store, geom = bodies.store, bodies.ensure_geometry()
         rows = store.active()[2]
@@ -361,9 +362,10 @@ class Solve:
                             cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
                             cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
                             cat([cs.impulse0, zeros]))
-        far_done, near = np.zeros(rows.size, dtype=bool), np.ones(rows.size, dtype=bool)
-        far_done[remap], near[remap] = self.far_done, self.near_static
-        self.rows, self.dx, self.dy, self.x0, self.y0, self.far_done = rows, dx, dy, x0, y0, far_done
+        near, looked_x, looked_y = np.ones(rows.size, dtype=bool), np.zeros(rows.size), np.zeros(rows.size)
+        near[remap], looked_x[remap], looked_y[remap] = self.near_static, self.looked_x, self.looked_y
+        self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
+        self.looked_x, self.looked_y = looked_x, looked_y
         self.near_static = near  # (new bodies: looked at)
         self.local = cat([remap[self.a], new_a, remap[self.b], new_b])
         self.push = cat([self.push, zeros])
