@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ..arrays import distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
 from ..events import pair_keys, sorted_member
@@ -80,7 +81,9 @@ class Solve:
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
         dropped = overlapping & ~cs.alive0  # the covering tile's own contact holds the body
         self.cs = cs = cs.take(np.flatnonzero(~dropped)) if dropped.any() else cs
-        self.rows, self.local = _local_numbers(store.n, np.concatenate([cs.ra, cs.rb]))
+        # Bodies are numbered locally; ``table`` maps a store row to its number (-1: not in the solve).
+        self.table = np.full(store.n, -1, dtype=np.int64)
+        self.rows, self.local = _number(self.table, np.concatenate([cs.ra, cs.rb]), 0)
         self.tolerance = TOLERANCE * float(store.bound[self.rows].max())
         self.dirty = np.ones(cs.size, dtype=bool)  # the contacts the position solver is to look at
         self._columns()
@@ -255,13 +258,6 @@ class Solve:
 
     def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
         self.candidates = candidates
-        self._candidate_local = None  # (their bodies' local numbers, made when first needed)
-
-    def _local_of(self, rows: np.ndarray) -> np.ndarray:
-        """Local numbers of store ``rows`` (``len(self.rows)`` for a row not in the solve)."""
-        at = np.searchsorted(self.rows, rows)
-        found = self.rows[np.minimum(at, self.rows.size - 1)] == rows
-        return np.where(found, at, self.rows.size)
 
     def _far_candidates(self) -> bool:
         """Pushes that moved a body farther than its span (a quarter of its half-thickness) since it
@@ -297,12 +293,9 @@ class Solve:
         ra, rb, ea, eb = self.candidates
         if ra.size == 0:
             return False
-        # each candidate body's local number, or the extra last slot (never moved) if it has none
-        if self._candidate_local is None or self._candidate_local[0] != self.rows.size:
-            self._candidate_local = (self.rows.size, self._local_of(ra), self._local_of(rb))
-        _n, la, lb = self._candidate_local
+        # each candidate body's number, or -1 (the extra last slot: never moved) if it is not in the solve
         moved = np.append((self.dx != 0.0) | (self.dy != 0.0), False)
-        near = moved[la] | moved[lb]
+        near = moved[self.table[ra]] | moved[self.table[rb]]
         if immovable_only:
             store = self.store
             near &= ((store.inv_mass[ra] == 0.0) | store.asleep[ra]) | ((store.inv_mass[rb] == 0.0) | store.asleep[rb])
@@ -347,27 +340,26 @@ class Solve:
 
     def _add(self, ra, rb, ea, eb, r) -> None:
         """Append contacts measured where the bodies stand now (their depths are made relative to
-        where the solve began, like every other contact's)."""
-        old_rows = self.rows
-        rows, local = _local_numbers(self.store.n, np.concatenate([old_rows, ra, rb]))
-        remap = local[: old_rows.size]
-        new_a, new_b = local[old_rows.size: old_rows.size + ra.size], local[old_rows.size + ra.size:]
-        dx, dy = np.zeros(rows.size), np.zeros(rows.size)
-        dx[remap], dy[remap] = self.dx, self.dy
-        x0, y0 = self.store.x[rows].copy(), self.store.y[rows].copy()
-        x0[remap], y0[remap] = self.x0, self.y0
+        where the solve began, like every other contact's); bodies new to the solve are numbered
+        after the others."""
+        n_old = self.rows.size
+        new_rows, local = _number(self.table, np.concatenate([ra, rb]), n_old)
+        new_a, new_b = local[: ra.size], local[ra.size:]
+        k = new_rows.size
+        rows = np.concatenate([self.rows, new_rows])
+        dx, dy = np.concatenate([self.dx, np.zeros(k)]), np.concatenate([self.dy, np.zeros(k)])
+        x0 = np.concatenate([self.x0, self.store.x[new_rows]])
+        y0 = np.concatenate([self.y0, self.store.y[new_rows]])
         shift = (dx[new_b] - dx[new_a]) * r.nx + (dy[new_b] - dy[new_a]) * r.ny
         cs, cat, zeros = self.cs, np.concatenate, np.zeros(ra.size)
         self.cs = Contacts(cat([cs.ra, ra]), cat([cs.rb, rb]), cat([cs.ea, ea]), cat([cs.eb, eb]),
                             cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
                             cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
                             cat([cs.impulse0, zeros]))
-        near, looked_x, looked_y = np.ones(rows.size, dtype=bool), np.zeros(rows.size), np.zeros(rows.size)
-        near[remap], looked_x[remap], looked_y[remap] = self.near_static, self.looked_x, self.looked_y
         self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
-        self.looked_x, self.looked_y = looked_x, looked_y
-        self.near_static = near  # (new bodies: looked at)
-        self.local = cat([remap[self.a], new_a, remap[self.b], new_b])
+        self.looked_x, self.looked_y = cat([self.looked_x, np.zeros(k)]), cat([self.looked_y, np.zeros(k)])
+        self.near_static = cat([self.near_static, np.ones(k, dtype=bool)])  # (new bodies: looked at)
+        self.local = cat([self.a, new_a, self.b, new_b])
         self.push = cat([self.push, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
         self._columns()
@@ -495,15 +487,13 @@ class Solve:
         frame.counters["resolved"] = int(acted.size)
 
 
-def _local_numbers(n: int, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(unique, local)``: the distinct rows (sorted) and each entry's number among them, like
-    ``np.unique(rows, return_inverse=True)`` but by a lookup table over the ``n`` rows."""
-    seen = np.zeros(n, dtype=bool)
-    seen[rows] = True
-    unique = np.flatnonzero(seen)
-    table = np.empty(n, dtype=np.int64)
-    table[unique] = np.arange(unique.size)
-    return unique, table[rows]
+def _number(table: np.ndarray, rows: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:
+    """Number the rows of ``rows`` that ``table`` (row -> number, -1: none) does not know yet, from
+    ``first`` on in row order, entering them in the table; return ``(the new rows, every entry's
+    number)``."""
+    new = distinct(rows[table[rows] < 0])
+    table[new] = first + np.arange(new.size)
+    return new, table[rows]
 
 
 def bounce_speed(u: np.ndarray, g: np.ndarray, d: np.ndarray, dt: float) -> np.ndarray:
