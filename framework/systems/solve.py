@@ -37,7 +37,7 @@ __all__ = ["Contacts", "Solve", "bounce_speed"]
 # Solver passes at most per response iteration (Scene.response_iterations): passes stop once
 # nothing changes (a pile warm started from the last step needs one or two, a fresh one dozens);
 # a small solve may take up to MAX_PASSES, within PASS_BUDGET contact visits (nanoseconds each).
-SOLVER_PASSES = 4
+SOLVER_PASSES = 2
 PASS_BUDGET = 8_000
 MAX_PASSES = 16
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
@@ -272,13 +272,21 @@ class Solve:
         store, geom = bodies.store, bodies.ensure_geometry()
         rows = store.active()[2]
         rows = rows[store.kind[rows] >= 0]
-        ea, eb = SpatialHash(bodies.hash.cell_size).pairs(geom.minx[rows], geom.miny[rows], geom.maxx[rows],
-                                                          geom.maxy[rows], store.entity[rows])
-        far_ents = np.sort(store.entity[self.rows[far]])
-        keep = sorted_member(ea, far_ents) | sorted_member(eb, far_ents)
+        # The far bodies in a hash of their own, every moving body asked against it (only those
+        # near a far one are swept).
+        far_rows = self.rows[far]
+        index = SpatialHash(bodies.hash.cell_size)
+        base = int(store.entity.max()) + 1  # the far bodies' ids in the index: above every entity id
+        index.set_static(geom.minx[far_rows], geom.miny[far_rows], geom.maxx[far_rows], geom.maxy[far_rows],
+                         base + np.arange(far_rows.size))
+        ea, eb = index.static_pairs(geom.minx[rows], geom.miny[rows], geom.maxx[rows], geom.maxy[rows],
+                                    store.entity[rows])  # (entity, base + i)
+        eb = store.entity[far_rows[eb - base]]
+        keys = distinct(pair_keys(np.minimum(ea, eb), np.maximum(ea, eb))[ea != eb])  # (far-far pairs come twice)
+        ea, eb = keys >> 32, keys & 0xFFFFFFFF
         ca, cb = self.candidates[2], self.candidates[3]
         known = np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
-        keep &= ~sorted_member(pair_keys(ea, eb), known)
+        keep = ~sorted_member(keys, known)
         if not keep.any():
             return False
         ea, eb = ea[keep], eb[keep]
