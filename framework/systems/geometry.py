@@ -17,11 +17,12 @@ _TINY = 5e-324  # the smallest subnormal: the step away from 0
 
 
 def _ulp_step(v: np.ndarray) -> np.ndarray:
-    """``|v| * 2**-52`` (between one and two ulps of ``v``) plus the smallest subnormal (which
-    moves 0 and subnormals)."""
+    """``|v| * 2**-52`` (between one and two ulps of ``v``), at least the smallest subnormal (which
+    moves 0 and subnormals). (Not the sum of the two: below about 1e-292 the product is itself
+    subnormal, and rounded up it plus the smallest subnormal made three ulps.)"""
     step = np.abs(v)
     step *= 2.0**-52
-    step += _TINY
+    np.maximum(step, _TINY, out=step)
     return step
 
 

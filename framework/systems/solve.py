@@ -166,8 +166,10 @@ class Solve:
         self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
         self.near_static = self.stage.near_statics(self.rows, self.reach)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
+        self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _moved)
         for _round in range(rounds):
             held_back = self._solve(self.order)
+            self._moved()
             overlapping = self._measure_immovable()
             grew = self._far_candidates()
             grew = self._new_dynamic_contacts() or grew
@@ -175,6 +177,13 @@ class Solve:
             if not (held_back or overlapping or grew):
                 return
         self._clear_of_statics(rounds)
+
+    def _moved(self) -> None:
+        """``self.moved``: the bodies the solve moved since the geometry was last looked at (the
+        last round); only their contacts and candidates need looking at again."""
+        n = self.seen_x.size
+        self.moved = (self.dx[:n] != self.seen_x) | (self.dy[:n] != self.seen_y)
+        self.seen_x, self.seen_y = self.dx.copy(), self.dy.copy()
 
     def _clear_of_statics(self, rounds: int) -> None:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
@@ -187,6 +196,7 @@ class Solve:
                 return
             self.dirty[order] = True
             self._solve(order, tolerance=0.0)
+            self._moved()
             overlapping = self._measure_immovable()
             grew = self._new_dynamic_contacts(immovable_only=True)
             grew = self._late_contacts() or grew
@@ -240,7 +250,7 @@ class Solve:
         """Measure the pushed contacts with immovable bodies again; their depths (relative to where
         the solve began) follow the geometry. Whether one still overlaps."""
         cs = self.cs
-        moved = (self.dx != 0.0) | (self.dy != 0.0)
+        moved = self.moved
         check = np.flatnonzero(self.immovable & (moved[self.a] | moved[self.b]))
         if check.size == 0:
             return False
@@ -302,7 +312,7 @@ class Solve:
         if ra.size == 0:
             return False
         # each candidate body's number, or -1 (the extra last slot: never moved) if it is not in the solve
-        moved = np.append((self.dx != 0.0) | (self.dy != 0.0), False)
+        moved = np.append(self.moved, False)
         near = moved[self.table[ra]] | moved[self.table[rb]]
         if immovable_only:
             store = self.store
@@ -366,6 +376,8 @@ class Solve:
                             cat([cs.impulse0, zeros]))
         self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
         self.looked_x, self.looked_y = cat([self.looked_x, np.zeros(k)]), cat([self.looked_y, np.zeros(k)])
+        self.seen_x, self.seen_y = cat([self.seen_x, np.zeros(k)]), cat([self.seen_y, np.zeros(k)])
+        self.moved = cat([self.moved, np.zeros(k, dtype=bool)])
         self.near_static = cat([self.near_static, np.ones(k, dtype=bool)])  # (new bodies: looked at)
         self.local = cat([self.a, new_a, self.b, new_b])
         self.push = cat([self.push, zeros])
