@@ -38,6 +38,28 @@ __all__ = ["SpatialHash", "brute_force_pairs"]
 _I64 = np.int64
 _EMPTY_I = np.zeros(0, dtype=_I64)
 _EMPTY_BOUNDS = (np.zeros(0),) * 4
+# At most this many moving bodies are paired directly, every two of them (see SpatialHash.pairs).
+SMALL = 48
+
+
+class _FewBodies:
+    """The moving bodies of a :meth:`SpatialHash.pairs` call that paired them directly: what the
+    queries read of them (their bounds; none is large)."""
+
+    def __init__(self, bounds: tuple) -> None:
+        self.bounds = bounds
+        self.n = bounds[0].shape[0]
+        self.large = _EMPTY_I
+
+
+_UPPER: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _upper_pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(i, j)``, every ``i < j < n`` (cached per ``n``)."""
+    if n not in _UPPER:
+        _UPPER[n] = tuple(v.astype(_I64) for v in np.triu_indices(n, 1))
+    return _UPPER[n]
 
 
 def brute_force_pairs(minx, miny, maxx, maxy, static=None) -> tuple[np.ndarray, np.ndarray]:
@@ -150,6 +172,8 @@ class SpatialHash:
         """
         b = as_bounds(minx, miny, maxx, maxy)
         ids = _as_ids(ids, b[0].shape[0])
+        if b[0].shape[0] <= SMALL:
+            return self._small_pairs(b, ids, moving_pairs)
         mov = self._moving = StripSweep(b, self._choose_cell(b))
         self._moving_cells = None
         self._queries = 0
@@ -173,6 +197,32 @@ class SpatialHash:
                 out_a.append(ids[i[keep]])
                 out_b.append(ids[j[keep]])
         self._cross_static(mov, b, ids, out_a, out_b)
+        if not out_a:
+            return _EMPTY_I, _EMPTY_I
+        return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
+
+    def _small_pairs(self, b: tuple, ids: np.ndarray, moving_pairs: bool) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`pairs` for a few moving bodies (at most ``SMALL``): every two of them tested
+        directly (cheaper than sorting them into strips), the statics through the bodies near one.
+        The same pairs as the strips give."""
+        n = b[0].shape[0]
+        self._choose_cell(b)
+        self._moving = _FewBodies(tuple(v.copy() for v in b))
+        self._moving_cells = None
+        self._queries = 0
+        self._moving_ids = ids = ids.copy()
+        self.rehashed_last = n
+        out_a, out_b = [], []
+        if moving_pairs and n > 1:
+            i, j = _upper_pairs(n)
+            ok = strict_overlap(*(v[i] for v in b), *(v[j] for v in b))
+            out_a.append(ids[i[ok]])
+            out_b.append(ids[j[ok]])
+        if self._static.n and n:
+            near = np.flatnonzero(self._near_statics(b))
+            if near.size:
+                nb = subset(b, near)
+                self._cross_static(StripSweep(nb, self._choose_cell(nb)), nb, ids[near], out_a, out_b)
         if not out_a:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
