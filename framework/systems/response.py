@@ -184,21 +184,25 @@ class Response(Stage):
         self.redirect(ra, rb, r.nx, r.ny, r.depth, r.hit)
         return r
 
-    def near_statics(self, rows: np.ndarray, margin: np.ndarray) -> np.ndarray:
-        """Mask of ``rows`` that may come within ``margin`` (per row) of a static body: their
-        bounding circles, grown by it, share a cell with one (a cheap superset test)."""
+    def static_candidates(self, rows: np.ndarray, margin: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Pairs of the bodies ``rows`` with the static bodies their bounds, grown by ``margin`` (per
+        row), meet where they stand, other than the pairs whose keys are in ``known`` (sorted):
+        ``(rows a, rows b, entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the
+        margin can bring a body only to these statics."""
         bodies = self.bodies
-        store, hsh = bodies.store, bodies.hash
+        store, hsh, geom = bodies.store, bodies.hash, bodies.geometry
+        empty = np.zeros(0, dtype=np.int64)
+        rows = rows[np.isfinite(margin)]
+        margin = margin[np.isfinite(margin)]
         if rows.size == 0 or bodies.n_static == 0:
-            return np.zeros(rows.size, dtype=bool)
-        off = np.hypot(store.ox[rows], store.oy[rows]) if bodies.geometry.has_offset else 0.0
-        reach = store.bound[rows] + off + np.where(np.isfinite(margin), margin, 0.0)
-        x, y = store.x[rows], store.y[rows]
-        box = (np.nextafter(x - reach, -np.inf), np.nextafter(y - reach, -np.inf),
-               np.nextafter(x + reach, np.inf), np.nextafter(y + reach, np.inf))
+            return empty, empty, empty, empty
+        box = (geom.minx[rows] - margin, geom.miny[rows] - margin, geom.maxx[rows] + margin, geom.maxy[rows] + margin)
         if hsh.outside_statics(*(f(v) for f, v in zip((np.min, np.min, np.max, np.max), box))):
-            return np.zeros(rows.size, dtype=bool)
-        return hsh.near_statics(*box)
+            return empty, empty, empty, empty
+        ea, eb = hsh.static_pairs(*box, store.entity[rows])
+        keep = ~sorted_member(pair_keys(ea, eb), known)
+        ea, eb = ea[keep], eb[keep]
+        return self.solid_pairs(bodies.rows_of(ea), bodies.rows_of(eb), ea, eb)
 
     def new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
         """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs whose

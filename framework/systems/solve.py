@@ -163,8 +163,10 @@ class Solve:
         share_a, share_b = self.position_shares
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
         self.looked_x, self.looked_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _far_candidates)
+        # Candidates: the broad phase's pairs that were not contacts, and the statics within reach.
         self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
-        self.near_static = self.stage.near_statics(self.rows, self.reach)
+        self._static_candidates(np.arange(self.rows.size))
+        self.static_x, self.static_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _late_contacts)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
         self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _moved)
         for _round in range(rounds):
@@ -269,6 +271,18 @@ class Solve:
     def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
         self.candidates = candidates
 
+    def _static_candidates(self, bodies: np.ndarray) -> None:
+        """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
+        store, rows = self.store, self.rows[bodies]
+        movable = ~(store.asleep[rows] | (store.inv_mass[rows] == 0.0))
+        if not movable.any() or self.stage.bodies.n_static == 0:
+            return
+        ca, cb = self.candidates[2], self.candidates[3]
+        known = np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
+        near = self.stage.static_candidates(rows[movable], self.reach[bodies[movable]], known)
+        if near[0].size:
+            self._set_candidates(tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, near)))
+
     def _far_candidates(self) -> bool:
         """Pushes that moved a body farther than its span (a quarter of its half-thickness) since it
         was last looked at (a heap spawned on one spot) may bring it to bodies the broad phase did
@@ -335,19 +349,19 @@ class Solve:
         """Add the contacts with statics that bodies pushed by dynamic bodies were shoved into (they
         were not touching them when the step's contacts were found). Whether there were any.
 
-        Only bodies that were within their reach of a static when the solve began (most of a pile
-        is not), or that have been pushed farther than that (a crowd spawned in a heap), are looked
-        up in the static hash."""
+        The statics within a body's reach of where it stood when the solve began are candidates
+        already (:meth:`_new_dynamic_contacts`); the static hash is asked again only about bodies
+        pushed farther than their reach since it was last asked (a crowd spawned in a heap)."""
         cs = self.cs
         if self.stage.bodies.n_static == 0:
             return False
         both = ~self.immovable & (self.push > 0.0)
         pushed = np.zeros(self.rows.size, dtype=bool)
         pushed[self.a[both]] = pushed[self.b[both]] = True
-        # near a static when the solve began, or pushed farther than the reach that was looked at
-        pushed &= self.near_static | (np.hypot(self.dx, self.dy) > self.reach)
+        pushed &= np.hypot(self.dx - self.static_x, self.dy - self.static_y) > self.reach
         if not pushed.any():
             return False
+        self.static_x[pushed], self.static_y[pushed] = self.dx[pushed], self.dy[pushed]
         extra = self.stage.new_static_contacts(self.rows[pushed], np.sort(pair_keys(cs.ea, cs.eb)))
         if extra is None:
             return False
@@ -378,11 +392,12 @@ class Solve:
         self.looked_x, self.looked_y = cat([self.looked_x, np.zeros(k)]), cat([self.looked_y, np.zeros(k)])
         self.seen_x, self.seen_y = cat([self.seen_x, np.zeros(k)]), cat([self.seen_y, np.zeros(k)])
         self.moved = cat([self.moved, np.zeros(k, dtype=bool)])
-        self.near_static = cat([self.near_static, np.ones(k, dtype=bool)])  # (new bodies: looked at)
+        self.static_x, self.static_y = cat([self.static_x, np.zeros(k)]), cat([self.static_y, np.zeros(k)])
         self.local = cat([self.a, new_a, self.b, new_b])
         self.push = cat([self.push, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
         self._columns()
+        self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
 
