@@ -19,6 +19,7 @@ import numpy as np
 from ..collision import batch
 from ..events import pair_keys, sorted_member
 from ..frame import NO_RESOLVED, NO_SUPPORT, StepFrame
+from ..store import STATIC
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Solve
@@ -36,6 +37,7 @@ class Response(Stage):
     def __init__(self, pipeline) -> None:
         super().__init__(pipeline)
         self.internal_faces = InternalFaces()
+        self._near: _NearStatics | None = None
 
     def run(self, frame: StepFrame) -> bool:
         store = self.bodies.store
@@ -188,21 +190,33 @@ class Response(Stage):
         """Pairs of the bodies ``rows`` with the static bodies their bounds, grown by ``margin`` (per
         row), meet where they stand, other than the pairs whose keys are in ``known`` (sorted):
         ``(rows a, rows b, entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the
-        margin can bring a body only to these statics."""
+        margin can bring a body only to these statics.
+
+        Kept from step to step: a body's statics are looked up (with twice the margin) again only
+        once it has moved more than the margin since, or the statics changed; a resting pile asks
+        the static hash nothing."""
         bodies = self.bodies
-        store, hsh, geom = bodies.store, bodies.hash, bodies.geometry
+        store = bodies.store
         empty = np.zeros(0, dtype=np.int64)
-        rows = rows[np.isfinite(margin)]
-        margin = margin[np.isfinite(margin)]
+        ok = np.isfinite(margin)
+        rows, margin = rows[ok], margin[ok]
         if rows.size == 0 or bodies.n_static == 0:
             return empty, empty, empty, empty
-        box = (geom.minx[rows] - margin, geom.miny[rows] - margin, geom.maxx[rows] + margin, geom.maxy[rows] + margin)
-        if hsh.outside_statics(*(f(v) for f, v in zip((np.min, np.min, np.max, np.max), box))):
-            return empty, empty, empty, empty
-        ea, eb = hsh.static_pairs(*box, store.entity[rows])
+        cache = self._static_cache()
+        far = ~(np.abs(store.x[rows] - cache.x[rows]) + np.abs(store.y[rows] - cache.y[rows]) <= margin)
+        if far.any():
+            cache.refresh(bodies, rows[far], 2.0 * margin[far])
+        ea, eb = cache.pairs_of(store.n, rows)
         keep = ~sorted_member(pair_keys(ea, eb), known)
         ea, eb = ea[keep], eb[keep]
         return self.solid_pairs(bodies.rows_of(ea), bodies.rows_of(eb), ea, eb)
+
+    def _static_cache(self) -> _NearStatics:
+        store = self.bodies.store
+        key = (store.version, store.static_epoch, store.n)
+        if self._near is None or self._near.key != key:
+            self._near = _NearStatics(key, store.n)
+        return self._near
 
     def new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
         """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs whose
@@ -243,3 +257,38 @@ class Response(Stage):
             return None
         h = np.flatnonzero(r.hit)
         return ea[h], eb[h], ra[h], rb[h], batch.ContactArrays(*(v[h] for v in r))
+
+
+class _NearStatics:
+    """Per dynamic row, the static bodies near it (entity pairs), and where it stood when they were
+    looked up; valid until rows or statics change (``key``)."""
+
+    def __init__(self, key: tuple[int, ...], n: int) -> None:
+        self.key = key
+        self.x, self.y = np.full(n, np.nan), np.full(n, np.nan)
+        self.row = np.zeros(0, dtype=np.int64)  # per pair: the dynamic body's row
+        self.ea = self.eb = np.zeros(0, dtype=np.int64)
+
+    def refresh(self, bodies, rows: np.ndarray, margin: np.ndarray) -> None:
+        """Look up the statics within ``margin`` of ``rows`` again."""
+        store, geom, hsh = bodies.store, bodies.geometry, bodies.hash
+        stale = np.zeros(store.n, dtype=bool)
+        stale[rows] = True
+        keep = ~stale[self.row]
+        self.row, self.ea, self.eb = self.row[keep], self.ea[keep], self.eb[keep]
+        self.x[rows], self.y[rows] = store.x[rows], store.y[rows]
+        box = (geom.minx[rows] - margin, geom.miny[rows] - margin, geom.maxx[rows] + margin, geom.maxy[rows] + margin)
+        if hsh.outside_statics(*(f(v) for f, v in zip((np.min, np.min, np.max, np.max), box))):
+            return
+        ea, eb = hsh.static_pairs(*box, store.entity[rows])
+        if ea.size:
+            dyn = np.where(store.body[bodies.rows_of(ea)] == STATIC, eb, ea)
+            self.row = np.concatenate([self.row, bodies.rows_of(dyn)])
+            self.ea, self.eb = np.concatenate([self.ea, ea]), np.concatenate([self.eb, eb])
+
+    def pairs_of(self, n: int, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The kept pairs of ``rows``."""
+        want = np.zeros(n, dtype=bool)
+        want[rows] = True
+        sel = want[self.row]
+        return self.ea[sel], self.eb[sel]
