@@ -145,8 +145,8 @@ def test_perf_pipeline_pairs_equal_brute_force():
     out = perf.check_pairs(wl)
     # About one pair per box at the start; the response then pushes them apart (the contact solver
     # leaves fewer overlapping after each step than the old push-out passes did, so the later steps
-    # have fewer pairs to check, but still dozens).
-    assert out["ok"] and out["pairs"][0] > 250 and min(out["pairs"]) > 50
+    # have fewer pairs to check, but still some: boxes keep running into each other).
+    assert out["ok"] and out["pairs"][0] > 250 and min(out["pairs"]) > 20
     tiled = perf.check_pairs(perf.with_tiles(wl, count=600, overlapping=True))
     assert tiled["ok"] and tiled["pairs"][0] > out["pairs"][0]  # the moving-static pairs are found too
 

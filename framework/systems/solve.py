@@ -206,8 +206,12 @@ class Solve:
                 return
 
     def _warm_pushes(self, push0: np.ndarray) -> np.ndarray:
-        """Last step's pushes as this step's first guess, scaled down where they would move a body
-        farther than its reach (see :meth:`_solve`) before the solver has looked at anything."""
+        """Last step's pushes as this step's first guess: none longer than its bodies' half-thickness
+        (a body wedged between others that keep still may ask for more than any push can give, and
+        its pushes must not grow from step to step: the 200-body soak shot a triangle 10 units
+        through a wall that way), and scaled down where together they would move a body farther
+        than its reach (see :meth:`_solve`) before the solver has looked at anything."""
+        push0 = np.minimum(push0, self._push_cap())
         if np.isfinite(self.reach).all() and push0.any():
             share_a, share_b = self.position_shares
             cs = self.cs
@@ -216,6 +220,11 @@ class Solve:
             scale = np.minimum(1.0, self.reach / np.maximum(far, 1e-300))
             return push0 * np.minimum(scale[self.a], scale[self.b])
         return push0.copy()
+
+    def _push_cap(self) -> np.ndarray:
+        """Per contact, the longest push worth remembering: the smaller half-thickness of its two
+        bodies (a push that long in one step is a body being pushed out of a heap, not resting)."""
+        return 2.0 * np.minimum(self.span[self.a], self.span[self.b])
 
     def _solve(self, order: np.ndarray, tolerance: float | None = None) -> bool:
         """One run of the position solver over the contacts ``order``; the bodies are then placed.
@@ -518,7 +527,8 @@ class Solve:
         ea, eb, nx, ny = cs.ea[acted], cs.eb[acted], cs.nx[acted], cs.ny[acted]
         frame.resolved = (ea, eb, nx, ny, self.push[acted])
         gap = np.maximum(self._separations()[acted], 0.0)
-        frame.support = (ea, eb, nx, ny, self.push[acted], self.impulse[acted], gap)
+        push = np.minimum(self.push, self._push_cap())[acted]  # (see _warm_pushes)
+        frame.support = (ea, eb, nx, ny, push, self.impulse[acted], gap)
         frame.counters["resolved"] = int(acted.size)
 
 
