@@ -2,7 +2,8 @@
 
 The compiled loops are checked on problems with exact answers (dyadic values), the whole response
 on scenes a game builds: crowds of every shape mix dropped into a pit come to rest within 30 s
-of game time with no overlap deeper than 0.02 and nobody outside; piles of boxes rest at their
+of game time with no overlap deeper than 0.02 and nobody outside (the frictionless mix of balls
+and boxes does not yet: a strict xfail until friction, issue 23); piles of boxes rest at their
 exact height; a tall pile of balls pushes none of them through its walls.
 """
 
@@ -133,13 +134,20 @@ def deepest_overlap(s: Scene, ents: list[int]) -> float:
     return worst
 
 
-@pytest.mark.parametrize(("kind", "seconds"), [("balls", 30), ("boxes", 30), ("mixed", 60)])
+MIXED_NOT_YET = pytest.mark.xfail(
+    strict=True, reason="issue 19's goal not met yet: without friction this crowd rests after 33 s (13-39 s over "
+    "five seeds); friction (issue 23) is what should stop it within 30 s")
+
+
+@pytest.mark.parametrize(("kind", "seconds"), [
+    ("balls", 30), ("boxes", 30), pytest.param("mixed", 30, marks=MIXED_NOT_YET), ("mixed", 60)])
 def test_a_crowd_dropped_into_a_pit_comes_to_rest(kind, seconds):
-    """Balls alone and boxes alone rest within the issue's 30 s (balls: 9 to 15 s over five seeds,
-    boxes: under 2 s). Half and half, without friction, a box that lands on a flat top with some
-    sideways speed slides on until it meets a wall: the crowd rests after 13 to 39 s depending on
-    the seed (measured 2026-11-25), so here within 60 s; friction (issue 23) is what will stop it
-    sooner. No overlap deeper than 0.02 and nobody outside, for all three."""
+    """The issue's goal: a crowd rests within 30 s, with no overlap deeper than 0.02 and nobody
+    outside. Balls alone (9 to 15 s over five seeds) and boxes alone (under 2 s) meet it. Half and
+    half, without friction, a box that lands on a flat top with some sideways speed slides on until
+    it meets a wall: that crowd rests after 13 to 39 s depending on the seed (measured 2026-11-25).
+    Its 30 s case is a strict xfail until friction (issue 23) meets the goal; the 60 s case guards
+    what holds today."""
     s, ents = crowd(kind)
     with s:
         for _ in range(60 * seconds):
