@@ -77,11 +77,11 @@ class Bodies:
             self.hash.set_cell_size(max(sizes))
             self.sleep_hash.set_cell_size(max(sizes))
 
-    def static_rows_in_box(self, minx: float, miny: float, maxx: float, maxy: float) -> list[int]:
+    def static_rows_in_box(self, minx: float, miny: float, maxx: float, maxy: float) -> np.ndarray:
         """Rows of the static bodies whose hashed cells meet the box (candidates, not overlaps)."""
         rows = self.rows_of(self.hash.query_box(minx, miny, maxx, maxy))
         rows = rows[rows >= 0]
-        return rows[self.store.body[rows] == STATIC].tolist()
+        return rows[self.store.body[rows] == STATIC]
 
     def wake_near(self, row: int) -> None:
         """Wake the sleepers whose bounds come within a tenth of ``row``'s size of it (whatever slept

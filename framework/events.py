@@ -68,7 +68,13 @@ class StepContacts(NamedTuple):
 
 
 def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """One int64 per pair of entity ids (each below 2**32), ordered as ``(a, b)`` is."""
     return (a.astype(np.int64) << 32) | b.astype(np.int64)
+
+
+def pair_parts(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The ``(a, b)`` of :func:`pair_keys`."""
+    return keys >> 32, keys & 0xFFFFFFFF
 
 
 def sorted_member(keys: np.ndarray, table: np.ndarray) -> np.ndarray:

@@ -50,9 +50,7 @@ class SpatialQueries:
         geom = bodies.ensure_geometry()
         self.pipeline.frame.counters["rehashed"] = (self.pipeline.frame.counters.get("rehashed", 0)
                                                     + bodies.sync_static())
-        st = bodies.rows_of(bodies.hash.query_box(minx, miny, maxx, maxy))
-        st = st[(st >= 0)]
-        st = st[store.body[st] == STATIC]
+        st = bodies.static_rows_in_box(minx, miny, maxx, maxy)
         mv = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
         hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)
         return np.concatenate([st, mv[hit]])

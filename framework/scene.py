@@ -42,9 +42,10 @@ _scene_ids = itertools.count(1)
 System = Callable[["Scene", float], Any]
 
 
-def _iterations(value: Any) -> int:
+def _count(name: str, value: Any) -> int:
+    """``value`` if it is an int >= 1 (not a bool), else ``ValueError`` naming ``name``."""
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise InvalidValue(f"Scene response_iterations must be an int >= 1, got {value!r}")
+        raise InvalidValue(f"Scene {name} must be an int >= 1, got {value!r}")
     return value
 
 
@@ -79,10 +80,8 @@ class Scene:
         gravity = vector2("Scene gravity", gravity)
         if cell_size is not None:
             cell_size = positive("Scene cell_size", cell_size)
-        iterations = _iterations(response_iterations)
-        if isinstance(substeps, bool) or not isinstance(substeps, int) or substeps < 1:
-            raise InvalidValue(f"Scene substeps must be an int >= 1, got {substeps!r}")
-        self.substeps = substeps
+        iterations = _count("response_iterations", response_iterations)
+        self.substeps = _count("substeps", substeps)
         self.world = f"framework.scene.{next(_scene_ids)}"
         self.bodies = Bodies(cell_size)
         self.handlers = CollisionHandlers(self.bodies.rows_of)
@@ -128,7 +127,7 @@ class Scene:
 
     @response_iterations.setter
     def response_iterations(self, value: int) -> None:
-        self._pipeline.response_iterations = _iterations(value)
+        self._pipeline.response_iterations = _count("response_iterations", value)
 
     @property
     def step_frame(self) -> StepFrame:

@@ -170,6 +170,10 @@ class BodyStore:
         out[ok] = self._lookup[entities[ok]]
         return out
 
+    def movable(self, rows: np.ndarray) -> np.ndarray:
+        """Mask of ``rows`` the response may move: a finite mass (``inv_mass > 0``), and awake."""
+        return (self.inv_mass[rows] > 0.0) & ~self.asleep[rows]
+
     # --- moves: the only ways the pipeline changes positions -----------------------------------
     # Each bumps ``motion``, so whatever is derived from positions (hitbox bounds) knows it is stale
     # without the mover having to say so.

@@ -30,7 +30,7 @@ from .batch_common import (
     pick,
     take,
 )
-from .exact import BAND, TINY, Offset, circle_circle_exact, float_rounded, polygon_circle_exact
+from .exact import BAND, TINY, Offset, circle_circle_exact, float_rounded, polygon_circle_exact, vertex_contact
 from .tiebreak import pick as pick_one
 
 __all__ = ["circle_circle", "polygon_circle"]
@@ -183,12 +183,7 @@ def _polygon_circle_exact(
         nx, ny = fey / ln, -fex / ln
         dist = fs / ln
         return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
-    j = found.index
-    ddx, ddy = float_rounded(found.dx, e), float_rounded(found.dy, e)
-    dist = math.hypot(ddx, ddy)
-    depth = max(float_rounded(found.num, 2 * e) / (r + dist), TINY)
-    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
-    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
+    return vertex_contact(found, poly, r, f, float_rounded)
 
 
 def polygon_circle(ax, ay, averts, acount, bx, by, br, flip=False, size=None, exact: bool = True) -> ContactArrays:

@@ -172,57 +172,42 @@ class SpatialHash:
         """
         b = as_bounds(minx, miny, maxx, maxy)
         ids = _as_ids(ids, b[0].shape[0])
-        if b[0].shape[0] <= SMALL:
-            return self._small_pairs(b, ids, moving_pairs)
-        mov = self._moving = StripSweep(b, self._choose_cell(b))
-        self._moving_cells = None
-        self._queries = 0
-        self._moving_ids = ids = ids.copy()
-        self.rehashed_last = mov.n
-
-        out_a, out_b = [], []
-        if moving_pairs:
-            if mov.entries:
-                a, c = mov.self_pairs()
-                out_a.append(ids[a])
-                out_b.append(ids[c])
-            if mov.large.shape[0]:
-                # large movers against every mover (each large-large pair once)
-                lg = mov.large
-                i, j = overlap_pairs(subset(b, lg), b)
-                i = lg[i]
-                is_large = np.zeros(mov.n, dtype=bool)
-                is_large[lg] = True
-                keep = ~is_large[j] | (i < j)
-                out_a.append(ids[i[keep]])
-                out_b.append(ids[j[keep]])
-        self._cross_static(mov, b, ids, out_a, out_b)
-        if not out_a:
-            return _EMPTY_I, _EMPTY_I
-        return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
-
-    def _small_pairs(self, b: tuple, ids: np.ndarray, moving_pairs: bool) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`pairs` for a few moving bodies (at most ``SMALL``): every two of them tested
-        directly (cheaper than sorting them into strips), the statics through the bodies near one.
-        The same pairs as the strips give."""
         n = b[0].shape[0]
-        self._choose_cell(b)
-        self._moving = _FewBodies(tuple(v.copy() for v in b))
+        cell = self._choose_cell(b)
+        # Up to SMALL bodies are paired directly, every two of them (cheaper than sorting them into
+        # strips), the statics through the bodies near one: the same pairs as the strips give.
+        few = n <= SMALL
+        mov = self._moving = _FewBodies(tuple(v.copy() for v in b)) if few else StripSweep(b, cell)
         self._moving_cells = None
         self._queries = 0
         self._moving_ids = ids = ids.copy()
         self.rehashed_last = n
+
         out_a, out_b = [], []
-        if moving_pairs and n > 1:
-            i, j = _upper_pairs(n)
-            ok = strict_overlap(*(v[i] for v in b), *(v[j] for v in b))
-            out_a.append(ids[i[ok]])
-            out_b.append(ids[j[ok]])
-        if self._static.n and n:
-            near = np.flatnonzero(self._near_statics(b))
-            if near.size:
-                nb = subset(b, near)
-                self._cross_static(StripSweep(nb, self._choose_cell(nb)), nb, ids[near], out_a, out_b)
+        if few:
+            if moving_pairs and n > 1:
+                i, j = _upper_pairs(n)
+                ok = strict_overlap(*(v[i] for v in b), *(v[j] for v in b))
+                out_a.append(ids[i[ok]])
+                out_b.append(ids[j[ok]])
+            self._near_static_pairs(b, ids, out_a, out_b)
+        else:
+            if moving_pairs:
+                if mov.entries:
+                    a, c = mov.self_pairs()
+                    out_a.append(ids[a])
+                    out_b.append(ids[c])
+                if mov.large.shape[0]:
+                    # large movers against every mover (each large-large pair once)
+                    lg = mov.large
+                    i, j = overlap_pairs(subset(b, lg), b)
+                    i = lg[i]
+                    is_large = np.zeros(mov.n, dtype=bool)
+                    is_large[lg] = True
+                    keep = ~is_large[j] | (i < j)
+                    out_a.append(ids[i[keep]])
+                    out_b.append(ids[j[keep]])
+            self._cross_static(mov, b, ids, out_a, out_b)
         if not out_a:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
@@ -234,14 +219,20 @@ class SpatialHash:
         ids = _as_ids(ids, b[0].shape[0])
         out_a: list[np.ndarray] = []
         out_b: list[np.ndarray] = []
-        if b[0].shape[0] and self._static.bounds[0].shape[0]:
-            near = np.flatnonzero(self._near_statics(b))
-            if near.size:
-                b, ids = subset(b, near), ids[near]
-                self._cross_static(StripSweep(b, self._choose_cell(b)), b, ids, out_a, out_b)
+        self._near_static_pairs(b, ids, out_a, out_b)
         if not out_a:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
+
+    def _near_static_pairs(self, b: tuple, ids: np.ndarray, out_a: list, out_b: list) -> None:
+        """Append the pairs of the bodies ``b`` (ids ``ids``) with the statics: only the bodies near
+        a static are swept against them."""
+        if b[0].shape[0] == 0 or self._static.n == 0:
+            return
+        near = np.flatnonzero(self._near_statics(b))
+        if near.size:
+            nb = subset(b, near)
+            self._cross_static(StripSweep(nb, self._choose_cell(nb)), nb, ids[near], out_a, out_b)
 
     def outside_statics(self, minx: float, miny: float, maxx: float, maxy: float) -> bool:
         """Whether the box surely meets no static body: it lies outside the box around every static

@@ -39,6 +39,7 @@ from .exact import (
     polygon_circle_exact,
     polygon_polygon_exact,
     ratio_approx,
+    vertex_contact,
 )
 from .kinds import CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
 from .placement import check_shape, local_outline, pose
@@ -256,12 +257,7 @@ def _polygon_circle_exact(
         depth = max(ratio_approx(found.num, found.edge2, 2 * e) / (r + dist), TINY)
         nx, ny = fey / ln, -fex / ln
         return f * nx, f * ny, depth, cx - nx * dist, cy - ny * dist
-    j = found.index
-    ddx, ddy = float_approx(found.dx, e), float_approx(found.dy, e)
-    dist = math.hypot(ddx, ddy)
-    depth = max(float_approx(found.num, 2 * e) / (r + dist), TINY)
-    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
-    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
+    return vertex_contact(found, poly, r, f, float_approx)
 
 
 # --- polygon / polygon (AABBs are polygons here) ----------------------------------------------

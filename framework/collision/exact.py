@@ -19,12 +19,12 @@ normal and point of its own arithmetic: :mod:`~framework.collision.collide` with
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 __all__ = [
     "BAND", "TINY", "Offset", "PolygonCircleExact", "circle_circle_exact", "exact_ints", "float_approx",
-    "float_rounded", "polygon_circle_exact", "polygon_polygon_exact", "ratio_approx",
+    "float_rounded", "polygon_circle_exact", "polygon_polygon_exact", "ratio_approx", "vertex_contact",
 ]
 
 # Half-width of the band, relative to the magnitudes involved, inside which a float decision is not
@@ -127,6 +127,21 @@ def polygon_circle_exact(poly: Pts, offset: Offset, r: float) -> PolygonCircleEx
     dx, dy = ecx - pts[j][0], ecy - pts[j][1]
     num = er * er - dx**2 - dy**2
     return None if num <= 0 else PolygonCircleExact("vertex", j, seps, num, 0, dx, dy, e)
+
+
+def vertex_contact(found: PolygonCircleExact, poly: Pts, r: float, f: float,
+                   to_float: Callable[[int, int], float]) -> tuple[float, float, float, float, float]:
+    """The contact of a ``"vertex"`` overlap: ``(nx, ny, depth, px, py)``, the normal from the
+    vertex toward the circle's centre (``(0, f)`` if the centre is on it) times ``f`` (-1: the
+    circle is shape A), the depth ``r - |d|`` as ``(r^2 - |d|^2) / (r + |d|)``, the point the
+    vertex. ``to_float``: the caller's conversion of ``n * 2**e`` (:func:`float_rounded` for the
+    batch kernels, :func:`float_approx` for the scalar queries)."""
+    e, j = found.e, found.index
+    ddx, ddy = to_float(found.dx, e), to_float(found.dy, e)
+    dist = math.hypot(ddx, ddy)
+    depth = max(to_float(found.num, 2 * e) / (r + dist), TINY)
+    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)  # (0, f): up once turned round
+    return f * nx, f * ny, depth, poly[j][0], poly[j][1]
 
 
 def _extent(pts: list[tuple[int, int]], ux: int, uy: int) -> tuple[int, int]:

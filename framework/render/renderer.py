@@ -169,7 +169,7 @@ class Renderer:
         static = (store.kind >= 0) & (store.body == STATIC)
         if bodies.static_hash_current:
             r = float(reach[static].max()) if static.any() else 0.0
-            near = np.asarray(bodies.static_rows_in_box(x0 - r, y0 - r, x1 + r, y1 + r), dtype=np.int64)
+            near = bodies.static_rows_in_box(x0 - r, y0 - r, x1 + r, y1 + r)
             candidates = np.concatenate([near, np.flatnonzero(~static)])
         else:
             candidates = np.arange(store.n)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..events import pair_keys
+from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from .narrow_phase import filter_layers
 from .stage import Stage
@@ -46,7 +46,7 @@ class BroadPhase(Stage):
             if sa.size:
                 keys = np.concatenate([pair_keys(ea, eb), pair_keys(sa, sb)])
                 keys.sort()
-                ea, eb = keys >> 32, keys & 0xFFFFFFFF
+                ea, eb = pair_parts(keys)
         ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
         keep = filter_layers(store, ra, rb)
         if "events" not in self.pipeline.effects:

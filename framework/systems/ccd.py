@@ -73,7 +73,7 @@ def sweep_ccd_bodies(
         bmaxx = max(x0, x1) + dxs + ext_x
         bminy = min(y0, y1) + dys + low_y
         bmaxy = max(y0, y1) + dys + ext_y
-        cands = list(static_candidates(bminx, bminy, bmaxx, bmaxy))
+        cands = static_candidates(bminx, bminy, bmaxx, bmaxy).tolist()
         hitm = (
             (geom.minx[moving] < bmaxx) & (geom.maxx[moving] > bminx)
             & (geom.miny[moving] < bmaxy) & (geom.maxy[moving] > bminy)

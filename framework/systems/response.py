@@ -89,10 +89,7 @@ class Response(Stage):
         """Mask of the contacts the response acts on."""
         store = self.bodies.store
         ra, rb = cs.ra, cs.rb
-        inv, asleep = store.inv_mass, store.asleep  # sleeping bodies keep still
-        movable_a, movable_b = (inv[ra] > 0) & ~asleep[ra], (inv[rb] > 0) & ~asleep[rb]
-        solid = ~(store.sensor[ra] | store.sensor[rb]) & (movable_a | movable_b)
-        solid &= (store.kind[ra] >= 0) & (store.kind[rb] >= 0)  # a system may have removed a hitbox
+        solid = self._takes_part(ra, rb)
         # A body a system spoiled (NaN) is left alone, so the step reports it as written and the
         # bad value spreads to no other body.
         solid &= np.isfinite(store.vx[ra] + store.vy[ra] + store.vx[rb] + store.vy[rb])
@@ -153,13 +150,18 @@ class Response(Stage):
         """The pairs among ``(ra, rb, ea, eb)`` the response may act on: hitboxes whose layers
         meet, neither a sensor nor a one-way platform, at least one body movable."""
         store = self.bodies.store
-        inv, asleep = store.inv_mass, store.asleep
         ok = (ra >= 0) & (rb >= 0)
         ra, rb, ea, eb = ra[ok], rb[ok], ea[ok], eb[ok]
-        ok = (store.kind[ra] >= 0) & (store.kind[rb] >= 0) & ~(store.sensor[ra] | store.sensor[rb])
-        ok &= ~(store.one_way[ra] | store.one_way[rb]) & filter_layers(store, ra, rb)
-        ok &= ((inv[ra] > 0) & ~asleep[ra]) | ((inv[rb] > 0) & ~asleep[rb])
+        ok = self._takes_part(ra, rb) & ~(store.one_way[ra] | store.one_way[rb]) & filter_layers(store, ra, rb)
         return ra[ok], rb[ok], ea[ok], eb[ok]
+
+    def _takes_part(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+        """Mask of the pairs the response may act on by their bodies alone: both still have a
+        hitbox (a system may have removed one), neither is a sensor, and at least one is movable
+        (sleeping bodies keep still)."""
+        store = self.bodies.store
+        ok = (store.kind[ra] >= 0) & (store.kind[rb] >= 0) & ~(store.sensor[ra] | store.sensor[rb])
+        return ok & (store.movable(ra) | store.movable(rb))
 
     # --- geometry the solve asks for ---------------------------------------------------------
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..frame import StepFrame
+from ..store import DYNAMIC
 from .stage import Stage
 
 __all__ = ["SLEEP_SPEED", "SLEEP_STEPS", "Sleeping"]
@@ -35,7 +36,7 @@ class Sleeping(Stage):
         if n0 == 0:  # (nothing moved this step: the movement stage did not run)
             return False
         c = store.cols
-        rows = np.flatnonzero((store.body[:n0] == 0) & (store.kind[:n0] >= 0) & ~store.asleep[:n0])
+        rows = np.flatnonzero((store.body[:n0] == DYNAMIC) & (store.kind[:n0] >= 0) & ~store.asleep[:n0])
         if rows.size == 0:
             return True
         dt = frame.dt

@@ -28,8 +28,9 @@ import numpy as np
 from ..arrays import distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
-from ..events import pair_keys, sorted_member
+from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import StepFrame
+from ..store import KINEMATIC
 from . import solver_loops as solver
 
 __all__ = ["Contacts", "Solve", "bounce_speed"]
@@ -280,14 +281,18 @@ class Solve:
     def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
         self.candidates = candidates
 
+    def _known_keys(self) -> np.ndarray:
+        """The sorted pair keys of the solve's contacts and its candidates."""
+        ca, cb = self.candidates[2], self.candidates[3]
+        return np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
+
     def _static_candidates(self, bodies: np.ndarray) -> None:
         """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
         store, rows = self.store, self.rows[bodies]
-        movable = ~(store.asleep[rows] | (store.inv_mass[rows] == 0.0))
+        movable = store.movable(rows)
         if not movable.any() or self.stage.bodies.n_static == 0:
             return
-        ca, cb = self.candidates[2], self.candidates[3]
-        known = np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
+        known = self._known_keys()
         near = self.stage.static_candidates(rows[movable], self.reach[bodies[movable]], known)
         if near[0].size:
             self._set_candidates(tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, near)))
@@ -316,9 +321,8 @@ class Solve:
                                     store.entity[rows])  # (entity, base + i)
         eb = store.entity[far_rows[eb - base]]
         keys = distinct(pair_keys(np.minimum(ea, eb), np.maximum(ea, eb))[ea != eb])  # (far-far pairs come twice)
-        ea, eb = keys >> 32, keys & 0xFFFFFFFF
-        ca, cb = self.candidates[2], self.candidates[3]
-        known = np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
+        ea, eb = pair_parts(keys)
+        known = self._known_keys()
         keep = ~sorted_member(keys, known)
         if not keep.any():
             return False
@@ -339,7 +343,7 @@ class Solve:
         near = moved[self.table[ra]] | moved[self.table[rb]]
         if immovable_only:
             store = self.store
-            near &= ((store.inv_mass[ra] == 0.0) | store.asleep[ra]) | ((store.inv_mass[rb] == 0.0) | store.asleep[rb])
+            near &= ~(store.movable(ra) & store.movable(rb))
         look = np.flatnonzero(near)
         if look.size == 0:
             return False
@@ -430,7 +434,7 @@ class Solve:
         solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
                                 self.iterations, tol, np.ones(cs.size, dtype=bool))
         bounce = self._bounce_targets(u, act)
-        movable = ~((store.inv_mass[self.rows] == 0.0) | store.asleep[self.rows])
+        movable = store.movable(self.rows)
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, share_a, share_b, self.impulse,
@@ -468,7 +472,7 @@ class Solve:
         energy, as they should: then nothing is scaled."""
         store, cs = self.store, self.cs
         hit = bounce > 0.0
-        kinematic = (store.body[cs.ra[hit]] == 1) | (store.body[cs.rb[hit]] == 1)
+        kinematic = (store.body[cs.ra[hit]] == KINEMATIC) | (store.body[cs.rb[hit]] == KINEMATIC)
         if kinematic.any():
             return
         mass = np.where(movable, 1.0 / np.where(movable, store.inv_mass[self.rows], 1.0), 0.0)

@@ -26,7 +26,9 @@ more than ``tolerance``) in the pass before or in this one. An isolated pair cos
 settled pile warm started from the last step costs one pass; work follows what moves.
 
 One code path: these loops are the solver; numba compiles them on first use (``cache=True``: once
-per installation).
+per installation). The two solvers' loops are written out each in full: with the visit test and the
+per-body update as shared compiled functions (even inlined), both ran 2 to 3 times slower
+(numba 0.68, measured 2026-11-25).
 """
 
 from __future__ import annotations
