@@ -43,6 +43,9 @@ PASS_BUDGET = 8_000
 MAX_PASSES = 16
 # Passes stop once no push (impulse) changes by more than this much of the bodies' size (speed).
 TOLERANCE = 1e-9
+# Rounds at most of pushing bodies out of static ones after the solver's rounds ran out (each moves
+# a body at most its reach: a body sunk this many reaches deep is left partly inside).
+MAX_CLEAR_ROUNDS = 1024
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
@@ -192,8 +195,10 @@ class Solve:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
         the contacts with immovable bodies alone, while one still overlaps: each pushes its body
         exactly out, so no body ends the step inside static geometry; overlaps between dynamic
-        bodies are left to the next step."""
-        for _round in range(rounds):
+        bodies are left to the next step. A body moves at most its reach in a round, so there are
+        as many rounds as the deepest overlap needs at that pace (a small body that fell into
+        the floor faster than its size), and at least ``rounds``."""
+        for _round in range(max(rounds, self._rounds_to_clear())):
             order = self.order[self.immovable[self.order]]
             if not (self._separations()[order] < 0.0).any():
                 return
@@ -205,6 +210,17 @@ class Solve:
             grew = self._late_contacts() or grew
             if not (overlapping or grew):
                 return
+
+    def _rounds_to_clear(self) -> int:
+        """Rounds of :meth:`_clear_of_statics` that push every body out of the immovable ones at
+        its reach per round (one more for the geometry to confirm), at most ``MAX_CLEAR_ROUNDS``."""
+        imm = np.flatnonzero(self.immovable)
+        deep = -self._separations()[imm]
+        if imm.size == 0 or not (deep > 0.0).any():
+            return 0
+        mover = np.where(self.share_a[imm] > 0.0, self.a[imm], self.b[imm])
+        need = float(np.max(np.ceil(np.maximum(deep, 0.0) / self.reach[mover])))
+        return int(min(need + 1.0, MAX_CLEAR_ROUNDS))
 
     def _warm_pushes(self, push0: np.ndarray) -> np.ndarray:
         """Last step's pushes as this step's first guess: none longer than its bodies' half-thickness
