@@ -116,7 +116,7 @@ class Body(Enum):
 
 
 _HITBOX_FIELDS = (
-    "shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd", "one_way",
+    "shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd", "one_way", "friction",
 )
 _ALL_BITS = 0xFFFFFFFF
 
@@ -135,6 +135,10 @@ class Hitbox:
     - ``mass``: > 0, used to split push-outs and impulses between two dynamic bodies;
       ``math.inf`` makes a dynamic body immovable by contacts.
     - ``restitution``: 0 (slide) to 1 (elastic bounce); a pair uses the larger of the two.
+    - ``friction``: Coulomb coefficient (>= 0), or None (the default: no material of its own).
+      A pair where both hitboxes give one uses ``sqrt(f1 * f2)`` (Box2D's rule); where one does,
+      that one (a crate given 0.5 slides with 0.5 on a plain floor); where neither does, none.
+      Needs the ``"friction"`` effect (on by default); see docs/physics.md.
     - ``ccd``: continuous detection. The body is swept along its motion each step so it cannot
       pass through thin walls; bodies without it pay nothing for it.
     - ``one_way``: a platform that is solid only from above (its local +y, turning with its
@@ -157,11 +161,12 @@ class Hitbox:
         restitution: float = 0.0,
         ccd: bool = False,
         one_way: bool = False,
+        friction: float | None = None,
     ) -> None:
         object.__setattr__(self, "_store", None)
         object.__setattr__(self, "_entity", -1)
         for name, value in zip(
-            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd, one_way)
+            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd, one_way, friction)
         ):
             object.__setattr__(self, "_" + name, check_hitbox_field(name, value))
 
@@ -224,6 +229,13 @@ def check_hitbox_field(name: str, value: object) -> Any:
         if not 0.0 <= r <= 1.0:
             raise InvalidValue(f"Hitbox restitution must be in [0, 1], got {value!r}")
         return r
+    if name == "friction":
+        if value is None:
+            return None
+        f = finite("Hitbox friction", value)
+        if not f >= 0.0:
+            raise InvalidValue(f"Hitbox friction must be >= 0 (or None), got {value!r}")
+        return f
     raise AttributeError(name)
 
 

@@ -24,7 +24,7 @@ __all__ = ["NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counte
 _INTS = np.zeros(0, dtype=np.int64)
 _FLOATS = np.zeros(0)
 NO_RESOLVED = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS)
-NO_SUPPORT = (*NO_RESOLVED, _FLOATS, _FLOATS)
+NO_SUPPORT = (*NO_RESOLVED, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
 
 
 def new_counters() -> dict[str, Any]:
@@ -74,7 +74,8 @@ class StepFrame:
     started: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     ended: StepContacts = field(default_factory=StepContacts.empty)
     # response: the contacts applied (a, b, nx, ny, pushed) and the pairs acted on, kept for the next
-    # step with their push, impulse and the gap they ended with (a, b, nx, ny, push, impulse, gap)
+    # step with their push, impulse, the gap they ended with and their friction's tangential push
+    # and impulse (a, b, nx, ny, push, impulse, gap, tangent push, tangent impulse)
     resolved: tuple[np.ndarray, ...] = NO_RESOLVED
     support: tuple[np.ndarray, ...] = NO_SUPPORT
     # queries during the step: (origin, end, first hit or None), for the overlay

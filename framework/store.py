@@ -28,10 +28,12 @@ __all__ = ["BodyStore", "KIND_AABB", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE",
 
 BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
 DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
+NO_FRICTION = -1.0  # the friction column of a hitbox that gives no coefficient (Hitbox(friction=None))
 
 _FLOATS = (
     "x", "y", "rot", "vx", "vy", "w",  # transform and velocity (component views)
     "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
+    "friction",  # the hitbox's friction coefficient; NO_FRICTION where it gives none
 )
 _INTS = {
     "kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64,
@@ -169,6 +171,14 @@ class BodyStore:
         ok = entities < self._lookup.size
         out[ok] = self._lookup[entities[ok]]
         return out
+
+    def pair_friction(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+        """The friction coefficient of each pair ``(ra, rb)``: ``sqrt(f_a * f_b)`` where both
+        hitboxes give one, the one given where one does, 0 where neither does."""
+        fa, fb = self.friction[ra], self.friction[rb]
+        given_a, given_b = fa >= 0.0, fb >= 0.0
+        both = np.sqrt(np.maximum(fa, 0.0) * np.maximum(fb, 0.0))
+        return np.where(given_a & given_b, both, np.where(given_a, fa, np.where(given_b, fb, 0.0)))
 
     def movable(self, rows: np.ndarray) -> np.ndarray:
         """Mask of ``rows`` the response may move: a finite mass (``inv_mass > 0``), and awake."""
@@ -315,6 +325,7 @@ class BodyStore:
             c["layer"][row] = c["mask"][row] = 0
             for name in ("ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution"):
                 c[name][row] = 0.0
+            c["friction"][row] = NO_FRICTION
             return
         shape = hb._shape
         if isinstance(shape, AABB):
@@ -334,6 +345,7 @@ class BodyStore:
         c["body"][row] = BODY_CODES[hb._body]
         c["inv_mass"][row] = hb.inverse_mass
         c["restitution"][row] = hb._restitution
+        c["friction"][row] = NO_FRICTION if hb._friction is None else hb._friction
 
     # --- component views -------------------------------------------------------------------
 
@@ -426,7 +438,7 @@ class BodyStore:
         for e in changed:
             row = self.row_of[e]
             hb = self.hitboxes[row]
-            for name in ("offset", "layer", "mask", "body", "mass", "restitution"):
+            for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction"):
                 object.__setattr__(hb, "_" + name, check_hitbox_field(name, object.__getattribute__(hb, "_" + name)))
             self._set_hitbox_row(row, hb)
         self.dirty_hitboxes = set()

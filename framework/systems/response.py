@@ -63,13 +63,15 @@ class Response(Stage):
         there, with hitboxes whose layers meet)."""
         store, bodies = self.bodies.store, self.bodies
         c = frame.contacts
-        sa, sb, snx, sny, spush, simp, ssep = frame.support
+        sa, sb, snx, sny, spush, simp, ssep, stpush, stimp = frame.support
         now_keys, kept_keys = pair_keys(c.a, c.b), pair_keys(sa, sb)
         push0, impulse0 = np.zeros(c.a.size), np.zeros(c.a.size)
+        tpush0, timpulse0 = np.zeros(c.a.size), np.zeros(c.a.size)
         if kept_keys.size:  # the warm start of the pairs found again
             at = np.minimum(np.searchsorted(kept_keys, now_keys), kept_keys.size - 1)
             found = kept_keys[at] == now_keys
             push0[found], impulse0[found] = spush[at[found]], simp[at[found]]
+            tpush0[found], timpulse0[found] = stpush[at[found]], stimp[at[found]]
         old = np.flatnonzero(~sorted_member(kept_keys, now_keys))
         sra, srb = bodies.rows_of(sa[old]), bodies.rows_of(sb[old])
         live = (sra >= 0) & (srb >= 0)
@@ -83,7 +85,8 @@ class Response(Stage):
         return Contacts(
             cat([frame.contact_rows[0], sra]), cat([frame.contact_rows[1], srb]), cat([c.a, sa[old]]),
             cat([c.b, sb[old]]), cat([c.nx, snx[old]]), cat([c.ny, sny[old]]), cat([c.depth, gaps]),
-            np.arange(c.a.size + old.size) < c.a.size, cat([push0, spush[old]]), cat([impulse0, simp[old]]))
+            np.arange(c.a.size + old.size) < c.a.size, cat([push0, spush[old]]), cat([impulse0, simp[old]]),
+            cat([tpush0, stpush[old]]), cat([timpulse0, stimp[old]]))
 
     def _solid(self, frame: StepFrame, cs: Contacts) -> np.ndarray:
         """Mask of the contacts the response acts on."""

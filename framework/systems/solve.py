@@ -49,21 +49,23 @@ MAX_CLEAR_ROUNDS = 1024
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
+NO_FRICTION = np.zeros(0)  # the solver loops' friction columns in a solve without friction
 
 
 class Contacts:
     """The contacts of one solve, as columns: rows and entities of the two bodies, normal (a to b),
     depth (> 0 overlap, <= 0 a kept pair's gap), whether each overlaps now (``alive0``), and the
-    warm start (last step's push and impulse of the pair)."""
+    warm start (last step's push and impulse of the pair, and its friction's tangential push and
+    impulse)."""
 
-    def __init__(self, ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0) -> None:
+    def __init__(self, ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0) -> None:
         self.ra, self.rb, self.ea, self.eb = ra, rb, ea, eb
         self.nx, self.ny, self.depth, self.alive0 = nx, ny, depth, alive0
-        self.push0, self.impulse0 = push0, impulse0
+        self.push0, self.impulse0, self.tpush0, self.timpulse0 = push0, impulse0, tpush0, timpulse0
 
     def take(self, idx: np.ndarray) -> Contacts:
         return Contacts(*(v[idx] for v in (self.ra, self.rb, self.ea, self.eb, self.nx, self.ny, self.depth,
-                                            self.alive0, self.push0, self.impulse0)))
+                                            self.alive0, self.push0, self.impulse0, self.tpush0, self.timpulse0)))
 
     @property
     def size(self) -> int:
@@ -81,6 +83,7 @@ class Solve:
         its = stage.pipeline.response_iterations
         self.iterations = max(SOLVER_PASSES * its, min(MAX_PASSES * its, PASS_BUDGET * its // cs.size))
         self.dt = frame.dt
+        self.friction = "friction" in stage.pipeline.effects
         overlapping = cs.alive0.copy()
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
         dropped = overlapping & ~cs.alive0  # the covering tile's own contact holds the body
@@ -107,10 +110,17 @@ class Solve:
         wa = np.where(store.asleep[cs.ra], 0.0, store.inv_mass[cs.ra])  # a sleeper keeps still
         wb = np.where(store.asleep[cs.rb], 0.0, store.inv_mass[cs.rb])
         w = 1.0 / (wa + wb)
+        self.wa, self.wb = wa, wb
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
+        self.mu = NO_FRICTION
+        if self.friction:
+            mu = store.pair_friction(cs.ra, cs.rb)
+            if mu.any():
+                self.mu = mu
         self.order = self._order()
         self.position_shares = self._shock_shares()
+        self.position_mu = self._friction_limits(*self.position_shares)
 
     def _shock_shares(self) -> tuple[np.ndarray, np.ndarray]:
         """The shares of the position pushes (shock propagation). In a pair resting one on the other
@@ -166,6 +176,13 @@ class Solve:
         self.push = self._warm_pushes(cs.push0)
         share_a, share_b = self.position_shares
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
+        self.mx, self.my = self._step_motion(self.rows, self.x0, self.y0)
+        self.tpush = self._warm_tangent(cs.tpush0, self.push, self.position_mu)
+        if self.tpush.any():
+            tx, ty = solver.warm_start(self.a, self.b, -cs.ny, cs.nx, self.share_a, self.share_b, self.tpush,
+                                       self.rows.size)
+            self.dx += tx
+            self.dy += ty
         self.looked_x, self.looked_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _far_candidates)
         # Candidates: the broad phase's pairs that were not contacts, and the statics within reach.
         self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
@@ -238,6 +255,43 @@ class Solve:
             return push0 * np.minimum(scale[self.a], scale[self.b])
         return push0.copy()
 
+    def _friction_limits(self, share_a: np.ndarray, share_b: np.ndarray) -> np.ndarray:
+        """Per contact, the friction coefficient as the solver loops use it: the largest tangential
+        push (impulse) per unit of normal push, both in the loops' units (a unit moves the pair one
+        unit relative to each other). The tangential ones are shared by inverse mass, the normal
+        ones by ``share_a, share_b``; where a pair's lower body keeps still for the normal push
+        (shock propagation), a unit of it is the upper body's mass worth of impulse, not the
+        pair's, and the limit grows by the ratio (two equal boxes: twice)."""
+        mu = self.mu
+        if mu is NO_FRICTION:
+            return mu
+        wa, wb = self.wa, self.wb
+        lower_a = (share_a == 0.0) & (wa > 0.0)  # a keeps still although it could move
+        lower_b = (share_b == 0.0) & (wb > 0.0)
+        if not (lower_a.any() or lower_b.any()):
+            return mu
+        total = wa + wb
+        return mu * np.where(lower_a, total / np.where(lower_a, wb, 1.0),
+                             np.where(lower_b, total / np.where(lower_b, wa, 1.0), 1.0))
+
+    def _warm_tangent(self, value0: np.ndarray, limit: np.ndarray, mu: np.ndarray) -> np.ndarray:
+        """Last step's tangential pushes (impulses) of friction as this step's first guess, within
+        the friction limit ``mu`` of the normal ones ``limit`` (none without friction)."""
+        if mu is NO_FRICTION:
+            return np.zeros(self.cs.size)
+        bound = mu * limit
+        return np.clip(value0, -bound, bound)
+
+    def _step_motion(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """How far each of ``rows`` (now at ``x, y``) moved this step before the solve (rows
+        spawned during the step: not at all): the slip friction undoes."""
+        fx, fy = self.frame.start_x, self.frame.start_y
+        mx, my = np.zeros(rows.size), np.zeros(rows.size)
+        if self.mu is not NO_FRICTION and fx.size:
+            known = rows < fx.size
+            mx[known], my[known] = x[known] - fx[rows[known]], y[known] - fy[rows[known]]
+        return mx, my
+
     def _push_cap(self) -> np.ndarray:
         """Per contact, the longest push worth remembering: the smaller half-thickness of its two
         bodies (a push that long in one step is a body being pushed out of a heap, not resting)."""
@@ -256,7 +310,8 @@ class Solve:
         _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
                                                self.push, self.dx, self.dy, self.iterations,
                                                self.tolerance if tolerance is None else tolerance, self.dirty,
-                                               self.reach)
+                                               self.reach, self.position_mu, self.share_a, self.share_b, self.tpush,
+                                               self.mx, self.my)
         self._place()
         return bool(held)
 
@@ -416,7 +471,7 @@ class Solve:
         self.cs = Contacts(cat([cs.ra, ra]), cat([cs.rb, rb]), cat([cs.ea, ea]), cat([cs.eb, eb]),
                             cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
                             cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
-                            cat([cs.impulse0, zeros]))
+                            cat([cs.impulse0, zeros]), cat([cs.tpush0, zeros]), cat([cs.timpulse0, zeros]))
         self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
         self.looked_x, self.looked_y = cat([self.looked_x, np.zeros(k)]), cat([self.looked_y, np.zeros(k)])
         self.seen_x, self.seen_y = cat([self.seen_x, np.zeros(k)]), cat([self.seen_y, np.zeros(k)])
@@ -424,8 +479,10 @@ class Solve:
         self.static_x, self.static_y = cat([self.static_x, np.zeros(k)]), cat([self.static_y, np.zeros(k)])
         self.local = cat([self.a, new_a, self.b, new_b])
         self.push = cat([self.push, zeros])
+        self.tpush = cat([self.tpush, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
         self._columns()
+        self.mx, self.my = self._step_motion(rows, x0, y0)  # (friction may have come with the new contacts)
         self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
@@ -444,17 +501,25 @@ class Solve:
         wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, self.rows.size)
         vx += wx
         vy += wy
+        velocity_mu = self._friction_limits(share_a, share_b)
+        self.timpulse = self._warm_tangent(cs.timpulse0, self.impulse, velocity_mu)
+        if self.timpulse.any():
+            wx, wy = solver.warm_start(a, b, -cs.ny, cs.nx, self.share_a, self.share_b, self.timpulse, self.rows.size)
+            vx += wx
+            vy += wy
         target = np.zeros(cs.size)
         gx, gy = self.gravity
         tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
         solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
-                                self.iterations, tol, np.ones(cs.size, dtype=bool))
+                                self.iterations, tol, np.ones(cs.size, dtype=bool), velocity_mu, self.share_a,
+                                self.share_b, self.timpulse)
         bounce = self._bounce_targets(u, act)
         movable = store.movable(self.rows)
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, share_a, share_b, self.impulse,
-                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool))
+                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool), velocity_mu,
+                                    self.share_a, self.share_b, self.timpulse)
             if not self.solo[bounce > 0.0].all():
                 self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy)
         rows = self.rows[movable]
@@ -548,7 +613,10 @@ class Solve:
         frame.resolved = (ea, eb, nx, ny, self.push[acted])
         gap = np.maximum(self._separations()[acted], 0.0)
         push = np.minimum(self.push, self._push_cap())[acted]  # (see _warm_pushes)
-        frame.support = (ea, eb, nx, ny, push, self.impulse[acted], gap)
+        mu = self.position_mu
+        cap = mu[acted] * push if mu is not NO_FRICTION else np.zeros(acted.size)
+        tpush = np.clip(self.tpush[acted], -cap, cap)
+        frame.support = (ea, eb, nx, ny, push, self.impulse[acted], gap, tpush, self.timpulse[acted])
         frame.counters["resolved"] = int(acted.size)
 
 

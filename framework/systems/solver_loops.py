@@ -60,13 +60,22 @@ def _within(change, share, sign, ex, ey, nx, ny, reach):
 
 
 @njit(cache=True)
-def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, reach):
+def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, reach,
+                    mu, tshare_a, tshare_b, tpush, mx, my):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
     exit) and the per-body displacements ``dx, dy`` (which must already hold the warm start's
     displacement) are updated in place. ``dirty``: the contacts to look at first; on return, those
     still to look at (none once converged). ``reach``: how far each body may move in this call
-    (a push that would take it farther is held back). Returns ``(passes made, whether a push was
-    held back)``."""
+    (a push that would take it farther is held back).
+
+    Friction (``mu``, per contact; empty for none): tangential pushes ``tpush`` (warm start in,
+    solution out; along ``t = (-ny, nx)``), with ``|tpush| <= mu * push``, undo the bodies' slip
+    along the contact over the step (``mx, my``: each body's motion this step before the solve),
+    so a body held by static friction does not creep. They are shared by ``tshare_a, tshare_b``
+    (by inverse mass: a box sliding on another drags it, whatever holds the lower one up);
+    ``mu`` is then the limit in those units (see ``Solve._friction_limits``). Returns ``(passes
+    made, whether a push was held back)``."""
+    friction = mu.size > 0
     moved = np.full(dx.size, -1, dtype=np.int64)  # the last pass in which each body moved
     x0, y0 = dx.copy(), dy.copy()
     held = False
@@ -83,20 +92,42 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
             if new < 0.0:
                 new = 0.0
             change = new - push[i]
+            if change != 0.0:
+                wanted = change
+                change = _within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
+                change = _within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
+                if change != wanted:
+                    held = True
+                if change != 0.0:
+                    push[i] += change
+                    dx[ia] -= share_a[i] * change * nx[i]
+                    dy[ia] -= share_a[i] * change * ny[i]
+                    dx[ib] += share_b[i] * change * nx[i]
+                    dy[ib] += share_b[i] * change * ny[i]
+                    if abs(change) > tolerance:
+                        moved[ia] = moved[ib] = it
+                        any_moved = True
+            if not friction:
+                continue
+            tx, ty = -ny[i], nx[i]
+            slip = (mx[ib] + dx[ib] - mx[ia] - dx[ia]) * tx + (my[ib] + dy[ib] - my[ia] - dy[ia]) * ty
+            limit = mu[i] * push[i]
+            new = min(max(tpush[i] - slip, -limit), limit)
+            change = new - tpush[i]
             if change == 0.0:
                 continue
             wanted = change
-            change = _within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
-            change = _within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
+            change = _within(change, tshare_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], tx, ty, reach[ia])
+            change = _within(change, tshare_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], tx, ty, reach[ib])
             if change != wanted:
                 held = True
                 if change == 0.0:
                     continue
-            push[i] += change
-            dx[ia] -= share_a[i] * change * nx[i]
-            dy[ia] -= share_a[i] * change * ny[i]
-            dx[ib] += share_b[i] * change * nx[i]
-            dy[ib] += share_b[i] * change * ny[i]
+            tpush[i] += change
+            dx[ia] -= tshare_a[i] * change * tx
+            dy[ia] -= tshare_a[i] * change * ty
+            dx[ib] += tshare_b[i] * change * tx
+            dy[ib] += tshare_b[i] * change * ty
             if abs(change) > tolerance:
                 moved[ia] = moved[ib] = it
                 any_moved = True
@@ -107,10 +138,15 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
 
 
 @njit(cache=True)
-def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty):
+def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty,
+                     mu, tshare_a, tshare_b, timpulse):
     """Projected Gauss-Seidel on the normal velocities: ``impulse`` (warm start on entry; the
     velocities ``vx, vy`` must already include it) and the velocities are updated in place;
-    ``dirty`` as in :func:`solve_positions`. Returns the passes made."""
+    ``dirty`` as in :func:`solve_positions`. Friction (``mu``; empty for none): tangential
+    impulses ``timpulse`` along ``t = (-ny, nx)``, ``|timpulse| <= mu * impulse``, shared by
+    ``tshare_a, tshare_b``, stop the bodies sliding along the contact (Coulomb: a contact that
+    needs more slides, braked by the limit). Returns the passes made."""
+    friction = mu.size > 0
     moved = np.full(vx.size, -1, dtype=np.int64)
     for it in range(passes):
         any_moved = False
@@ -125,13 +161,29 @@ def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx,
             if new < 0.0:
                 new = 0.0
             change = new - impulse[i]
+            if change != 0.0:
+                impulse[i] = new
+                vx[ia] -= share_a[i] * change * nx[i]
+                vy[ia] -= share_a[i] * change * ny[i]
+                vx[ib] += share_b[i] * change * nx[i]
+                vy[ib] += share_b[i] * change * ny[i]
+                if abs(change) > tolerance:
+                    moved[ia] = moved[ib] = it
+                    any_moved = True
+            if not friction:
+                continue
+            tx, ty = -ny[i], nx[i]
+            ut = (vx[ib] - vx[ia]) * tx + (vy[ib] - vy[ia]) * ty
+            limit = mu[i] * impulse[i]
+            new = min(max(timpulse[i] - ut, -limit), limit)
+            change = new - timpulse[i]
             if change == 0.0:
                 continue
-            impulse[i] = new
-            vx[ia] -= share_a[i] * change * nx[i]
-            vy[ia] -= share_a[i] * change * ny[i]
-            vx[ib] += share_b[i] * change * nx[i]
-            vy[ib] += share_b[i] * change * ny[i]
+            timpulse[i] = new
+            vx[ia] -= tshare_a[i] * change * tx
+            vy[ia] -= tshare_a[i] * change * ty
+            vx[ib] += tshare_b[i] * change * tx
+            vy[ib] += tshare_b[i] * change * ty
             if abs(change) > tolerance:
                 moved[ia] = moved[ib] = it
                 any_moved = True

@@ -1,0 +1,224 @@
+"""Coulomb friction (issue 23, part 1): exact stops, static friction on slopes, the combining rule.
+
+Semi-implicit Euler moves a body with the velocity the step ends with, friction included, so a
+crate braked at ``a = mu g`` from ``v`` covers ``v^2 / (2 a) - v dt / 2`` (the analytic distance
+less half a step of its first speed) and stops after exactly ``v / a`` seconds; with dyadic values
+(v = 4, mu = 1/2, g = 8, dt = 1/64) both are exact in floating point. A body sliding down a slope
+gains ``g (sin t - mu cos t) dt`` per step, to rounding; one whose friction holds it does not move.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
+from framework.collision import collide
+from framework.effects import DEFAULT_EFFECTS
+from framework.validation import InvalidValue
+
+DT = 1.0 / 64.0
+G = 8.0
+
+
+def _crate_scene(mu_crate, mu_floor=None, v0=4.0, effects=None, tiles=False):
+    s = Scene(gravity=(0.0, -G), effects=effects)
+    if tiles:  # a floor of unit tiles: the crate crosses a seam every unit
+        for i in range(-8, 40):
+            s.spawn(Transform(i + 0.5, -0.5), Hitbox(AABB(1.0, 1.0), body="static", friction=mu_floor))
+    else:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(1000.0, 1.0), body="static", friction=mu_floor))
+    crate = s.spawn(Transform(0.0, 0.5), Velocity(v0, 0.0), Hitbox(AABB(1.0, 1.0), friction=mu_crate))
+    return s, crate
+
+
+def _slide(s, crate, steps):
+    """Step ``steps`` times; the step on which the crate first stood still (or None)."""
+    stop = None
+    for k in range(steps):
+        s.step(DT)
+        if stop is None and s.get(crate, Velocity).x == 0.0:
+            stop = k + 1
+    return stop
+
+
+@pytest.mark.parametrize("mu_floor", [None, 0.5], ids=["floor-without-material", "floor-also-0.5"])
+def test_a_pushed_crate_stops_after_v2_over_2_mu_g(mu_floor):
+    s, crate = _crate_scene(0.5, mu_floor)
+    with s:
+        stop = _slide(s, crate, 100)
+        t = s.get(crate, Transform)
+        # v / (mu g) = 1 s = 64 steps; v^2 / (2 mu g) - v dt / 2 = 2 - 1/32
+        assert stop == 64
+        assert (t.x, t.y) == (2.0 - 1.0 / 32.0, 0.5)
+        assert (s.get(crate, Velocity).x, s.get(crate, Velocity).y) == (0.0, 0.0)
+
+
+def test_a_crate_crosses_tile_seams_as_it_crosses_one_floor():
+    # Friction never catches on the seams between tiles, nor pushes the crate into them.
+    s, crate = _crate_scene(0.5, tiles=True)
+    with s:
+        assert _slide(s, crate, 100) == 64
+        t = s.get(crate, Transform)
+        assert (t.x, t.y) == (2.0 - 1.0 / 32.0, 0.5)
+
+
+def test_without_the_friction_effect_or_a_coefficient_the_crate_slides_on():
+    for s, crate in (_crate_scene(0.5, effects=DEFAULT_EFFECTS - {"friction"}), _crate_scene(None),
+                     _crate_scene(0.0, 0.5)):  # sqrt(0 * 0.5) = 0
+        with s:
+            _slide(s, crate, 64)
+            assert s.get(crate, Velocity).x == 4.0 and s.get(crate, Transform).x == 4.0
+
+
+def test_friction_coefficients_combine_as_documented():
+    with Scene() as s:
+        pairs = [(0.5, None, 0.5), (None, 0.5, 0.5), (0.25, 1.0, 0.5), (None, None, 0.0), (0.0, 2.0, 0.0),
+                 (2.0, 0.5, 1.0)]
+        rows = []
+        for fa, fb, _ in pairs:
+            a = s.spawn(Transform(0.0, 0.0), Hitbox(AABB(1.0, 1.0), friction=fa))
+            b = s.spawn(Transform(0.0, 0.0), Hitbox(AABB(1.0, 1.0), friction=fb))
+            rows.append((s.bodies.store.row_of[a], s.bodies.store.row_of[b]))
+        ra, rb = (np.array(r) for r in zip(*rows))
+        assert s.bodies.store.pair_friction(ra, rb).tolist() == [m for _, _, m in pairs]
+
+
+# --- slopes ------------------------------------------------------------------------------------
+# A slope rising 3 in 4 (tan t = 3/4, sin t = 3/5, cos t = 4/5) through the origin, g = 10.
+
+SIN, COS = 0.6, 0.8
+
+
+def _on_slope(mu, shape):
+    s = Scene(gravity=(0.0, -10.0))
+    L = 40.0
+    s.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-L * COS, -L * SIN), (L * COS, L * SIN), (L * COS, -L * SIN)]),
+                                        body="static"))
+    if shape == "box":  # its lower right corner on the slope at the origin
+        body = s.spawn(Transform(-0.5, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=mu))
+    else:  # touching the slope at the origin
+        body = s.spawn(Transform(-0.5 * SIN, 0.5 * COS), Velocity(), Hitbox(Circle(0.5), friction=mu))
+    return s, body
+
+
+@pytest.mark.parametrize("shape", ["box", "circle"])
+@pytest.mark.parametrize("mu", [0.76, 0.8, 1.5])
+def test_static_friction_holds_a_body_on_a_slope_without_creeping(shape, mu):
+    s, body = _on_slope(mu, shape)
+    with s:
+        start = s.get(body, Transform)
+        x0, y0 = start.x, start.y
+        for _ in range(5 * 60):
+            s.step(1.0 / 60.0)
+        t, v = s.get(body, Transform), s.get(body, Velocity)
+        assert math.hypot(t.x - x0, t.y - y0) < 1e-12  # rounding, not creep (5 s would show 1e-3/s)
+        assert math.hypot(v.x, v.y) < 1e-12
+
+
+@pytest.mark.parametrize("shape", ["box", "circle"])
+@pytest.mark.parametrize("mu", [0.0, 0.25, 0.7])
+def test_a_body_slides_down_a_slope_at_g_sin_minus_mu_g_cos(shape, mu):
+    s, body = _on_slope(mu, shape)
+    with s:
+        n = 120
+        for _ in range(n):
+            s.step(1.0 / 60.0)
+        v = s.get(body, Velocity)
+        a = 10.0 * (SIN - mu * COS)
+        along = -(v.x * COS + v.y * SIN)  # down the slope
+        across = -v.x * SIN + v.y * COS
+        assert along == pytest.approx(a * n / 60.0, rel=1e-9)
+        assert abs(across) < 1e-9 * a * n / 60.0 + 1e-12
+        # and it is on the slope, not in it (touching to the solver's tolerance)
+        floor = s.query_point(0.0, -1.0)  # the slope's entity
+        c = collide(s.get(floor[0], Hitbox).shape, s.get(floor[0], Transform), s.get(body, Hitbox).shape,
+                    s.get(body, Transform))
+        assert c is None or c.depth < 1e-9
+
+
+# --- between moving bodies ------------------------------------------------------------------------
+
+
+def test_a_box_sliding_on_a_box_drags_it_and_momentum_is_kept():
+    # The lower box stands on a frictionless floor (its floor gives 0: sqrt(0 * 0.5) = 0), the upper
+    # one slides on it at 4: each is braked (or driven) at mu g = 4, so after 1/2 s both move at 2.
+    with Scene(gravity=(0.0, -G)) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(1000.0, 1.0), body="static", friction=0.0))
+        low = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(AABB(4.0, 1.0), friction=0.5))
+        top = s.spawn(Transform(0.0, 1.5), Velocity(4.0, 0.0), Hitbox(AABB(1.0, 1.0), friction=0.5))
+        for k in range(64):
+            s.step(DT)
+            vl, vt = s.get(low, Velocity).x, s.get(top, Velocity).x
+            assert vl + vt == 4.0  # momentum, exactly
+            if k + 1 == 32:
+                assert (vl, vt) == (2.0, 2.0)
+        assert (s.get(low, Velocity).x, s.get(top, Velocity).x) == (2.0, 2.0)
+        assert (s.get(low, Transform).y, s.get(top, Transform).y) == (0.5, 1.5)
+
+
+def test_a_kinematic_platform_carries_a_box_with_friction():
+    with Scene(gravity=(0.0, -G)) as s:
+        plat = s.spawn(Transform(0.0, -0.5), Velocity(2.0, 0.0), Hitbox(AABB(8.0, 1.0), body="kinematic"))
+        box = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=1.0))
+        for _ in range(64):
+            s.step(DT)
+        assert s.get(box, Velocity).x == 2.0  # taken up within the first steps (mu g = 8: 2 units/s in 16 steps)
+        # and it rides: no slip once it moves with the platform
+        gap = s.get(box, Transform).x - s.get(plat, Transform).x
+        for _ in range(64):
+            s.step(DT)
+        assert s.get(box, Transform).x - s.get(plat, Transform).x == gap
+        assert s.get(box, Transform).y == 0.5
+
+
+def test_friction_makes_no_energy_in_a_closed_box_of_bodies():
+    # Boxes and balls thrown about a closed room with friction everywhere: the total energy
+    # (kinetic + potential) never rises above its start (rounding allowed: 1e-9 of it).
+    rng = np.random.default_rng(7)
+    with Scene(gravity=(0.0, -10.0)) as s:
+        for x, y, w, h in ((5.0, -0.5, 12.0, 1.0), (5.0, 10.5, 12.0, 1.0), (-0.5, 5.0, 1.0, 12.0), (10.5, 5.0, 1.0, 12.0)):
+            s.spawn(Transform(x, y), Hitbox(AABB(w, h), body="static", friction=0.6))
+        bodies = []
+        for i in range(30):
+            x, y = 1.0 + (i % 6) * 1.5, 1.0 + (i // 6) * 1.5
+            shape = AABB(0.8, 0.8) if i % 2 else Circle(0.4)
+            vx, vy = rng.uniform(-6.0, 6.0, 2)
+            bodies.append(s.spawn(Transform(x, y), Velocity(vx, vy), Hitbox(shape, friction=float(rng.uniform(0.1, 1.0)))))
+
+        def energy():
+            return sum(0.5 * (s.get(e, Velocity).x ** 2 + s.get(e, Velocity).y ** 2) + 10.0 * s.get(e, Transform).y
+                       for e in bodies)
+
+        e0 = energy()
+        for _ in range(600):
+            s.step(1.0 / 60.0)
+            assert energy() <= e0 + 1e-9 * abs(e0)
+        for e in bodies:  # all inside the room
+            t = s.get(e, Transform)
+            assert 0.0 < t.x < 10.0 and 0.0 < t.y < 10.0
+
+
+# --- bad input ------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bad", [-0.5, math.nan, math.inf, "rough", True])
+def test_bad_friction_is_refused(bad):
+    with pytest.raises(InvalidValue, match="friction"):
+        Hitbox(AABB(1.0, 1.0), friction=bad)
+
+
+def test_a_bad_friction_written_later_is_refused_and_the_scene_is_unchanged():
+    s, crate = _crate_scene(0.5)
+    with s:
+        s.step(DT)
+        before = (s.get(crate, Transform).x, s.get(crate, Velocity).x)
+        s.get(crate, Hitbox).friction = -1.0
+        with pytest.raises(InvalidValue, match="friction"):
+            s.step(DT)
+        assert (s.get(crate, Transform).x, s.get(crate, Velocity).x) == before
+        s.get(crate, Hitbox).friction = 0.5
+        s.step(DT)
+        assert s.get(crate, Velocity).x == 4.0 - 2 * 0.5 * G * DT
