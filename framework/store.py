@@ -84,6 +84,7 @@ class BodyStore:
         self._kinds: frozenset[int] = frozenset()
         self._layers_open = False
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
+        self._friction_seen = (-1, False)  # (version, whether a hitbox gives friction then)
         self.writes = 0  # bumped by every write from game code (component views)
         self.motion = 0  # bumped by every move the pipeline makes (move_by_velocity, place)
         self._lookup = np.full(1, -1, dtype=np.int64)  # entity id -> row (rows_of)
@@ -171,6 +172,13 @@ class BodyStore:
         ok = entities < self._lookup.size
         out[ok] = self._lookup[entities[ok]]
         return out
+
+    def has_friction(self) -> bool:
+        """Whether any hitbox gives a friction coefficient above 0 (looked at again only after a
+        structural change: a scene without friction pays one comparison per step for it)."""
+        if self._friction_seen[0] != self.version:
+            self._friction_seen = (self.version, bool((self.friction > 0.0).any()))
+        return self._friction_seen[1]
 
     def pair_friction(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
         """The friction coefficient of each pair ``(ra, rb)``: ``sqrt(f_a * f_b)`` where both

@@ -43,7 +43,7 @@ def _parser() -> argparse.ArgumentParser:
         else:
             s.add_argument("--scenes", type=_names, metavar="A,B,...", help="only these scenes (default: all)")
             s.add_argument("--crowds", type=_names, metavar="A,B,...",
-                           help="only these crowds: balls, boxes, mixed ('' for none; default: all)")
+                           help="only these crowds: balls, boxes, mixed, mixed-friction ('' for none; default: all)")
             s.add_argument("--rounds", type=int, metavar="R", help="timed rounds of every scene (default: by size)")
             s.add_argument("--crowd-steps", type=int, metavar="S",
                            help="cap on a crowd's steps (default 1,800, the issue's 30 s; quick: 600)")

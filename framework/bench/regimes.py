@@ -49,7 +49,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -67,7 +67,7 @@ __all__ = [
     "COLUMNS", "CROWDS", "CROWD_COLUMNS", "CROWD_KEYS", "Box2DEngine", "Engine", "Ours", "Piece", "PymunkEngine",
     "ROW_KEYS", "Regime", "SCENES", "box_pile", "crowd", "goals", "judge", "make_engines", "markdown",
     "max_penetration", "peer_modules", "pile_layout", "platformer", "pyramid", "run_crowd", "run_regimes",
-    "run_scene", "scattered", "shape_pile", "stack", "text_report",
+    "run_scene", "scattered", "shape_pile", "stack", "text_report", "with_friction",
 ]
 
 DT = 1.0 / 60.0
@@ -77,7 +77,7 @@ SLEEP_TIME = 0.5  # s at rest before a peer body sleeps (Box2D's b2_timeToSleep;
 CROWD = {"bodies": 120, "pit": 8.0, "gravity": (0.0, -20.0), "max_steps": 1_800, "overlap": 0.02}
 ENGINES = ("ours", "pymunk", "box2d")
 
-CROWDS = ("balls", "boxes", "mixed")
+CROWDS = ("balls", "boxes", "mixed", "mixed-friction")
 #: untimed steps before timing, by scene kind (the same in --quick: the accuracy figures do not move)
 SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer": 0}
 # timed rounds by the number of moving bodies (the first bound that is >= it); the crowds' step cap
@@ -115,7 +115,8 @@ class Regime:
 
     ``top``: indices of the pieces of the pile's top row, whose exact resting centre height is
     ``exact_top`` (``None`` where no exact answer exists); ``height``: the pile's height, for the
-    sink ratio. ``kind`` picks the untimed steps before timing (:data:`SETTLE`). ``dynamic_pairs``:
+    sink ratio. ``friction``: every body's coefficient (the pair's, in all three engines; 0: none).
+    ``kind`` picks the untimed steps before timing (:data:`SETTLE`). ``dynamic_pairs``:
     whether overlaps between two moving bodies count in the penetration figure. ``pit``: ``(minx, maxx, floor)`` for the
     crowds' outside count."""
 
@@ -126,6 +127,7 @@ class Regime:
     dt: float = DT
     effects: frozenset[str] | None = None
     sleeping: bool = False
+    friction: float = 0.0
     top: list[int] = field(default_factory=list)
     exact_top: float | None = None
     height: float | None = None
@@ -224,9 +226,17 @@ def scattered(n: int, seed: int = 0) -> Regime:
                   effects=frozenset(PERF_EFFECTS))
 
 
+def with_friction(regime: Regime, mu: float = 0.5) -> Regime:
+    """``regime`` with friction ``mu`` between every pair of bodies, named ``<name>-friction``."""
+    return replace(regime, name=f"{regime.name}-friction", friction=mu)
+
+
 def crowd(kind: str, seed: int = 0, bodies: int = CROWD["bodies"]) -> Regime:
     """``bodies`` balls (radius 0.25-0.5), boxes (sides 0.5-1) or ``mixed`` (alternating), on a
-    grid of unit cells 8 wide, jittered within their cells, dropped into a pit 8 units wide."""
+    grid of unit cells 8 wide, jittered within their cells, dropped into a pit 8 units wide
+    (``<kind>-friction``: the same with friction 0.5)."""
+    if kind.endswith("-friction"):
+        return with_friction(crowd(kind.removesuffix("-friction"), seed, bodies))
     rng = np.random.default_rng(seed)
     width = CROWD["pit"]
     cols = int(width)
@@ -330,7 +340,8 @@ class Engine:
 
 class Ours(Engine):
     """Our :class:`~framework.scene.Scene`, through its public API only: one entity per piece
-    (``Transform``, ``Velocity`` unless static, ``Hitbox``, mass 1, restitution 0); or, for the
+    (``Transform``, ``Velocity`` unless static, ``Hitbox``, mass 1, restitution 0, the regime's
+    friction on every hitbox, none when 0); or, for the
     platformer, the game the regime carries. Effects: the regime's, else the default effects, minus
     ``sleeping`` unless the regime sleeps."""
 
@@ -345,10 +356,11 @@ class Ours(Engine):
             return
         effects = regime.effects or (DEFAULT_EFFECTS if regime.sleeping else DEFAULT_EFFECTS - {"sleeping"})
         scene = self.scene = Scene(gravity=regime.gravity, effects=effects)
-        self.entities = [scene.spawn(Transform(p.x, p.y), Hitbox(p.shape, body=p.kind, sensor=p.sensor))
+        mu = regime.friction or None
+        self.entities = [scene.spawn(Transform(p.x, p.y), Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu))
                          if p.kind == "static" else
                          scene.spawn(Transform(p.x, p.y), Velocity(p.vx, p.vy),
-                                     Hitbox(p.shape, body=p.kind, sensor=p.sensor))
+                                     Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu))
                          for p in regime.pieces]
         dt = regime.dt
         self._step = lambda: scene.step(dt)
@@ -454,7 +466,8 @@ class Peer(Engine):
 
 class PymunkEngine(Peer):
     """pymunk: dynamic pieces on ``Body(1, inf)`` (mass 1, no rotation), kinematic ones on kinematic
-    bodies, static ones as shapes of the space's static body; friction and elasticity 0; sleeping
+    bodies, static ones as shapes of the space's static body; elasticity 0, friction the square root
+    of the regime's on every shape (pymunk multiplies a pair's: the pair then has the regime's); sleeping
     (when the regime sleeps) after ``SLEEP_TIME`` s idle; everything else pymunk's defaults."""
 
     name = "pymunk"
@@ -476,7 +489,7 @@ class PymunkEngine(Peer):
                 items.append(body)
             shape = (pymunk.Circle(body, p.shape.radius, (ox, oy)) if isinstance(p.shape, Circle)
                      else pymunk.Poly(body, _outline(p.shape, ox, oy)))
-            shape.friction, shape.elasticity, shape.sensor = 0.0, 0.0, p.sensor
+            shape.friction, shape.elasticity, shape.sensor = math.sqrt(regime.friction), 0.0, p.sensor
             items.append(shape)
             self.handles.append(handle)
         space.add(*items)
@@ -501,8 +514,9 @@ class PymunkEngine(Peer):
 
 class Box2DEngine(Peer):
     """Box2D v3 (``pyb2d3``): dynamic pieces on ``fixed_rotation`` bodies with density 1 / area (mass
-    1), kinematic ones on kinematic bodies, static ones as shapes of one static body; friction and
-    restitution 0; ``sleeping_enabled`` as the regime says; ``step(dt, 4)`` (its default 4 sub-steps)."""
+    1), kinematic ones on kinematic bodies, static ones as shapes of one static body; restitution 0,
+    the regime's friction on every shape (Box2D's pair rule is ``sqrt(f1 f2)``); ``sleeping_enabled``
+    as the regime says; ``step(dt, 4)`` (its default 4 sub-steps)."""
 
     name = "box2d"
 
@@ -519,7 +533,7 @@ class Box2DEngine(Peer):
                 body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy), fixed_rotation=True)
                 ox = oy = 0.0
             sd = b2.shape_def(density=1.0 / _area(p.shape), is_sensor=p.sensor,
-                              material=b2.surface_material(friction=0.0, restitution=0.0))
+                              material=b2.surface_material(friction=regime.friction, restitution=0.0))
             if isinstance(p.shape, Circle):
                 body.create_circle_shape(sd, b2.circle(center=(ox, oy), radius=p.shape.radius))
             elif isinstance(p.shape, AABB):
@@ -719,6 +733,9 @@ SCENES: dict[str, Callable[[], Regime | None]] = {
     "pile-mixed-1000": lambda: shape_pile("mixed", 40, 25),
     "stack-20": lambda: stack(20),
     "pyramid-20": lambda: pyramid(20),
+    "pile-boxes-1000-friction": lambda: with_friction(box_pile(40, 25)),
+    "pile-mixed-1000-friction": lambda: with_friction(shape_pile("mixed", 40, 25)),
+    "pyramid-20-friction": lambda: with_friction(pyramid(20)),
     "scattered-10": lambda: scattered(10),
     "scattered-100": lambda: scattered(100),
     "scattered-1000": lambda: scattered(1_000),

@@ -83,7 +83,7 @@ class Solve:
         its = stage.pipeline.response_iterations
         self.iterations = max(SOLVER_PASSES * its, min(MAX_PASSES * its, PASS_BUDGET * its // cs.size))
         self.dt = frame.dt
-        self.friction = "friction" in stage.pipeline.effects
+        self.friction = "friction" in stage.pipeline.effects and self.store.has_friction()
         overlapping = cs.alive0.copy()
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
         dropped = overlapping & ~cs.alive0  # the covering tile's own contact holds the body
