@@ -179,14 +179,16 @@ def test_friction_makes_no_energy_in_a_closed_box_of_bodies():
     # (kinetic + potential) never rises above its start (rounding allowed: 1e-9 of it).
     rng = np.random.default_rng(7)
     with Scene(gravity=(0.0, -10.0)) as s:
-        for x, y, w, h in ((5.0, -0.5, 12.0, 1.0), (5.0, 10.5, 12.0, 1.0), (-0.5, 5.0, 1.0, 12.0), (10.5, 5.0, 1.0, 12.0)):
+        walls = ((5.0, -0.5, 12.0, 1.0), (5.0, 10.5, 12.0, 1.0), (-0.5, 5.0, 1.0, 12.0), (10.5, 5.0, 1.0, 12.0))
+        for x, y, w, h in walls:
             s.spawn(Transform(x, y), Hitbox(AABB(w, h), body="static", friction=0.6))
         bodies = []
         for i in range(30):
             x, y = 1.0 + (i % 6) * 1.5, 1.0 + (i // 6) * 1.5
             shape = AABB(0.8, 0.8) if i % 2 else Circle(0.4)
             vx, vy = rng.uniform(-6.0, 6.0, 2)
-            bodies.append(s.spawn(Transform(x, y), Velocity(vx, vy), Hitbox(shape, friction=float(rng.uniform(0.1, 1.0)))))
+            mu = float(rng.uniform(0.1, 1.0))
+            bodies.append(s.spawn(Transform(x, y), Velocity(vx, vy), Hitbox(shape, friction=mu)))
 
         def energy():
             return sum(0.5 * (s.get(e, Velocity).x ** 2 + s.get(e, Velocity).y ** 2) + 10.0 * s.get(e, Transform).y
