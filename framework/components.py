@@ -117,6 +117,7 @@ class Body(Enum):
 
 _HITBOX_FIELDS = (
     "shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd", "one_way", "friction",
+    "inertia",
 )
 _ALL_BITS = 0xFFFFFFFF
 
@@ -139,6 +140,10 @@ class Hitbox:
       A pair where both hitboxes give one uses ``sqrt(f1 * f2)`` (Box2D's rule); where one does,
       that one (a crate given 0.5 slides with 0.5 on a plain floor); where neither does, none.
       Needs the ``"friction"`` effect (on by default); see docs/physics.md.
+    - ``inertia``: moment of inertia about the centre (> 0), or None (the default: from the shape
+      and ``mass``, a solid disk's ``m r^2 / 2``); ``math.inf`` keeps the body from turning.
+      Friction turns dynamic circles (centred on their entity): they roll. Boxes and polygons do
+      not turn from contacts yet. Needs the ``"rotation"`` effect (on by default).
     - ``ccd``: continuous detection. The body is swept along its motion each step so it cannot
       pass through thin walls; bodies without it pay nothing for it.
     - ``one_way``: a platform that is solid only from above (its local +y, turning with its
@@ -162,11 +167,13 @@ class Hitbox:
         ccd: bool = False,
         one_way: bool = False,
         friction: float | None = None,
+        inertia: float | None = None,
     ) -> None:
         object.__setattr__(self, "_store", None)
         object.__setattr__(self, "_entity", -1)
         for name, value in zip(
-            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd, one_way, friction)
+            _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd, one_way, friction,
+                             inertia)
         ):
             object.__setattr__(self, "_" + name, check_hitbox_field(name, value))
 
@@ -229,6 +236,16 @@ def check_hitbox_field(name: str, value: object) -> Any:
         if not 0.0 <= r <= 1.0:
             raise InvalidValue(f"Hitbox restitution must be in [0, 1], got {value!r}")
         return r
+    if name == "inertia":
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
+            raise InvalidValue(f"Hitbox inertia must be a number > 0 (or None), got {value!r}")
+        i = float(value)  # type: ignore[arg-type]
+        if not (i > 0.0):  # inf allowed: never turns
+            raise InvalidValue(f"Hitbox inertia must be > 0 (math.inf: never turns; None: from the shape), "
+                               f"got {value!r}")
+        return i
     if name == "friction":
         if value is None:
             return None

@@ -17,13 +17,14 @@ EFFECTS: dict[str, tuple[str, ...]] = {
     "events": ("detection",),                # every pair's started / ongoing / ended events
     "response": ("detection",),              # push bodies apart, slide, bounce
     "friction": ("response",),               # Coulomb friction between hitboxes that have some
+    "rotation": ("response",),               # contacts turn bodies (today: friction rolls circles)
     "continuous": ("movement", "detection"),  # sweep Hitbox(ccd=True) bodies
     "rendering": (),                         # the render stage (a renderer must be attached)
     "debug_overlay": ("rendering",),         # hitboxes, contacts, cells, rays on screen
     "sleeping": (),                          # bodies at rest sleep: no work until woken
 }
-DEFAULT_EFFECTS = frozenset({"movement", "gravity", "detection", "events", "response", "friction", "continuous",
-                             "sleeping"})
+DEFAULT_EFFECTS = frozenset({"movement", "gravity", "detection", "events", "response", "friction", "rotation",
+                             "continuous", "sleeping"})
 
 
 def resolve_effects(effects: Iterable[str] | None) -> frozenset[str]:

@@ -34,6 +34,7 @@ _FLOATS = (
     "x", "y", "rot", "vx", "vy", "w",  # transform and velocity (component views)
     "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
     "friction",  # the hitbox's friction coefficient; NO_FRICTION where it gives none
+    "inv_inertia",  # 1 / moment of inertia of a body contacts turn (dynamic centred circles), else 0
 )
 _INTS = {
     "kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64,
@@ -334,6 +335,7 @@ class BodyStore:
             for name in ("ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution"):
                 c[name][row] = 0.0
             c["friction"][row] = NO_FRICTION
+            c["inv_inertia"][row] = 0.0
             return
         shape = hb._shape
         if isinstance(shape, AABB):
@@ -354,6 +356,7 @@ class BodyStore:
         c["inv_mass"][row] = hb.inverse_mass
         c["restitution"][row] = hb._restitution
         c["friction"][row] = NO_FRICTION if hb._friction is None else hb._friction
+        c["inv_inertia"][row] = _inverse_inertia(hb)
 
     # --- component views -------------------------------------------------------------------
 
@@ -446,8 +449,12 @@ class BodyStore:
         for e in changed:
             row = self.row_of[e]
             hb = self.hitboxes[row]
-            for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction"):
-                object.__setattr__(hb, "_" + name, check_hitbox_field(name, object.__getattribute__(hb, "_" + name)))
+            for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction", "inertia"):
+                try:
+                    value = check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
+                except InvalidValue as err:
+                    raise InvalidValue(f"entity {e}: {err}") from None
+                object.__setattr__(hb, "_" + name, value)
             self._set_hitbox_row(row, hb)
         self.dirty_hitboxes = set()
         if changed:
@@ -458,3 +465,14 @@ class BodyStore:
 
 
 _MISSING = object()
+
+
+def _inverse_inertia(hb: Hitbox) -> float:
+    """1 / the moment of inertia of a body that contacts turn, else 0: a dynamic circle centred on
+    its entity (its turning moves no geometry), of finite mass and inertia; the inertia given, or a
+    solid disk's ``m r^2 / 2``. (Boxes and polygons do not turn from contacts yet.)"""
+    shape = hb._shape
+    if hb._body is not Body.DYNAMIC or not isinstance(shape, Circle) or hb._offset != (0.0, 0.0):
+        return 0.0
+    inertia = hb._inertia if hb._inertia is not None else 0.5 * hb._mass * shape.radius * shape.radius
+    return 0.0 if math.isinf(inertia) else 1.0 / inertia

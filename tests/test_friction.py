@@ -93,6 +93,8 @@ SIN, COS = 0.6, 0.8
 
 
 def _on_slope(mu, shape):
+    """A box, a circle that may not turn (``inertia=inf``: it slides as a box does) or a disk
+    (``"disk"``: it rolls) resting on the slope at the origin."""
     s = Scene(gravity=(0.0, -10.0))
     L = 40.0
     s.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-L * COS, -L * SIN), (L * COS, L * SIN), (L * COS, -L * SIN)]),
@@ -100,7 +102,9 @@ def _on_slope(mu, shape):
     if shape == "box":  # its lower right corner on the slope at the origin
         body = s.spawn(Transform(-0.5, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=mu))
     else:  # touching the slope at the origin
-        body = s.spawn(Transform(-0.5 * SIN, 0.5 * COS), Velocity(), Hitbox(Circle(0.5), friction=mu))
+        inertia = math.inf if shape == "circle" else None
+        body = s.spawn(Transform(-0.5 * SIN, 0.5 * COS), Velocity(),
+                       Hitbox(Circle(0.5), friction=mu, inertia=inertia))
     return s, body
 
 
@@ -176,7 +180,7 @@ def test_a_kinematic_platform_carries_a_box_with_friction():
 
 def test_friction_makes_no_energy_in_a_closed_box_of_bodies():
     # Boxes and balls thrown about a closed room with friction everywhere: the total energy
-    # (kinetic + potential) never rises above its start (rounding allowed: 1e-9 of it).
+    # (kinetic, of rolling too, + potential) never rises above its start (rounding: 1e-9 of it).
     rng = np.random.default_rng(7)
     with Scene(gravity=(0.0, -10.0)) as s:
         walls = ((5.0, -0.5, 12.0, 1.0), (5.0, 10.5, 12.0, 1.0), (-0.5, 5.0, 1.0, 12.0), (10.5, 5.0, 1.0, 12.0))
@@ -190,9 +194,12 @@ def test_friction_makes_no_energy_in_a_closed_box_of_bodies():
             mu = float(rng.uniform(0.1, 1.0))
             bodies.append(s.spawn(Transform(x, y), Velocity(vx, vy), Hitbox(shape, friction=mu)))
 
-        def energy():
-            return sum(0.5 * (s.get(e, Velocity).x ** 2 + s.get(e, Velocity).y ** 2) + 10.0 * s.get(e, Transform).y
-                       for e in bodies)
+        def energy():  # mass 1; the balls roll: I = r^2 / 2
+            total = 0.0
+            for e in bodies:
+                v, inertia = s.get(e, Velocity), 0.08 if isinstance(s.get(e, Hitbox).shape, Circle) else 0.0
+                total += 0.5 * (v.x ** 2 + v.y ** 2 + inertia * v.angular ** 2) + 10.0 * s.get(e, Transform).y
+            return total
 
         e0 = energy()
         for _ in range(600):
@@ -224,3 +231,93 @@ def test_a_bad_friction_written_later_is_refused_and_the_scene_is_unchanged():
         s.get(crate, Hitbox).friction = 0.5
         s.step(DT)
         assert s.get(crate, Velocity).x == 4.0 - 2 * 0.5 * G * DT
+
+
+# --- rolling -------------------------------------------------------------------------------------------
+# A solid disk (I = m r^2 / 2) rolls without slipping where mu >= tan(t) / 3 (here 1/4), at
+# (2/3) g sin t with w = v / r; below, it slips: v' = g (sin t - mu cos t), w' = 2 mu g cos t / r.
+
+
+@pytest.mark.parametrize("mu", [0.25, 0.5, 1.0])
+def test_a_disk_rolls_down_a_slope_at_two_thirds_g_sin(mu):
+    s, disk = _on_slope(mu, "disk")
+    with s:
+        n = 120
+        for _ in range(n):
+            s.step(1.0 / 60.0)
+        v = s.get(disk, Velocity)
+        along = -(v.x * COS + v.y * SIN)
+        assert along == pytest.approx(2.0 / 3.0 * 10.0 * SIN * n / 60.0, rel=1e-9)  # 8
+        assert v.angular == pytest.approx(along / 0.5, rel=1e-9)  # rolling: w = v / r (counter-clockwise)
+
+
+def test_a_disk_on_a_slippery_slope_slips_and_spins_up_at_its_friction():
+    s, disk = _on_slope(0.1, "disk")
+    with s:
+        n = 120
+        for _ in range(n):
+            s.step(1.0 / 60.0)
+        v = s.get(disk, Velocity)
+        along = -(v.x * COS + v.y * SIN)
+        assert along == pytest.approx(10.0 * (SIN - 0.1 * COS) * n / 60.0, rel=1e-9)  # 10.4
+        assert v.angular == pytest.approx(2.0 * 0.1 * 10.0 * COS / 0.5 * n / 60.0, rel=1e-9)  # 6.4
+
+
+def test_a_disk_thrown_without_spin_ends_rolling_at_two_thirds_of_its_speed():
+    # v0 = 3 on a flat floor, mu g = 4: it slows at 4 and spins up (w r) at 8; the slip 3 - 12 t
+    # ends at t = 1/4 (16 steps of 1/64), at v = w r = 2 = (2/3) v0, exactly; it rolls on at 2.
+    with Scene(gravity=(0.0, -G)) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(1000.0, 1.0), body="static"))
+        disk = s.spawn(Transform(0.0, 0.5), Velocity(3.0, 0.0), Hitbox(Circle(0.5), friction=0.5))
+        for k in range(64):
+            s.step(DT)
+            v = s.get(disk, Velocity)
+            if k + 1 < 16:
+                assert v.x > 2.0 and v.x + 0.5 * v.angular > 0.0  # slipping
+            else:
+                assert (v.x, v.angular, v.y) == (2.0, -4.0, 0.0)
+        assert s.get(disk, Transform).y == 0.5
+
+
+def test_inertia_may_be_given_and_infinite_inertia_never_turns():
+    # A ring (I = m r^2): rolls at g sin t / 2 = 3 (slope 3-4-5, g 10); inertia inf: slides.
+    s, _ = _on_slope(0.5, "disk")
+    with s:
+        ring = s.spawn(Transform(-10.0 * COS - 0.5 * SIN, -10.0 * SIN + 0.5 * COS), Velocity(),
+                       Hitbox(Circle(0.5), friction=0.5, inertia=0.25))
+        for _ in range(60):
+            s.step(1.0 / 60.0)
+        v = s.get(ring, Velocity)
+        assert -(v.x * COS + v.y * SIN) == pytest.approx(3.0, rel=1e-9)
+    s, circle = _on_slope(0.0, "circle")
+    with s:
+        for _ in range(60):
+            s.step(1.0 / 60.0)
+        assert s.get(circle, Velocity).angular == 0.0 and s.get(circle, Transform).rotation == 0.0
+
+
+def test_without_the_rotation_effect_a_disk_slides():
+    with Scene(gravity=(0.0, -G), effects=DEFAULT_EFFECTS - {"rotation"}) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(1000.0, 1.0), body="static"))
+        disk = s.spawn(Transform(0.0, 0.5), Velocity(3.0, 0.0), Hitbox(Circle(0.5), friction=0.5))
+        for _ in range(64):
+            s.step(DT)
+        assert (s.get(disk, Velocity).x, s.get(disk, Velocity).angular) == (0.0, 0.0)  # stopped at 3 / 4 s
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, "heavy", False])
+def test_bad_inertia_is_refused(bad):
+    with pytest.raises(InvalidValue, match="inertia"):
+        Hitbox(Circle(1.0), inertia=bad)
+
+
+def test_a_bad_inertia_written_later_names_the_entity_and_changes_nothing():
+    with Scene(gravity=(0.0, -G)) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(1000.0, 1.0), body="static"))
+        disk = s.spawn(Transform(0.0, 0.5), Velocity(3.0, 0.0), Hitbox(Circle(0.5), friction=0.5))
+        s.step(DT)
+        before = (s.get(disk, Transform).x, s.get(disk, Velocity).x, s.get(disk, Velocity).angular)
+        s.get(disk, Hitbox).inertia = math.nan
+        with pytest.raises(InvalidValue, match=f"entity {disk}: Hitbox inertia"):
+            s.step(DT)
+        assert (s.get(disk, Transform).x, s.get(disk, Velocity).x, s.get(disk, Velocity).angular) == before

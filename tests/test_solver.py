@@ -19,7 +19,9 @@ from framework.collision import collide
 from framework.systems import solver_loops as loops
 
 DT = 1.0 / 60.0
-NONE = np.zeros(0)  # no friction
+NONE = np.zeros(0)
+NO_FRICTION_P = (NONE,) * 12  # solve_positions' friction arguments, for none
+NO_FRICTION_V = (NONE,) * 9  # solve_velocities'
 
 
 # --- the compiled loops, on problems with exact answers ---------------------------------------------
@@ -35,7 +37,7 @@ def _positions(a, b, nx, ny, sep0, share_a, share_b, n_bodies, push0=None, reach
     used, held = loops.solve_positions(np.arange(C), a, b, np.asarray(nx, float), np.asarray(ny, float),
                                        np.asarray(sep0, float), np.asarray(share_a, float),
                                        np.asarray(share_b, float), push, dx, dy, passes, 0.0,
-                                       np.ones(C, dtype=bool), reach, NONE, NONE, NONE, NONE, NONE, NONE)
+                                       np.ones(C, dtype=bool), reach, *NO_FRICTION_P)
     return push, dx, dy, used, held
 
 
@@ -76,10 +78,10 @@ def test_velocities_stop_a_closing_pair_and_bounce_to_a_target():
     vx, vy = np.array([2.0, -2.0]), np.zeros(2)
     impulse = np.zeros(1)
     used = loops.solve_velocities(np.arange(1), a, b, n1, n0, np.zeros(1), half, half, impulse, vx, vy, 8, 0.0,
-                                  np.ones(1, dtype=bool), NONE, NONE, NONE, NONE)
+                                  np.ones(1, dtype=bool), *NO_FRICTION_V)
     assert vx.tolist() == [0.0, 0.0] and impulse.tolist() == [4.0] and used == 2
     loops.solve_velocities(np.arange(1), a, b, n1, n0, np.array([4.0]), half, half, impulse, vx, vy, 8, 0.0,
-                           np.ones(1, dtype=bool), NONE, NONE, NONE, NONE)
+                           np.ones(1, dtype=bool), *NO_FRICTION_V)
     assert vx.tolist() == [-2.0, 2.0] and impulse.tolist() == [8.0]  # an elastic bounce: speeds swapped
 
 

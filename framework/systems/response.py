@@ -71,7 +71,8 @@ class Response(Stage):
             at = np.minimum(np.searchsorted(kept_keys, now_keys), kept_keys.size - 1)
             found = kept_keys[at] == now_keys
             push0[found], impulse0[found] = spush[at[found]], simp[at[found]]
-            tpush0[found], timpulse0[found] = stpush[at[found]], stimp[at[found]]
+            if stpush.any() or stimp.any():  # (friction acted last step)
+                tpush0[found], timpulse0[found] = stpush[at[found]], stimp[at[found]]
         old = np.flatnonzero(~sorted_member(kept_keys, now_keys))
         sra, srb = bodies.rows_of(sa[old]), bodies.rows_of(sb[old])
         live = (sra >= 0) & (srb >= 0)

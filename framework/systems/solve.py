@@ -32,6 +32,7 @@ from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import StepFrame
 from ..store import KINEMATIC
 from . import solver_loops as solver
+from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
 
 __all__ = ["Contacts", "Solve", "bounce_speed"]
 
@@ -49,7 +50,6 @@ MAX_CLEAR_ROUNDS = 1024
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
-NO_FRICTION = np.zeros(0)  # the solver loops' friction columns in a solve without friction
 
 
 class Contacts:
@@ -84,6 +84,8 @@ class Solve:
         self.iterations = max(SOLVER_PASSES * its, min(MAX_PASSES * its, PASS_BUDGET * its // cs.size))
         self.dt = frame.dt
         self.friction = "friction" in stage.pipeline.effects and self.store.has_friction()
+        self.rotation = "rotation" in stage.pipeline.effects
+        self.fr: Friction | None = None
         overlapping = cs.alive0.copy()
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
         dropped = overlapping & ~cs.alive0  # the covering tile's own contact holds the body
@@ -113,14 +115,13 @@ class Solve:
         self.wa, self.wb = wa, wb
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
-        self.mu = NO_FRICTION
-        if self.friction:
-            mu = store.pair_friction(cs.ra, cs.rb)
-            if mu.any():
-                self.mu = mu
+        fr0 = self.fr
+        self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation) if self.friction else None
+        if fr is not None and hasattr(self, "x0"):  # (contacts added during the position solve)
+            fr.start(self.frame, store, rows, self.x0, self.y0, fr0)
         self.order = self._order()
         self.position_shares = self._shock_shares()
-        self.position_mu = self._friction_limits(*self.position_shares)
+        self.position_mu = None if fr is None else fr.limits(*self.position_shares)
 
     def _shock_shares(self) -> tuple[np.ndarray, np.ndarray]:
         """The shares of the position pushes (shock propagation). In a pair resting one on the other
@@ -176,13 +177,16 @@ class Solve:
         self.push = self._warm_pushes(cs.push0)
         share_a, share_b = self.position_shares
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
-        self.mx, self.my = self._step_motion(self.rows, self.x0, self.y0)
-        self.tpush = self._warm_tangent(cs.tpush0, self.push, self.position_mu)
-        if self.tpush.any():
-            tx, ty = solver.warm_start(self.a, self.b, -cs.ny, cs.nx, self.share_a, self.share_b, self.tpush,
-                                       self.rows.size)
-            self.dx += tx
-            self.dy += ty
+        self.tpush = np.zeros(cs.size)
+        fr = self.fr
+        if fr is not None:
+            fr.start(self.frame, store, self.rows, self.x0, self.y0)
+            self.tpush = fr.clip(cs.tpush0, self.push, self.position_mu)
+            if self.tpush.any():
+                tx, ty, turn = fr.spread(self.a, self.b, cs.nx, cs.ny, self.tpush, self.rows.size)
+                self.dx += tx
+                self.dy += ty
+                fr.dturn += turn
         self.looked_x, self.looked_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _far_candidates)
         # Candidates: the broad phase's pairs that were not contacts, and the statics within reach.
         self._set_candidates(self.stage.candidate_pairs(self.frame, cs))
@@ -255,43 +259,6 @@ class Solve:
             return push0 * np.minimum(scale[self.a], scale[self.b])
         return push0.copy()
 
-    def _friction_limits(self, share_a: np.ndarray, share_b: np.ndarray) -> np.ndarray:
-        """Per contact, the friction coefficient as the solver loops use it: the largest tangential
-        push (impulse) per unit of normal push, both in the loops' units (a unit moves the pair one
-        unit relative to each other). The tangential ones are shared by inverse mass, the normal
-        ones by ``share_a, share_b``; where a pair's lower body keeps still for the normal push
-        (shock propagation), a unit of it is the upper body's mass worth of impulse, not the
-        pair's, and the limit grows by the ratio (two equal boxes: twice)."""
-        mu = self.mu
-        if mu is NO_FRICTION:
-            return mu
-        wa, wb = self.wa, self.wb
-        lower_a = (share_a == 0.0) & (wa > 0.0)  # a keeps still although it could move
-        lower_b = (share_b == 0.0) & (wb > 0.0)
-        if not (lower_a.any() or lower_b.any()):
-            return mu
-        total = wa + wb
-        return mu * np.where(lower_a, total / np.where(lower_a, wb, 1.0),
-                             np.where(lower_b, total / np.where(lower_b, wa, 1.0), 1.0))
-
-    def _warm_tangent(self, value0: np.ndarray, limit: np.ndarray, mu: np.ndarray) -> np.ndarray:
-        """Last step's tangential pushes (impulses) of friction as this step's first guess, within
-        the friction limit ``mu`` of the normal ones ``limit`` (none without friction)."""
-        if mu is NO_FRICTION:
-            return np.zeros(self.cs.size)
-        bound = mu * limit
-        return np.clip(value0, -bound, bound)
-
-    def _step_motion(self, rows: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """How far each of ``rows`` (now at ``x, y``) moved this step before the solve (rows
-        spawned during the step: not at all): the slip friction undoes."""
-        fx, fy = self.frame.start_x, self.frame.start_y
-        mx, my = np.zeros(rows.size), np.zeros(rows.size)
-        if self.mu is not NO_FRICTION and fx.size:
-            known = rows < fx.size
-            mx[known], my[known] = x[known] - fx[rows[known]], y[known] - fy[rows[known]]
-        return mx, my
-
     def _push_cap(self) -> np.ndarray:
         """Per contact, the longest push worth remembering: the smaller half-thickness of its two
         bodies (a push that long in one step is a body being pushed out of a heap, not resting)."""
@@ -310,15 +277,20 @@ class Solve:
         _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
                                                self.push, self.dx, self.dy, self.iterations,
                                                self.tolerance if tolerance is None else tolerance, self.dirty,
-                                               self.reach, self.position_mu, self.share_a, self.share_b, self.tpush,
-                                               self.mx, self.my)
+                                               self.reach, *self._friction_positions())
         self._place()
         return bool(held)
+
+    def _friction_positions(self) -> tuple[np.ndarray, ...]:
+        fr = self.fr
+        return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)
 
     def _place(self) -> None:
         moved = np.flatnonzero((self.dx != 0.0) | (self.dy != 0.0))
         if moved.size:
             self.store.place(self.rows[moved], self.x0[moved] + self.dx[moved], self.y0[moved] + self.dy[moved])
+        if self.fr is not None and self.fr.turns:
+            self.fr.place_turns(self.store, self.rows)
 
     def _shift(self, idx: np.ndarray) -> np.ndarray:
         """How far the solve has moved the bodies of contacts ``idx`` apart along their normals."""
@@ -482,7 +454,6 @@ class Solve:
         self.tpush = cat([self.tpush, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
         self._columns()
-        self.mx, self.my = self._step_motion(rows, x0, y0)  # (friction may have come with the new contacts)
         self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
@@ -501,29 +472,36 @@ class Solve:
         wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, self.rows.size)
         vx += wx
         vy += wy
-        velocity_mu = self._friction_limits(share_a, share_b)
-        self.timpulse = self._warm_tangent(cs.timpulse0, self.impulse, velocity_mu)
-        if self.timpulse.any():
-            wx, wy = solver.warm_start(a, b, -cs.ny, cs.nx, self.share_a, self.share_b, self.timpulse, self.rows.size)
-            vx += wx
-            vy += wy
+        self.timpulse = np.zeros(cs.size)
+        fr = self.fr
+        friction = NO_FRICTION_VELOCITIES
+        if fr is not None:
+            spin = store.w[self.rows].copy()
+            limits = fr.limits(share_a, share_b)
+            self.timpulse = fr.clip(cs.timpulse0, self.impulse, limits)
+            if self.timpulse.any():
+                wx, wy, turn = fr.spread(a, b, cs.nx, cs.ny, self.timpulse, self.rows.size)
+                vx += wx
+                vy += wy
+                spin += turn
+            friction = fr.velocities_args(limits, self.timpulse, spin)
         target = np.zeros(cs.size)
         gx, gy = self.gravity
         tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
         solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
-                                self.iterations, tol, np.ones(cs.size, dtype=bool), velocity_mu, self.share_a,
-                                self.share_b, self.timpulse)
+                                self.iterations, tol, np.ones(cs.size, dtype=bool), *friction)
         bounce = self._bounce_targets(u, act)
         movable = store.movable(self.rows)
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, share_a, share_b, self.impulse,
-                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool), velocity_mu,
-                                    self.share_a, self.share_b, self.timpulse)
+                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool), *friction)
             if not self.solo[bounce > 0.0].all():
                 self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy)
         rows = self.rows[movable]
         store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
+        if fr is not None and fr.turns:
+            store.w[rows] = spin[movable]
 
     def _velocity_shares(self, vx: np.ndarray, vy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Shares of the velocity impulses. As for the pushes, the lower body of a supported resting
@@ -613,9 +591,9 @@ class Solve:
         frame.resolved = (ea, eb, nx, ny, self.push[acted])
         gap = np.maximum(self._separations()[acted], 0.0)
         push = np.minimum(self.push, self._push_cap())[acted]  # (see _warm_pushes)
-        mu = self.position_mu
-        cap = mu[acted] * push if mu is not NO_FRICTION else np.zeros(acted.size)
-        tpush = np.clip(self.tpush[acted], -cap, cap)
+        tpush = np.zeros(acted.size)
+        if self.fr is not None:
+            tpush = self.fr.clip(self.tpush[acted], push, self.position_mu[acted])
         frame.support = (ea, eb, nx, ny, push, self.impulse[acted], gap, tpush, self.timpulse[acted])
         frame.counters["resolved"] = int(acted.size)
 

@@ -64,7 +64,7 @@ def _within(change, share, sign, ex, ey, nx, ny, reach):
 
 @njit(cache=True)
 def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, reach,
-                    mu, tshare_a, tshare_b, tpush, mx, my):
+                    mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, tpush, mx, my, mturn, dturn):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
     exit) and the per-body displacements ``dx, dy`` (which must already hold the warm start's
     displacement) are updated in place. ``dirty``: the contacts to look at first; on return, those
@@ -73,11 +73,14 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
 
     Friction (``mu``, per contact; empty for none): tangential pushes ``tpush`` (warm start in,
     solution out; along ``t = (-ny, nx)``), with ``|tpush| <= mu * push``, undo the bodies' slip
-    along the contact over the step (``mx, my``: each body's motion this step before the solve),
-    so a body held by static friction does not creep. They are shared by ``tshare_a, tshare_b``
-    (by inverse mass: a box sliding on another drags it, whatever holds the lower one up);
-    ``mu`` is then the limit in those units (see ``Solve._friction_limits``). Returns ``(passes
-    made, whether a push was held back)``."""
+    along the contact over the step, so a body held by static friction does not creep. The slip
+    at the contact point: the bodies' motion this step before the solve (``mx, my``, turns
+    ``mturn``) plus the solve's (``dx, dy``, turns ``dturn``), a turn counting with the body's
+    lever arm along the contact (``arm_a, arm_b``: ``r x t`` from its centre to the point). A unit
+    of tangential push moves a body by ``tshare`` (by inverse mass: a box sliding on another
+    drags it, whatever holds the lower one up) and turns it by ``turn`` (``1/I`` times its arm,
+    over the pair's effective inverse mass); ``mu`` is the limit in those units (see
+    ``Solve._friction_limits``). Returns ``(passes made, whether a push was held back)``."""
     friction = mu.size > 0
     moved = np.full(dx.size, -1, dtype=np.int64)  # the last pass in which each body moved
     x0, y0 = dx.copy(), dy.copy()
@@ -113,7 +116,8 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
             if not friction:
                 continue
             tx, ty = -ny[i], nx[i]
-            slip = (mx[ib] + dx[ib] - mx[ia] - dx[ia]) * tx + (my[ib] + dy[ib] - my[ia] - dy[ia]) * ty
+            slip = ((mx[ib] + dx[ib] - mx[ia] - dx[ia]) * tx + (my[ib] + dy[ib] - my[ia] - dy[ia]) * ty
+                    + arm_b[i] * (mturn[ib] + dturn[ib]) - arm_a[i] * (mturn[ia] + dturn[ia]))
             limit = mu[i] * push[i]
             new = min(max(tpush[i] - slip, -limit), limit)
             change = new - tpush[i]
@@ -131,6 +135,8 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
             dy[ia] -= tshare_a[i] * change * ty
             dx[ib] += tshare_b[i] * change * tx
             dy[ib] += tshare_b[i] * change * ty
+            dturn[ia] -= turn_a[i] * change
+            dturn[ib] += turn_b[i] * change
             if abs(change) > tolerance:
                 moved[ia] = moved[ib] = it
                 any_moved = True
@@ -142,13 +148,14 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
 
 @njit(cache=True)
 def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty,
-                     mu, tshare_a, tshare_b, timpulse):
+                     mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, timpulse, w):
     """Projected Gauss-Seidel on the normal velocities: ``impulse`` (warm start on entry; the
     velocities ``vx, vy`` must already include it) and the velocities are updated in place;
     ``dirty`` as in :func:`solve_positions`. Friction (``mu``; empty for none): tangential
-    impulses ``timpulse`` along ``t = (-ny, nx)``, ``|timpulse| <= mu * impulse``, shared by
-    ``tshare_a, tshare_b``, stop the bodies sliding along the contact (Coulomb: a contact that
-    needs more slides, braked by the limit). Returns the passes made."""
+    impulses ``timpulse`` along ``t = (-ny, nx)``, ``|timpulse| <= mu * impulse``, stop the
+    bodies sliding along the contact at its point (Coulomb: a contact that needs more slides,
+    braked by the limit); they change the velocities by ``tshare`` and the angular velocities
+    ``w`` by ``turn`` (as the pushes in :func:`solve_positions`). Returns the passes made."""
     friction = mu.size > 0
     moved = np.full(vx.size, -1, dtype=np.int64)
     for it in range(passes):
@@ -173,8 +180,8 @@ def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx,
                 if abs(change) > tolerance:
                     moved[ia] = moved[ib] = it
                     any_moved = True
-            if friction and _stop_sliding(i, ia, ib, nx, ny, mu[i] * impulse[i], tshare_a, tshare_b, timpulse, vx, vy,
-                                          tolerance):
+            if friction and _stop_sliding(i, ia, ib, nx, ny, mu[i] * impulse[i], tshare_a, tshare_b, turn_a, turn_b,
+                                          arm_a, arm_b, timpulse, vx, vy, w, tolerance):
                 moved[ia] = moved[ib] = it
                 any_moved = True
         if not any_moved:
@@ -184,12 +191,13 @@ def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx,
 
 
 @njit(cache=True)
-def _stop_sliding(i, ia, ib, nx, ny, limit, tshare_a, tshare_b, timpulse, vx, vy, tolerance):
+def _stop_sliding(i, ia, ib, nx, ny, limit, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, timpulse, vx, vy, w,
+                  tolerance):
     """Friction's update of contact ``i`` in :func:`solve_velocities` (a function of its own, off
     the frictionless path: inside the loop it made that path 45% slower, numba 0.68). Whether it
     changed the velocities by more than ``tolerance``."""
     tx, ty = -ny[i], nx[i]
-    ut = (vx[ib] - vx[ia]) * tx + (vy[ib] - vy[ia]) * ty
+    ut = (vx[ib] - vx[ia]) * tx + (vy[ib] - vy[ia]) * ty + arm_b[i] * w[ib] - arm_a[i] * w[ia]
     new = min(max(timpulse[i] - ut, -limit), limit)
     change = new - timpulse[i]
     if change == 0.0:
@@ -199,6 +207,8 @@ def _stop_sliding(i, ia, ib, nx, ny, limit, tshare_a, tshare_b, timpulse, vx, vy
     vy[ia] -= tshare_a[i] * change * ty
     vx[ib] += tshare_b[i] * change * tx
     vy[ib] += tshare_b[i] * change * ty
+    w[ia] -= turn_a[i] * change
+    w[ib] += turn_b[i] * change
     return abs(change) > tolerance
 
 

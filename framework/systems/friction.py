@@ -1,0 +1,125 @@
+"""Friction's part of one solve: per-contact coefficients and lever arms, per-body slip and turn.
+
+Coulomb friction at a contact resists the two bodies sliding along it at its point, up to ``mu``
+times what presses them together (see docs/physics.md). The solver loops
+(:mod:`framework.systems.solver_loops`) do the work, in the same units as the normal pushes and
+impulses: a unit of tangential push (impulse) changes the bodies' relative slip (slip speed) at the
+contact point by exactly one unit. This module prepares what they read:
+
+- ``mu``: the pair's coefficient (:meth:`BodyStore.pair_friction`), and, per normal share, the
+  limit in the loops' units (:meth:`Friction.limits`);
+- ``tshare``, ``turn``: how far a unit moves and turns each body. A body moves by its inverse
+  mass and turns by its inverse inertia times its lever arm ``r x t`` (the arm from its centre to
+  the contact point, across the tangent), both over the pair's effective inverse mass along the
+  tangent, ``k = w_a + w_b + i_a arm_a^2 + i_b arm_b^2``;
+- per body, its motion this step before the solve (``mx, my``, turn ``mturn``): the slip the
+  position solve undoes, so static friction holds a body without creep.
+
+Which bodies turn: dynamic circles centred on their entity (``inv_inertia > 0`` in the store), and
+only with the ``rotation`` effect; a circle's arm is its radius (the point is on its rim, along the
+normal), so friction rolls it. Other shapes have no arm yet: boxes and polygons do not turn from
+contacts (issue 23, part 2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..collision.kinds import KIND_CIRCLE
+from ..frame import StepFrame
+from ..store import STATIC, BodyStore
+from .solver_loops import warm_start
+
+__all__ = ["NO_FRICTION_POSITIONS", "NO_FRICTION_VELOCITIES", "Friction"]
+
+_NONE = np.zeros(0)
+# the loops' friction arguments in a solve without friction
+NO_FRICTION_POSITIONS = (_NONE,) * 12
+NO_FRICTION_VELOCITIES = (_NONE,) * 9
+
+
+class Friction:
+    """The friction columns of one solve's contacts ``(ra, rb)`` (local bodies ``a``, ``b``, shares
+    of inverse mass ``wa``, ``wb``; sleepers count as immovable)."""
+
+    def __init__(self, store: BodyStore, ra: np.ndarray, rb: np.ndarray, wa: np.ndarray, wb: np.ndarray,
+                 mu: np.ndarray, rotation: bool) -> None:
+        self.mu = mu
+        self.wa, self.wb = wa, wb
+        self.arm_a = np.where(store.kind[ra] == KIND_CIRCLE, store.radius[ra], 0.0)
+        self.arm_b = np.where(store.kind[rb] == KIND_CIRCLE, -store.radius[rb], 0.0)
+        if rotation:
+            ia = np.where(store.asleep[ra], 0.0, store.inv_inertia[ra])
+            ib = np.where(store.asleep[rb], 0.0, store.inv_inertia[rb])
+        else:
+            ia = ib = np.zeros(ra.size)
+        self.k = wa + wb + ia * self.arm_a * self.arm_a + ib * self.arm_b * self.arm_b
+        inv = 1.0 / self.k
+        self.tshare_a, self.tshare_b = wa * inv, wb * inv
+        self.turn_a, self.turn_b = ia * self.arm_a * inv, ib * self.arm_b * inv
+        self.turns = bool(ia.any() or ib.any())
+
+    @classmethod
+    def of(cls, store: BodyStore, ra: np.ndarray, rb: np.ndarray, wa: np.ndarray, wb: np.ndarray,
+           rotation: bool) -> Friction | None:
+        """The columns, or None when no pair has friction."""
+        mu = store.pair_friction(ra, rb)
+        return cls(store, ra, rb, wa, wb, mu, rotation) if mu.any() else None
+
+    def limits(self, share_a: np.ndarray, share_b: np.ndarray) -> np.ndarray:
+        """Per contact, the largest tangential push (impulse) per unit of normal push (impulse),
+        in the loops' units, for normal pushes shared by ``share_a, share_b``: ``mu`` times the
+        tangential effective inverse mass over the normal one. Where shock propagation keeps a
+        pair's lower body still for the normal push, a unit of it is the upper body's mass worth of
+        impulse, not the pair's, and the limit grows by the ratio (two equal boxes: twice)."""
+        wa, wb = self.wa, self.wb
+        lower_a = (share_a == 0.0) & (wa > 0.0)  # a keeps still although it could move
+        lower_b = (share_b == 0.0) & (wb > 0.0)
+        k_normal = np.where(lower_a, wb, np.where(lower_b, wa, wa + wb))
+        return self.mu * (self.k / k_normal)
+
+    def start(self, frame: StepFrame, store: BodyStore, rows: np.ndarray, x: np.ndarray, y: np.ndarray,
+              before: Friction | None = None) -> None:
+        """Per body (``rows``, standing at ``x, y`` when the solve began): its motion this step
+        before the solve, and its turn by the solve so far (the bodies ``before`` knew keep theirs;
+        contacts were added during the solve)."""
+        fx, fy = frame.start_x, frame.start_y
+        n = rows.size
+        self.mx, self.my, self.mturn = np.zeros(n), np.zeros(n), np.zeros(n)
+        known = rows < fx.size  # (rows spawned during the step did not move before it)
+        self.mx[known], self.my[known] = x[known] - fx[rows[known]], y[known] - fy[rows[known]]
+        moving = known & store.has_vel[rows] & ~store.asleep[rows] & (store.body[rows] != STATIC)
+        self.mturn[moving] = store.w[rows[moving]] * frame.dt
+        self.rot0 = store.rot[rows].copy()
+        self.dturn = np.zeros(n)
+        if before is not None:
+            k = before.dturn.size
+            self.rot0[:k], self.dturn[:k] = before.rot0, before.dturn
+
+    def clip(self, value: np.ndarray, normal: np.ndarray, limits: np.ndarray) -> np.ndarray:
+        """Tangential values (last step's, as a warm start) within the limits of the normal ones."""
+        bound = limits * normal
+        return np.clip(value, -bound, bound)
+
+    def spread(self, a: np.ndarray, b: np.ndarray, nx: np.ndarray, ny: np.ndarray, value: np.ndarray,
+               n_bodies: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per body, the ``(x, y, turn)`` changes the tangential ``value`` of every contact makes
+        (a warm start)."""
+        ox, oy = warm_start(a, b, -ny, nx, self.tshare_a, self.tshare_b, value, n_bodies)
+        turn = np.bincount(b, self.turn_b * value, n_bodies) - np.bincount(a, self.turn_a * value, n_bodies)
+        return ox, oy, turn
+
+    def positions_args(self, limits: np.ndarray, tpush: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:func:`solve_positions`' friction arguments."""
+        return (limits, self.tshare_a, self.tshare_b, self.turn_a, self.turn_b, self.arm_a, self.arm_b, tpush,
+                self.mx, self.my, self.mturn, self.dturn)
+
+    def velocities_args(self, limits: np.ndarray, timpulse: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:func:`solve_velocities`' friction arguments."""
+        return (limits, self.tshare_a, self.tshare_b, self.turn_a, self.turn_b, self.arm_a, self.arm_b, timpulse, w)
+
+    def place_turns(self, store: BodyStore, rows: np.ndarray) -> None:
+        """Turn the bodies the position solve turned."""
+        turned = np.flatnonzero(self.dturn != 0.0)
+        if turned.size:
+            store.rot[rows[turned]] = self.rot0[turned] + self.dturn[turned]
