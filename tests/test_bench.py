@@ -309,6 +309,30 @@ def test_every_engine_builds_the_same_bodies():
     assert {e.name for e in engines} == {"ours"} | {n for n, m in reg.peer_modules().items() if m}
 
 
+@pytest.mark.parametrize("shape", ["crate", "disk"])
+def test_friction_regimes_give_every_engine_the_same_friction(shape):
+    # A crate at 5 units/s on a floor, mu 1/2, g 10: every engine stops it near v^2 / (2 mu g) = 2.5
+    # (within a step's travel); a rolling disk thrown at 3 without spin ends rolling at 2 in each.
+    crate = shape == "crate"
+    piece = reg.Piece(AABB(1.0, 1.0) if crate else Circle(0.5), 0.0, 0.5, vx=5.0 if crate else 3.0)
+    floor = reg.Piece(AABB(100.0, 1.0), 0.0, -0.5, kind="static")
+    regime = reg.with_friction(reg.Regime("one", "pile", [floor, piece]), 0.5, rolling=not crate)
+    engines = reg.make_engines(regime)
+    try:
+        for eng in engines:
+            for _ in range(120):
+                eng.step()
+            x, _, vx, _, _ = eng.state()
+            if crate:
+                assert x[1] == pytest.approx(2.5, abs=5.0 / 60.0), eng.name
+                assert abs(vx[1]) < 1e-6, eng.name
+            else:
+                assert vx[1] == pytest.approx(2.0, abs=0.02), eng.name
+    finally:
+        for eng in engines:
+            eng.close()
+
+
 def test_regimes_report_of_a_tiny_configuration(tmp_path):
     report = reg.run_regimes(TINY_REGIMES, scenes=("stack-20", "scattered-10", "platformer-1"), crowds=("boxes",),
                              progress=False)

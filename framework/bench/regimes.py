@@ -115,7 +115,8 @@ class Regime:
 
     ``top``: indices of the pieces of the pile's top row, whose exact resting centre height is
     ``exact_top`` (``None`` where no exact answer exists); ``height``: the pile's height, for the
-    sink ratio. ``friction``: every body's coefficient (the pair's, in all three engines; 0: none).
+    sink ratio. ``friction``: every body's coefficient (the pair's, in all three engines; 0: none);
+    ``rolling``: the circles may turn (a solid disk's inertia in every engine; else no body turns).
     ``kind`` picks the untimed steps before timing (:data:`SETTLE`). ``dynamic_pairs``:
     whether overlaps between two moving bodies count in the penetration figure. ``pit``: ``(minx, maxx, floor)`` for the
     crowds' outside count."""
@@ -128,6 +129,7 @@ class Regime:
     effects: frozenset[str] | None = None
     sleeping: bool = False
     friction: float = 0.0
+    rolling: bool = False
     top: list[int] = field(default_factory=list)
     exact_top: float | None = None
     height: float | None = None
@@ -226,9 +228,10 @@ def scattered(n: int, seed: int = 0) -> Regime:
                   effects=frozenset(PERF_EFFECTS))
 
 
-def with_friction(regime: Regime, mu: float = 0.5) -> Regime:
-    """``regime`` with friction ``mu`` between every pair of bodies, named ``<name>-friction``."""
-    return replace(regime, name=f"{regime.name}-friction", friction=mu)
+def with_friction(regime: Regime, mu: float = 0.5, rolling: bool = False) -> Regime:
+    """``regime`` with friction ``mu`` between every pair of bodies, named ``<name>-friction``
+    (``rolling``: and its circles roll, ``<name>-rolling``)."""
+    return replace(regime, name=f"{regime.name}-{'rolling' if rolling else 'friction'}", friction=mu, rolling=rolling)
 
 
 def crowd(kind: str, seed: int = 0, bodies: int = CROWD["bodies"]) -> Regime:
@@ -357,10 +360,11 @@ class Ours(Engine):
         effects = regime.effects or (DEFAULT_EFFECTS if regime.sleeping else DEFAULT_EFFECTS - {"sleeping"})
         scene = self.scene = Scene(gravity=regime.gravity, effects=effects)
         mu = regime.friction or None
+        inertia = None if regime.rolling else math.inf  # (only circles turn, and only from friction)
         self.entities = [scene.spawn(Transform(p.x, p.y), Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu))
                          if p.kind == "static" else
                          scene.spawn(Transform(p.x, p.y), Velocity(p.vx, p.vy),
-                                     Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu))
+                                     Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu, inertia=inertia))
                          for p in regime.pieces]
         dt = regime.dt
         self._step = lambda: scene.step(dt)
@@ -465,7 +469,8 @@ class Peer(Engine):
 
 
 class PymunkEngine(Peer):
-    """pymunk: dynamic pieces on ``Body(1, inf)`` (mass 1, no rotation), kinematic ones on kinematic
+    """pymunk: dynamic pieces on ``Body(1, inf)`` (mass 1, no rotation; a rolling regime's circles
+    ``Body(1, r^2 / 2)``), kinematic ones on kinematic
     bodies, static ones as shapes of the space's static body; elasticity 0, friction the square root
     of the regime's on every shape (pymunk multiplies a pair's: the pair then has the regime's); sleeping
     (when the regime sleeps) after ``SLEEP_TIME`` s idle; everything else pymunk's defaults."""
@@ -483,8 +488,9 @@ class PymunkEngine(Peer):
             if p.kind == "static":
                 body, ox, oy, handle = space.static_body, p.x, p.y, None
             else:
-                body = handle = (pymunk.Body(1.0, math.inf) if p.kind == "dynamic"
-                                 else pymunk.Body(body_type=pymunk.Body.KINEMATIC))
+                turns = regime.rolling and isinstance(p.shape, Circle)
+                body = handle = (pymunk.Body(1.0, 0.5 * p.shape.radius ** 2 if turns else math.inf)
+                                 if p.kind == "dynamic" else pymunk.Body(body_type=pymunk.Body.KINEMATIC))
                 body.position, body.velocity, ox, oy = (p.x, p.y), (p.vx, p.vy), 0.0, 0.0
                 items.append(body)
             shape = (pymunk.Circle(body, p.shape.radius, (ox, oy)) if isinstance(p.shape, Circle)
@@ -514,9 +520,10 @@ class PymunkEngine(Peer):
 
 class Box2DEngine(Peer):
     """Box2D v3 (``pyb2d3``): dynamic pieces on ``fixed_rotation`` bodies with density 1 / area (mass
-    1), kinematic ones on kinematic bodies, static ones as shapes of one static body; restitution 0,
-    the regime's friction on every shape (Box2D's pair rule is ``sqrt(f1 f2)``); ``sleeping_enabled``
-    as the regime says; ``step(dt, 4)`` (its default 4 sub-steps)."""
+    1; a rolling regime's circles turn), kinematic ones on kinematic bodies, static ones as shapes of
+    one static body; restitution 0, the regime's friction on every shape (Box2D's pair rule is
+    ``sqrt(f1 f2)``); ``sleeping_enabled`` as the regime says; ``step(dt, 4)`` (its default 4
+    sub-steps)."""
 
     name = "box2d"
 
@@ -530,7 +537,8 @@ class Box2DEngine(Peer):
                 body, ox, oy, handle = ground, p.x, p.y, None
             else:
                 make = world.create_dynamic_body if p.kind == "dynamic" else world.create_kinematic_body
-                body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy), fixed_rotation=True)
+                turns = regime.rolling and isinstance(p.shape, Circle)
+                body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy), fixed_rotation=not turns)
                 ox = oy = 0.0
             sd = b2.shape_def(density=1.0 / _area(p.shape), is_sensor=p.sensor,
                               material=b2.surface_material(friction=regime.friction, restitution=0.0))
@@ -736,6 +744,7 @@ SCENES: dict[str, Callable[[], Regime | None]] = {
     "pile-boxes-1000-friction": lambda: with_friction(box_pile(40, 25)),
     "pile-mixed-1000-friction": lambda: with_friction(shape_pile("mixed", 40, 25)),
     "pyramid-20-friction": lambda: with_friction(pyramid(20)),
+    "pile-circles-1000-rolling": lambda: with_friction(shape_pile("circles", 40, 25), rolling=True),
     "scattered-10": lambda: scattered(10),
     "scattered-100": lambda: scattered(100),
     "scattered-1000": lambda: scattered(1_000),
