@@ -130,6 +130,17 @@ def test_substeps_reduce_the_elastic_balls_energy_drift():
     assert abs(four["energy_drift"]) < abs(one["energy_drift"])
 
 
+def test_friction_rows_meet_the_analytic_answers():
+    # The crate stops v dt / 2 short of v^2 / (2 mu g) (semi-implicit Euler: 1/60 of 2.5 at one
+    # sub-step, a quarter of that at four); the rest is exact to rounding.
+    for mode, short in (("substeps-1", 1 / 60), ("substeps-4", 1 / 240)):
+        row = acc.run_friction("crate-stop", mode)
+        assert row["expected"] == 2.5 and row["rel_error"] == pytest.approx(short, rel=1e-9)
+    for case in ("slope-hold", "slope-slide", "disk-roll", "disk-slip"):
+        row = acc.run_friction(case, "substeps-1")
+        assert row["rel_error"] < 1e-12, (case, row)
+
+
 def test_resting_stack_metrics_have_the_documented_keys():
     row = acc.run_rest("stack", "response-iterations-4", steps=20)
     assert row["max_depth"] >= 0.0 and row["jitter"] >= 0.0 and row["snags"] is None

@@ -31,6 +31,14 @@ Scenarios (each has an exact reference, so every error is measured, not judged b
   energy is conserved. ``energy_drift``: the least-squares slope of the energy over 1,000 steps,
   relative to the initial energy; ``apex_drop``: how much lower than its start the last apex was,
   relative. Modes ``substeps-N``.
+- **friction**: gravity 10, friction as a game maker would set it, against the analytic answers.
+  ``crate-stop``: a crate at 5 units/s on a floor, mu 0.5, stops after ``v^2 / (2 mu g) = 2.5``;
+  ``slope-hold``: a box on a 30 degree slope with mu 0.7 (> tan 30) must not move in 5 s;
+  ``slope-slide``: with mu 0.3 it slides at ``g (sin - mu cos)``; ``disk-roll``: a solid disk on
+  that slope with mu 0.5 rolls at ``(2/3) g sin``; ``disk-slip``: with mu 0.1 (< tan 30 / 3) it
+  slips at ``g (sin - mu cos)``. ``measured`` / ``expected``: the stop distance, the distance
+  moved, or the acceleration (speed after 2 s over 2 s); ``rel_error``: their relative difference
+  (``slope-hold``: the distance itself). Modes ``substeps-N``.
 
 Sleeping is off in every scene (except ``default-sleeping``) so the solver is measured, not the
 sleep. ``ms_per_step``: median over the steps of every repeated run, timed in the same process
@@ -54,9 +62,9 @@ from .progress import Progress
 from .report import Column, format_table, frozen_gc, machine_info, median
 
 __all__ = [
-    "BULLET_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES", "ROW_KEYS", "analytic_bullet_toi",
-    "bullet_lanes", "crate_placements", "crates_overlap_exact", "markdown", "run_accuracy", "run_ball",
-    "run_bullets", "run_crates", "run_rest", "text_report",
+    "BULLET_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES", "FRICTION_CASES", "FRICTION_MODES", "ROW_KEYS",
+    "analytic_bullet_toi", "bullet_lanes", "crate_placements", "crates_overlap_exact", "markdown", "run_accuracy",
+    "run_ball", "run_bullets", "run_crates", "run_friction", "run_rest", "text_report",
 ]
 
 DT = 1.0 / 60.0
@@ -73,7 +81,9 @@ CRATE_MODES = ("aabb", "aabb-bounds", "circle", "polygon")
 REST_MODES = ("response-iterations-1", "response-iterations-2", "response-iterations-4",
               "response-iterations-8", "substeps-2", "substeps-4", "substeps-8", "default-sleeping")
 BALL_MODES = ("substeps-1", "substeps-2", "substeps-4", "substeps-8")
-SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball")
+FRICTION_MODES = ("substeps-1", "substeps-2", "substeps-4")
+FRICTION_CASES = ("crate-stop", "slope-hold", "slope-slide", "disk-roll", "disk-slip")
+SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction")
 DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
 
 FULL = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3, "crate_steps": 10,
@@ -84,7 +94,8 @@ CROWD_MODES = REST_MODES[:-1]
 CROWD_BOXES = 64
 
 ROW_KEYS = ["scenario", "mode", "speed", "ms_per_step", "missed", "undetected", "stop_error", "fp_rate", "fn_rate",
-            "max_depth", "jitter", "sink", "snags", "residual", "energy_drift", "apex_drop", "samples", "steps"]
+            "max_depth", "jitter", "sink", "snags", "residual", "energy_drift", "apex_drop", "case", "measured",
+            "expected", "rel_error", "samples", "steps"]
 
 
 def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
@@ -445,6 +456,56 @@ def run_crowd(mode: str, crowds: int = 5, boxes: int = CROWD_BOXES) -> dict[str,
                 max_depth=float(np.mean(deepest)), residual=float(np.mean(residual)))
 
 
+# --- friction -----------------------------------------------------------------------------------------
+
+FRICTION_G = 10.0
+SLOPE = math.radians(30.0)
+
+
+def run_friction(case: str, mode: str, runs: int = 1) -> dict[str, Any]:
+    """One friction case (see the module's docstring) in one mode; the row."""
+    times: list[float] = []
+    measured = expected = 0.0
+    steps = 0
+    for _ in range(runs):
+        ms, measured, expected, steps = _friction_run(case, mode)
+        times += ms
+    error = abs(measured) if case == "slope-hold" else abs(measured - expected) / expected
+    return _row("friction", mode, case=case, ms_per_step=median(times), measured=measured, expected=expected,
+                rel_error=error, samples=1, steps=steps)
+
+
+def _friction_run(case: str, mode: str) -> tuple[list[float], float, float, int]:
+    g, sin, cos = FRICTION_G, math.sin(SLOPE), math.cos(SLOPE)
+    scene = _scene_for(mode, gravity=(0.0, -g))
+    try:
+        if case == "crate-stop":
+            scene.spawn(Transform(0.0, -0.5), Hitbox(AABB(100.0, 1.0), body="static"))
+            body = scene.spawn(Transform(0.0, 0.5), Velocity(5.0, 0.0), Hitbox(AABB(1.0, 1.0), friction=0.5))
+            times = _timed_steps(scene, 120)  # it stops after 1 s
+            return times, scene.get(body, Transform).x, 25.0 / (2.0 * 0.5 * g), 120
+        length = 60.0  # a static triangle whose long side is the slope, rising to the right through (0, 0)
+        scene.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-length * cos, -length * sin), (length * cos, length * sin),
+                                                         (length * cos, -length * sin)]), body="static"))
+        mu = {"slope-hold": 0.7, "slope-slide": 0.3, "disk-roll": 0.5, "disk-slip": 0.1}[case]
+        if case.startswith("slope"):  # a box with its lower right corner on the slope at the origin
+            body = scene.spawn(Transform(-0.5, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=mu))
+        else:  # a disk of radius 1/2 touching the slope at the origin
+            body = scene.spawn(Transform(-0.5 * sin, 0.5 * cos), Velocity(), Hitbox(Circle(0.5), friction=mu))
+        t = scene.get(body, Transform)
+        x0, y0 = t.x, t.y
+        steps = 300 if case == "slope-hold" else 120
+        times = _timed_steps(scene, steps)
+        if case == "slope-hold":
+            return times, math.hypot(t.x - x0, t.y - y0), 0.0, steps
+        v = scene.get(body, Velocity)
+        accel = -(v.x * cos + v.y * sin) / (steps * DT)
+        expected = (2.0 / 3.0) * g * sin if case == "disk-roll" else g * (sin - mu * cos)
+        return times, accel, expected, steps
+    finally:
+        scene.close()
+
+
 # --- the whole benchmark ------------------------------------------------------------------------------
 
 
@@ -473,6 +534,10 @@ def run_accuracy(config: dict[str, Any] | None = None, progress: bool = True, qu
     if "ball" in want:
         for mode in BALL_MODES:
             jobs.append((f"ball {mode}", lambda m=mode: run_ball(m, cfg["ball_steps"], cfg["runs"])))
+    if "friction" in want:
+        for case in FRICTION_CASES:
+            for mode in FRICTION_MODES:
+                jobs.append((f"friction {case} {mode}", lambda c=case, m=mode: run_friction(c, m, cfg["runs"])))
     rows = []
     with Progress(len(jobs), "accuracy", enabled=progress) as bar:
         for name, job in jobs:
@@ -512,6 +577,9 @@ TABLES: dict[str, tuple[str, list[Column]]] = {
     "ball": ("Ball with restitution 1 bouncing on a floor",
              [*_COMMON, ("energy_drift", "energy drift / 1,000 steps", "pct"),
               ("apex_drop", "last apex lower by", "pct")]),
+    "friction": ("Friction and rolling against the analytic answers (g = 10; slope 30 degrees)",
+                 [("case", "case", "str"), *_COMMON, ("measured", "measured", "g"), ("expected", "exact", "g"),
+                  ("rel_error", "relative error (hold: distance)", "sci")]),
 }
 
 
