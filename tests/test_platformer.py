@@ -681,3 +681,60 @@ def test_an_enemy_that_falls_out_of_the_level_is_removed():
     g.scene.get(g.scene.query(Enemy)[0][0], Enemy).direction = 1
     steps(g, 90)
     assert not g.scene.query(Enemy) and g.state.deaths == 0
+
+
+# --- crates and barrels (friction and rolling) ---------------------------------------------------------
+
+
+def _prop(g: Game, kind: str) -> int:
+    from examples.platformer.components import LevelPiece
+
+    return next(e for e, p in g.scene.query(LevelPiece) if p.kind == kind)
+
+
+def test_a_crate_moves_while_the_player_pushes_it_and_stops_when_it_stops():
+    g = make("""
+....................
+.P.B................
+####################
+""")
+    crate = _prop(g, "crate")
+    x0 = g.scene.get(crate, Transform).x
+    steps(g, 60, {"right"})
+    pushed = g.scene.get(crate, Transform).x
+    assert pushed > x0 + 3 * T  # pushed along, several tiles in a second
+    assert g.scene.get(crate, Velocity).x > 0.5 * RUN
+    steps(g, 60)  # let go: friction (0.6 of g) stops it within a fraction of a second
+    v = g.scene.get(crate, Velocity).x
+    stop = g.scene.get(crate, Transform).x
+    assert v == 0.0
+    # it slides at most v^2 / (2 mu g) past where the push ended (plus a step of travel)
+    assert stop - pushed <= RUN ** 2 / (2 * TU.prop_friction * G) + RUN * DT
+    assert g.scene.get(crate, Transform).y == pytest.approx(T + TU.crate_size * T / 2, abs=1e-6)  # on the floor
+
+
+def test_a_barrel_pushed_along_rolls_on_and_off_a_ledge():
+    g = make("""
+.......................
+.P.O...................
+##########.............
+""")
+    barrel = _prop(g, "barrel")
+    steps(g, 20, {"right"})
+    v = g.scene.get(barrel, Velocity)
+    assert v.x > 0.0 and v.angular == pytest.approx(-v.x / (TU.barrel_radius * T), rel=1e-6)  # rolling
+    steps(g, 120)  # let go: a rolling barrel keeps rolling (no rolling resistance) ...
+    t = g.scene.get(barrel, Transform)
+    assert t.x > 10 * T and t.y < T  # ... off the ledge at x = 10 tiles, falling
+
+
+def test_crates_and_barrels_come_from_text_and_tiled_maps():
+    level = parse_text("""
+.P.B.O..
+########
+""", "props.txt")
+    assert [o.kind for o in level.objects if o.kind in ("crate", "barrel")] == ["crate", "barrel"]
+    again = parse_tmj(to_tmj(level), "props.tmj")
+    assert [(o.kind, o.x, o.bottom) for o in again.objects] == [(o.kind, o.x, o.bottom) for o in level.objects]
+    shipped = load_level(builtin_levels()[0])
+    assert {o.kind for o in shipped.objects} >= {"crate", "barrel"}

@@ -41,6 +41,10 @@ class Tuning:
     player_size: tuple[float, float] = (0.75, 0.875)  # tiles
     enemy_size: tuple[float, float] = (0.75, 0.6875)
     coin_radius: float = 0.25
+    crate_size: float = 0.875      # tiles (a square)
+    crate_mass: float = 2.0        # the player's is 1
+    barrel_radius: float = 0.375   # tiles
+    prop_friction: float = 0.6     # crates and barrels (the player's hitbox has none: its speed is the game's)
 
 
 @dataclass

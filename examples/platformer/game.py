@@ -49,8 +49,9 @@ DT = 1.0 / 60.0
 COLORS = {
     "solid": (86, 98, 128), "oneway": (176, 134, 82), "spikes": (226, 70, 70), "player": (84, 176, 255),
     "enemy": (196, 84, 164), "coin": (255, 212, 64), "goal": (90, 224, 120), "checkpoint": (150, 150, 150),
-    "platform": (214, 170, 96),
+    "platform": (214, 170, 96), "crate": (168, 112, 64), "barrel": (120, 84, 52),
 }
+PROP_MASK = SOLID | ONE_WAY | PLAYER | ENEMY  # crates and barrels: solid to everything that moves
 PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
 ART_TILE = 32.0  # the tile images (see art.py) are drawn for 32-unit tiles; other sizes get colours
 IMAGES = {name: Path(__file__).with_name("images") / f"{name}.png" for name in (
@@ -159,6 +160,16 @@ class Game:
                     self._spikes(x, obj.bottom, obj.width / n, piece)
             elif obj.kind == "platform":
                 self._platform(obj, t, piece)
+            elif obj.kind == "crate":
+                s = tu.crate_size * t
+                piece("crate", Transform(obj.x, obj.bottom + s * 0.5), Velocity(), Hitbox(
+                    AABB(s, s), layer=SOLID, mask=PROP_MASK, mass=tu.crate_mass, friction=tu.prop_friction),
+                    Visual(COLORS["crate"], z=2))
+            elif obj.kind == "barrel":
+                r = tu.barrel_radius * t
+                piece("barrel", Transform(obj.x, obj.bottom + r), Velocity(), Hitbox(
+                    Circle(r), layer=SOLID, mask=PROP_MASK, friction=tu.prop_friction),
+                    Visual(COLORS["barrel"], z=2))
             elif obj.kind == "enemy":
                 w, h = tu.enemy_size[0] * t, tu.enemy_size[1] * t
                 speed = float(obj.props.get("speed", 2.0)) * t
@@ -168,7 +179,7 @@ class Game:
         st.coin_total_in_level = len(level.of_kind("coin"))
         w, h = tu.player_size[0] * t, tu.player_size[1] * t
         st.player = piece("player", Transform(start.x, start.bottom + h * 0.5), Velocity(),
-                          Hitbox(AABB(w, h), layer=PLAYER, mask=PLAYER_MASK), Player(),
+                          Hitbox(AABB(w, h), layer=PLAYER, mask=PLAYER_MASK, friction=0.0), Player(),
                           look("player_right", "player", 4))
         systems.follow_camera(scene, 0.0)
 

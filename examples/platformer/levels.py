@@ -9,6 +9,7 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
     #  solid tile          -  one-way platform     ^  spikes
     P  player start        C  coin                 E  enemy
     K  checkpoint          G  goal                 .  empty (so is a space)
+    B  crate (pushable)    O  barrel (rolls)
     M  moving platform (a run of M is one platform, half a tile thick, one-way)
     ~  the cells a moving platform sweeps: to its right, left, above or below (one side)
 
@@ -20,7 +21,7 @@ or per tile from the tileset (each tile's ``type``/``class`` or ``kind`` propert
 ``background`` or ``decoration`` (or ``kind`` = ``decoration``) are ignored. Layer ``data`` may
 be a plain array or base64 (uncompressed, zlib or gzip). One object layer (or more) holds
 objects whose ``type``/``class`` (or ``name``) is ``player``, ``coin``, ``enemy``, ``goal``,
-``checkpoint``, ``platform`` or ``spikes``; points and rectangles both work. Properties:
+``checkpoint``, ``platform``, ``spikes``, ``crate`` or ``barrel``; points and rectangles both work. Properties:
 ``platform``: ``dx``, ``dy`` (travel in tiles, y up), ``speed`` (tiles/s), ``one_way`` (bool);
 ``enemy``: ``speed`` (tiles/s), ``direction`` (-1 left, 1 right).
 
@@ -47,12 +48,13 @@ __all__ = [
 
 LEVEL_DIR = Path(__file__).with_name("levels")
 TILE_KINDS = ("solid", "oneway", "spikes")
-OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes")
+OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel")
 DECORATION = ("background", "decoration")
 DEFAULT_TILE = 32.0
 
 _TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes"}
-_TEXT_OBJECTS = {"P": "player", "C": "coin", "E": "enemy", "G": "goal", "K": "checkpoint"}
+_TEXT_OBJECTS = {"P": "player", "C": "coin", "E": "enemy", "G": "goal", "K": "checkpoint", "B": "crate",
+                 "O": "barrel"}
 _TEXT_EMPTY = ". "
 _FLIP_BITS = 0xF0000000  # Tiled's flip / rotate flags in the high bits of a gid
 
