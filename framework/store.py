@@ -86,6 +86,7 @@ class BodyStore:
         self._layers_open = False
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
         self._friction_seen = (-1, False)  # (version, whether a hitbox gives friction then)
+        self.wakes = 0  # bumped whenever a sleeping row wakes
         self.writes = 0  # bumped by every write from game code (component views)
         self.motion = 0  # bumped by every move the pipeline makes (move_by_velocity, place)
         self._lookup = np.full(1, -1, dtype=np.int64)  # entity id -> row (rows_of)
@@ -373,6 +374,7 @@ class BodyStore:
         if asleep[rows].any():
             asleep[rows] = False
             self.sleep_dirty = True
+            self.wakes += 1
         self.cols["still"][rows] = 0
 
     def write(self, entity: int, col: str, value: object) -> None:

@@ -206,10 +206,10 @@ def test_a_body_bumped_awake_has_real_contacts_and_keeps_its_floor_contact():
     assert s.get(box, Transform).y == pytest.approx(0.5, abs=1e-9)  # pushed back out, no hop
 
 
-@pytest.mark.xfail(strict=True, reason="found 2026-11-25, not fixed: sleeping has no islands. A body asleep on "
-                   "another merely touches it (they fell together), so when the lower one is woken and moved away "
-                   "sideways no pair ends and nothing wakes the upper one: it hangs where it slept")
 def test_a_sleeper_whose_support_is_moved_away_falls():
+    # A body asleep on another merely touches it (they fell together): when the game shoves the
+    # lower one away, no contact ends; the two fell asleep linked, so the upper one wakes with the
+    # lower one and falls (found 2026-11-25: it hung where it slept).
     with Scene(gravity=(0.0, -10.0)) as s:
         s.spawn(Transform(0.0, -0.5), Hitbox(AABB(100.0, 1.0), body="static"))
         low = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0)))
@@ -220,4 +220,5 @@ def test_a_sleeper_whose_support_is_moved_away_falls():
         s.get(low, Velocity).x = 3.0  # the game shoves the lower box out from under the upper one
         for _ in range(60):
             s.step(1 / 60)
-        assert s.get(top, Transform).y == pytest.approx(0.25)  # fallen to the floor
+        assert s.get(top, Transform).y == pytest.approx(0.25, abs=1e-9)  # fallen to the floor
+        assert s.counters["asleep"] == 0 or s.get(top, Velocity).y == 0.0

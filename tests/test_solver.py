@@ -16,6 +16,7 @@ import pytest
 
 from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.collision import collide
+from framework.effects import DEFAULT_EFFECTS
 from framework.systems import solver_loops as loops
 
 DT = 1.0 / 60.0
@@ -221,3 +222,21 @@ def test_a_small_fast_box_sunk_deep_into_the_floor_ends_on_top_of_it():
         t = s.get(box, Transform)
         assert (t.x, t.y) == (0.0, 0.125)
         assert collide(s.get(floor, Hitbox).shape, s.get(floor, Transform), s.get(box, Hitbox).shape, t) is None
+
+
+def test_a_box_whose_support_slides_away_sideways_falls():
+    # Resting pairs that merely touch are kept in the solve (they fell together); one whose lower
+    # body has slid out from under the upper one no longer holds it up, however small its gap
+    # along the normal (found 2026-11-25: the upper box hung in the air, held by the kept pair).
+    with Scene(gravity=(0.0, -10.0), effects=DEFAULT_EFFECTS - {"sleeping"}) as s:
+        s.spawn(Transform(0.0, -0.5), Hitbox(AABB(100.0, 1.0), body="static"))
+        low = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0)))
+        top = s.spawn(Transform(0.0, 1.25), Velocity(), Hitbox(AABB(0.5, 0.5)))
+        for _ in range(120):
+            s.step(DT)
+        assert s.get(top, Transform).y == 1.25
+        for _ in range(60):
+            s.get(low, Velocity).x = 3.0  # the game drives the lower box out from under the upper one
+            s.step(DT)
+        assert s.get(low, Transform).x > 0.75 + 0.25  # clear of it
+        assert s.get(top, Transform).y == pytest.approx(0.25, abs=1e-9) and s.get(top, Transform).x == 0.0

@@ -80,7 +80,8 @@ class Response(Stage):
         live[ok] = (store.kind[sra[ok]] >= 0) & (store.kind[srb[ok]] >= 0) & filter_layers(store, sra[ok], srb[ok])
         old, sra, srb = old[live], sra[live], srb[live]
         gaps = self._support_gaps(frame, sra, srb, snx[old], sny[old]) - ssep[old]
-        near = gaps >= -KEEP_GAP * np.minimum(store.bound[sra], store.bound[srb])
+        margin = KEEP_GAP * np.minimum(store.bound[sra], store.bound[srb])
+        near = (gaps >= -margin) & self._facing(sra, srb, snx[old], sny[old], margin)
         old, sra, srb, gaps = old[near], sra[near], srb[near], gaps[near]
         cat = np.concatenate
         return Contacts(
@@ -101,6 +102,15 @@ class Response(Stage):
         if one_way.any():
             solid &= ~one_way | self._lands_on_one_way(frame, cs)
         return solid
+
+    def _facing(self, ra, rb, nx, ny, margin) -> np.ndarray:
+        """Mask of the kept pairs whose bodies still face each other across their contact: their
+        bounds meet when grown by ``margin`` along the normal only (a box whose support slid away
+        sideways is no longer held by it, however small the gap along the normal)."""
+        geom = self.bodies.ensure_geometry()
+        gx, gy = margin * np.abs(nx), margin * np.abs(ny)
+        return ((geom.minx[ra] - gx < geom.maxx[rb]) & (geom.minx[rb] - gx < geom.maxx[ra])
+                & (geom.miny[ra] - gy < geom.maxy[rb]) & (geom.miny[rb] - gy < geom.maxy[ra]))
 
     def _support_gaps(self, frame: StepFrame, ra, rb, nx, ny) -> np.ndarray:
         """How far the step's movement took last step's pairs apart along their normal, as a depth

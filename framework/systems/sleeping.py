@@ -5,12 +5,19 @@ A dynamic body sleeps after :data:`SLEEP_STEPS` steps at rest: moving less than
 as one: a body touching an awake, restless dynamic body stays awake, and so, in turn, does
 whatever touches it. Game code writing its Transform or Velocity, a contact with an awake body, a
 change to the static level or a despawn nearby wake it.
+
+And a stack wakes as one: the bodies that fell asleep touching each other (contacts and resting
+pairs, as the response saw them then) are linked, and when one of them wakes, for whatever reason,
+the others it is linked to wake at the end of that step, and in turn theirs (a box asleep on a
+crate the game shoves away falls, rather than hanging where it slept).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import distinct
+from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from ..store import DYNAMIC
 from .stage import Stage
@@ -25,13 +32,23 @@ SLEEP_SPEED = 0.03
 
 
 class Sleeping(Stage):
-    """Count the steps each awake dynamic body has been at rest; put the restful to sleep."""
+    """Count the steps each awake dynamic body has been at rest; put the restful to sleep; wake
+    the sleepers linked to a body that woke."""
 
     name = "sleeping"
     needs = frozenset({"sleeping"})
 
+    def __init__(self, pipeline) -> None:
+        super().__init__(pipeline)
+        # The sleepers' links: sorted pair keys of the entities that fell asleep touching each other.
+        self.links = np.zeros(0, dtype=np.int64)
+        self.wakes_seen = -1
+
     def run(self, frame: StepFrame) -> bool:
         store = self.bodies.store
+        if self.links.size and store.wakes != self.wakes_seen:
+            self._wake_linked()
+        self.wakes_seen = store.wakes
         n0 = frame.start_x.size
         if n0 == 0:  # (nothing moved this step: the movement stage did not run)
             return False
@@ -53,7 +70,39 @@ class Sleeping(Stage):
             c["asleep"][sleepy] = True
             c["vx"][sleepy] = c["vy"][sleepy] = c["w"][sleepy] = 0.0
             store.sleep_dirty = True
+            self._link(frame, sleepy)
+        self.wakes_seen = store.wakes
         return True
+
+    def _link(self, frame: StepFrame, sleepy: np.ndarray) -> None:
+        """Remember which of the bodies now asleep touch each other (contacts and resting pairs of
+        this step with both bodies dynamic and asleep)."""
+        store, bodies = self.bodies.store, self.bodies
+        ea = np.concatenate([frame.contacts.a, frame.support[0]])
+        eb = np.concatenate([frame.contacts.b, frame.support[1]])
+        ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
+        ok = (ra >= 0) & (rb >= 0)
+        ea, eb, ra, rb = ea[ok], eb[ok], ra[ok], rb[ok]
+        both = store.asleep[ra] & store.asleep[rb] & (store.body[ra] == DYNAMIC) & (store.body[rb] == DYNAMIC)
+        if both.any():
+            keys = pair_keys(np.minimum(ea[both], eb[both]), np.maximum(ea[both], eb[both]))
+            self.links = distinct(np.concatenate([self.links, keys]))
+
+    def _wake_linked(self) -> None:
+        """Wake, in turn, every sleeper linked to a body that is no longer asleep (woken, or gone);
+        forget the links of bodies awake again."""
+        store, bodies = self.bodies.store, self.bodies
+        ea, eb = pair_parts(self.links)
+        while True:
+            ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
+            sleeps_a = (ra >= 0) & store.asleep[np.maximum(ra, 0)]
+            sleeps_b = (rb >= 0) & store.asleep[np.maximum(rb, 0)]
+            wake = np.concatenate([ra[sleeps_a & ~sleeps_b], rb[sleeps_b & ~sleeps_a]])
+            if wake.size == 0:
+                break
+            store.wake(distinct(wake))
+        keep = sleeps_a & sleeps_b
+        self.links = self.links[keep]
 
     def _whole_islands(self, frame: StepFrame, ready_rows: np.ndarray) -> np.ndarray:
         """The ready rows whose whole group of touching dynamic bodies is ready (or asleep)."""
