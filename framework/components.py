@@ -117,7 +117,7 @@ class Body(Enum):
 
 _HITBOX_FIELDS = (
     "shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd", "one_way", "friction",
-    "inertia",
+    "inertia", "density",
 )
 _ALL_BITS = 0xFFFFFFFF
 
@@ -134,7 +134,9 @@ class Hitbox:
     - ``sensor``: reports collision events but never takes part in the response.
     - ``body``: :class:`Body` kind (or its name: ``"dynamic"``, ``"kinematic"``, ``"static"``).
     - ``mass``: > 0, used to split push-outs and impulses between two dynamic bodies;
-      ``math.inf`` makes a dynamic body immovable by contacts.
+      ``math.inf`` makes a dynamic body immovable by contacts. With a ``density``, leave it at its
+      default: the mass is then the density times the shape's area (reading ``mass`` gives that).
+    - ``density``: > 0, or None (the default); a mass other than 1 and a density is an error.
     - ``restitution``: 0 (slide) to 1 (elastic bounce); a pair uses the larger of the two.
     - ``friction``: Coulomb coefficient (>= 0), or None (the default: no material of its own).
       A pair where both hitboxes give one uses ``sqrt(f1 * f2)`` (Box2D's rule); where one does,
@@ -168,16 +170,20 @@ class Hitbox:
         one_way: bool = False,
         friction: float | None = None,
         inertia: float | None = None,
+        density: float | None = None,
     ) -> None:
         object.__setattr__(self, "_store", None)
         object.__setattr__(self, "_entity", -1)
         for name, value in zip(
             _HITBOX_FIELDS, (shape, offset, layer, mask, sensor, body, mass, restitution, ccd, one_way, friction,
-                             inertia)
+                             inertia, density)
         ):
             object.__setattr__(self, "_" + name, check_hitbox_field(name, value))
+        check_mass_and_density(self)
 
     def __getattr__(self, name: str) -> Any:
+        if name == "mass":
+            return self.effective_mass
         if name in _HITBOX_FIELDS:
             return object.__getattribute__(self, "_" + name)
         raise AttributeError(f"Hitbox has no attribute {name!r}")
@@ -193,8 +199,15 @@ class Hitbox:
         object.__setattr__(self, "_" + name, value)
 
     @property
+    def effective_mass(self) -> float:
+        """The mass given, else ``density`` times the shape's area, else 1."""
+        if self._density is not None:
+            return self._density * self._shape.area
+        return self._mass
+
+    @property
     def inverse_mass(self) -> float:
-        return 0.0 if self._body is not Body.DYNAMIC else 1.0 / self._mass
+        return 0.0 if self._body is not Body.DYNAMIC else 1.0 / self.effective_mass
 
     def __repr__(self) -> str:
         inner = ", ".join(f"{f}={object.__getattribute__(self, '_' + f)!r}" for f in _HITBOX_FIELDS)
@@ -224,6 +237,13 @@ def check_hitbox_field(name: str, value: object) -> Any:
             raise InvalidValue(
                 f"Hitbox body must be 'dynamic', 'kinematic' or 'static', got {value!r}"
             ) from None
+    if name == "density":
+        if value is None:
+            return None
+        d = finite("Hitbox density", value)
+        if not d > 0.0:
+            raise InvalidValue(f"Hitbox density must be > 0 (or None), got {value!r}")
+        return d
     if name == "mass":
         if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
             raise InvalidValue(f"Hitbox mass must be a number > 0, got {value!r}")
@@ -256,6 +276,17 @@ def check_hitbox_field(name: str, value: object) -> Any:
     raise AttributeError(name)
 
 
+def check_mass_and_density(hb: Hitbox) -> None:
+    """:class:`InvalidValue` if a hitbox gives both a mass (other than the default 1) and a density."""
+    _check_mass_and_density(object.__getattribute__(hb, "_mass"), object.__getattribute__(hb, "_density"))
+
+
+def _check_mass_and_density(mass: float, density: float | None) -> None:
+    if density is not None and mass != 1.0:
+        raise InvalidValue(f"Hitbox mass and density are both given ({mass!r} and {density!r}): give one "
+                           "(the mass of a body with a density is the density times its area)")
+
+
 def check_component(comp: object) -> None:
     """Raise :class:`InvalidValue` if ``comp``, about to join an entity, holds a bad value (one
     written after it was made, or while it belonged to another entity). Normalises a Hitbox's
@@ -265,6 +296,7 @@ def check_component(comp: object) -> None:
             finite(f"{type(comp).__name__}.{name}", value)
     elif isinstance(comp, Hitbox):
         fields = [check_hitbox_field(f, object.__getattribute__(comp, "_" + f)) for f in _HITBOX_FIELDS]
+        _check_mass_and_density(fields[_HITBOX_FIELDS.index("mass")], fields[_HITBOX_FIELDS.index("density")])
         for name, value in zip(_HITBOX_FIELDS, fields):
             object.__setattr__(comp, "_" + name, value)
 

@@ -40,6 +40,11 @@ class Shape:
         """Radius of the smallest origin-centred circle that holds the shape at any rotation."""
         raise NotImplementedError
 
+    @property
+    def area(self) -> float:
+        """The shape's area (a hitbox's mass from its density)."""
+        raise NotImplementedError
+
 
 @dataclass(frozen=True, slots=True)
 class AABB(Shape):
@@ -65,6 +70,10 @@ class AABB(Shape):
     def bounding_radius(self) -> float:
         return math.hypot(self.width * 0.5, self.height * 0.5)
 
+    @property
+    def area(self) -> float:
+        return self.width * self.height
+
 
 @dataclass(frozen=True, slots=True)
 class Circle(Shape):
@@ -79,6 +88,10 @@ class Circle(Shape):
     @property
     def bounding_radius(self) -> float:
         return self.radius
+
+    @property
+    def area(self) -> float:
+        return math.pi * self.radius * self.radius
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +129,11 @@ class Polygon(Shape):
     @property
     def bounding_radius(self) -> float:
         return self._radius
+
+    @property
+    def area(self) -> float:
+        pts = self.points
+        return 0.5 * abs(math.fsum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1])))
 
     def __len__(self) -> int:
         return len(self.points)

@@ -20,7 +20,7 @@ import numpy as np
 
 from .collision.kinds import KIND_AABB, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
-from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field
+from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field, check_mass_and_density
 from .shapes import AABB, Circle
 from .validation import InvalidValue
 
@@ -451,12 +451,14 @@ class BodyStore:
         for e in changed:
             row = self.row_of[e]
             hb = self.hitboxes[row]
-            for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction", "inertia"):
-                try:
+            try:
+                for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction", "inertia",
+                             "density"):
                     value = check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
-                except InvalidValue as err:
-                    raise InvalidValue(f"entity {e}: {err}") from None
-                object.__setattr__(hb, "_" + name, value)
+                    object.__setattr__(hb, "_" + name, value)
+                check_mass_and_density(hb)
+            except InvalidValue as err:
+                raise InvalidValue(f"entity {e}: {err}") from None
             self._set_hitbox_row(row, hb)
         self.dirty_hitboxes = set()
         if changed:
@@ -476,5 +478,5 @@ def _inverse_inertia(hb: Hitbox) -> float:
     shape = hb._shape
     if hb._body is not Body.DYNAMIC or not isinstance(shape, Circle) or hb._offset != (0.0, 0.0):
         return 0.0
-    inertia = hb._inertia if hb._inertia is not None else 0.5 * hb._mass * shape.radius * shape.radius
+    inertia = hb._inertia if hb._inertia is not None else 0.5 * hb.effective_mass * shape.radius * shape.radius
     return 0.0 if math.isinf(inertia) else 1.0 / inertia

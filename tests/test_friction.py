@@ -321,3 +321,51 @@ def test_a_bad_inertia_written_later_names_the_entity_and_changes_nothing():
         with pytest.raises(InvalidValue, match=f"entity {disk}: Hitbox inertia"):
             s.step(DT)
         assert (s.get(disk, Transform).x, s.get(disk, Velocity).x, s.get(disk, Velocity).angular) == before
+
+
+# --- mass from density ------------------------------------------------------------------------------
+
+
+def test_density_gives_mass_and_inertia_from_the_shape():
+    assert Hitbox(AABB(2.0, 4.0), density=0.25).mass == 2.0
+    assert Hitbox(Polygon.box(2.0, 4.0), density=0.25).mass == 2.0
+    assert Hitbox(Circle(2.0), density=0.25).mass == pytest.approx(math.pi)
+    assert Hitbox(AABB(2.0, 4.0)).mass == 1.0 and Hitbox(AABB(2.0, 4.0), mass=3.0).mass == 3.0
+    with Scene() as s:  # a disk of density 2 / pi and radius 1/2: mass 1/2, inertia m r^2 / 2 = 1/16
+        e = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.5), density=2.0 / math.pi))
+        row = s.bodies.store.row_of[e]
+        assert s.bodies.store.inv_mass[row] == pytest.approx(2.0)
+        assert s.bodies.store.inv_inertia[row] == pytest.approx(16.0)
+
+
+def test_densities_split_a_push_by_mass():
+    # A 2 x 2 box of density 1 (mass 4) and a unit box of density 1 (mass 1) overlapping by 1/2:
+    # the small one takes 4/5 of the push, the big one 1/5.
+    with Scene(gravity=(0.0, 0.0)) as s:
+        big = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(AABB(2.0, 2.0), density=1.0))
+        small = s.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(AABB(1.0, 1.0), density=1.0))
+        s.step(1 / 64)
+        assert s.get(big, Transform).x == pytest.approx(-0.1) and s.get(small, Transform).x == pytest.approx(1.4)
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, math.inf, "dense"])
+def test_bad_density_is_refused(bad):
+    with pytest.raises(InvalidValue, match="density"):
+        Hitbox(AABB(1.0, 1.0), density=bad)
+
+
+def test_mass_and_density_together_are_refused_and_a_later_edit_names_the_entity():
+    with pytest.raises(InvalidValue, match="mass and density"):
+        Hitbox(AABB(1.0, 1.0), mass=2.0, density=1.0)
+    with Scene(gravity=(0.0, 0.0)) as s:
+        e = s.spawn(Transform(0.0, 0.0), Velocity(1.0, 0.0), Hitbox(AABB(1.0, 1.0), density=1.0))
+        s.step(DT)
+        x = s.get(e, Transform).x
+        s.get(e, Hitbox).mass = 3.0
+        with pytest.raises(InvalidValue, match=f"entity {e}: Hitbox mass and density"):
+            s.step(DT)
+        assert s.get(e, Transform).x == x
+        s.get(e, Hitbox).density = -1.0
+        s.get(e, Hitbox).mass = 1.0
+        with pytest.raises(InvalidValue, match=f"entity {e}: Hitbox density"):
+            s.step(DT)
