@@ -422,6 +422,19 @@ def test_overlay_shows_contacts_sweeps_rays_cells_and_the_text_line(render, scen
     assert count(without, colors["swept"]) == 0
 
 
+@pytest.mark.parametrize("friction", [0.5, None])
+def test_overlay_shows_the_friction_in_use(render, friction):
+    colors = render.OVERLAY_COLORS
+    with Scene(gravity=(0.0, -200.0), cell_size=256.0) as s:
+        s.spawn(Transform(100.0, 10.0), Hitbox(AABB(200.0, 20.0), body="static"))
+        s.spawn(Transform(40.0, 30.0), Velocity(100.0, 0.0), Hitbox(AABB(20.0, 20.0), friction=friction))
+        for _ in range(3):
+            s.step(1 / 60)
+        img = render.screenshot(s, width=200, height=120, background=BG, debug=True)
+        lit = count(img, colors["friction"])
+        assert (lit > 0) == (friction is not None), lit  # sliding: a line along the floor, backwards
+
+
 def test_scene_effect_debug_overlay_turns_the_overlay_on(render):
     with Scene(effects=["movement", "detection", "debug_overlay"]) as s:
         r = render.Renderer(width=32, height=32)

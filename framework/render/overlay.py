@@ -4,6 +4,9 @@
   (:data:`OVERLAY_COLORS`), a circle with a radius showing its rotation;
 - this step's contacts (``scene.step_frame.contacts``): a cross at each point and the normal (A
   toward B);
+- the friction in use at them (``scene.step_frame.support``): a line along the contact, the way
+  friction pushes B, as long as a normal where friction is at its limit (the bodies slide) and
+  shorter in proportion where it holds them (static friction);
 - the swept paths of continuous-detection bodies (``scene.step_frame.swept_paths``);
 - the spatial hash's cells in use, by the static bodies and the last step's moving ones
   (``scene.bodies.hash.cells_in_use()``);
@@ -27,6 +30,7 @@ import pyglet
 from pyglet import gl
 from pyglet.graphics import Batch, Group
 
+from ..events import pair_keys
 from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON
 
 __all__ = ["OVERLAY_COLORS", "DebugOverlay"]
@@ -40,6 +44,7 @@ OVERLAY_COLORS: dict[str, tuple[int, int, int, int]] = {
     "asleep": (60, 120, 255, 255),
     "contact": (255, 40, 40, 255),
     "normal": (255, 255, 0, 255),
+    "friction": (255, 110, 200, 255),
     "swept": (255, 0, 255, 255),
     "cell": (50, 50, 100, 255),
     "ray": (255, 255, 255, 255),
@@ -197,6 +202,29 @@ def _contact_segments(contacts: Any, cross: float, normal_len: float) -> list[Se
     return [_segments(normals, OVERLAY_COLORS["normal"]), _segments(crosses, OVERLAY_COLORS["contact"])]
 
 
+def _friction_segments(store: Any, rows_of: Any, contacts: Any, support: tuple, length: float) -> list[Segments]:
+    """At each contact where friction acted this step, a line along the contact (the way it
+    pushes B), ``length`` long at the friction limit and in proportion below it."""
+    sa, sb, snx, sny, _push, impulse, _gap, _tpush, timpulse = support
+    acting = np.flatnonzero(timpulse != 0.0)
+    if acting.size == 0 or len(contacts.a) == 0:
+        return []
+    keys = pair_keys(np.asarray(contacts.a), np.asarray(contacts.b))
+    order = np.argsort(keys)
+    want = pair_keys(sa[acting], sb[acting])
+    at = np.minimum(np.searchsorted(keys[order], want), keys.size - 1)
+    found = keys[order][at] == want
+    acting, at = acting[found], order[at[found]]
+    if acting.size == 0:
+        return []
+    px, py = np.asarray(contacts.px, dtype=np.float64)[at], np.asarray(contacts.py, dtype=np.float64)[at]
+    limit = store.pair_friction(rows_of(sa[acting]), rows_of(sb[acting])) * impulse[acting]
+    t = timpulse[acting]
+    share = np.clip(np.abs(t) / np.where(limit > 0.0, limit, np.abs(t)), 0.0, 1.0) * np.sign(t) * length
+    ends = np.stack([px, py, px - sny[acting] * share, py + snx[acting] * share], axis=1)
+    return [_segments(ends, OVERLAY_COLORS["friction"])]
+
+
 def _hud_text(scene: Any, renderer: Any) -> str:
     """The overlay's two text lines: FPS, entities, drawn, contacts, frame; ms per stage."""
     frame = scene.step_frame
@@ -257,6 +285,7 @@ class DebugOverlay:
         parts += _swept_path_segments(frame.swept_paths)
         parts += _ray_segments(frame.ray_log, NORMAL_PX / zoom)
         parts += _contact_segments(frame.contacts, CROSS_PX / zoom, NORMAL_PX / zoom)
+        parts += _friction_segments(store, bodies.rows_of, frame.contacts, frame.support, NORMAL_PX / zoom)
         parts = [p for p in parts if p[0].shape[0]]
         if parts:
             ends = np.concatenate([p[0] for p in parts])
