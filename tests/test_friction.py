@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.collision import collide
@@ -369,3 +371,56 @@ def test_mass_and_density_together_are_refused_and_a_later_edit_names_the_entity
         s.get(e, Hitbox).mass = 1.0
         with pytest.raises(InvalidValue, match=f"entity {e}: Hitbox density"):
             s.step(DT)
+
+
+# --- any slope, any friction (hypothesis) --------------------------------------------------------------
+
+
+def _slope_run(theta: float, mu: float, shape: str, steps: int = 60):
+    """A box (or disk) resting on a static slope of angle ``theta`` through the origin, stepped
+    ``steps`` times at 1/60 s; its speed down the slope and how far it moved."""
+    s = Scene(gravity=(0.0, -10.0))
+    cos, sin = math.cos(theta), math.sin(theta)
+    L = 60.0
+    with s:
+        s.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-L * cos, -L * sin), (L * cos, L * sin), (L * cos, -L * sin)]),
+                                            body="static"))
+        if shape == "box":
+            e = s.spawn(Transform(-0.5, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=mu))
+        else:
+            e = s.spawn(Transform(-0.5 * sin, 0.5 * cos), Velocity(), Hitbox(Circle(0.5), friction=mu))
+        t0 = s.get(e, Transform)
+        x0, y0 = t0.x, t0.y
+        for _ in range(steps):
+            s.step(1.0 / 60.0)
+        t, v = s.get(e, Transform), s.get(e, Velocity)
+        return -(v.x * cos + v.y * sin), math.hypot(t.x - x0, t.y - y0), v.angular
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(theta=st.floats(math.radians(5.0), math.radians(60.0)), ratio=st.floats(0.0, 2.0))
+def test_a_box_on_any_slope_holds_or_slides_as_coulomb_says(theta, ratio):
+    # mu = ratio * tan(theta): holds (exactly, no creep) above 1, slides at g (sin - mu cos) below.
+    assume(abs(ratio - 1.0) > 0.02)
+    mu = ratio * math.tan(theta)
+    speed, moved, _ = _slope_run(theta, mu, "box")
+    if ratio > 1.0:
+        assert moved < 1e-12 and abs(speed) < 1e-12
+    else:
+        expected = 10.0 * (math.sin(theta) - mu * math.cos(theta))
+        assert speed == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(theta=st.floats(math.radians(5.0), math.radians(60.0)), ratio=st.floats(0.0, 3.0))
+def test_a_disk_on_any_slope_rolls_or_slips_as_coulomb_says(theta, ratio):
+    # A solid disk rolls (w = v / r, v' = (2/3) g sin) where mu >= tan / 3, else slips.
+    assume(abs(ratio - 1.0) > 0.02)
+    mu = ratio * math.tan(theta) / 3.0
+    speed, _, w = _slope_run(theta, mu, "disk")
+    if ratio > 1.0:
+        assert speed == pytest.approx(10.0 * math.sin(theta) * 2.0 / 3.0, rel=1e-9)
+        assert w == pytest.approx(speed / 0.5, rel=1e-9)
+    else:
+        assert speed == pytest.approx(10.0 * (math.sin(theta) - mu * math.cos(theta)), rel=1e-9)
+        assert w == pytest.approx(2.0 * mu * 10.0 * math.cos(theta) / 0.5, rel=1e-9, abs=1e-12)
