@@ -16,6 +16,11 @@ copies of their bodies' positions and velocities, with the compiled loops of
    brings in two steps bounce with the pair's restitution. A lone bounce off an immovable body
    gives up the potential energy its push-out added (:func:`bounce_speed`); several bounces at
    once never leave more kinetic energy than there was.
+
+Where hitboxes give friction (and the scene has the ``friction`` effect), both halves also work
+along each contact (:mod:`framework.systems.friction`): tangential pushes undo the step's slip,
+tangential impulses stop the sliding, each within ``mu`` times its normal counterpart; with the
+``rotation`` effect they turn the circles they act on. Without friction none of it runs.
 """
 
 from __future__ import annotations
