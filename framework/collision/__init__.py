@@ -5,8 +5,10 @@ touching is not a collision; normals point from A toward B; grazing rays and swe
 """
 
 from .collide import collide
+from .manifold import manifold
 from .ray import raycast
-from .results import Contact, Impact, RayHit, Vec2
+from .results import Contact, Impact, Manifold, ManifoldPoint, RayHit, Vec2
 from .sweep import time_of_impact
 
-__all__ = ["Contact", "Impact", "RayHit", "Vec2", "collide", "raycast", "time_of_impact"]
+__all__ = ["Contact", "Impact", "Manifold", "ManifoldPoint", "RayHit", "Vec2", "collide", "manifold", "raycast",
+           "time_of_impact"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ["Contact", "Impact", "RayHit", "Vec2"]
+__all__ = ["Contact", "Impact", "Manifold", "ManifoldPoint", "RayHit", "Vec2"]
 
 
 class Vec2(NamedTuple):
@@ -24,6 +24,22 @@ class Contact(NamedTuple):
     normal: Vec2
     depth: float
     point: Vec2
+
+
+class ManifoldPoint(NamedTuple):
+    """One point of a contact manifold: a world ``point`` in the overlap region, on the boundary
+    of one shape, and how deep it lies inside the other (``depth`` > 0, along the normal)."""
+
+    point: Vec2
+    depth: float
+
+
+class Manifold(NamedTuple):
+    """Where two overlapping shapes touch: the ``normal`` from A toward B (as :class:`Contact`'s)
+    and one or two ``points``, deepest first (two where a face rests on a face)."""
+
+    normal: Vec2
+    points: tuple[ManifoldPoint, ...]
 
 
 class RayHit(NamedTuple):
