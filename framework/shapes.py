@@ -45,6 +45,12 @@ class Shape:
         """The shape's area (a hitbox's mass from its density)."""
         raise NotImplementedError
 
+    @property
+    def second_moment(self) -> float:
+        """The moment of inertia of the shape, uniformly filled, about its origin, per unit of
+        mass (a body of mass ``m`` turning about its hitbox origin has inertia ``m`` times this)."""
+        raise NotImplementedError
+
 
 @dataclass(frozen=True, slots=True)
 class AABB(Shape):
@@ -74,6 +80,10 @@ class AABB(Shape):
     def area(self) -> float:
         return self.width * self.height
 
+    @property
+    def second_moment(self) -> float:
+        return (self.width * self.width + self.height * self.height) / 12.0
+
 
 @dataclass(frozen=True, slots=True)
 class Circle(Shape):
@@ -92,6 +102,10 @@ class Circle(Shape):
     @property
     def area(self) -> float:
         return math.pi * self.radius * self.radius
+
+    @property
+    def second_moment(self) -> float:
+        return 0.5 * self.radius * self.radius
 
 
 @dataclass(frozen=True, slots=True)
@@ -134,6 +148,18 @@ class Polygon(Shape):
     def area(self) -> float:
         pts = self.points
         return 0.5 * abs(math.fsum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1])))
+
+    @property
+    def second_moment(self) -> float:
+        # Each edge and the origin span a triangle; summed with the sign of their winding (the
+        # points are counter-clockwise), they give the polygon's integrals of 1 and x^2 + y^2.
+        pts = self.points
+        twice_area, moment = [], []
+        for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]):
+            cross = x0 * y1 - x1 * y0
+            twice_area.append(cross)
+            moment.append(cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1))
+        return math.fsum(moment) / (6.0 * math.fsum(twice_area))
 
     def __len__(self) -> int:
         return len(self.points)

@@ -473,10 +473,11 @@ _MISSING = object()
 
 def _inverse_inertia(hb: Hitbox) -> float:
     """1 / the moment of inertia of a body that contacts turn, else 0: a dynamic circle centred on
-    its entity (its turning moves no geometry), of finite mass and inertia; the inertia given, or a
-    solid disk's ``m r^2 / 2``. (Boxes and polygons do not turn from contacts yet.)"""
+    its entity (its turning moves no geometry), of finite mass and inertia; the inertia given, or
+    the mass times the shape's second moment (a solid disk's ``m r^2 / 2``). (Boxes and polygons
+    do not turn from contacts yet.)"""
     shape = hb._shape
     if hb._body is not Body.DYNAMIC or not isinstance(shape, Circle) or hb._offset != (0.0, 0.0):
         return 0.0
-    inertia = hb._inertia if hb._inertia is not None else 0.5 * hb.effective_mass * shape.radius * shape.radius
+    inertia = hb._inertia if hb._inertia is not None else hb.effective_mass * shape.second_moment
     return 0.0 if math.isinf(inertia) else 1.0 / inertia

@@ -101,3 +101,15 @@ def test_any_box_on_a_wide_floor_touches_at_its_two_bottom_corners(w, h, x, sink
     assert xs == pytest.approx([x - hw, x + hw], abs=1e-12)
     for p in m.points:
         assert p.depth == pytest.approx(sink, abs=1e-12) and p.point.y == pytest.approx(-sink, abs=1e-12)
+
+
+def test_second_moments_of_the_shapes_about_their_origin():
+    # Per unit mass: a w x h box (w^2 + h^2) / 12, a disk r^2 / 2, a right triangle with legs a, b
+    # from the origin (a^2 + b^2) / 6 (dyadic values: exact).
+    assert AABB(2.0, 4.0).second_moment == Polygon.box(2.0, 4.0).second_moment == pytest.approx(20.0 / 12.0)
+    assert Circle(2.0).second_moment == 2.0
+    assert Polygon([(0.0, 0.0), (4.0, 0.0), (0.0, 2.0)]).second_moment == pytest.approx(20.0 / 6.0, rel=1e-15)
+    # the same triangle wound the other way, and a polygon off its origin (parallel axes: + d^2)
+    assert Polygon([(0.0, 0.0), (0.0, 2.0), (4.0, 0.0)]).second_moment == pytest.approx(20.0 / 6.0, rel=1e-15)
+    off = Polygon([(2.0, -1.0), (4.0, -1.0), (4.0, 1.0), (2.0, 1.0)])  # a 2 x 2 square centred at (3, 0)
+    assert off.second_moment == pytest.approx(8.0 / 12.0 + 9.0, rel=1e-15)
