@@ -186,6 +186,8 @@ def is_bad(attr: str, value: object) -> bool:
         return not (number and value > 0.0)  # inf is allowed: immovable
     if attr == "restitution":
         return not (number and 0.0 <= value <= 1.0)
+    if attr == "friction":
+        return not (value is None or number and 0.0 <= value < math.inf)
     if attr in ("layer", "mask"):
         return not (isinstance(value, int) and 0 <= value < 2**32)
     return not (number and math.isfinite(value))
@@ -199,7 +201,7 @@ MOVER = dict(
     ccd=st.booleans(), sensor=st.sampled_from([False, False, False, True]),
     layer=st.sampled_from([1, 1, 1, 0, 2, 3, 0xFFFFFFFF, 0x80000000]),
     mask=st.sampled_from([0xFFFFFFFF, 0xFFFFFFFF, 0, 1, 2, 3, 0x80000000]),
-    mass=st.sampled_from([0.5, 1.0, 3.0, math.inf]),
+    mass=st.sampled_from([0.5, 1.0, 3.0, math.inf]), friction=st.sampled_from([None, None, 0.0, 0.4, 1.0]),
     offset=st.tuples(coord, coord).map(lambda p: (p[0] * 0.25, p[1] * 0.25)),
     velocity=st.sampled_from([True, True, True, False]), doomed=st.sampled_from([False, False, True]),
 )
@@ -343,10 +345,10 @@ class SceneMachine(RuleBasedStateMachine):
 
     @rule(**MOVER)
     def spawn_mover(self, shape, body, x, y, rot, vx, vy, w, restitution, ccd, sensor, layer, mask, mass,
-                    offset, velocity, doomed):
+                    friction, offset, velocity, doomed):
         comps = [Transform(x, y, rot),
                  Hitbox(shape, offset, body=body, restitution=restitution, ccd=ccd, sensor=sensor,
-                        layer=layer, mask=mask, mass=mass)]
+                        layer=layer, mask=mask, mass=mass, friction=friction)]
         if velocity:
             comps.append(Velocity(vx, vy, w))
         if doomed:
@@ -355,14 +357,15 @@ class SceneMachine(RuleBasedStateMachine):
 
     @rule(shape=shapes(max_size=2.0), data=st.data(), rot=st.floats(-4.0, 4.0),
           one_way=st.sampled_from([False, False, True]), sensor=st.sampled_from([False, False, True]),
-          layer=layer_bits)
-    def spawn_static(self, shape, data, rot, one_way, sensor, layer):
+          layer=layer_bits, friction=st.sampled_from([None, None, 0.0, 0.7]))
+    def spawn_static(self, shape, data, rot, one_way, sensor, layer, friction):
         free = self.free_slots()
         if not free:
             return
         slot = data.draw(st.sampled_from(free))
         e = self.scene.spawn(Transform(*SLOTS[slot], rot),
-                             Hitbox(shape, body="static", one_way=one_way, sensor=sensor, layer=layer))
+                             Hitbox(shape, body="static", one_way=one_way, sensor=sensor, layer=layer,
+                                    friction=friction))
         self.slot_of[e] = slot
 
     @precondition(lambda self: len(self.scene.entities) > 1)
@@ -451,8 +454,8 @@ class SceneMachine(RuleBasedStateMachine):
         self.scene.gravity = gravity
 
     @rule(data=st.data(), field=st.sampled_from(["Transform.x", "Transform.rotation", "Velocity.y",
-                                                 "Hitbox.mass", "Hitbox.restitution", "Hitbox.layer",
-                                                 "Hitbox.shape"]),
+                                                 "Hitbox.mass", "Hitbox.restitution", "Hitbox.friction",
+                                                 "Hitbox.layer", "Hitbox.shape"]),
           bad=st.sampled_from([math.nan, math.inf, -math.inf, None, "1", -1, 2.0]))
     def bad_value_is_refused_and_changes_nothing(self, data, field, bad):
         comp_name, attr = field.split(".")
