@@ -94,20 +94,34 @@ def test_friction_coefficients_combine_as_documented():
 SIN, COS = 0.6, 0.8
 
 
-def _on_slope(mu, shape):
+def _on_slope(mu, shape, sin=SIN, cos=COS):
     """A box, a circle that may not turn (``inertia=inf``: it slides as a box does) or a disk
-    (``"disk"``: it rolls) resting on the slope at the origin."""
+    (``"disk"``: it rolls) resting on a slope (rising to the right at the angle of ``sin, cos``)
+    at the origin."""
     s = Scene(gravity=(0.0, -10.0))
     L = 40.0
-    s.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-L * COS, -L * SIN), (L * COS, L * SIN), (L * COS, -L * SIN)]),
+    s.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-L * cos, -L * sin), (L * cos, L * sin), (L * cos, -L * sin)]),
                                         body="static"))
     if shape == "box":  # its lower right corner on the slope at the origin
         body = s.spawn(Transform(-0.5, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=mu))
     else:  # touching the slope at the origin
         inertia = math.inf if shape == "circle" else None
-        body = s.spawn(Transform(-0.5 * SIN, 0.5 * COS), Velocity(),
+        body = s.spawn(Transform(-0.5 * sin, 0.5 * cos), Velocity(),
                        Hitbox(Circle(0.5), friction=mu, inertia=inertia))
     return s, body
+
+
+def _slope_run(mu, shape, steps, sin=SIN, cos=COS):
+    """:func:`_on_slope` stepped ``steps`` times at 1/60 s: the body's speed down the slope, how
+    far it moved, and its angular velocity."""
+    s, body = _on_slope(mu, shape, sin, cos)
+    with s:
+        t0 = s.get(body, Transform)
+        x0, y0 = t0.x, t0.y
+        for _ in range(steps):
+            s.step(1.0 / 60.0)
+        t, v = s.get(body, Transform), s.get(body, Velocity)
+        return -(v.x * cos + v.y * sin), math.hypot(t.x - x0, t.y - y0), v.angular
 
 
 @pytest.mark.parametrize("shape", ["box", "circle"])
@@ -242,27 +256,17 @@ def test_a_bad_friction_written_later_is_refused_and_the_scene_is_unchanged():
 
 @pytest.mark.parametrize("mu", [0.25, 0.5, 1.0])
 def test_a_disk_rolls_down_a_slope_at_two_thirds_g_sin(mu):
-    s, disk = _on_slope(mu, "disk")
-    with s:
-        n = 120
-        for _ in range(n):
-            s.step(1.0 / 60.0)
-        v = s.get(disk, Velocity)
-        along = -(v.x * COS + v.y * SIN)
-        assert along == pytest.approx(2.0 / 3.0 * 10.0 * SIN * n / 60.0, rel=1e-9)  # 8
-        assert v.angular == pytest.approx(along / 0.5, rel=1e-9)  # rolling: w = v / r (counter-clockwise)
+    n = 120
+    along, _, w = _slope_run(mu, "disk", n)
+    assert along == pytest.approx(2.0 / 3.0 * 10.0 * SIN * n / 60.0, rel=1e-9)  # 8
+    assert w == pytest.approx(along / 0.5, rel=1e-9)  # rolling: w = v / r (counter-clockwise)
 
 
 def test_a_disk_on_a_slippery_slope_slips_and_spins_up_at_its_friction():
-    s, disk = _on_slope(0.1, "disk")
-    with s:
-        n = 120
-        for _ in range(n):
-            s.step(1.0 / 60.0)
-        v = s.get(disk, Velocity)
-        along = -(v.x * COS + v.y * SIN)
-        assert along == pytest.approx(10.0 * (SIN - 0.1 * COS) * n / 60.0, rel=1e-9)  # 10.4
-        assert v.angular == pytest.approx(2.0 * 0.1 * 10.0 * COS / 0.5 * n / 60.0, rel=1e-9)  # 6.4
+    n = 120
+    along, _, w = _slope_run(0.1, "disk", n)
+    assert along == pytest.approx(10.0 * (SIN - 0.1 * COS) * n / 60.0, rel=1e-9)  # 10.4
+    assert w == pytest.approx(2.0 * 0.1 * 10.0 * COS / 0.5 * n / 60.0, rel=1e-9)  # 6.4
 
 
 def test_a_disk_thrown_without_spin_ends_rolling_at_two_thirds_of_its_speed():
@@ -376,34 +380,13 @@ def test_mass_and_density_together_are_refused_and_a_later_edit_names_the_entity
 # --- any slope, any friction (hypothesis) --------------------------------------------------------------
 
 
-def _slope_run(theta: float, mu: float, shape: str, steps: int = 60):
-    """A box (or disk) resting on a static slope of angle ``theta`` through the origin, stepped
-    ``steps`` times at 1/60 s; its speed down the slope and how far it moved."""
-    s = Scene(gravity=(0.0, -10.0))
-    cos, sin = math.cos(theta), math.sin(theta)
-    L = 60.0
-    with s:
-        s.spawn(Transform(0.0, 0.0), Hitbox(Polygon([(-L * cos, -L * sin), (L * cos, L * sin), (L * cos, -L * sin)]),
-                                            body="static"))
-        if shape == "box":
-            e = s.spawn(Transform(-0.5, 0.5), Velocity(), Hitbox(AABB(1.0, 1.0), friction=mu))
-        else:
-            e = s.spawn(Transform(-0.5 * sin, 0.5 * cos), Velocity(), Hitbox(Circle(0.5), friction=mu))
-        t0 = s.get(e, Transform)
-        x0, y0 = t0.x, t0.y
-        for _ in range(steps):
-            s.step(1.0 / 60.0)
-        t, v = s.get(e, Transform), s.get(e, Velocity)
-        return -(v.x * cos + v.y * sin), math.hypot(t.x - x0, t.y - y0), v.angular
-
-
 @settings(max_examples=40, deadline=None, derandomize=True)
 @given(theta=st.floats(math.radians(5.0), math.radians(60.0)), ratio=st.floats(0.0, 2.0))
 def test_a_box_on_any_slope_holds_or_slides_as_coulomb_says(theta, ratio):
     # mu = ratio * tan(theta): holds (exactly, no creep) above 1, slides at g (sin - mu cos) below.
     assume(abs(ratio - 1.0) > 0.02)
     mu = ratio * math.tan(theta)
-    speed, moved, _ = _slope_run(theta, mu, "box")
+    speed, moved, _ = _slope_run(mu, "box", 60, math.sin(theta), math.cos(theta))
     if ratio > 1.0:
         assert moved < 1e-12 and abs(speed) < 1e-12
     else:
@@ -417,7 +400,7 @@ def test_a_disk_on_any_slope_rolls_or_slips_as_coulomb_says(theta, ratio):
     # A solid disk rolls (w = v / r, v' = (2/3) g sin) where mu >= tan / 3, else slips.
     assume(abs(ratio - 1.0) > 0.02)
     mu = ratio * math.tan(theta) / 3.0
-    speed, _, w = _slope_run(theta, mu, "disk")
+    speed, _, w = _slope_run(mu, "disk", 60, math.sin(theta), math.cos(theta))
     if ratio > 1.0:
         assert speed == pytest.approx(10.0 * math.sin(theta) * 2.0 / 3.0, rel=1e-9)
         assert w == pytest.approx(speed / 0.5, rel=1e-9)
