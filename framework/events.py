@@ -21,8 +21,8 @@ import numpy as np
 from .collision.results import Vec2
 from .validation import InvalidValue
 
-__all__ = ["CollisionEvent", "CollisionHandlers", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_member",
-           "sorted_members"]
+__all__ = ["CollisionEvent", "CollisionHandlers", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_find",
+           "sorted_member", "sorted_members"]
 
 STARTED: Literal["started"] = "started"
 ONGOING: Literal["ongoing"] = "ongoing"
@@ -77,12 +77,18 @@ def pair_parts(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return keys >> 32, keys & 0xFFFFFFFF
 
 
-def sorted_member(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """``np.isin(keys, table)`` for a sorted ``table`` (one binary search per key)."""
+def sorted_find(keys: np.ndarray, table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where each of ``keys`` is in the sorted ``table`` (one binary search per key), and whether
+    it is there at all (where not, the position is meaningless)."""
     if table.size == 0:
-        return np.zeros(keys.size, dtype=bool)
+        return np.zeros(keys.size, dtype=np.int64), np.zeros(keys.size, dtype=bool)
     pos = np.minimum(np.searchsorted(table, keys), table.size - 1)
-    return table[pos] == keys
+    return pos, table[pos] == keys
+
+
+def sorted_member(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """``np.isin(keys, table)`` for a sorted ``table``."""
+    return sorted_find(keys, table)[1]
 
 
 def sorted_members(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -30,7 +30,7 @@ import pyglet
 from pyglet import gl
 from pyglet.graphics import Batch, Group
 
-from ..events import pair_keys
+from ..events import pair_keys, sorted_find
 from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON
 
 __all__ = ["OVERLAY_COLORS", "DebugOverlay"]
@@ -211,9 +211,7 @@ def _friction_segments(store: Any, rows_of: Any, contacts: Any, support: tuple, 
         return []
     keys = pair_keys(np.asarray(contacts.a), np.asarray(contacts.b))
     order = np.argsort(keys)
-    want = pair_keys(sa[acting], sb[acting])
-    at = np.minimum(np.searchsorted(keys[order], want), keys.size - 1)
-    found = keys[order][at] == want
+    at, found = sorted_find(pair_keys(sa[acting], sb[acting]), keys[order])
     acting, at = acting[found], order[at[found]]
     if acting.size == 0:
         return []

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..collision import batch
-from ..events import pair_keys, sorted_member
+from ..events import pair_keys, sorted_find, sorted_member
 from ..frame import NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..store import STATIC
 from .internal_faces import InternalFaces
@@ -68,8 +68,7 @@ class Response(Stage):
         push0, impulse0 = np.zeros(c.a.size), np.zeros(c.a.size)
         tpush0, timpulse0 = np.zeros(c.a.size), np.zeros(c.a.size)
         if kept_keys.size:  # the warm start of the pairs found again
-            at = np.minimum(np.searchsorted(kept_keys, now_keys), kept_keys.size - 1)
-            found = kept_keys[at] == now_keys
+            at, found = sorted_find(now_keys, kept_keys)
             push0[found], impulse0[found] = spush[at[found]], simp[at[found]]
             if stpush.any() or stimp.any():  # (friction acted last step)
                 tpush0[found], timpulse0[found] = stpush[at[found]], stimp[at[found]]

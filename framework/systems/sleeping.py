@@ -64,28 +64,35 @@ class Sleeping(Stage):
         still = c["still"]
         still[rows] = np.where(rest, still[rows] + 1, 0)
         sleepy = rows[still[rows] >= SLEEP_STEPS]
-        if sleepy.size:
-            sleepy = self._whole_islands(frame, sleepy)
+        if sleepy.size == 0:
+            return True
+        ta, tb = self._touching(frame)
+        sleepy = self._whole_islands(ta, tb, sleepy)
         if sleepy.size:
             c["asleep"][sleepy] = True
             c["vx"][sleepy] = c["vy"][sleepy] = c["w"][sleepy] = 0.0
             store.sleep_dirty = True
-            self._link(frame, sleepy)
-        self.wakes_seen = store.wakes
+            self._link(ta, tb)
         return True
 
-    def _link(self, frame: StepFrame, sleepy: np.ndarray) -> None:
-        """Remember which of the bodies now asleep touch each other (contacts and resting pairs of
-        this step with both bodies dynamic and asleep)."""
-        store, bodies = self.bodies.store, self.bodies
-        ea = np.concatenate([frame.contacts.a, frame.support[0]])
-        eb = np.concatenate([frame.contacts.b, frame.support[1]])
-        ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
-        ok = (ra >= 0) & (rb >= 0)
-        ea, eb, ra, rb = ea[ok], eb[ok], ra[ok], rb[ok]
+    def _touching(self, frame: StepFrame) -> tuple[np.ndarray, np.ndarray]:
+        """The rows of the pairs touching this step: its contacts and the response's resting pairs
+        (bodies that fell together merely touch), both still in the store."""
+        store = self.bodies.store
+        sa, sb = self.bodies.rows_of(frame.support[0]), self.bodies.rows_of(frame.support[1])
+        ra = np.concatenate([frame.contact_rows[0], sa])
+        rb = np.concatenate([frame.contact_rows[1], sb])
+        ok = (ra >= 0) & (rb >= 0) & (ra < store.n) & (rb < store.n)
+        return ra[ok], rb[ok]
+
+    def _link(self, ra: np.ndarray, rb: np.ndarray) -> None:
+        """Remember which bodies now asleep touch each other (of the touching rows ``ra, rb``, the
+        pairs of two dynamic sleepers)."""
+        store = self.bodies.store
         both = store.asleep[ra] & store.asleep[rb] & (store.body[ra] == DYNAMIC) & (store.body[rb] == DYNAMIC)
         if both.any():
-            keys = pair_keys(np.minimum(ea[both], eb[both]), np.maximum(ea[both], eb[both]))
+            ea, eb = store.entity[ra[both]], store.entity[rb[both]]
+            keys = pair_keys(np.minimum(ea, eb), np.maximum(ea, eb))
             self.links = distinct(np.concatenate([self.links, keys]))
 
     def _wake_linked(self) -> None:
@@ -104,17 +111,12 @@ class Sleeping(Stage):
         keep = sleeps_a & sleeps_b
         self.links = self.links[keep]
 
-    def _whole_islands(self, frame: StepFrame, ready_rows: np.ndarray) -> np.ndarray:
-        """The ready rows whose whole group of touching dynamic bodies is ready (or asleep)."""
+    def _whole_islands(self, ea: np.ndarray, eb: np.ndarray, ready_rows: np.ndarray) -> np.ndarray:
+        """The ready rows whose whole group of touching dynamic bodies (the touching rows ``ea,
+        eb``) is ready (or asleep)."""
         store = self.bodies.store
         ready = np.zeros(store.n, dtype=bool)
         ready[ready_rows] = True
-        ra, rb = frame.contact_rows
-        sa, sb = self.bodies.rows_of(frame.support[0]), self.bodies.rows_of(frame.support[1])
-        ea = np.concatenate([ra, sa])
-        eb = np.concatenate([rb, sb])
-        ok = (ea >= 0) & (eb >= 0) & (ea < store.n) & (eb < store.n)
-        ea, eb = ea[ok], eb[ok]
         restless = (store.body == 0) & ~store.asleep
         for _ in range(store.n):
             blocked_a = ready[ea] & restless[eb] & ~ready[eb]

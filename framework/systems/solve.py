@@ -120,10 +120,7 @@ class Solve:
         self.wa, self.wb = wa, wb
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
-        fr0 = self.fr
         self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation) if self.friction else None
-        if fr is not None and hasattr(self, "x0"):  # (contacts added during the position solve)
-            fr.start(self.frame, store, rows, self.x0, self.y0, fr0)
         self.order = self._order()
         self.position_shares = self._shock_shares()
         self.position_mu = None if fr is None else fr.limits(*self.position_shares)
@@ -458,7 +455,10 @@ class Solve:
         self.push = cat([self.push, zeros])
         self.tpush = cat([self.tpush, zeros])
         self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
+        fr0 = self.fr
         self._columns()
+        if self.fr is not None:  # (friction's per-body columns, the turns made so far kept)
+            self.fr.start(self.frame, self.store, rows, x0, y0, fr0)
         self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
