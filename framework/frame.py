@@ -19,12 +19,13 @@ import numpy as np
 
 from .events import CollisionEvent, StepContacts, to_events
 
-__all__ = ["NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counters"]
+__all__ = ["NO_POINTS", "NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counters"]
 
 _INTS = np.zeros(0, dtype=np.int64)
 _FLOATS = np.zeros(0)
 NO_RESOLVED = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS)
 NO_SUPPORT = (*NO_RESOLVED, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
+NO_POINTS = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
 
 
 def new_counters() -> dict[str, Any]:
@@ -78,6 +79,9 @@ class StepFrame:
     # and impulse (a, b, nx, ny, push, impulse, gap, tangent push, tangent impulse)
     resolved: tuple[np.ndarray, ...] = NO_RESOLVED
     support: tuple[np.ndarray, ...] = NO_SUPPORT
+    # where bodies turn (see framework.systems.turning): each contact point acted on, by pair and
+    # slot (pair key, slot, push, impulse, tangent push, tangent impulse, x, y), sorted by pair
+    points: tuple[np.ndarray, ...] = NO_POINTS
     # queries during the step: (origin, end, first hit or None), for the overlay
     ray_log: list[tuple[tuple[float, float], tuple[float, float], Any]] = field(default_factory=list)
     _events: list[CollisionEvent] | None = None
@@ -89,7 +93,8 @@ class StepFrame:
         resting pairs)."""
         return StepFrame(dt=dt, render=render, pairs=self.pairs, contacts=self.contacts,
                          contact_rows=self.contact_rows, started=self.started, ended=self.ended,
-                         resolved=self.resolved, support=self.support, _events=self._events)
+                         resolved=self.resolved, support=self.support, points=self.points,
+                         _events=self._events)
 
     @property
     def events(self) -> list[CollisionEvent]:

@@ -34,7 +34,7 @@ _FLOATS = (
     "x", "y", "rot", "vx", "vy", "w",  # transform and velocity (component views)
     "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
     "friction",  # the hitbox's friction coefficient; NO_FRICTION where it gives none
-    "inv_inertia",  # 1 / moment of inertia of a body contacts turn (dynamic centred circles), else 0
+    "inv_inertia",  # 1 / moment of inertia of a body contacts turn (dynamic, centred, not an AABB), else 0
 )
 _INTS = {
     "kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64,
@@ -472,12 +472,13 @@ _MISSING = object()
 
 
 def _inverse_inertia(hb: Hitbox) -> float:
-    """1 / the moment of inertia of a body that contacts turn, else 0: a dynamic circle centred on
-    its entity (its turning moves no geometry), of finite mass and inertia; the inertia given, or
-    the mass times the shape's second moment (a solid disk's ``m r^2 / 2``). (Boxes and polygons
-    do not turn from contacts yet.)"""
+    """1 / the moment of inertia of a body that contacts turn (with the ``rotation`` effect), else
+    0: a dynamic circle, box or polygon centred on its entity (it turns about its entity's
+    position), of finite mass and inertia; the inertia given, or the mass times the shape's second
+    moment about that point (a solid disk's ``m r^2 / 2``, a box's ``m (w^2 + h^2) / 12``). An
+    ``AABB`` never turns."""
     shape = hb._shape
-    if hb._body is not Body.DYNAMIC or not isinstance(shape, Circle) or hb._offset != (0.0, 0.0):
+    if hb._body is not Body.DYNAMIC or isinstance(shape, AABB) or hb._offset != (0.0, 0.0):
         return 0.0
     inertia = hb._inertia if hb._inertia is not None else hb.effective_mass * shape.second_moment
     return 0.0 if math.isinf(inertia) else 1.0 / inertia

@@ -102,6 +102,10 @@ class Meter:
     def __init__(self, scene: Scene, ents: np.ndarray, shapes: list) -> None:
         self.scene, self.ents = scene, ents
         self.mass = np.array([scene.get(int(e), Hitbox).mass for e in ents])
+        # moments of inertia (boxes and polygons turn from contacts; an AABB never does): the
+        # default rule, the mass times the shape's second moment about its centre
+        self.inertia = np.array([0.0 if isinstance(sh, AABB) else m * sh.second_moment
+                                 for m, sh in zip(self.mass, shapes)])
         n = len(ents)
         self.kind = np.array([0 if isinstance(sh, AABB) else 1 if isinstance(sh, Circle) else 2 for sh in shapes])
         self.hw = np.array([sh.width / 2 if isinstance(sh, AABB) else sh.radius if isinstance(sh, Circle) else 0.0
@@ -138,7 +142,8 @@ class Meter:
         # leftmost... points are the bounds).
         pen = np.maximum.reduce([LEFT - minx, maxx - RIGHT, BOTTOM - miny, maxy - TOP, np.zeros_like(x)])
         escaped = (x < LEFT) | (x > RIGHT) | (y < BOTTOM) | (y > TOP)
-        energy = float(np.sum(self.mass * (0.5 * (vx * vx + vy * vy) + G * (y - BOTTOM))))
+        w = store.w[r]
+        energy = float(np.sum(self.mass * (0.5 * (vx * vx + vy * vy) + G * (y - BOTTOM)) + 0.5 * self.inertia * w * w))
         finite = all(bool(np.isfinite(col[: store.n]).all()) for col in store.cols.values()
                      if col.dtype.kind == "f")
         return {"penetration": float(pen.max()), "escaped": int(escaped.sum()), "energy": energy,

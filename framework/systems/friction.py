@@ -15,10 +15,10 @@ contact point by exactly one unit. This module prepares what they read:
 - per body, its motion this step before the solve (``mx, my``, turn ``mturn``): the slip the
   position solve undoes, so static friction holds a body without creep.
 
-Which bodies turn: dynamic circles centred on their entity (``inv_inertia > 0`` in the store), and
-only with the ``rotation`` effect; a circle's arm is its radius (the point is on its rim, along the
-normal), so friction rolls it. Other shapes have no arm yet: boxes and polygons do not turn from
-contacts (issue 23, part 2).
+Which bodies turn: dynamic bodies centred on their entity with a finite inertia (``inv_inertia >
+0`` in the store), and only with the ``rotation`` effect. A circle's arm is its radius (the point is
+on its rim, along the normal), so friction rolls it; where a box or polygon turns, every contact of
+the solve is at a manifold point with arms from both centres (:mod:`framework.systems.turning`).
 """
 
 from __future__ import annotations
@@ -43,12 +43,18 @@ class Friction:
     of inverse mass ``wa``, ``wb``; sleepers count as immovable)."""
 
     def __init__(self, store: BodyStore, ra: np.ndarray, rb: np.ndarray, wa: np.ndarray, wb: np.ndarray,
-                 mu: np.ndarray, rotation: bool) -> None:
+                 mu: np.ndarray, rotation: bool, arms: tuple[np.ndarray, np.ndarray] | None = None,
+                 inertia: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         self.mu = mu
         self.wa, self.wb = wa, wb
-        self.arm_a = np.where(store.kind[ra] == KIND_CIRCLE, store.radius[ra], 0.0)
-        self.arm_b = np.where(store.kind[rb] == KIND_CIRCLE, -store.radius[rb], 0.0)
-        if rotation:
+        if arms is None:
+            self.arm_a = np.where(store.kind[ra] == KIND_CIRCLE, store.radius[ra], 0.0)
+            self.arm_b = np.where(store.kind[rb] == KIND_CIRCLE, -store.radius[rb], 0.0)
+        else:  # (contacts at points: see framework.systems.turning)
+            self.arm_a, self.arm_b = arms
+        if inertia is not None:
+            ia, ib = inertia
+        elif rotation:
             ia = np.where(store.asleep[ra], 0.0, store.inv_inertia[ra])
             ib = np.where(store.asleep[rb], 0.0, store.inv_inertia[rb])
         else:
@@ -61,12 +67,16 @@ class Friction:
 
     @classmethod
     def of(cls, store: BodyStore, ra: np.ndarray, rb: np.ndarray, wa: np.ndarray, wb: np.ndarray,
-           rotation: bool) -> Friction | None:
-        """The columns, or None when no pair has friction."""
+           rotation: bool, arms: tuple[np.ndarray, np.ndarray] | None = None,
+           inertia: tuple[np.ndarray, np.ndarray] | None = None) -> Friction | None:
+        """The columns, or None when no pair has friction. ``arms``, ``inertia``: each contact's
+        lever arms along it and its bodies' inverse inertias, for contacts at points (default:
+        circles' radii; the store's inertias with ``rotation``)."""
         mu = store.pair_friction(ra, rb)
-        return cls(store, ra, rb, wa, wb, mu, rotation) if mu.any() else None
+        return cls(store, ra, rb, wa, wb, mu, rotation, arms, inertia) if mu.any() else None
 
-    def limits(self, share_a: np.ndarray, share_b: np.ndarray) -> np.ndarray:
+    def limits(self, share_a: np.ndarray, share_b: np.ndarray,
+               turning: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """Per contact, the largest tangential push (impulse) per unit of normal push (impulse),
         in the loops' units, for normal pushes shared by ``share_a, share_b``: ``mu`` times the
         tangential effective inverse mass over the normal one. Where shock propagation keeps a

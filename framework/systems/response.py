@@ -17,8 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..collision import batch
+from ..collision.batch_manifold import pair_manifolds
 from ..events import pair_keys, sorted_find, sorted_member
-from ..frame import NO_RESOLVED, NO_SUPPORT, StepFrame
+from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..store import STATIC
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
@@ -44,12 +45,13 @@ class Response(Stage):
         cs = self._gather(frame)
         frame.support = NO_SUPPORT
         frame.resolved = NO_RESOLVED
+        points, frame.points = frame.points, NO_POINTS
         if cs.size and cs.ra.max() >= store.n:  # rows spawned mid-step are not in this step
             return False
         cs = cs.take(np.flatnonzero(self._solid(frame, cs)))
         if cs.size == 0:
             return True
-        solve = Solve(self, frame, cs)
+        solve = Solve(self, frame, cs, points)
         solve.positions()
         solve.velocities()
         solve.record(frame)
@@ -87,7 +89,8 @@ class Response(Stage):
             cat([frame.contact_rows[0], sra]), cat([frame.contact_rows[1], srb]), cat([c.a, sa[old]]),
             cat([c.b, sb[old]]), cat([c.nx, snx[old]]), cat([c.ny, sny[old]]), cat([c.depth, gaps]),
             np.arange(c.a.size + old.size) < c.a.size, cat([push0, spush[old]]), cat([impulse0, simp[old]]),
-            cat([tpush0, stpush[old]]), cat([timpulse0, stimp[old]]))
+            cat([tpush0, stpush[old]]), cat([timpulse0, stimp[old]]), cat([c.px, np.zeros(old.size)]),
+            cat([c.py, np.zeros(old.size)]))
 
     def _solid(self, frame: StepFrame, cs: Contacts) -> np.ndarray:
         """Mask of the contacts the response acts on."""
@@ -190,16 +193,30 @@ class Response(Stage):
         """The pairs ``(ra, rb)`` measured again where the bodies now are (pairs within rounding of
         touching count as apart), pushes re-aimed off internal faces. Only these rows' hitbox
         origins are brought up to date (a full update waits for the next reader)."""
-        store, geom = self.bodies.store, self.bodies.geometry
-        if geom.version != store.version:
-            geom.update(store)
-        elif geom.has_offset:
-            geom.update_rows(store, np.concatenate([ra, rb]))
-        else:  # origins are the positions
-            geom.hx, geom.hy = store.x, store.y
+        store, geom = self.bodies.store, self._geometry_of(ra, rb, False)
         r = pair_contacts(store, geom, ra, rb, remeasure=True)
         self.redirect(ra, rb, r.nx, r.ny, r.depth, r.hit)
         return r
+
+    def remeasure_points(self, ra: np.ndarray, rb: np.ndarray, nx: np.ndarray, ny: np.ndarray,
+                         margin: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The manifold points of the box and polygon pairs ``(ra, rb)`` along the normals ``(nx,
+        ny)``, where the bodies (and their turns) now are (see :func:`pair_manifolds`)."""
+        store, geom = self.bodies.store, self._geometry_of(ra, rb, True)
+        return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh,
+                              geom.poly_slot, geom.world_poly, geom.count)
+
+    def _geometry_of(self, ra: np.ndarray, rb: np.ndarray, turned: bool):
+        """The geometry, with the hitboxes of these rows where their bodies now stand (``turned``:
+        and as they are now turned; a full update waits for the next reader)."""
+        store, geom = self.bodies.store, self.bodies.geometry
+        if geom.version != store.version:
+            geom.update(store)
+        elif geom.has_offset or turned:
+            geom.update_rows(store, np.concatenate([ra, rb]))
+        else:  # origins are the positions
+            geom.hx, geom.hy = store.x, store.y
+        return geom
 
     def static_candidates(self, rows: np.ndarray, margin: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, ...]:
         """Pairs of the bodies ``rows`` with the static bodies their bounds, grown by ``margin`` (per

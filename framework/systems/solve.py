@@ -34,10 +34,11 @@ from ..arrays import distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
 from ..events import pair_keys, pair_parts, sorted_member
-from ..frame import StepFrame
+from ..frame import NO_POINTS, StepFrame
 from ..store import KINEMATIC
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
+from .turning import expand, turning_polygons
 
 __all__ = ["Contacts", "Solve", "bounce_speed"]
 
@@ -63,14 +64,24 @@ class Contacts:
     warm start (last step's push and impulse of the pair, and its friction's tangential push and
     impulse)."""
 
-    def __init__(self, ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0) -> None:
+    def __init__(self, ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, px, py,
+                 slot=None, arms=None) -> None:
         self.ra, self.rb, self.ea, self.eb = ra, rb, ea, eb
         self.nx, self.ny, self.depth, self.alive0 = nx, ny, depth, alive0
         self.push0, self.impulse0, self.tpush0, self.timpulse0 = push0, impulse0, tpush0, timpulse0
+        self.px, self.py = px, py  # a point of the contact (0 where not known: a kept pair's)
+        # contacts at points (see framework.systems.turning): the point's slot in its pair's
+        # manifold, and the lever arms (x, y) from a's and b's centres to it
+        self.slot = np.zeros(ra.size, dtype=np.int64) if slot is None else slot
+        self.arms = arms
+
+    def columns(self) -> tuple[np.ndarray, ...]:
+        return (self.ra, self.rb, self.ea, self.eb, self.nx, self.ny, self.depth, self.alive0, self.push0,
+                self.impulse0, self.tpush0, self.timpulse0, self.px, self.py, self.slot)
 
     def take(self, idx: np.ndarray) -> Contacts:
-        return Contacts(*(v[idx] for v in (self.ra, self.rb, self.ea, self.eb, self.nx, self.ny, self.depth,
-                                            self.alive0, self.push0, self.impulse0, self.tpush0, self.timpulse0)))
+        arms = None if self.arms is None else tuple(v[idx] for v in self.arms)
+        return Contacts(*(v[idx] for v in self.columns()), arms=arms)
 
     @property
     def size(self) -> int:
@@ -81,7 +92,8 @@ class Solve:
     """One step's solve over the solid contacts ``cs``, on local copies of the bodies' positions and
     velocities (written to the store when done)."""
 
-    def __init__(self, stage: Any, frame: StepFrame, cs: Contacts) -> None:  # stage: the Response
+    def __init__(self, stage: Any, frame: StepFrame, cs: Contacts,
+                 points: tuple[np.ndarray, ...] = NO_POINTS) -> None:  # stage: the Response
         self.stage, self.frame = stage, frame
         self.store = store = stage.bodies.store
         self.gravity = stage.pipeline.active_gravity()
@@ -95,6 +107,11 @@ class Solve:
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
         dropped = overlapping & ~cs.alive0  # the covering tile's own contact holds the body
         self.cs = cs = cs.take(np.flatnonzero(~dropped)) if dropped.any() else cs
+        # Bodies that turn from contacts: the solve works on manifold points with lever arms.
+        store = self.store
+        self.rigid = self.rotation and bool((turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)).any())
+        if self.rigid:
+            self.cs = cs = expand(cs, store, stage.bodies.ensure_geometry(), points, KEEP_GAP)
         # Bodies are numbered locally; ``table`` maps a store row to its number (-1: not in the solve).
         self.table = np.full(store.n, -1, dtype=np.int64)
         self.rows, self.local = _number(self.table, np.concatenate([cs.ra, cs.rb]), 0)
@@ -120,10 +137,41 @@ class Solve:
         self.wa, self.wb = wa, wb
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
-        self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation) if self.friction else None
+        arms = inertia = None
+        if self.rigid:
+            self._arms()
+            arms, inertia = (self.rt_a, self.rt_b), (self.ia, self.ib)
+            self.share_a, self.share_b, self.turns = self._rigid_shares(np.zeros(C, dtype=bool), np.zeros(C, dtype=bool))
+        self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, arms, inertia) if self.friction else None
         self.order = self._order()
         self.position_shares = self._shock_shares()
-        self.position_mu = None if fr is None else fr.limits(*self.position_shares)
+        self.position_turns = self._turns
+        self.position_mu = None if fr is None else fr.limits(*self.position_shares, self._angular())
+
+    def _arms(self) -> None:
+        """Contacts at points: each body's inverse inertia (a sleeper keeps still), and the lever
+        arms across the normal (``rn = r x n``) and along the contact (``rt = r x t``, ``t = (-ny,
+        nx)``) from each body's centre to the point; contacts of turning polygons are not measured
+        again in the solve (their points hold)."""
+        store, cs = self.store, self.cs
+        rax, ray, rbx, rby = cs.arms
+        self.ia = np.where(store.asleep[cs.ra], 0.0, store.inv_inertia[cs.ra])
+        self.ib = np.where(store.asleep[cs.rb], 0.0, store.inv_inertia[cs.rb])
+        self.rn_a, self.rn_b = rax * cs.ny - ray * cs.nx, rbx * cs.ny - rby * cs.nx
+        self.rt_a, self.rt_b = rax * cs.nx + ray * cs.ny, rbx * cs.nx + rby * cs.ny
+        self.at_points = turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)
+
+    def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Contacts at points: how far a unit of push (impulse) moves and turns each body, the
+        bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a, turn_b))``."""
+        wa, wb = np.where(still_a, 0.0, self.wa), np.where(still_b, 0.0, self.wb)
+        ia, ib = np.where(still_a, 0.0, self.ia), np.where(still_b, 0.0, self.ib)
+        inv = 1.0 / (wa + wb + ia * self.rn_a * self.rn_a + ib * self.rn_b * self.rn_b)
+        return wa * inv, wb * inv, (ia * self.rn_a * inv, ib * self.rn_b * inv)
+
+    def _angular(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Contacts at points: each body's angular part of the normal effective inverse mass."""
+        return (self.ia * self.rn_a * self.rn_a, self.ib * self.rn_b * self.rn_b) if self.rigid else None
 
     def _shock_shares(self) -> tuple[np.ndarray, np.ndarray]:
         """The shares of the position pushes (shock propagation). In a pair resting one on the other
@@ -136,6 +184,7 @@ class Solve:
         gx, gy = self.gravity
         g = math.hypot(gx, gy)
         both = ~self.immovable
+        self._turns = self.turns if self.rigid else None
         if g == 0.0 or not both.any():
             self.b_on_a = self.a_on_b = None
             return self.share_a, self.share_b
@@ -148,7 +197,11 @@ class Solve:
         return self._lower_stays(b_on_a, a_on_b)
 
     def _lower_stays(self, b_on_a: np.ndarray, a_on_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still."""
+        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still (and,
+        for contacts at points, the turns in ``self._turns``)."""
+        if self.rigid:
+            share_a, share_b, self._turns = self._rigid_shares(b_on_a, a_on_b)
+            return share_a, share_b
         share_a = np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, self.share_a))
         share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
         return share_a, share_b
@@ -180,9 +233,16 @@ class Solve:
         share_a, share_b = self.position_shares
         self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
         self.tpush = np.zeros(cs.size)
+        n = self.rows.size
+        if self.rigid:
+            self.rot0, self.dturn = store.rot[self.rows].copy(), np.zeros(n)
+            turn_a, turn_b = self.position_turns
+            self.dturn += np.bincount(self.b, turn_b * self.push, n) - np.bincount(self.a, turn_a * self.push, n)
         fr = self.fr
         if fr is not None:
             fr.start(self.frame, store, self.rows, self.x0, self.y0)
+            if self.rigid:  # (one turn per body: the normal pushes' and friction's)
+                fr.rot0, fr.dturn = self.rot0, self.dturn
             self.tpush = fr.clip(cs.tpush0, self.push, self.position_mu)
             if self.tpush.any():
                 tx, ty, turn = fr.spread(self.a, self.b, cs.nx, cs.ny, self.tpush, self.rows.size)
@@ -276,10 +336,17 @@ class Solve:
         back out the way it came rather than on through."""
         cs = self.cs
         share_a, share_b = self.position_shares
-        _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
-                                               self.push, self.dx, self.dy, self.iterations,
-                                               self.tolerance if tolerance is None else tolerance, self.dirty,
-                                               self.reach, *self._friction_positions())
+        tol = self.tolerance if tolerance is None else tolerance
+        if self.rigid:
+            turn_a, turn_b = self.position_turns
+            _passes, held = solver.solve_positions_rigid(
+                order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b, turn_a, turn_b, self.rn_a,
+                self.rn_b, self.push, self.dx, self.dy, self.dturn, self.iterations, tol, self.dirty, self.reach,
+                *self._friction_positions())
+        else:
+            _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
+                                                   self.push, self.dx, self.dy, self.iterations, tol, self.dirty,
+                                                   self.reach, *self._friction_positions())
         self._place()
         return bool(held)
 
@@ -291,13 +358,21 @@ class Solve:
         moved = np.flatnonzero((self.dx != 0.0) | (self.dy != 0.0))
         if moved.size:
             self.store.place(self.rows[moved], self.x0[moved] + self.dx[moved], self.y0[moved] + self.dy[moved])
-        if self.fr is not None and self.fr.turns:
+        if self.rigid:
+            turned = np.flatnonzero(self.dturn != 0.0)
+            if turned.size:
+                self.store.rot[self.rows[turned]] = self.rot0[turned] + self.dturn[turned]
+                self.store.motion += 1
+        elif self.fr is not None and self.fr.turns:
             self.fr.place_turns(self.store, self.rows)
 
     def _shift(self, idx: np.ndarray) -> np.ndarray:
         """How far the solve has moved the bodies of contacts ``idx`` apart along their normals."""
         cs, a, b = self.cs, self.a[idx], self.b[idx]
-        return (self.dx[b] - self.dx[a]) * cs.nx[idx] + (self.dy[b] - self.dy[a]) * cs.ny[idx]
+        shift = (self.dx[b] - self.dx[a]) * cs.nx[idx] + (self.dy[b] - self.dy[a]) * cs.ny[idx]
+        if self.rigid:
+            shift += self.rn_b[idx] * self.dturn[b] - self.rn_a[idx] * self.dturn[a]
+        return shift
 
     def _separations(self) -> np.ndarray:
         """Every contact's separation where the bodies now stand, along its normal (linear)."""
@@ -308,9 +383,14 @@ class Solve:
         the solve began) follow the geometry. Whether one still overlaps."""
         cs = self.cs
         moved = self.moved
-        check = np.flatnonzero(self.immovable & (moved[self.a] | moved[self.b]))
+        check = self.immovable & (moved[self.a] | moved[self.b])
+        overlapping = False
+        if self.rigid:
+            overlapping = self._measure_points(np.flatnonzero(check & self.at_points))
+            check &= ~self.at_points
+        check = np.flatnonzero(check)
         if check.size == 0:
-            return False
+            return overlapping
         r = self.stage.remeasure(cs.ra[check], cs.rb[check])
         apart = check[~r.hit]  # touching, or a sliver within rounding: no longer pushed along
         cs.depth[apart] = np.minimum(cs.depth[apart], self._shift(apart))
@@ -321,7 +401,33 @@ class Solve:
         cs.depth[hit] = r.depth[r.hit] + self._shift(hit)
         self.dirty[hit] = True
         # Another round only for an overlap the solver would act on (not one within its tolerance).
-        return bool((r.depth[r.hit] > self.tolerance).any())
+        return bool((r.depth[r.hit] > self.tolerance).any()) or overlapping
+
+    def _measure_points(self, check: np.ndarray) -> bool:
+        """Measure the contact points ``check`` (turning polygons against immovable bodies) again
+        where the bodies now stand and are turned: a turn moves a point along an arc, which the
+        solver's linear separations follow only to first order. A pair measured with as many
+        points as it has keeps each point's new separation; otherwise all its points take its
+        deepest. Whether one still overlaps."""
+        if check.size == 0:
+            return False
+        cs = self.cs
+        keys = pair_keys(cs.ea[check], cs.eb[check])
+        _u, first, pair = np.unique(keys, return_index=True, return_inverse=True)
+        rows = check[first]
+        store = self.store
+        margin = KEEP_GAP * np.minimum(store.bound[cs.ra[rows]], store.bound[cs.rb[rows]])
+        n_pts, _px, _py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], cs.nx[rows], cs.ny[rows], margin)
+        had = np.bincount(pair, minlength=rows.size)
+        same = n_pts[pair] == had[pair]
+        slot = np.minimum(cs.slot[check], 1)
+        deepest = np.where(n_pts > 1, sep.min(axis=1), sep[:, 0])
+        now = np.where(same, sep[pair, slot], deepest[pair])
+        apart = n_pts[pair] == 0  # no point within the margin: apart, no longer pushed along
+        shift = self._shift(check)
+        cs.depth[check] = np.where(apart, np.minimum(cs.depth[check], shift), shift - now)
+        self.dirty[check] = True
+        return bool(((-now > self.tolerance) & ~apart).any())
 
     def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
         self.candidates = candidates
@@ -442,10 +548,20 @@ class Solve:
         y0 = np.concatenate([self.y0, self.store.y[new_rows]])
         shift = (dx[new_b] - dx[new_a]) * r.nx + (dy[new_b] - dy[new_a]) * r.ny
         cs, cat, zeros = self.cs, np.concatenate, np.zeros(ra.size)
+        arms = None
+        if self.rigid:  # (the point where the bodies stand now, and their turns so far)
+            store = self.store
+            self.rot0 = cat([self.rot0, store.rot[new_rows]])
+            self.dturn = cat([self.dturn, np.zeros(k)])
+            rax, ray, rbx, rby = r.px - store.x[ra], r.py - store.y[ra], r.px - store.x[rb], r.py - store.y[rb]
+            shift += (rbx * r.ny - rby * r.nx) * self.dturn[new_b] - (rax * r.ny - ray * r.nx) * self.dturn[new_a]
+            arms = tuple(cat([c, v]) for c, v in zip(cs.arms, (rax, ray, rbx, rby)))
         self.cs = Contacts(cat([cs.ra, ra]), cat([cs.rb, rb]), cat([cs.ea, ea]), cat([cs.eb, eb]),
                             cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
                             cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
-                            cat([cs.impulse0, zeros]), cat([cs.tpush0, zeros]), cat([cs.timpulse0, zeros]))
+                            cat([cs.impulse0, zeros]), cat([cs.tpush0, zeros]), cat([cs.timpulse0, zeros]),
+                            cat([cs.px, r.px]), cat([cs.py, r.py]), cat([cs.slot, np.zeros(ra.size, dtype=np.int64)]),
+                            arms)
         self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
         self.looked_x, self.looked_y = cat([self.looked_x, np.zeros(k)]), cat([self.looked_y, np.zeros(k)])
         self.seen_x, self.seen_y = cat([self.seen_x, np.zeros(k)]), cat([self.seen_y, np.zeros(k)])
@@ -459,6 +575,8 @@ class Solve:
         self._columns()
         if self.fr is not None:  # (friction's per-body columns, the turns made so far kept)
             self.fr.start(self.frame, self.store, rows, x0, y0, fr0)
+            if self.rigid:
+                self.fr.rot0, self.fr.dturn = self.rot0, self.dturn
         self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
@@ -468,24 +586,33 @@ class Solve:
         store, cs = self.store, self.cs
         self.touching = self.push > 0.0  # (a contact merely touching, never pushed, does not brake)
         vx, vy = store.vx[self.rows].copy(), store.vy[self.rows].copy()
+        n = self.rows.size
         a, b = self.a, self.b
         u = (vx[b] - vx[a]) * cs.nx + (vy[b] - vy[a]) * cs.ny  # closing speed before the solve
+        spin = None
+        if self.rigid:
+            spin = store.w[self.rows].copy()
+            u += self.rn_b * spin[b] - self.rn_a * spin[a]
         act = np.flatnonzero(self.touching)
         order = self.order[self.touching[self.order]]
         share_a, share_b = self._velocity_shares(vx, vy)
+        turns = self._turns
         self.impulse = np.where(self.touching, cs.impulse0, 0.0)
-        wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, self.rows.size)
+        wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, n)
         vx += wx
         vy += wy
+        if spin is not None:
+            spin += np.bincount(b, turns[1] * self.impulse, n) - np.bincount(a, turns[0] * self.impulse, n)
         self.timpulse = np.zeros(cs.size)
         fr = self.fr
         friction = NO_FRICTION_VELOCITIES
         if fr is not None:
-            spin = store.w[self.rows].copy()
-            limits = fr.limits(share_a, share_b)
+            if spin is None:
+                spin = store.w[self.rows].copy()
+            limits = fr.limits(share_a, share_b, self._angular())
             self.timpulse = fr.clip(cs.timpulse0, self.impulse, limits)
             if self.timpulse.any():
-                wx, wy, turn = fr.spread(a, b, cs.nx, cs.ny, self.timpulse, self.rows.size)
+                wx, wy, turn = fr.spread(a, b, cs.nx, cs.ny, self.timpulse, n)
                 vx += wx
                 vy += wy
                 spin += turn
@@ -493,20 +620,30 @@ class Solve:
         target = np.zeros(cs.size)
         gx, gy = self.gravity
         tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
-        solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
-                                self.iterations, tol, np.ones(cs.size, dtype=bool), *friction)
+        self._solve_velocities(order, target, share_a, share_b, turns, vx, vy, spin, tol, friction)
         bounce = self._bounce_targets(u, act)
         movable = store.movable(self.rows)
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
-            solver.solve_velocities(order, a, b, cs.nx, cs.ny, bounce, share_a, share_b, self.impulse,
-                                    vx, vy, self.iterations, tol, np.ones(cs.size, dtype=bool), *friction)
-            if not self.solo[bounce > 0.0].all():
-                self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy)
+            w_in = None if spin is None else spin.copy()
+            self._solve_velocities(order, bounce, share_a, share_b, turns, vx, vy, spin, tol, friction)
+            if not self.solo[bounce > 0.0].all() or self.rigid:
+                self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy, w_in, spin)
         rows = self.rows[movable]
         store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
-        if fr is not None and fr.turns:
+        if self.rigid or (fr is not None and fr.turns):
             store.w[rows] = spin[movable]
+
+    def _solve_velocities(self, order, target, share_a, share_b, turns, vx, vy, spin, tol, friction) -> None:
+        cs, a, b = self.cs, self.a, self.b
+        dirty = np.ones(cs.size, dtype=bool)
+        if self.rigid:
+            solver.solve_velocities_rigid(order, a, b, cs.nx, cs.ny, target, share_a, share_b, turns[0], turns[1],
+                                          self.rn_a, self.rn_b, self.impulse, vx, vy, spin, self.iterations, tol,
+                                          dirty, *friction)
+        else:
+            solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
+                                    self.iterations, tol, dirty, *friction)
 
     def _velocity_shares(self, vx: np.ndarray, vy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Shares of the velocity impulses. As for the pushes, the lower body of a supported resting
@@ -515,6 +652,7 @@ class Solve:
         lower body moves into the upper one faster than a body at rest does (it bounced): an
         immovable body moving up would hand the upper one a bounce off a moving wall and keep its
         own speed, making energy; those pairs meet as the dynamic bodies they are."""
+        self._turns = self.turns if self.rigid else None
         if self.b_on_a is None or not (self.b_on_a.any() or self.a_on_b.any()):
             return self.share_a, self.share_b
         cs, a, b = self.cs, self.a, self.b
@@ -527,13 +665,14 @@ class Solve:
         a_on_b = self.a_on_b & (b_down <= resting_speed)
         return self._lower_stays(b_on_a, a_on_b)
 
-    def _no_energy_made(self, bounce, movable, vx_in, vy_in, vx, vy) -> None:
+    def _no_energy_made(self, bounce, movable, vx_in, vy_in, vx, vy, w_in=None, w=None) -> None:
         """Bounces hand back (some of) the energy the stopping took, never more than the bodies had
         before the response: where they would end with more kinetic energy (bodies in several
         bounces at once; rounding), the bounces are scaled back until they do not. (Not called
-        when every bounce is a lone bounce off an immovable body: its speed is energy-exact by
-        construction, see :func:`bounce_speed`.) Bounces off a moving kinematic body may add
-        energy, as they should: then nothing is scaled."""
+        when every bounce is a lone bounce off an immovable body that does not turn: its speed is
+        energy-exact by construction, see :func:`bounce_speed`.) Bounces off a moving kinematic
+        body may add energy, as they should: then nothing is scaled. ``w_in, w``: angular
+        velocities, for bodies that turn (their energy ``I w^2 / 2`` counts)."""
         store, cs = self.store, self.cs
         hit = bounce > 0.0
         kinematic = (store.body[cs.ra[hit]] == KINEMATIC) | (store.body[cs.rb[hit]] == KINEMATIC)
@@ -547,6 +686,14 @@ class Solve:
         c0 = float(np.sum(mass * (vx_in * vx_in + vy_in * vy_in)))
         c1 = 2.0 * float(np.sum(mass * (vx_in * dx + vy_in * dy)))
         c2 = float(np.sum(mass * (dx * dx + dy * dy)))
+        if w is not None:
+            inv_i = store.inv_inertia[self.rows]
+            inertia = np.where(movable & (inv_i > 0.0), 1.0 / np.where(inv_i > 0.0, inv_i, 1.0), 0.0)
+            w0, dw = store.w[self.rows], w - w_in
+            before += float(np.sum(inertia * w0 * w0))
+            c0 += float(np.sum(inertia * w_in * w_in))
+            c1 += 2.0 * float(np.sum(inertia * w_in * dw))
+            c2 += float(np.sum(inertia * dw * dw))
         if c0 + c1 + c2 <= before or c2 <= 0.0:
             return
         before -= 16.0 * np.finfo(float).eps * before  # (scaled: a margin for the rounding of any way of summing)
@@ -554,6 +701,8 @@ class Solve:
         t = max(0.0, min(1.0, (-c1 + math.sqrt(disc)) / (2.0 * c2)))
         t = math.nextafter(t, 0.0)  # (rounding: stay on the safe side)
         vx[:], vy[:] = vx_in + t * dx, vy_in + t * dy
+        if w is not None:
+            w[:] = w_in + t * dw
 
     def _bounce_targets(self, u: np.ndarray, act: np.ndarray) -> np.ndarray | None:
         """The speed each touching contact must part at (0: no bounce), or None if none bounces.
@@ -586,21 +735,29 @@ class Solve:
 
     def record(self, frame: StepFrame) -> None:
         """``frame.resolved`` (sorted by pair) and the pairs acted on, with their push and impulse
-        (the next step's warm start)."""
+        (the next step's warm start); for contacts at points, each point's (``frame.points``), and
+        the pair's the sums of its points'."""
         cs = self.cs
         acted = np.flatnonzero(self.touching | (self.push > 0.0))
         keys = pair_keys(cs.ea[acted], cs.eb[acted])
         order = np.argsort(keys, kind="stable")
-        acted = acted[order]
+        acted, keys = acted[order], keys[order]
         ea, eb, nx, ny = cs.ea[acted], cs.eb[acted], cs.nx[acted], cs.ny[acted]
-        frame.resolved = (ea, eb, nx, ny, self.push[acted])
         gap = np.maximum(self._separations()[acted], 0.0)
         push = np.minimum(self.push, self._push_cap())[acted]  # (see _warm_pushes)
         tpush = np.zeros(acted.size)
         if self.fr is not None:
             tpush = self.fr.clip(self.tpush[acted], push, self.position_mu[acted])
-        frame.support = (ea, eb, nx, ny, push, self.impulse[acted], gap, tpush, self.timpulse[acted])
-        frame.counters["resolved"] = int(acted.size)
+        values = (self.push[acted], push, self.impulse[acted], tpush, self.timpulse[acted])
+        if self.rigid:
+            frame.points = (keys, cs.slot[acted], *values[1:], cs.px[acted], cs.py[acted])
+            first = np.flatnonzero(np.diff(keys, prepend=keys[:1] - 1))  # (each pair's first point)
+            ea, eb, nx, ny, gap = ea[first], eb[first], nx[first], ny[first], np.minimum.reduceat(gap, first)
+            values = tuple(np.add.reduceat(v, first) for v in values) if first.size else values
+        pushed, push, impulse, tpush, timpulse = values
+        frame.resolved = (ea, eb, nx, ny, pushed)
+        frame.support = (ea, eb, nx, ny, push, impulse, gap, tpush, timpulse)
+        frame.counters["resolved"] = int(ea.size)
 
 
 def _number(table: np.ndarray, rows: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:

@@ -39,7 +39,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["solve_positions", "solve_velocities", "supported", "warm_start"]
+__all__ = ["solve_positions", "solve_positions_rigid", "solve_velocities", "solve_velocities_rigid", "supported",
+           "warm_start"]
 
 
 @njit(cache=True)
@@ -251,3 +252,124 @@ def warm_start(a, b, nx, ny, share_a, share_b, value, n_bodies):
         ox[b[i]] += share_b[i] * v * nx[i]
         oy[b[i]] += share_b[i] * v * ny[i]
     return ox, oy
+
+
+@njit(cache=True)
+def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, nturn_b, rn_a, rn_b, push, dx, dy,
+                          dturn, passes, tolerance, dirty, reach, mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b,
+                          tpush, mx, my, mturn, fturn):
+    """:func:`solve_positions` for contacts at points off the bodies' centres (bodies that turn):
+    a contact's separation also follows the turns ``dturn`` of its bodies by their lever arms
+    ``rn = r x n``, and a unit of push turns each body by ``nturn`` besides moving it by
+    ``share`` (see :mod:`framework.systems.turning`). ``fturn``: friction's turns, the same
+    array as ``dturn`` (empty without friction)."""
+    friction = mu.size > 0
+    moved = np.full(dx.size, -1, dtype=np.int64)
+    x0, y0 = dx.copy(), dy.copy()
+    held = False
+    for it in range(passes):
+        any_moved = False
+        for k in range(order.size):
+            i = order[k]
+            ia, ib = a[i], b[i]
+            if not (dirty[i] or moved[ia] >= it - 1 or moved[ib] >= it - 1):
+                continue
+            dirty[i] = False
+            s = (sep0[i] + (dx[ib] - dx[ia]) * nx[i] + (dy[ib] - dy[ia]) * ny[i]
+                 + rn_b[i] * dturn[ib] - rn_a[i] * dturn[ia])
+            new = push[i] - s
+            if new < 0.0:
+                new = 0.0
+            change = new - push[i]
+            if change != 0.0:
+                wanted = change
+                change = _within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
+                change = _within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
+                if change != wanted:
+                    held = True
+                if change != 0.0:
+                    push[i] += change
+                    dx[ia] -= share_a[i] * change * nx[i]
+                    dy[ia] -= share_a[i] * change * ny[i]
+                    dx[ib] += share_b[i] * change * nx[i]
+                    dy[ib] += share_b[i] * change * ny[i]
+                    dturn[ia] -= nturn_a[i] * change
+                    dturn[ib] += nturn_b[i] * change
+                    if abs(change) > tolerance:
+                        moved[ia] = moved[ib] = it
+                        any_moved = True
+            if not friction:
+                continue
+            tx, ty = -ny[i], nx[i]
+            slip = ((mx[ib] + dx[ib] - mx[ia] - dx[ia]) * tx + (my[ib] + dy[ib] - my[ia] - dy[ia]) * ty
+                    + arm_b[i] * (mturn[ib] + dturn[ib]) - arm_a[i] * (mturn[ia] + dturn[ia]))
+            limit = mu[i] * push[i]
+            new = min(max(tpush[i] - slip, -limit), limit)
+            change = new - tpush[i]
+            if change == 0.0:
+                continue
+            wanted = change
+            change = _within(change, tshare_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], tx, ty, reach[ia])
+            change = _within(change, tshare_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], tx, ty, reach[ib])
+            if change != wanted:
+                held = True
+                if change == 0.0:
+                    continue
+            tpush[i] += change
+            dx[ia] -= tshare_a[i] * change * tx
+            dy[ia] -= tshare_a[i] * change * ty
+            dx[ib] += tshare_b[i] * change * tx
+            dy[ib] += tshare_b[i] * change * ty
+            dturn[ia] -= turn_a[i] * change
+            dturn[ib] += turn_b[i] * change
+            if abs(change) > tolerance:
+                moved[ia] = moved[ib] = it
+                any_moved = True
+        if not any_moved:
+            return it + 1, held
+    _left(order, a, b, moved, passes - 1, dirty)
+    return passes, held
+
+
+@njit(cache=True)
+def solve_velocities_rigid(order, a, b, nx, ny, target, share_a, share_b, nturn_a, nturn_b, rn_a, rn_b, impulse, vx,
+                           vy, w, passes, tolerance, dirty, mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b,
+                           timpulse, fw):
+    """:func:`solve_velocities` for contacts at points off the bodies' centres: the closing speed
+    at a point includes the bodies' angular velocities ``w`` by their lever arms ``rn``, and a
+    unit of impulse changes them by ``nturn``. ``fw``: friction's angular velocities, the same
+    array as ``w`` (empty without friction)."""
+    friction = mu.size > 0
+    moved = np.full(vx.size, -1, dtype=np.int64)
+    for it in range(passes):
+        any_moved = False
+        for k in range(order.size):
+            i = order[k]
+            ia, ib = a[i], b[i]
+            if not (dirty[i] or moved[ia] >= it - 1 or moved[ib] >= it - 1):
+                continue
+            dirty[i] = False
+            u = (vx[ib] - vx[ia]) * nx[i] + (vy[ib] - vy[ia]) * ny[i] + rn_b[i] * w[ib] - rn_a[i] * w[ia]
+            new = impulse[i] + (target[i] - u)
+            if new < 0.0:
+                new = 0.0
+            change = new - impulse[i]
+            if change != 0.0:
+                impulse[i] = new
+                vx[ia] -= share_a[i] * change * nx[i]
+                vy[ia] -= share_a[i] * change * ny[i]
+                vx[ib] += share_b[i] * change * nx[i]
+                vy[ib] += share_b[i] * change * ny[i]
+                w[ia] -= nturn_a[i] * change
+                w[ib] += nturn_b[i] * change
+                if abs(change) > tolerance:
+                    moved[ia] = moved[ib] = it
+                    any_moved = True
+            if friction and _stop_sliding(i, ia, ib, nx, ny, mu[i] * impulse[i], tshare_a, tshare_b, turn_a, turn_b,
+                                          arm_a, arm_b, timpulse, vx, vy, w, tolerance):
+                moved[ia] = moved[ib] = it
+                any_moved = True
+        if not any_moved:
+            return it + 1
+    _left(order, a, b, moved, passes - 1, dirty)
+    return passes

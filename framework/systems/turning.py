@@ -1,0 +1,96 @@
+"""Contacts of bodies that turn: manifold points with lever arms.
+
+With the ``rotation`` effect, a dynamic box or polygon (``Hitbox`` of finite inertia, centred on
+its entity) turns when contacts push it off its centre. The solve then works on *points*, not
+pairs: each pair with such a body becomes the points of its manifold
+(:func:`~framework.collision.batch_manifold.pair_manifolds`: two where a face rests on a face,
+one at a corner), each with its own separation and its lever arms ``r`` from each body's centre
+(its entity's position) to the point. A unit of push or impulse at a point moves a body by its
+inverse mass and turns it by its inverse inertia times ``r x n`` (``r x t`` along the contact),
+both over the pair's effective inverse mass at that point, ``k = w_a + w_b + i_a (r_a x n)^2 +
+i_b (r_b x n)^2``, so that a unit changes the point's separation (speed) by exactly one unit, as
+in the translational solve. Pairs with no turning polygon keep one row with their narrow-phase
+point (a circle's lever arm along the normal is 0; along the contact, its radius: it rolls).
+
+Each point's push, impulse and friction's are kept for the next step by pair and slot (the
+points are ordered along the contact's tangent), in ``frame.points``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..collision.batch_manifold import pair_manifolds
+from ..collision.kinds import KIND_CIRCLE, KIND_POLYGON
+from ..events import pair_keys
+from ..store import BodyStore
+
+__all__ = ["expand", "turning_polygons"]
+
+
+def turning_polygons(store: BodyStore, rows: np.ndarray) -> np.ndarray:
+    """Mask of ``rows`` that are boxes or polygons contacts turn."""
+    return (store.kind[rows] == KIND_POLYGON) & (store.inv_inertia[rows] > 0.0)
+
+
+def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: float):
+    """``cs`` (:class:`~framework.systems.solve.Contacts`) with every pair that has a turning
+    polygon replaced by its manifold points (points within ``margin`` times the smaller body's
+    size of touching), warm started from last step's ``points`` (``frame.points``), and every
+    row's lever arms set (``cs.arms``)."""
+    from .solve import Contacts  # (the solve imports this module)
+
+    ra, rb = cs.ra, cs.rb
+    turn = turning_polygons(store, ra) | turning_polygons(store, rb)
+    circle = (store.kind[ra] == KIND_CIRCLE) | (store.kind[rb] == KIND_CIRCLE)
+    clip = np.flatnonzero(turn & ~circle)
+    marg = margin * np.minimum(store.bound[ra[clip]], store.bound[rb[clip]])
+    n_pts, px, py, sep = pair_manifolds(ra[clip], rb[clip], cs.nx[clip], cs.ny[clip], marg, store.kind, geom.hx,
+                                        geom.hy, store.hw, store.hh, geom.poly_slot, geom.world_poly, geom.count)
+    # rows: every pair once (a pair with no manifold point keeps its own row if it overlaps), then
+    # each clipped pair's second point
+    count = np.ones(cs.size, dtype=np.int64)
+    count[clip] = np.where(n_pts == 0, cs.alive0[clip].astype(np.int64), n_pts)
+    src = np.repeat(np.arange(cs.size), count)
+    slot = np.arange(src.size) - np.repeat(np.cumsum(count) - count, count)
+    out = cs.take(src)
+    out.slot = slot
+    # the clipped pairs' points
+    at = np.full(cs.size, -1, dtype=np.int64)
+    at[clip] = np.arange(clip.size)
+    c = at[src]
+    has = c >= 0
+    has[has] = n_pts[c[has]] > 0
+    k, s = c[has], slot[has]
+    out.px[has], out.py[has] = px[k, s], py[k, s]
+    out.depth[has] = -sep[k, s]
+    # kept pairs with a circle: the point on the circle's rim facing the other body
+    rim = ~out.alive0 & ~has
+    if rim.any():
+        ca = rim & (store.kind[out.ra] == KIND_CIRCLE)
+        cb = rim & ~ca
+        for m, rows, sign in ((ca, out.ra, 1.0), (cb, out.rb, -1.0)):
+            r = rows[m]
+            out.px[m] = store.x[r] + sign * store.radius[r] * out.nx[m]
+            out.py[m] = store.y[r] + sign * store.radius[r] * out.ny[m]
+    _warm_points(out, count[src], points)
+    out.arms = (out.px - store.x[out.ra], out.py - store.y[out.ra], out.px - store.x[out.rb], out.py - store.y[out.rb])
+    assert isinstance(out, Contacts)
+    return out
+
+
+def _warm_points(cs, n_points: np.ndarray, points: tuple[np.ndarray, ...]) -> None:
+    """Each point's warm start: last step's values of the same pair and slot, or (a pair that had
+    another number of points) its pair's, shared evenly."""
+    keys = pair_keys(cs.ea, cs.eb)
+    pk, pslot, *values = points[:6]
+    found = np.zeros(cs.size, dtype=bool)
+    if pk.size:  # (sorted by pair, then slot: a pair's slots follow each other)
+        at = np.minimum(np.searchsorted(pk, keys) + cs.slot, pk.size - 1)
+        found = (pk[at] == keys) & (pslot[at] == cs.slot)
+    split = ~found
+    columns = (cs.push0, cs.impulse0, cs.tpush0, cs.timpulse0)
+    for col, last in zip(columns, values):
+        if found.any():
+            col[found] = last[at[found]]
+        col[split] = col[split] / n_points[split]
