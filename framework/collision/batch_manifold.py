@@ -9,7 +9,9 @@ against the normal) whose outward normal lies closest to it, the *incident* face
 face most opposed to that; the incident face clipped to the reference face's side planes gives up
 to two points, kept where they are less than ``margin`` above the reference face. Each point is
 reported midway between the incident face and the reference face's plane, with its separation
-along the pair's normal (< 0: overlapping), ordered along the tangent ``(-ny, nx)``.
+along the pair's normal (< 0: overlapping), ordered along the tangent ``(-ny, nx)``. Where the
+clipping leaves nothing (a deep overlap, the incident face beside the reference face), the point is
+B's deepest vertex along the normal, with the overlap of the shapes' projections on it.
 """
 
 from __future__ import annotations
@@ -100,6 +102,21 @@ def pair_manifolds(ra, rb, nx, ny, margin, kind, hx, hy, hw, hh, slot, world_pol
             elif s1 < 0.0:
                 hi = min(hi, s0 / (s0 - s1))
         if empty or lo > hi:
+            # (a deep overlap, the incident face beside the reference face: B's deepest vertex
+            # along the normal, with the overlap of the two shapes' projections on it)
+            top, low, k_low = -np.inf, np.inf, 0
+            for k in range(ma):
+                top = max(top, A[k, 0] * n_x + A[k, 1] * n_y)
+            for k in range(mb):
+                d = B[k, 0] * n_x + B[k, 1] * n_y
+                if d < low:
+                    low, k_low = d, k
+            s = low - top
+            if s < margin[p]:
+                px[p, 0] = B[k_low, 0] - 0.5 * s * n_x
+                py[p, 0] = B[k_low, 1] - 0.5 * s * n_y
+                sep[p, 0] = s
+                n_pts[p] = 1
             continue
         r0x, r0y = ref[i, 0], ref[i, 1]
         tx, ty = -n_y, n_x

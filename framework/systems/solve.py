@@ -103,6 +103,7 @@ class Solve:
         self.friction = "friction" in stage.pipeline.effects and self.store.has_friction()
         self.rotation = "rotation" in stage.pipeline.effects
         self.fr: Friction | None = None
+        self.fpos: Friction | None = None
         overlapping = cs.alive0.copy()
         stage.redirect(cs.ra, cs.rb, cs.nx, cs.ny, cs.depth, cs.alive0)
         dropped = overlapping & ~cs.alive0  # the covering tile's own contact holds the body
@@ -141,12 +142,21 @@ class Solve:
         if self.rigid:
             self._arms()
             arms, inertia = (self.rt_a, self.rt_b), (self.ia, self.ib)
-            self.share_a, self.share_b, self.turns = self._rigid_shares(np.zeros(C, dtype=bool), np.zeros(C, dtype=bool))
+            still = np.zeros(C, dtype=bool)
+            self.share_a, self.share_b, _turns = self._rigid_shares(still, still, self.rn_a, self.rn_b)
         self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, arms, inertia) if self.friction else None
+        # The position solve's friction (``fpos``) turns bodies only against immovable ones: with
+        # tangential pushes turning both bodies of a pair, a pyramid of 20 rows crept apart.
+        self.fpos = fr
+        if self.rigid and fr is not None:
+            imm = self.immovable
+            self.fpos = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, (imm * self.rt_a, imm * self.rt_b),
+                                    inertia)
         self.order = self._order()
         self.position_shares = self._shock_shares()
         self.position_turns = self._turns
-        self.position_mu = None if fr is None else fr.limits(*self.position_shares, self._angular())
+        fp = self.fpos
+        self.position_mu = None if fp is None else fp.limits(*self.position_shares, self._angular())
 
     def _arms(self) -> None:
         """Contacts at points: each body's inverse inertia (a sleeper keeps still), and the lever
@@ -157,21 +167,38 @@ class Solve:
         rax, ray, rbx, rby = cs.arms
         self.ia = np.where(store.asleep[cs.ra], 0.0, store.inv_inertia[cs.ra])
         self.ib = np.where(store.asleep[cs.rb], 0.0, store.inv_inertia[cs.rb])
-        self.rn_a, self.rn_b = rax * cs.ny - ray * cs.nx, rbx * cs.ny - rby * cs.nx
-        self.rt_a, self.rt_b = rax * cs.nx + ray * cs.ny, rbx * cs.nx + rby * cs.ny
+        # A deep overlap (a fast hit, a heap spawned on one spot) moves its bodies without turning
+        # them: its points say little about where the bodies met, a turn by its push would be far
+        # off the arc the linear separations follow, and one point of a face that hit a face
+        # would set the body spinning.
+        flat = cs.depth <= np.minimum(self.span[self.a], self.span[self.b])
+        self.rn_a, self.rn_b = flat * (rax * cs.ny - ray * cs.nx), flat * (rbx * cs.ny - rby * cs.nx)
+        self.rt_a, self.rt_b = flat * (rax * cs.nx + ray * cs.ny), flat * (rbx * cs.nx + rby * cs.ny)
         self.at_points = turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)
 
-    def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Contacts at points: how far a unit of push (impulse) moves and turns each body, the
-        bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a, turn_b))``."""
+    def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray, rn_a: np.ndarray,
+                      rn_b: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Contacts at points: how far a unit of push (impulse) moves and turns each body, with
+        lever arms ``rn`` and the bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a,
+        turn_b))``."""
         wa, wb = np.where(still_a, 0.0, self.wa), np.where(still_b, 0.0, self.wb)
         ia, ib = np.where(still_a, 0.0, self.ia), np.where(still_b, 0.0, self.ib)
-        inv = 1.0 / (wa + wb + ia * self.rn_a * self.rn_a + ib * self.rn_b * self.rn_b)
-        return wa * inv, wb * inv, (ia * self.rn_a * inv, ib * self.rn_b * inv)
+        inv = 1.0 / (wa + wb + ia * rn_a * rn_a + ib * rn_b * rn_b)
+        return wa * inv, wb * inv, (ia * rn_a * inv, ib * rn_b * inv)
 
     def _angular(self) -> tuple[np.ndarray, np.ndarray] | None:
         """Contacts at points: each body's angular part of the normal effective inverse mass."""
-        return (self.ia * self.rn_a * self.rn_a, self.ib * self.rn_b * self.rn_b) if self.rigid else None
+        if not self.rigid:
+            return None
+        return self.ia * self.rn_a * self.rn_a, self.ib * self.rn_b * self.rn_b
+
+    def _base_shares(self) -> tuple[np.ndarray, np.ndarray]:
+        """The shares by inverse mass (and, for contacts at points, the turns in ``self._turns``)."""
+        if not self.rigid:
+            self._turns = None
+            return self.share_a, self.share_b
+        still = np.zeros(self.cs.size, dtype=bool)
+        return self._lower_stays(still, still)
 
     def _shock_shares(self) -> tuple[np.ndarray, np.ndarray]:
         """The shares of the position pushes (shock propagation). In a pair resting one on the other
@@ -184,10 +211,9 @@ class Solve:
         gx, gy = self.gravity
         g = math.hypot(gx, gy)
         both = ~self.immovable
-        self._turns = self.turns if self.rigid else None
         if g == 0.0 or not both.any():
             self.b_on_a = self.a_on_b = None
-            return self.share_a, self.share_b
+            return self._base_shares()
         cs = self.cs
         up = -(cs.nx * gx + cs.ny * gy) / g  # > 0.5: b rests on a
         fixed_a, fixed_b = self.share_a == 0.0, self.share_b == 0.0
@@ -199,8 +225,9 @@ class Solve:
     def _lower_stays(self, b_on_a: np.ndarray, a_on_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still (and,
         for contacts at points, the turns in ``self._turns``)."""
+        self._turns = None
         if self.rigid:
-            share_a, share_b, self._turns = self._rigid_shares(b_on_a, a_on_b)
+            share_a, share_b, self._turns = self._rigid_shares(b_on_a, a_on_b, self.rn_a, self.rn_b)
             return share_a, share_b
         share_a = np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, self.share_a))
         share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
@@ -238,7 +265,7 @@ class Solve:
             self.rot0, self.dturn = store.rot[self.rows].copy(), np.zeros(n)
             turn_a, turn_b = self.position_turns
             self.dturn += np.bincount(self.b, turn_b * self.push, n) - np.bincount(self.a, turn_a * self.push, n)
-        fr = self.fr
+        fr = self.fpos
         if fr is not None:
             fr.start(self.frame, store, self.rows, self.x0, self.y0)
             if self.rigid:  # (one turn per body: the normal pushes' and friction's)
@@ -351,7 +378,7 @@ class Solve:
         return bool(held)
 
     def _friction_positions(self) -> tuple[np.ndarray, ...]:
-        fr = self.fr
+        fr = self.fpos
         return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)
 
     def _place(self) -> None:
@@ -363,8 +390,8 @@ class Solve:
             if turned.size:
                 self.store.rot[self.rows[turned]] = self.rot0[turned] + self.dturn[turned]
                 self.store.motion += 1
-        elif self.fr is not None and self.fr.turns:
-            self.fr.place_turns(self.store, self.rows)
+        elif self.fpos is not None and self.fpos.turns:
+            self.fpos.place_turns(self.store, self.rows)
 
     def _shift(self, idx: np.ndarray) -> np.ndarray:
         """How far the solve has moved the bodies of contacts ``idx`` apart along their normals."""
@@ -537,7 +564,13 @@ class Solve:
     def _add(self, ra, rb, ea, eb, r) -> None:
         """Append contacts measured where the bodies stand now (their depths are made relative to
         where the solve began, like every other contact's); bodies new to the solve are numbered
-        after the others."""
+        after the others. (Contacts at points: the new pairs' manifold points, measured now.)"""
+        ones = np.ones(ra.size, dtype=bool)
+        zeros = np.zeros(ra.size)
+        new = Contacts(ra, rb, ea, eb, r.nx, r.ny, r.depth, ones, zeros, zeros, zeros, zeros, r.px, r.py)
+        if self.rigid:
+            new = expand(new, self.store, self.stage.bodies.ensure_geometry(), NO_POINTS, KEEP_GAP)
+            ra, rb = new.ra, new.rb
         n_old = self.rows.size
         new_rows, local = _number(self.table, np.concatenate([ra, rb]), n_old)
         new_a, new_b = local[: ra.size], local[ra.size:]
@@ -546,22 +579,18 @@ class Solve:
         dx, dy = np.concatenate([self.dx, np.zeros(k)]), np.concatenate([self.dy, np.zeros(k)])
         x0 = np.concatenate([self.x0, self.store.x[new_rows]])
         y0 = np.concatenate([self.y0, self.store.y[new_rows]])
-        shift = (dx[new_b] - dx[new_a]) * r.nx + (dy[new_b] - dy[new_a]) * r.ny
-        cs, cat, zeros = self.cs, np.concatenate, np.zeros(ra.size)
-        arms = None
-        if self.rigid:  # (the point where the bodies stand now, and their turns so far)
-            store = self.store
-            self.rot0 = cat([self.rot0, store.rot[new_rows]])
+        shift = (dx[new_b] - dx[new_a]) * new.nx + (dy[new_b] - dy[new_a]) * new.ny
+        new.depth = new.depth + shift
+        cs, cat = self.cs, np.concatenate
+        if self.rigid:  # (the turns so far, by the new points' arms)
+            self.rot0 = cat([self.rot0, self.store.rot[new_rows]])
             self.dturn = cat([self.dturn, np.zeros(k)])
-            rax, ray, rbx, rby = r.px - store.x[ra], r.py - store.y[ra], r.px - store.x[rb], r.py - store.y[rb]
-            shift += (rbx * r.ny - rby * r.nx) * self.dturn[new_b] - (rax * r.ny - ray * r.nx) * self.dturn[new_a]
-            arms = tuple(cat([c, v]) for c, v in zip(cs.arms, (rax, ray, rbx, rby)))
-        self.cs = Contacts(cat([cs.ra, ra]), cat([cs.rb, rb]), cat([cs.ea, ea]), cat([cs.eb, eb]),
-                            cat([cs.nx, r.nx]), cat([cs.ny, r.ny]), cat([cs.depth, r.depth + shift]),
-                            cat([cs.alive0, np.ones(ra.size, dtype=bool)]), cat([cs.push0, zeros]),
-                            cat([cs.impulse0, zeros]), cat([cs.tpush0, zeros]), cat([cs.timpulse0, zeros]),
-                            cat([cs.px, r.px]), cat([cs.py, r.py]), cat([cs.slot, np.zeros(ra.size, dtype=np.int64)]),
-                            arms)
+            rax, ray, rbx, rby = new.arms
+            new.depth += ((rbx * new.ny - rby * new.nx) * self.dturn[new_b]
+                          - (rax * new.ny - ray * new.nx) * self.dturn[new_a])
+        arms = None if cs.arms is None else tuple(cat([c, v]) for c, v in zip(cs.arms, new.arms))
+        self.cs = Contacts(*(cat([c, v]) for c, v in zip(cs.columns(), new.columns())), arms=arms)
+        zeros = np.zeros(new.size)
         self.rows, self.dx, self.dy, self.x0, self.y0 = rows, dx, dy, x0, y0
         self.looked_x, self.looked_y = cat([self.looked_x, np.zeros(k)]), cat([self.looked_y, np.zeros(k)])
         self.seen_x, self.seen_y = cat([self.seen_x, np.zeros(k)]), cat([self.seen_y, np.zeros(k)])
@@ -570,13 +599,13 @@ class Solve:
         self.local = cat([self.a, new_a, self.b, new_b])
         self.push = cat([self.push, zeros])
         self.tpush = cat([self.tpush, zeros])
-        self.dirty = cat([self.dirty, np.ones(ra.size, dtype=bool)])
-        fr0 = self.fr
+        self.dirty = cat([self.dirty, np.ones(new.size, dtype=bool)])
+        fr0 = self.fpos
         self._columns()
-        if self.fr is not None:  # (friction's per-body columns, the turns made so far kept)
-            self.fr.start(self.frame, self.store, rows, x0, y0, fr0)
+        if self.fpos is not None:  # (friction's per-body columns, the turns made so far kept)
+            self.fpos.start(self.frame, self.store, rows, x0, y0, fr0)
             if self.rigid:
-                self.fr.rot0, self.fr.dturn = self.rot0, self.dturn
+                self.fpos.rot0, self.fpos.dturn = self.rot0, self.dturn
         self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
@@ -585,6 +614,9 @@ class Solve:
         """Stop the touching contacts closing, then bounce the ones that hit."""
         store, cs = self.store, self.cs
         self.touching = self.push > 0.0  # (a contact merely touching, never pushed, does not brake)
+        if self.rigid:  # (but a point where the bodies touch does: a body pushed out at one point of
+            # its two touches at the other, and braked at one point alone it would spin)
+            self.touching |= self.at_points & (self._separations() <= self.tolerance)
         vx, vy = store.vx[self.rows].copy(), store.vy[self.rows].copy()
         n = self.rows.size
         a, b = self.a, self.b
@@ -652,9 +684,8 @@ class Solve:
         lower body moves into the upper one faster than a body at rest does (it bounced): an
         immovable body moving up would hand the upper one a bounce off a moving wall and keep its
         own speed, making energy; those pairs meet as the dynamic bodies they are."""
-        self._turns = self.turns if self.rigid else None
         if self.b_on_a is None or not (self.b_on_a.any() or self.a_on_b.any()):
-            return self.share_a, self.share_b
+            return self._base_shares()
         cs, a, b = self.cs, self.a, self.b
         gx, gy = self.gravity
         resting_speed = 2.0 * np.abs(gx * cs.nx + gy * cs.ny) * self.dt
@@ -746,8 +777,8 @@ class Solve:
         gap = np.maximum(self._separations()[acted], 0.0)
         push = np.minimum(self.push, self._push_cap())[acted]  # (see _warm_pushes)
         tpush = np.zeros(acted.size)
-        if self.fr is not None:
-            tpush = self.fr.clip(self.tpush[acted], push, self.position_mu[acted])
+        if self.fpos is not None:
+            tpush = self.fpos.clip(self.tpush[acted], push, self.position_mu[acted])
         values = (self.push[acted], push, self.impulse[acted], tpush, self.timpulse[acted])
         if self.rigid:
             frame.points = (keys, cs.slot[acted], *values[1:], cs.px[acted], cs.py[acted])
