@@ -17,7 +17,7 @@ EFFECTS: dict[str, tuple[str, ...]] = {
     "events": ("detection",),                # every pair's started / ongoing / ended events
     "response": ("detection",),              # push bodies apart, slide, bounce
     "friction": ("response",),               # Coulomb friction between hitboxes that have some
-    "rotation": ("response",),               # contacts turn bodies (today: friction rolls circles)
+    "rotation": ("response",),               # contacts turn bodies: boxes and polygons tip, circles roll
     "continuous": ("movement", "detection"),  # sweep Hitbox(ccd=True) bodies
     "rendering": (),                         # the render stage (a renderer must be attached)
     "debug_overlay": ("rendering",),         # hitboxes, contacts, cells, rays on screen

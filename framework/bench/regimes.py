@@ -116,7 +116,9 @@ class Regime:
     ``top``: indices of the pieces of the pile's top row, whose exact resting centre height is
     ``exact_top`` (``None`` where no exact answer exists); ``height``: the pile's height, for the
     sink ratio. ``friction``: every body's coefficient (the pair's, in all three engines; 0: none);
-    ``rolling``: the circles may turn (a solid disk's inertia in every engine; else no body turns).
+    ``rolling``: the circles may turn (a solid disk's inertia in every engine; else no body turns);
+    ``tumbling``: every dynamic body turns (boxes as rotating polygons in ours, each shape's own
+    inertia for mass 1 in every engine).
     ``kind`` picks the untimed steps before timing (:data:`SETTLE`). ``dynamic_pairs``:
     whether overlaps between two moving bodies count in the penetration figure. ``pit``: ``(minx, maxx, floor)`` for the
     crowds' outside count."""
@@ -130,6 +132,7 @@ class Regime:
     sleeping: bool = False
     friction: float = 0.0
     rolling: bool = False
+    tumbling: bool = False
     top: list[int] = field(default_factory=list)
     exact_top: float | None = None
     height: float | None = None
@@ -228,10 +231,25 @@ def scattered(n: int, seed: int = 0) -> Regime:
                   effects=frozenset(PERF_EFFECTS))
 
 
-def with_friction(regime: Regime, mu: float = 0.5, rolling: bool = False) -> Regime:
+def with_friction(regime: Regime, mu: float = 0.5, rolling: bool = False, tumbling: bool = False) -> Regime:
     """``regime`` with friction ``mu`` between every pair of bodies, named ``<name>-friction``
-    (``rolling``: and its circles roll, ``<name>-rolling``)."""
-    return replace(regime, name=f"{regime.name}-{'rolling' if rolling else 'friction'}", friction=mu, rolling=rolling)
+    (``rolling``: and its circles roll, ``<name>-rolling``; ``tumbling``: and every body turns,
+    ``<name>-tumbling``)."""
+    suffix = "tumbling" if tumbling else "rolling" if rolling else "friction"
+    return replace(regime, name=f"{regime.name}-{suffix}", friction=mu, rolling=rolling or tumbling, tumbling=tumbling)
+
+
+def _turns(regime: Regime, shape: Shape) -> bool:
+    """Whether a dynamic piece of ``shape`` turns in ``regime``."""
+    return regime.tumbling or (regime.rolling and isinstance(shape, Circle))
+
+
+def _ours_shape(regime: Regime, shape: Shape) -> Shape:
+    """The hitbox shape ours gives a dynamic piece: in a tumbling regime a box is a polygon (an AABB
+    never turns)."""
+    if regime.tumbling and isinstance(shape, AABB):
+        return Polygon.box(shape.width, shape.height)
+    return shape
 
 
 def crowd(kind: str, seed: int = 0, bodies: int = CROWD["bodies"]) -> Regime:
@@ -333,6 +351,10 @@ class Engine:
     def state(self) -> tuple[np.ndarray, ...]:
         raise NotImplementedError
 
+    def angles(self) -> np.ndarray:
+        """Every piece's rotation (radians; 0 for those that cannot turn)."""
+        return np.zeros(len(self.regime.pieces))
+
     def asleep(self) -> bool:
         """Every dynamic body sleeps."""
         raise NotImplementedError
@@ -360,11 +382,11 @@ class Ours(Engine):
         effects = regime.effects or (DEFAULT_EFFECTS if regime.sleeping else DEFAULT_EFFECTS - {"sleeping"})
         scene = self.scene = Scene(gravity=regime.gravity, effects=effects)
         mu = regime.friction or None
-        inertia = None if regime.rolling else math.inf  # (only circles turn, and only from friction)
         self.entities = [scene.spawn(Transform(p.x, p.y), Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu))
                          if p.kind == "static" else
                          scene.spawn(Transform(p.x, p.y), Velocity(p.vx, p.vy),
-                                     Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu, inertia=inertia))
+                                     Hitbox(_ours_shape(regime, p.shape), body=p.kind, sensor=p.sensor, friction=mu,
+                                            inertia=None if _turns(regime, p.shape) else math.inf))
                          for p in regime.pieces]
         dt = regime.dt
         self._step = lambda: scene.step(dt)
@@ -384,6 +406,10 @@ class Ours(Engine):
                 out[k] = (t.x * s, t.y * s, v.x * s if v else 0.0, v.y * s if v else 0.0, 1.0)
         x, y, vx, vy, alive = out.T
         return x, y, vx, vy, alive.astype(bool)
+
+    def angles(self) -> np.ndarray:
+        scene = self.scene
+        return np.array([scene.get(e, Transform).rotation if scene.exists(e) else 0.0 for e in self.entities])
 
     def asleep(self) -> bool:
         n = sum(p.kind == "dynamic" for p in self.regime.pieces)
@@ -467,6 +493,9 @@ class Peer(Engine):
         x, y, vx, vy = out.T
         return x, y, vx, vy, np.ones(x.size, dtype=bool)
 
+    def angles(self) -> np.ndarray:
+        return np.array([0.0 if h is None else float(h.angle) for h in self.handles])
+
 
 class PymunkEngine(Peer):
     """pymunk: dynamic pieces on ``Body(1, inf)`` (mass 1, no rotation; a rolling regime's circles
@@ -488,9 +517,9 @@ class PymunkEngine(Peer):
             if p.kind == "static":
                 body, ox, oy, handle = space.static_body, p.x, p.y, None
             else:
-                turns = regime.rolling and isinstance(p.shape, Circle)
-                body = handle = (pymunk.Body(1.0, 0.5 * p.shape.radius ** 2 if turns else math.inf)
-                                 if p.kind == "dynamic" else pymunk.Body(body_type=pymunk.Body.KINEMATIC))
+                moment = p.shape.second_moment if _turns(regime, p.shape) else math.inf
+                body = handle = (pymunk.Body(1.0, moment) if p.kind == "dynamic"
+                                 else pymunk.Body(body_type=pymunk.Body.KINEMATIC))
                 body.position, body.velocity, ox, oy = (p.x, p.y), (p.vx, p.vy), 0.0, 0.0
                 items.append(body)
             shape = (pymunk.Circle(body, p.shape.radius, (ox, oy)) if isinstance(p.shape, Circle)
@@ -537,8 +566,8 @@ class Box2DEngine(Peer):
                 body, ox, oy, handle = ground, p.x, p.y, None
             else:
                 make = world.create_dynamic_body if p.kind == "dynamic" else world.create_kinematic_body
-                turns = regime.rolling and isinstance(p.shape, Circle)
-                body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy), fixed_rotation=not turns)
+                body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy),
+                                     fixed_rotation=not _turns(regime, p.shape))
                 ox = oy = 0.0
             sd = b2.shape_def(density=1.0 / _area(p.shape), is_sensor=p.sensor,
                               material=b2.surface_material(friction=regime.friction, restitution=0.0))
@@ -600,8 +629,9 @@ def _half_extents(shape: Shape) -> tuple[float, float]:
     return max(abs(x) for x, _ in shape.points), max(abs(y) for _, y in shape.points)
 
 
-def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool = True) -> float:
-    """The deepest overlap among the shapes at ``(x, y)`` (no rotation), by our exact geometry: the
+def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool = True, rot=None) -> float:
+    """The deepest overlap among the shapes at ``(x, y)`` (turned by ``rot``, default none), by our
+    exact geometry: the
     pairs whose bounds overlap (:func:`~framework.collision.broad_phase.brute_force_pairs`, numpy in
     row blocks, never two static ones: once per scene, so its O(N^2) does not matter), then
     ``collide_many`` (the same answers as :func:`~framework.collision.collide`).
@@ -612,14 +642,19 @@ def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool =
     if x.size < 2:
         return 0.0
     hw, hh = (np.array(v) for v in zip(*(_half_extents(s) for s in shapes)))
+    rot = np.zeros(x.size) if rot is None else np.asarray(rot, dtype=float)
+    turned = rot != 0.0
+    if turned.any():  # (bounds that hold the shape at any rotation)
+        reach = np.array([s.bounding_radius for s in shapes])
+        hw, hh = np.where(turned, reach, hw), np.where(turned, reach, hh)
     i, j = brute_force_pairs(x - hw, y - hh, x + hw, y + hh, static)
     if not dynamic_pairs:
         keep = static[i] | static[j]
         i, j = i[keep], j[keep]
     if i.size == 0:
         return 0.0
-    res = collide_many([shapes[k] for k in i.tolist()], list(zip(x[i].tolist(), y[i].tolist())),
-                       [shapes[k] for k in j.tolist()], list(zip(x[j].tolist(), y[j].tolist())))
+    res = collide_many([shapes[k] for k in i.tolist()], list(zip(x[i].tolist(), y[i].tolist(), rot[i].tolist())),
+                       [shapes[k] for k in j.tolist()], list(zip(x[j].tolist(), y[j].tolist(), rot[j].tolist())))
     return float(res.depth[res.hit].max()) if res.hit.any() else 0.0
 
 
@@ -630,8 +665,9 @@ def judge(regime: Regime, engine: Engine) -> dict[str, Any]:
     x, y, vx, vy, alive = engine.state()
     pieces = regime.pieces
     sel = np.flatnonzero(alive & np.array([p.judged for p in pieces]))
-    pen = max_penetration([pieces[k].shape for k in sel], x[sel], y[sel],
-                          [pieces[k].kind != "dynamic" for k in sel], regime.dynamic_pairs)
+    shapes = [_ours_shape(regime, pieces[k].shape) if pieces[k].kind == "dynamic" else pieces[k].shape for k in sel]
+    pen = max_penetration(shapes, x[sel], y[sel], [pieces[k].kind != "dynamic" for k in sel], regime.dynamic_pairs,
+                          engine.angles()[sel] if regime.tumbling else None)
     out: dict[str, Any] = {"pen": pen, "sink": None}
     if regime.exact_top is not None:
         out["sink"] = float((regime.exact_top - y[regime.top].min()) / regime.height)
@@ -745,6 +781,8 @@ SCENES: dict[str, Callable[[], Regime | None]] = {
     "pile-mixed-1000-friction": lambda: with_friction(shape_pile("mixed", 40, 25)),
     "pyramid-20-friction": lambda: with_friction(pyramid(20)),
     "pile-circles-1000-rolling": lambda: with_friction(shape_pile("circles", 40, 25), rolling=True),
+    "pyramid-20-tumbling": lambda: with_friction(pyramid(20), 0.6, tumbling=True),
+    "pile-boxes-1000-tumbling": lambda: with_friction(box_pile(40, 25), tumbling=True),
     "scattered-10": lambda: scattered(10),
     "scattered-100": lambda: scattered(100),
     "scattered-1000": lambda: scattered(1_000),

@@ -64,6 +64,25 @@ def _within(change, share, sign, ex, ey, nx, ny, reach):
 
 
 @njit(cache=True)
+def _kept_within(change, share, sign, ex, ey, nx, ny, reach):
+    """:func:`_within`, returning ``change`` itself where it is not limited (with shares that are
+    not 0, 1/2 or 1, ``t / (sign * share)`` rounds off ``change``, which read as held back)."""
+    if share == 0.0:
+        return change
+    en = ex * nx + ey * ny
+    disc = en * en - (ex * ex + ey * ey) + reach * reach
+    if disc < 0.0:
+        return 0.0
+    root = disc ** 0.5
+    t = sign * share * change
+    if t > -en + root:
+        return (-en + root) / (sign * share)
+    if t < -en - root:
+        return (-en - root) / (sign * share)
+    return change
+
+
+@njit(cache=True)
 def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, reach,
                     mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, tpush, mx, my, mturn, dturn):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
@@ -283,8 +302,8 @@ def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, 
             change = new - push[i]
             if change != 0.0:
                 wanted = change
-                change = _within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
-                change = _within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
+                change = _kept_within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
+                change = _kept_within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
                 if change != wanted:
                     held = True
                 if change != 0.0:
@@ -309,8 +328,8 @@ def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, 
             if change == 0.0:
                 continue
             wanted = change
-            change = _within(change, tshare_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], tx, ty, reach[ia])
-            change = _within(change, tshare_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], tx, ty, reach[ib])
+            change = _kept_within(change, tshare_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], tx, ty, reach[ia])
+            change = _kept_within(change, tshare_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], tx, ty, reach[ib])
             if change != wanted:
                 held = True
                 if change == 0.0:
