@@ -20,6 +20,7 @@ import pytest
 
 from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.components import Visual
+from framework.effects import DEFAULT_EFFECTS
 from framework.input import Input
 
 RED, GREEN, BLUE, BG = (255, 0, 0), (0, 255, 0), (0, 0, 255), (0, 0, 40)
@@ -433,6 +434,26 @@ def test_overlay_shows_the_friction_in_use(render, friction):
         img = render.screenshot(s, width=200, height=120, background=BG, debug=True)
         lit = count(img, colors["friction"])
         assert (lit > 0) == (friction is not None), lit  # sliding: a line along the floor, backwards
+
+
+@pytest.mark.parametrize("turns", [True, False])
+def test_overlay_marks_the_points_a_turning_box_rests_on(render, turns):
+    """A box resting on its face: with the rotation effect the solver pushes at its two corners,
+    and the overlay marks both (a diamond each, near the box's lower corners); without, none."""
+    colors = render.OVERLAY_COLORS
+    effects = None if turns else DEFAULT_EFFECTS - {"rotation"}
+    with Scene(gravity=(0.0, -200.0), cell_size=256.0, effects=effects) as s:
+        s.spawn(Transform(100.0, 10.0), Hitbox(AABB(200.0, 20.0), body="static"))
+        s.spawn(Transform(100.0, 40.0), Velocity(), Hitbox(Polygon.box(40.0, 40.0)))
+        for _ in range(4):
+            s.step(1 / 60)
+        img = render.screenshot(s, width=200, height=120, background=BG, debug=True)
+        lit = np.argwhere(np.all(img[..., :3] == colors["point"][:3], axis=-1))
+        if not turns:
+            assert lit.size == 0
+            return
+        xs = lit[:, 1]
+        assert (np.abs(xs - 80) <= 4).any() and (np.abs(xs - 120) <= 4).any(), sorted(set(xs.tolist()))
 
 
 def test_scene_effect_debug_overlay_turns_the_overlay_on(render):

@@ -4,6 +4,8 @@
   (:data:`OVERLAY_COLORS`), a circle with a radius showing its rotation;
 - this step's contacts (``scene.step_frame.contacts``): a cross at each point and the normal (A
   toward B);
+- where boxes and polygons turn, the points the solver pushed at (``scene.step_frame.points``: two
+  where a face rests on a face), a diamond at each;
 - the friction in use at them (``scene.step_frame.support``): a line along the contact, the way
   friction pushes B, as long as a normal where friction is at its limit (the bodies slide) and
   shorter in proportion where it holds them (static friction);
@@ -45,6 +47,7 @@ OVERLAY_COLORS: dict[str, tuple[int, int, int, int]] = {
     "contact": (255, 40, 40, 255),
     "normal": (255, 255, 0, 255),
     "friction": (255, 110, 200, 255),
+    "point": (255, 140, 0, 255),
     "swept": (255, 0, 255, 255),
     "cell": (50, 50, 100, 255),
     "ray": (255, 255, 255, 255),
@@ -202,6 +205,17 @@ def _contact_segments(contacts: Any, cross: float, normal_len: float) -> list[Se
     return [_segments(normals, OVERLAY_COLORS["normal"]), _segments(crosses, OVERLAY_COLORS["contact"])]
 
 
+def _point_segments(points: tuple, size: float) -> list[Segments]:
+    """A diamond of half size ``size`` at each contact point the solver pushed at (``frame.points``:
+    pair key, slot, push, impulse, tangent push, tangent impulse, x, y)."""
+    if len(points[0]) == 0:
+        return []
+    px, py = np.asarray(points[6], dtype=np.float64), np.asarray(points[7], dtype=np.float64)
+    corners = [(px + size, py), (px, py + size), (px - size, py), (px, py - size)]
+    sides = [np.stack([*corners[k], *corners[(k + 1) % 4]], axis=1) for k in range(4)]
+    return [_segments(np.concatenate(sides), OVERLAY_COLORS["point"])]
+
+
 def _friction_segments(store: Any, rows_of: Any, contacts: Any, support: tuple, length: float) -> list[Segments]:
     """At each contact where friction acted this step, a line along the contact (the way it
     pushes B), ``length`` long at the friction limit and in proportion below it."""
@@ -283,6 +297,7 @@ class DebugOverlay:
         parts += _swept_path_segments(frame.swept_paths)
         parts += _ray_segments(frame.ray_log, NORMAL_PX / zoom)
         parts += _contact_segments(frame.contacts, CROSS_PX / zoom, NORMAL_PX / zoom)
+        parts += _point_segments(frame.points, CROSS_PX / zoom)
         parts += _friction_segments(store, bodies.rows_of, frame.contacts, frame.support, NORMAL_PX / zoom)
         parts = [p for p in parts if p[0].shape[0]]
         if parts:

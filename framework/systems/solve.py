@@ -168,6 +168,12 @@ class Solve:
         nx)``) from each body's centre to the point; contacts of turning polygons are not measured
         again in the solve (their points hold)."""
         store, cs = self.store, self.cs
+        # (arms that change during the solve keep every contact's separation where it is: a
+        # contact's depth is relative to where the solve began, through its arms)
+        turned_by = None
+        if getattr(self, "dturn", None) is not None and getattr(self, "rn_a", None) is not None:
+            k = self.rn_a.size
+            turned_by = self.rn_b * self.dturn[self.b[:k]] - self.rn_a * self.dturn[self.a[:k]]
         rax, ray, rbx, rby = cs.arms
         self.ia = np.where(store.asleep[cs.ra], 0.0, store.inv_inertia[cs.ra])
         self.ib = np.where(store.asleep[cs.rb], 0.0, store.inv_inertia[cs.rb])
@@ -179,6 +185,9 @@ class Solve:
         self.rn_a, self.rn_b = flat * (rax * cs.ny - ray * cs.nx), flat * (rbx * cs.ny - rby * cs.nx)
         self.rt_a, self.rt_b = flat * (rax * cs.nx + ray * cs.ny), flat * (rbx * cs.nx + rby * cs.ny)
         self.at_points = turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)
+        if turned_by is not None:
+            k = turned_by.size
+            cs.depth[:k] += self.rn_b[:k] * self.dturn[self.b[:k]] - self.rn_a[:k] * self.dturn[self.a[:k]] - turned_by
 
     def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray, rn_a: np.ndarray,
                       rn_b: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -294,7 +303,9 @@ class Solve:
             grew = self._far_candidates()
             grew = self._new_dynamic_contacts() or grew
             grew = self._late_contacts() or grew
-            if not (held_back or overlapping or grew):
+            # (where bodies turn, points measured again may be left to look at)
+            pending = self.rigid and bool(self.dirty.any())
+            if not (held_back or overlapping or grew or pending):
                 return
         self._clear_of_statics(rounds)
 
@@ -311,13 +322,15 @@ class Solve:
         exactly out, so no body ends the step inside static geometry; overlaps between dynamic
         bodies are left to the next step. A body moves at most its reach in a round, so there are
         as many rounds as the deepest overlap needs at that pace (a small body that fell into
-        the floor faster than its size), and at least ``rounds``."""
+        the floor faster than its size), and at least ``rounds``. (Where bodies turn, these pushes
+        only move them, as the classic solve does: a push that turns a body wedged between statics
+        may turn it into one as it pushes it out of another.)"""
         for _round in range(max(rounds, self._rounds_to_clear())):
             order = self.order[self.immovable[self.order]]
             if not (self._separations()[order] < 0.0).any():
                 return
             self.dirty[order] = True
-            self._solve(order, tolerance=0.0)
+            self._solve(order, tolerance=0.0, translate=True)
             self._moved()
             overlapping = self._measure_immovable()
             grew = self._new_dynamic_contacts(immovable_only=True)
@@ -357,7 +370,7 @@ class Solve:
         bodies (a push that long in one step is a body being pushed out of a heap, not resting)."""
         return 2.0 * np.minimum(self.span[self.a], self.span[self.b])
 
-    def _solve(self, order: np.ndarray, tolerance: float | None = None) -> bool:
+    def _solve(self, order: np.ndarray, tolerance: float | None = None, translate: bool = False) -> bool:
         """One run of the position solver over the contacts ``order``; the bodies are then placed.
         Whether a push was held back.
 
@@ -370,10 +383,15 @@ class Solve:
         tol = self.tolerance if tolerance is None else tolerance
         if self.rigid:
             turn_a, turn_b = self.position_turns
+            friction = self._friction_positions()
+            if translate:  # (moves only: shares by inverse mass, no turns, no friction)
+                inv = 1.0 / (self.wa + self.wb)
+                share_a, share_b, turn_a, turn_b = self.wa * inv, self.wb * inv, 0.0 * turn_a, 0.0 * turn_b
+                friction = NO_FRICTION_POSITIONS
             _passes, held = solver.solve_positions_rigid(
                 order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b, turn_a, turn_b, self.rn_a,
                 self.rn_b, self.push, self.dx, self.dy, self.dturn, self.iterations, tol, self.dirty, self.reach,
-                *self._friction_positions())
+                *friction)
         else:
             _passes, held = solver.solve_positions(order, self.a, self.b, cs.nx, cs.ny, -cs.depth, share_a, share_b,
                                                    self.push, self.dx, self.dy, self.iterations, tol, self.dirty,
@@ -437,21 +455,35 @@ class Solve:
     def _measure_points(self, check: np.ndarray) -> bool:
         """Measure the contact points ``check`` (turning polygons against immovable bodies) again
         where the bodies now stand and are turned: a turn moves a point along an arc, which the
-        solver's linear separations follow only to first order. A pair measured with as many
-        points as it has keeps each point's new separation; otherwise all its points take its
-        deepest. Whether one still overlaps."""
+        solver's linear separations follow only to first order, and may turn the pair's normal
+        (a box turning on a corner: the face it rests on changes), which the contact then takes,
+        with its new points. A pair measured with as many points as it has keeps each point's new
+        separation; otherwise all its points take its deepest. Whether one still overlaps."""
         if check.size == 0:
             return False
-        cs = self.cs
+        cs, store = self.cs, self.store
         keys = pair_keys(cs.ea[check], cs.eb[check])
         _u, first, pair = np.unique(keys, return_index=True, return_inverse=True)
         rows = check[first]
-        store = self.store
+        r = self.stage.remeasure(cs.ra[rows], cs.rb[rows])
+        turned = r.hit & (r.nx * cs.nx[rows] + r.ny * cs.ny[rows] < 1.0 - 1e-9)
+        nx, ny = np.where(turned, r.nx, cs.nx[rows]), np.where(turned, r.ny, cs.ny[rows])
         margin = KEEP_GAP * np.minimum(store.bound[cs.ra[rows]], store.bound[cs.rb[rows]])
-        n_pts, _px, _py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], cs.nx[rows], cs.ny[rows], margin)
+        n_pts, px, py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], nx, ny, margin)
         had = np.bincount(pair, minlength=rows.size)
         same = n_pts[pair] == had[pair]
         slot = np.minimum(cs.slot[check], 1)
+        if turned.any():  # (the new normal, and where the points are now)
+            t = check[turned[pair]]
+            cs.nx[t], cs.ny[t] = nx[pair[turned[pair]]], ny[pair[turned[pair]]]
+            ok = turned[pair] & same & (n_pts[pair] > 0)
+            moved, k, q = check[ok], pair[ok], slot[ok]
+            cs.px[moved], cs.py[moved] = px[k, q], py[k, q]
+            rax, ray, rbx, rby = cs.arms
+            ra, rb = cs.ra[moved], cs.rb[moved]
+            rax[moved], ray[moved] = px[k, q] - store.x[ra], py[k, q] - store.y[ra]
+            rbx[moved], rby[moved] = px[k, q] - store.x[rb], py[k, q] - store.y[rb]
+            self._arms()
         deepest = np.where(n_pts > 1, sep.min(axis=1), sep[:, 0])
         now = np.where(same, sep[pair, slot], deepest[pair])
         apart = n_pts[pair] == 0  # no point within the margin: apart, no longer pushed along
@@ -459,6 +491,9 @@ class Solve:
         depth = np.where(apart, np.minimum(cs.depth[check], shift), shift - now)
         self.dirty[check[np.abs(depth - cs.depth[check]) > self.tolerance]] = True
         cs.depth[check] = depth
+        if turned.any():
+            self.dirty[check[turned[pair]]] = True
+            self._recolumn()
         return bool(((-now > self.tolerance) & ~apart).any())
 
     def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
@@ -605,13 +640,18 @@ class Solve:
         self.push = cat([self.push, zeros])
         self.tpush = cat([self.tpush, zeros])
         self.dirty = cat([self.dirty, np.ones(new.size, dtype=bool)])
+        self._recolumn()
+        self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
+
+    def _recolumn(self) -> None:
+        """The per-contact columns again (contacts were added, or turned), friction's per-body
+        columns and the turns made so far kept."""
         fr0 = self.fpos
         self._columns()
-        if self.fpos is not None:  # (friction's per-body columns, the turns made so far kept)
-            self.fpos.start(self.frame, self.store, rows, x0, y0, fr0)
+        if self.fpos is not None:
+            self.fpos.start(self.frame, self.store, self.rows, self.x0, self.y0, fr0)
             if self.rigid:
                 self.fpos.rot0, self.fpos.dturn = self.rot0, self.dturn
-        self._static_candidates(np.arange(n_old, rows.size))  # (the new bodies')
 
     # --- velocities --------------------------------------------------------------------------
 
