@@ -54,6 +54,12 @@ TOLERANCE = 1e-9
 # billionth cost a pyramid of 20 rows five rounds of the solver each step: 15 ms a step, against
 # 11 ms at 1e-8, 4.7 ms at 1e-6 with the pyramid off by 2e-4 instead of 4e-6)
 TOLERANCE_TURNING = 1e-8
+# Where bodies turn, contact points this close (of the smaller body's size) are kept for the next step.
+NEAR_GAP = 1e-3
+# ... and a point measured again that overlaps by less than this (times 1 + the smaller body's size)
+# is left to the next step (a round for each hundred-millionth cost a pyramid of 20 rows three
+# rounds a step)
+POINT_SLACK = 1e-7
 # Rounds at most of pushing bodies out of static ones after the solver's rounds ran out (each moves
 # a body at most its reach: a body sunk this many reaches deep is left partly inside).
 MAX_CLEAR_ROUNDS = 1024
@@ -303,8 +309,9 @@ class Solve:
             grew = self._far_candidates()
             grew = self._new_dynamic_contacts() or grew
             grew = self._late_contacts() or grew
-            # (where bodies turn, points measured again may be left to look at)
-            pending = self.rigid and bool(self.dirty.any())
+            # (where bodies turn, points against immovable bodies measured again may be left
+            # overlapping, to look at; overlaps between moving bodies wait for the next step)
+            pending = self.rigid and bool(((self._separations() < -self._slack()) & self.dirty & self.immovable).any())
             if not (held_back or overlapping or grew or pending):
                 return
         self._clear_of_statics(rounds)
@@ -494,7 +501,16 @@ class Solve:
         if turned.any():
             self.dirty[check[turned[pair]]] = True
             self._recolumn()
-        return bool(((-now > self.tolerance) & ~apart).any())
+        over = (-now > self._slack()[check]) & ~apart
+        self.dirty[check[over]] = True
+        return bool(over.any())
+
+    def _slack(self) -> np.ndarray:
+        """Contacts at points: per contact, the overlap of a point measured again that is left to
+        the next step rather than given another round (second order: what a turn's arc adds),
+        ``POINT_SLACK`` times one plus the smaller body's size."""
+        store, cs = self.store, self.cs
+        return POINT_SLACK * (1.0 + np.minimum(store.bound[cs.ra], store.bound[cs.rb]))
 
     def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
         self.candidates = candidates
@@ -814,7 +830,13 @@ class Solve:
         (the next step's warm start); for contacts at points, each point's (``frame.points``), and
         the pair's the sums of its points'."""
         cs = self.cs
-        acted = np.flatnonzero(self.touching | (self.push > 0.0))
+        acted = self.touching | (self.push > 0.0)
+        if self.rigid:  # (and the points a hair apart: a turn in a pile opens such gaps, and a pair
+            # not kept would be found again only by the pushes, a round of the solve later)
+            store = self.store
+            near = NEAR_GAP * np.minimum(store.bound[cs.ra], store.bound[cs.rb])
+            acted |= self.at_points & (self._separations() <= near)
+        acted = np.flatnonzero(acted)
         keys = pair_keys(cs.ea[acted], cs.eb[acted])
         order = np.argsort(keys, kind="stable")
         acted, keys = acted[order], keys[order]
