@@ -42,10 +42,13 @@ def run(scene, steps: int, dt: float) -> str:
     return h.hexdigest()[:16]
 
 
-def soak(bodies: int, steps: int, seed: int = 1, restitution: bool = True) -> str:
+def soak(bodies: int, steps: int, seed: int = 1, restitution: bool = True, rotation: bool = True) -> str:
     from test_soak import DT, build_level
 
-    scene, _ents, _ = build_level(bodies, seed, restitution)
+    from framework.effects import DEFAULT_EFFECTS
+
+    effects = None if rotation else DEFAULT_EFFECTS - {"rotation"}
+    scene, _ents, _ = build_level(bodies, seed, restitution, effects)
     return run(scene, steps, DT)
 
 
@@ -76,6 +79,8 @@ SCENES = {
     "soak-200x1500": lambda q: soak(200, 300 if q else 1500),
     "soak-40x3000": lambda q: soak(40, 600 if q else 3000),
     "soak-40-inelastic-x1500": lambda q: soak(40, 300 if q else 1500, seed=2, restitution=False),
+    # (polygons that do not turn: the translational solver alone, as before boxes could tip)
+    "soak-200x1500-no-rotation": lambda q: soak(200, 300 if q else 1500, rotation=False),
     "perf-1k-x100": lambda q: perf(1000, 30 if q else 100),
     "perf-10k-x20": lambda q: perf(10_000, 5 if q else 20),
     "perf-1k-tiles-x50": lambda q: perf(1000, 20 if q else 50, tiles=20_000),

@@ -57,10 +57,12 @@ SHORT_STEPS, SHORT_BODIES = int(os.environ.get("SOAK_STEPS", 1500)), int(os.envi
 LONG_STEPS, LONG_BODIES = int(os.environ.get("LONG_SOAK_STEPS", 100_000)), int(os.environ.get("LONG_SOAK_BODIES", 200))
 
 
-def build_level(n_bodies: int, seed: int, restitution: bool = True) -> tuple[Scene, np.ndarray, list]:
-    """The level and its bodies; returns (scene, entity ids, local outline of each body)."""
+def build_level(n_bodies: int, seed: int, restitution: bool = True,
+                effects=None) -> tuple[Scene, np.ndarray, list]:
+    """The level and its bodies (``effects``: the scene's, default the defaults); returns (scene,
+    entity ids, local outline of each body)."""
     rng = np.random.default_rng(seed)
-    s = Scene(gravity=(0.0, -G))
+    s = Scene(gravity=(0.0, -G), effects=effects)
     for x in range(W):
         s.spawn(Transform(float(x), 0.0), Hitbox(AABB(1.0, 1.0), body="static"))
         s.spawn(Transform(float(x), float(H - 1)), Hitbox(AABB(1.0, 1.0), body="static"))

@@ -110,7 +110,8 @@ def _energy(s: Scene, ents) -> float:
         r = store.row_of[e]
         hb = s.get(e, Hitbox)
         inertia = hb.mass * hb.shape.second_moment
-        total += hb.mass * (0.5 * (store.vx[r] ** 2 + store.vy[r] ** 2) + G * store.y[r]) + 0.5 * inertia * store.w[r] ** 2
+        kinetic = 0.5 * (store.vx[r] ** 2 + store.vy[r] ** 2)
+        total += hb.mass * (kinetic + G * store.y[r]) + 0.5 * inertia * store.w[r] ** 2
     return total
 
 

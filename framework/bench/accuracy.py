@@ -36,8 +36,12 @@ Scenarios (each has an exact reference, so every error is measured, not judged b
   ``slope-hold``: a box on a 30 degree slope with mu 0.7 (> tan 30) must not move in 5 s;
   ``slope-slide``: with mu 0.3 it slides at ``g (sin - mu cos)``; ``disk-roll``: a solid disk on
   that slope with mu 0.5 rolls at ``(2/3) g sin``; ``disk-slip``: with mu 0.1 (< tan 30 / 3) it
-  slips at ``g (sin - mu cos)``. ``measured`` / ``expected``: the stop distance, the distance
-  moved, or the acceleration (speed after 2 s over 2 s); ``rel_error``: their relative difference
+  slips at ``g (sin - mu cos)``; ``box-tip``: a unit box (``Polygon.box``, mu 0.5) dropped from
+  1 unit tilted by 0.3 rad tips flat and rests at half its height, 0.5 (contacts at the two points
+  of the face it lands on); ``box-tip-one-point``: the same without the ``rotation`` effect, one
+  contact point per pair through the centres, as before boxes could tip (it stays on its corner).
+  ``measured`` / ``expected``: the stop distance, the distance moved, the acceleration (speed after
+  2 s over 2 s) or the resting height after 3 s; ``rel_error``: their relative difference
   (``slope-hold``: the distance itself). Modes ``substeps-N``.
 
 Sleeping is off in every scene (except ``default-sleeping``) so the solver is measured, not the
@@ -82,7 +86,7 @@ REST_MODES = ("response-iterations-1", "response-iterations-2", "response-iterat
               "response-iterations-8", "substeps-2", "substeps-4", "substeps-8", "default-sleeping")
 BALL_MODES = ("substeps-1", "substeps-2", "substeps-4", "substeps-8")
 FRICTION_MODES = ("substeps-1", "substeps-2", "substeps-4")
-FRICTION_CASES = ("crate-stop", "slope-hold", "slope-slide", "disk-roll", "disk-slip")
+FRICTION_CASES = ("crate-stop", "slope-hold", "slope-slide", "disk-roll", "disk-slip", "box-tip", "box-tip-one-point")
 SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction")
 DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
 
@@ -477,8 +481,18 @@ def run_friction(case: str, mode: str, runs: int = 1) -> dict[str, Any]:
 
 def _friction_run(case: str, mode: str) -> tuple[list[float], float, float, int]:
     g, sin, cos = FRICTION_G, math.sin(SLOPE), math.cos(SLOPE)
-    scene = _scene_for(mode, gravity=(0.0, -g))
+    effects = None
+    if case == "box-tip-one-point":
+        from ..scene import DEFAULT_EFFECTS
+
+        effects = DEFAULT_EFFECTS - {"sleeping", "rotation"}
+    scene = _scene_for(mode, gravity=(0.0, -g), effects=effects)
     try:
+        if case.startswith("box-tip"):
+            scene.spawn(Transform(0.0, -0.5), Hitbox(AABB(100.0, 1.0), body="static"))
+            body = scene.spawn(Transform(0.0, 1.0, 0.3), Velocity(), Hitbox(Polygon.box(1.0, 1.0), friction=0.5))
+            times = _timed_steps(scene, 180)
+            return times, scene.get(body, Transform).y, 0.5, 180
         if case == "crate-stop":
             scene.spawn(Transform(0.0, -0.5), Hitbox(AABB(100.0, 1.0), body="static"))
             body = scene.spawn(Transform(0.0, 0.5), Velocity(5.0, 0.0), Hitbox(AABB(1.0, 1.0), friction=0.5))

@@ -302,8 +302,10 @@ def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, 
             change = new - push[i]
             if change != 0.0:
                 wanted = change
-                change = _kept_within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i], reach[ia])
-                change = _kept_within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i], reach[ib])
+                change = _kept_within(change, share_a[i], -1.0, dx[ia] - x0[ia], dy[ia] - y0[ia], nx[i], ny[i],
+                                      reach[ia])
+                change = _kept_within(change, share_b[i], 1.0, dx[ib] - x0[ib], dy[ib] - y0[ib], nx[i], ny[i],
+                                      reach[ib])
                 if change != wanted:
                     held = True
                 if change != 0.0:
