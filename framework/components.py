@@ -143,9 +143,10 @@ class Hitbox:
       that one (a crate given 0.5 slides with 0.5 on a plain floor); where neither does, none.
       Needs the ``"friction"`` effect (on by default); see docs/physics.md.
     - ``inertia``: moment of inertia about the centre (> 0), or None (the default: from the shape
-      and ``mass``, a solid disk's ``m r^2 / 2``); ``math.inf`` keeps the body from turning.
-      Friction turns dynamic circles (centred on their entity): they roll. Boxes and polygons do
-      not turn from contacts yet. Needs the ``"rotation"`` effect (on by default).
+      and ``mass``, a solid disk's ``m r^2 / 2``, a box's ``m (w^2 + h^2) / 12``); ``math.inf``
+      keeps the body from turning (a player that must never tip). Contacts turn dynamic circles,
+      boxes and polygons centred on their entity: boxes tip and tumble, circles roll (through
+      friction). An ``AABB`` never turns. Needs the ``"rotation"`` effect (on by default).
     - ``ccd``: continuous detection. The body is swept along its motion each step so it cannot
       pass through thin walls; bodies without it pay nothing for it.
     - ``one_way``: a platform that is solid only from above (its local +y, turning with its
