@@ -24,7 +24,7 @@ from .bodies import Bodies
 from .components import Hitbox, Transform, Velocity
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import check_added_component, spawn_components
-from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
+from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
 from .frame import StepFrame, add_counters
 from .input import Input
 from .queries import ALL_LAYERS, SceneHit, SpatialQueries
@@ -164,6 +164,16 @@ class Scene:
         pushed into a wall, once the wall's push freed it) is not here: a game asking "am I
         standing on something?" should look here, not at every contact."""
         return self._pipeline.frame.resolved  # type: ignore[return-value]
+
+    @property
+    def contact_points(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Where boxes and polygons turn (the ``rotation`` effect): the points the response pushed
+        at this step, as arrays ``(a, b, x, y, push, impulse)`` (entity ids a < b; each point's
+        push-out and normal impulse), sorted by pair; two where a face rests on a face (see
+        docs/physics.md). Empty in a step where no such body was in a contact."""
+        keys, _slot, push, impulse, _tpush, _timpulse, x, y = self._pipeline.frame.points
+        a, b = pair_parts(keys)
+        return a, b, x, y, push, impulse
 
     @property
     def ray_log(self) -> list[tuple[tuple[float, float], tuple[float, float], SceneHit | None]]:

@@ -206,3 +206,19 @@ def test_the_manifold_kernel_agrees_with_manifold():
             compared += 1
         s.close()
     assert compared > 150
+
+
+def test_scene_contact_points_are_the_two_corners_a_box_rests_on():
+    with Scene(gravity=(0.0, -G)) as s:
+        _floor(s)
+        box = s.spawn(Transform(0.0, 0.5), Velocity(), Hitbox(Polygon.box(1.0, 1.0)))
+        s.step(DT)
+        a, b, x, y, push, impulse = s.contact_points
+        assert set(a.tolist()) | set(b.tolist()) >= {box}
+        assert sorted(x.tolist()) == pytest.approx([-0.5, 0.5], abs=1e-9)
+        assert (push > 0).all() and (impulse > 0).all()
+        assert impulse[0] == pytest.approx(impulse[1], rel=1e-9)  # the weight shared evenly
+        v = s.get(box, Velocity)
+        # stopped, not turned: to the velocity solver's tolerance, 1e-8 of the speeds (g dt here)
+        assert (v.x, v.y, v.angular) == pytest.approx((0.0, 0.0, 0.0), abs=1e-8 * G * DT)
+        assert s.resolved[0].size == 1  # one pair applied

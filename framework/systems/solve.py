@@ -843,31 +843,37 @@ class Solve:
         the pair's the sums of its points'."""
         cs = self.cs
         acted = self.touching | (self.push > 0.0)
+        kept = acted
         if self.rigid:  # (and the points a hair apart: a turn in a pile opens such gaps, and a pair
             # not kept would be found again only by the pushes, a round of the solve later)
             store = self.store
             near = NEAR_GAP * np.minimum(store.bound[cs.ra], store.bound[cs.rb])
-            acted |= self.at_points & (self._separations() <= near)
-        acted = np.flatnonzero(acted)
-        keys = pair_keys(cs.ea[acted], cs.eb[acted])
+            kept = acted | (self.at_points & (self._separations() <= near))
+        rows = np.flatnonzero(kept)
+        keys = pair_keys(cs.ea[rows], cs.eb[rows])
         order = np.argsort(keys, kind="stable")
-        acted, keys = acted[order], keys[order]
-        ea, eb, nx, ny = cs.ea[acted], cs.eb[acted], cs.nx[acted], cs.ny[acted]
-        gap = np.maximum(self._separations()[acted], 0.0)
-        push = np.minimum(self.push, self._push_cap())[acted]  # (see _warm_pushes)
-        tpush = np.zeros(acted.size)
+        rows, keys = rows[order], keys[order]
+        ea, eb, nx, ny = cs.ea[rows], cs.eb[rows], cs.nx[rows], cs.ny[rows]
+        gap = np.maximum(self._separations()[rows], 0.0)
+        push = np.minimum(self.push, self._push_cap())[rows]  # (see _warm_pushes)
+        tpush = np.zeros(rows.size)
         if self.fpos is not None:
-            tpush = self.fpos.clip(self.tpush[acted], push, self.position_mu[acted])
-        values = (self.push[acted], push, self.impulse[acted], tpush, self.timpulse[acted])
+            tpush = self.fpos.clip(self.tpush[rows], push, self.position_mu[rows])
+        values = (self.push[rows], push, self.impulse[rows], tpush, self.timpulse[rows])
+        applied = acted[rows]
         if self.rigid:
-            frame.points = (keys, cs.slot[acted], *values[1:], cs.px[acted], cs.py[acted])
+            frame.points = (keys, cs.slot[rows], *values[1:], cs.px[rows], cs.py[rows])
             first = np.flatnonzero(np.diff(keys, prepend=keys[:1] - 1))  # (each pair's first point)
-            ea, eb, nx, ny, gap = ea[first], eb[first], nx[first], ny[first], np.minimum.reduceat(gap, first)
-            values = tuple(np.add.reduceat(v, first) for v in values) if first.size else values
+            ea, eb, nx, ny = ea[first], eb[first], nx[first], ny[first]
+            if first.size:
+                gap = np.minimum.reduceat(gap, first)
+                values = tuple(np.add.reduceat(v, first) for v in values)
+                applied = np.maximum.reduceat(applied, first)
         pushed, push, impulse, tpush, timpulse = values
-        frame.resolved = (ea, eb, nx, ny, pushed)
+        a = np.flatnonzero(applied)
+        frame.resolved = (ea[a], eb[a], nx[a], ny[a], pushed[a])
         frame.support = (ea, eb, nx, ny, push, impulse, gap, tpush, timpulse)
-        frame.counters["resolved"] = int(ea.size)
+        frame.counters["resolved"] = int(a.size)
 
 
 def _number(table: np.ndarray, rows: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:
