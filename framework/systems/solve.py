@@ -21,6 +21,13 @@ Where hitboxes give friction (and the scene has the ``friction`` effect), both h
 along each contact (:mod:`framework.systems.friction`): tangential pushes undo the step's slip,
 tangential impulses stop the sliding, each within ``mu`` times its normal counterpart; with the
 ``rotation`` effect they turn the circles they act on. Without friction none of it runs.
+
+Where a box or polygon that turns is in a contact (the ``rotation`` effect), the solve works on
+points (:mod:`framework.systems.turning`): each such pair becomes its manifold points, pushes and
+impulses turn bodies by their lever arms (the ``*_rigid`` loops), the points against immovable
+bodies are measured again between rounds, and a contact with an immovable body that this step's
+speeds would close is in the velocity solve too (speculative). A solve without such a body runs
+exactly as before.
 """
 
 from __future__ import annotations
