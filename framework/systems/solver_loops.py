@@ -31,7 +31,11 @@ per-body update as shared compiled functions (even inlined), both ran 2 to 3 tim
 (numba 0.68, measured 2026-11-25). Friction is the exception, the other way round: its velocity
 update, written inside the loop, made the frictionless path 45% slower although it never ran, so
 it is a function of its own (:func:`_stop_sliding`), called only where there is friction; inside
-the position loop it costs nothing measurable.
+the position loop it costs nothing measurable. The ``*_rigid`` loops (contacts at points, bodies
+that turn: :mod:`framework.systems.turning`) repeat the two loops with the angular terms added,
+on purpose: a scene without turning bodies runs the translational loops as they were, bit for bit
+and without the angular arithmetic (a 2x2 block solve of two-point manifolds as a helper called
+from the rigid loop made it twice as slow, 2026-11-25).
 """
 
 from __future__ import annotations
