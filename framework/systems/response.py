@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..collision import batch
-from ..collision.batch_manifold import pair_manifolds
 from ..events import pair_keys, sorted_find, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..store import STATIC
@@ -25,6 +24,7 @@ from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Solve
 from .stage import Stage
+from .turning import manifold_points
 
 __all__ = ["Response"]
 
@@ -199,12 +199,10 @@ class Response(Stage):
         return r
 
     def remeasure_points(self, ra: np.ndarray, rb: np.ndarray, nx: np.ndarray, ny: np.ndarray,
-                         margin: np.ndarray) -> tuple[np.ndarray, ...]:
+                         gap: float) -> tuple[np.ndarray, ...]:
         """The manifold points of the box and polygon pairs ``(ra, rb)`` along the normals ``(nx,
-        ny)``, where the bodies (and their turns) now are (see :func:`pair_manifolds`)."""
-        store, geom = self.bodies.store, self._geometry_of(ra, rb, True)
-        return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh,
-                              geom.poly_slot, geom.world_poly, geom.count)
+        ny)``, where the bodies (and their turns) now are (see :func:`manifold_points`)."""
+        return manifold_points(self.bodies.store, self._geometry_of(ra, rb, True), ra, rb, nx, ny, gap)
 
     def _geometry_of(self, ra: np.ndarray, rb: np.ndarray, turned: bool):
         """The geometry, with the hitboxes of these rows where their bodies now stand (``turned``:

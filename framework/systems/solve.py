@@ -156,11 +156,12 @@ class Solve:
         self.share_a, self.share_b = wa * w, wb * w
         self.immovable = (wa == 0.0) | (wb == 0.0)
         arms = inertia = None
+        self.turn_shares = None  # (contacts at points: how far a unit turns each body, shared by inverse mass)
         if self.rigid:
             self._arms()
             arms, inertia = (self.rt_a, self.rt_b), (self.ia, self.ib)
             still = np.zeros(C, dtype=bool)
-            self.share_a, self.share_b, _turns = self._rigid_shares(still, still, self.rn_a, self.rn_b)
+            self.share_a, self.share_b, self.turn_shares = self._rigid_shares(still, still)
         self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, arms, inertia) if self.friction else None
         # The position solve's friction (``fpos``) turns bodies only against immovable ones: with
         # tangential pushes turning both bodies of a pair, a pyramid of 20 rows crept apart.
@@ -170,16 +171,16 @@ class Solve:
             self.fpos = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, (imm * self.rt_a, imm * self.rt_b),
                                     inertia)
         self.order = self._order()
-        self.position_shares = self._shock_shares()
-        self.position_turns = self._turns
+        share_a, share_b, self.position_turns = self._shock_shares()
+        self.position_shares = (share_a, share_b)
         fp = self.fpos
         self.position_mu = None if fp is None else fp.limits(*self.position_shares, self._angular())
 
     def _arms(self) -> None:
         """Contacts at points: each body's inverse inertia (a sleeper keeps still), and the lever
         arms across the normal (``rn = r x n``) and along the contact (``rt = r x t``, ``t = (-ny,
-        nx)``) from each body's centre to the point; contacts of turning polygons are not measured
-        again in the solve (their points hold)."""
+        nx)``) from each body's centre to the point, and which contacts have a turning polygon
+        (their points are measured again by :meth:`_measure_points`)."""
         store, cs = self.store, self.cs
         # (arms that change during the solve keep every contact's separation where it is: a
         # contact's depth is relative to where the solve began, through its arms)
@@ -202,11 +203,10 @@ class Solve:
             k = turned_by.size
             cs.depth[:k] += self.rn_b[:k] * self.dturn[self.b[:k]] - self.rn_a[:k] * self.dturn[self.a[:k]] - turned_by
 
-    def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray, rn_a: np.ndarray,
-                      rn_b: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Contacts at points: how far a unit of push (impulse) moves and turns each body, with
-        lever arms ``rn`` and the bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a,
-        turn_b))``."""
+    def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray) -> tuple[Any, ...]:
+        """Contacts at points: how far a unit of push (impulse) moves and turns each body, the
+        bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a, turn_b))``."""
+        rn_a, rn_b = self.rn_a, self.rn_b
         wa, wb = np.where(still_a, 0.0, self.wa), np.where(still_b, 0.0, self.wb)
         ia, ib = np.where(still_a, 0.0, self.ia), np.where(still_b, 0.0, self.ib)
         inv = 1.0 / (wa + wb + ia * rn_a * rn_a + ib * rn_b * rn_b)
@@ -218,28 +218,21 @@ class Solve:
             return None
         return self.ia * self.rn_a * self.rn_a, self.ib * self.rn_b * self.rn_b
 
-    def _base_shares(self) -> tuple[np.ndarray, np.ndarray]:
-        """The shares by inverse mass (and, for contacts at points, the turns in ``self._turns``)."""
-        if not self.rigid:
-            self._turns = None
-            return self.share_a, self.share_b
-        still = np.zeros(self.cs.size, dtype=bool)
-        return self._lower_stays(still, still)
-
-    def _shock_shares(self) -> tuple[np.ndarray, np.ndarray]:
+    def _shock_shares(self) -> tuple[Any, ...]:
         """The shares of the position pushes (shock propagation). In a pair resting one on the other
         (normal within 60 degrees of the vertical) whose lower body rests on something immovable
         (the floor, or a body resting on it...), the lower body keeps still and the push lifts the
         upper one: a stack is pushed out from the ground up, each body exactly onto the one below
         (Gauss-Seidel alone converges on a stack only geometrically, and a body on top would press
         the one below into it). Elsewhere the push is shared by inverse mass. (Velocities: see
-        :meth:`_velocity_shares`.)"""
+        :meth:`_velocity_shares`.) With the turns of contacts at points (None elsewhere):
+        ``(share_a, share_b, turns)``."""
         gx, gy = self.gravity
         g = math.hypot(gx, gy)
         both = ~self.immovable
         if g == 0.0 or not both.any():
             self.b_on_a = self.a_on_b = None
-            return self._base_shares()
+            return self.share_a, self.share_b, self.turn_shares
         cs = self.cs
         up = -(cs.nx * gx + cs.ny * gy) / g  # > 0.5: b rests on a
         fixed_a, fixed_b = self.share_a == 0.0, self.share_b == 0.0
@@ -248,16 +241,14 @@ class Solve:
         self.a_on_b = a_on_b = both & (up < -0.5) & held[self.b]
         return self._lower_stays(b_on_a, a_on_b)
 
-    def _lower_stays(self, b_on_a: np.ndarray, a_on_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still (and,
-        for contacts at points, the turns in ``self._turns``)."""
-        self._turns = None
+    def _lower_stays(self, b_on_a: np.ndarray, a_on_b: np.ndarray) -> tuple[Any, ...]:
+        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still, and
+        the turns of contacts at points (None elsewhere): ``(share_a, share_b, turns)``."""
         if self.rigid:
-            share_a, share_b, self._turns = self._rigid_shares(b_on_a, a_on_b, self.rn_a, self.rn_b)
-            return share_a, share_b
+            return self._rigid_shares(b_on_a, a_on_b)
         share_a = np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, self.share_a))
         share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
-        return share_a, share_b
+        return share_a, share_b, None
 
     def _order(self) -> np.ndarray:
         """Contacts from the bottom of a pile up (contacts with immovable bodies first): a push
@@ -482,8 +473,7 @@ class Solve:
         r = self.stage.remeasure(cs.ra[rows], cs.rb[rows])
         turned = r.hit & (r.nx * cs.nx[rows] + r.ny * cs.ny[rows] < 1.0 - 1e-9)
         nx, ny = np.where(turned, r.nx, cs.nx[rows]), np.where(turned, r.ny, cs.ny[rows])
-        margin = KEEP_GAP * np.minimum(store.bound[cs.ra[rows]], store.bound[cs.rb[rows]])
-        n_pts, px, py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], nx, ny, margin)
+        n_pts, px, py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], nx, ny, KEEP_GAP)
         had = np.bincount(pair, minlength=rows.size)
         same = n_pts[pair] == had[pair]
         slot = np.minimum(cs.slot[check], 1)
@@ -708,8 +698,7 @@ class Solve:
                 self.touching = self.touching | speculative  # (not warm started: not in contact yet)
                 target[speculative] = -sep[speculative] / dt
         order = self.order[self.touching[self.order]]
-        share_a, share_b = self._velocity_shares(vx, vy)
-        turns = self._turns
+        share_a, share_b, turns = self._velocity_shares(vx, vy)
         self.impulse = np.where(warm, cs.impulse0, 0.0)
         wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, n)
         vx += wx
@@ -757,15 +746,16 @@ class Solve:
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
                                     self.iterations, tol, dirty, *friction)
 
-    def _velocity_shares(self, vx: np.ndarray, vy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _velocity_shares(self, vx: np.ndarray, vy: np.ndarray) -> tuple[Any, ...]:
         """Shares of the velocity impulses. As for the pushes, the lower body of a supported resting
         pair keeps still (a pile's weight goes straight down to the ground within one pass; a body
         high in a pile cannot keep a falling speed that only the pushes hide), except where the
         lower body moves into the upper one faster than a body at rest does (it bounced): an
         immovable body moving up would hand the upper one a bounce off a moving wall and keep its
-        own speed, making energy; those pairs meet as the dynamic bodies they are."""
+        own speed, making energy; those pairs meet as the dynamic bodies they are. With the turns of
+        contacts at points, as :meth:`_shock_shares`."""
         if self.b_on_a is None or not (self.b_on_a.any() or self.a_on_b.any()):
-            return self._base_shares()
+            return self.share_a, self.share_b, self.turn_shares
         cs, a, b = self.cs, self.a, self.b
         gx, gy = self.gravity
         resting_speed = 2.0 * np.abs(gx * cs.nx + gy * cs.ny) * self.dt
@@ -877,10 +867,12 @@ class Solve:
                 values = tuple(np.add.reduceat(v, first) for v in values)
                 applied = np.maximum.reduceat(applied, first)
         pushed, push, impulse, tpush, timpulse = values
-        a = np.flatnonzero(applied)
-        frame.resolved = (ea[a], eb[a], nx[a], ny[a], pushed[a])
         frame.support = (ea, eb, nx, ny, push, impulse, gap, tpush, timpulse)
-        frame.counters["resolved"] = int(a.size)
+        frame.resolved = (ea, eb, nx, ny, pushed)
+        if not applied.all():  # (pairs only kept, a hair apart: not applied)
+            a = np.flatnonzero(applied)
+            frame.resolved = (ea[a], eb[a], nx[a], ny[a], pushed[a])
+        frame.counters["resolved"] = int(frame.resolved[0].size)
 
 
 def _number(table: np.ndarray, rows: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:

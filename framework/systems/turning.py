@@ -25,12 +25,22 @@ from ..collision.kinds import KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys
 from ..store import BodyStore
 
-__all__ = ["expand", "turning_polygons"]
+__all__ = ["expand", "manifold_points", "turning_polygons"]
 
 
 def turning_polygons(store: BodyStore, rows: np.ndarray) -> np.ndarray:
     """Mask of ``rows`` that are boxes or polygons contacts turn."""
     return (store.kind[rows] == KIND_POLYGON) & (store.inv_inertia[rows] > 0.0)
+
+
+def manifold_points(store: BodyStore, geom, ra: np.ndarray, rb: np.ndarray, nx: np.ndarray, ny: np.ndarray,
+                    gap: float) -> tuple[np.ndarray, ...]:
+    """:func:`pair_manifolds` of the box and polygon pairs ``(ra, rb)`` along ``(nx, ny)``, from
+    the step's geometry, keeping the points less than ``gap`` times the smaller body's size
+    apart: ``(count, px, py, sep)``."""
+    margin = gap * np.minimum(store.bound[ra], store.bound[rb])
+    return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh, geom.poly_slot,
+                          geom.world_poly, geom.count)
 
 
 def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: float):
@@ -42,9 +52,7 @@ def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: f
     turn = turning_polygons(store, ra) | turning_polygons(store, rb)
     circle = (store.kind[ra] == KIND_CIRCLE) | (store.kind[rb] == KIND_CIRCLE)
     clip = np.flatnonzero(turn & ~circle)
-    marg = margin * np.minimum(store.bound[ra[clip]], store.bound[rb[clip]])
-    n_pts, px, py, sep = pair_manifolds(ra[clip], rb[clip], cs.nx[clip], cs.ny[clip], marg, store.kind, geom.hx,
-                                        geom.hy, store.hw, store.hh, geom.poly_slot, geom.world_poly, geom.count)
+    n_pts, px, py, sep = manifold_points(store, geom, ra[clip], rb[clip], cs.nx[clip], cs.ny[clip], margin)
     # rows: every pair once (a pair with no manifold point keeps its own row if it overlaps), then
     # each clipped pair's second point
     count = np.ones(cs.size, dtype=np.int64)
