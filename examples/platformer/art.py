@@ -2,9 +2,13 @@
 
 ``images/``: ``ground.png`` and ``ground_top.png`` (a solid tile inside the ground and on its
 surface), ``plank.png`` (a one-way platform's slab), the player (looking either way), the enemy,
-the goal's and the checkpoints' flags; ``levels/tiles.png``: the tileset the ``.tmj`` maps name,
-so they open in Tiled with pictures (solid, one-way, spikes). The game uses the images for
-32-unit tiles and plain colours otherwise; runs without a renderer never load them.
+the goal's and the checkpoints' flags, and ``slope_<kind>.png`` for each slope kind of
+:mod:`framework.tiles` (ground under the slope, grass along its surface, transparent above);
+``levels/tiles.png``: the tileset the ``.tmj`` maps name, so they open in Tiled with pictures,
+three tiles a row in the order of ``levels.TILE_KINDS`` (solid, one-way, spikes, then the six
+slopes; the first row is the original three-tile tileset, so its tile ids keep their meaning).
+The game uses the images for 32-unit tiles and plain colours otherwise; runs without a renderer
+never load them.
 """
 
 from __future__ import annotations
@@ -14,6 +18,8 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+
+from framework.tiles import HEIGHTS, SLOPES
 
 HERE = Path(__file__).parent
 IMAGES = HERE / "images"
@@ -55,6 +61,27 @@ def ground(top: bool) -> np.ndarray:
             img[: depth[col], col, :3] = GRASS
             img[depth[col] - 1, col, :3] = GRASS_DARK
         img[0, :, :3] = (150, 220, 130)
+    return img
+
+
+def slope(kind: str) -> np.ndarray:
+    """A slope tile: ground below the surface line of ``kind`` (``framework.tiles.HEIGHTS``), grass
+    5-7 px deep (across the slope) under it, transparent above."""
+    left, right = HEIGHTS[kind]
+    img = ground(False)
+    y, x = np.mgrid[0:TILE, 0:TILE]
+    rise = (right - left) * TILE  # surface height rises by this over the tile
+    # Height of each pixel's centre above the tile's bottom, and of the surface above that column.
+    above = TILE - (y + 0.5)
+    surface = left * TILE + rise * (x + 0.5) / TILE
+    below = surface - above  # > 0 under the surface
+    img[below <= 0.0] = 0
+    stretch = float(np.hypot(1.0, rise / TILE))  # vertical depth of grass of a given thickness
+    depth = (5 + ((x * 7) % 5 == 0) + ((x * 3) % 4 == 0)) * stretch
+    grass = (below > 0.0) & (below <= depth)
+    img[grass, :3] = GRASS
+    img[grass & (below > depth - 1.0 * stretch), :3] = GRASS_DARK
+    img[(below > 0.0) & (below <= 1.0 * stretch), :3] = (150, 220, 130)
     return img
 
 
@@ -142,11 +169,15 @@ def flag(width: int, color: tuple[int, int, int]) -> np.ndarray:
 
 
 def tileset() -> np.ndarray:
-    """96 x 32: solid, one-way (a plank on the top quarter), spikes; for Tiled."""
-    img = np.zeros((TILE, 3 * TILE, 4), dtype=np.uint8)
-    img[:, :TILE] = ground(True)
-    img[:8, TILE:2 * TILE] = plank()
-    img[:, 2 * TILE:] = spikes()
+    """96 x 96, for Tiled: solid, one-way (a plank on the top quarter), spikes; then the slopes, in
+    the order of ``framework.tiles.SLOPES``, three a row."""
+    tiles = [ground(True), np.pad(plank(), ((0, TILE - 8), (0, 0), (0, 0))), spikes()]
+    tiles += [slope(k) for k in SLOPES]
+    rows = -(-len(tiles) // 3)
+    img = np.zeros((rows * TILE, 3 * TILE, 4), dtype=np.uint8)
+    for i, tile in enumerate(tiles):
+        r, c = divmod(i, 3)
+        img[r * TILE:(r + 1) * TILE, c * TILE:(c + 1) * TILE] = tile
     return img
 
 
@@ -174,6 +205,8 @@ def main() -> None:
     write_png(IMAGES / "goal.png", flag(32, (90, 224, 120)))
     write_png(IMAGES / "checkpoint.png", flag(16, (150, 150, 150)))
     write_png(IMAGES / "checkpoint_on.png", flag(16, (120, 230, 255)))
+    for kind in SLOPES:
+        write_png(IMAGES / f"{kind}.png", slope(kind))
     write_png(HERE / "levels" / "tiles.png", tileset())
 
 

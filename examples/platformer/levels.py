@@ -7,6 +7,9 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
 **Text maps**, one character per tile, rows top to bottom::
 
     #  solid tile          -  one-way platform     ^  spikes
+    /  slope up (45)       \\  slope down (45)
+    rR gentle slope up (2:1, two cells: low half, high half)
+    Ff gentle slope down (2:1, two cells: high half, low half)
     P  player start        C  coin                 E  enemy
     K  checkpoint          G  goal                 .  empty (so is a space)
     B  crate (pushable)    O  barrel (rolls)
@@ -16,9 +19,15 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
 Lines starting with ``;`` are comments; short rows are padded with empty cells.
 
 **Tiled maps** (orthogonal, finite, Tiled's JSON export): tile layers give tile kinds, either
-for the whole layer (a ``kind`` property, or the layer named ``solid``, ``oneway`` or ``spikes``)
-or per tile from the tileset (each tile's ``type``/``class`` or ``kind`` property). Layers named
-``background`` or ``decoration`` (or ``kind`` = ``decoration``) are ignored. Layer ``data`` may
+for the whole layer (a ``kind`` property, or the layer named after a kind: ``solid``, ``oneway``,
+``spikes`` or a slope) or per tile from the tileset (each tile's ``type``/``class`` or ``kind``
+property). The slope kinds are those of :mod:`framework.tiles`: ``slope_up``, ``slope_down``,
+``slope_up_low``, ``slope_up_high``, ``slope_down_high``, ``slope_down_low``. A slope tile flipped
+horizontally (Tiled's flip flag) is the mirrored slope (``slope_up`` <-> ``slope_down``,
+``slope_up_low`` <-> ``slope_down_low``, ``slope_up_high`` <-> ``slope_down_high``); a slope
+flipped vertically or rotated is an error (upside-down slopes are not supported); flips of other
+tiles are ignored. Layers named ``background`` or ``decoration`` (or ``kind`` = ``decoration``) are
+ignored. Layer ``data`` may
 be a plain array or base64 (uncompressed, zlib or gzip). One object layer (or more) holds
 objects whose ``type``/``class`` (or ``name``) is ``player``, ``coin``, ``enemy``, ``goal``,
 ``checkpoint``, ``platform``, ``spikes``, ``crate`` or ``barrel``; points and rectangles both work. Properties:
@@ -41,22 +50,29 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from framework import tiles as terrain
+
 __all__ = [
     "LEVEL_DIR", "Level", "LevelError", "LevelObject", "builtin_levels", "load_level", "parse_text",
     "parse_tmj", "to_tmj", "dump_tmj",
 ]
 
 LEVEL_DIR = Path(__file__).with_name("levels")
-TILE_KINDS = ("solid", "oneway", "spikes")
+# The order gives the tile ids of the tileset ``to_tmj`` writes: new kinds go at the end.
+TILE_KINDS = ("solid", "oneway", "spikes", *terrain.SLOPES)
 OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel")
 DECORATION = ("background", "decoration")
 DEFAULT_TILE = 32.0
 
-_TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes"}
+_TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes", "/": terrain.SLOPE_UP, "\\": terrain.SLOPE_DOWN,
+               "r": terrain.SLOPE_UP_LOW, "R": terrain.SLOPE_UP_HIGH, "F": terrain.SLOPE_DOWN_HIGH,
+               "f": terrain.SLOPE_DOWN_LOW}
 _TEXT_OBJECTS = {"P": "player", "C": "coin", "E": "enemy", "G": "goal", "K": "checkpoint", "B": "crate",
                  "O": "barrel"}
 _TEXT_EMPTY = ". "
 _FLIP_BITS = 0xF0000000  # Tiled's flip / rotate flags in the high bits of a gid
+_FLIP_H = 0x80000000  # flipped horizontally
+_FLIP_V_OR_D = 0x60000000  # flipped vertically, or diagonally (a rotation by 90 degrees)
 
 
 class LevelError(ValueError):
@@ -293,6 +309,13 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None) -> L
                 if k is None:
                     fail(f"{where}: tile {gid} at column {col}, row {row} has no kind: name the layer "
                          f"{'/'.join(TILE_KINDS)}, give it a 'kind' property, or give the tile a type")
+                if k in terrain.SLOPES:
+                    if raw & _FLIP_V_OR_D:
+                        fail(f"{where}: {k} tile {gid} at column {col}, row {row} is flipped vertically "
+                             "or rotated; upside-down slopes are not supported (flip slopes horizontally "
+                             "only)")
+                    if raw & _FLIP_H:
+                        k = terrain.MIRRORED[k]
                 tiles[row][col] = k
         elif ltype == "objectgroup":
             objs = layer.get("objects", [])
@@ -443,11 +466,24 @@ def builtin_levels() -> list[Path]:
     return sorted(LEVEL_DIR.glob("*.tmj"))
 
 
-_TILESET = {
-    "firstgid": 1, "name": "platformer", "tilewidth": 32, "tileheight": 32, "tilecount": 3,
-    "columns": 3, "margin": 0, "spacing": 0, "image": "tiles.png", "imagewidth": 96, "imageheight": 32,
-    "tiles": [{"id": 0, "type": "solid"}, {"id": 1, "type": "oneway"}, {"id": 2, "type": "spikes"}],
-}
+# levels/tiles.png (art.py draws it): three tiles a row, in the order of TILE_KINDS (solid, one-way,
+# spikes, then the slopes); its first row is the original three-tile tileset, so old ids keep their
+# meaning. A level without slopes is written with that original tileset (the first row only), so its
+# file is unchanged; a level with slopes gets every tile.
+_TILESET_COLUMNS = 3
+_BASIC_KINDS = 3  # solid, oneway, spikes
+
+
+def _tileset(tile: float, kinds: int) -> dict[str, Any]:
+    """The embedded tileset of ``to_tmj``: the first ``kinds`` of TILE_KINDS, typed, ``tile`` wide."""
+    t = int(tile)
+    rows = -(-kinds // _TILESET_COLUMNS)
+    return {
+        "firstgid": 1, "name": "platformer", "tilewidth": t, "tileheight": t, "tilecount": kinds,
+        "columns": min(kinds, _TILESET_COLUMNS), "margin": 0, "spacing": 0, "image": "tiles.png",
+        "imagewidth": int(_TILESET_COLUMNS * tile), "imageheight": int(rows * tile),
+        "tiles": [{"id": i, "type": k} for i, k in enumerate(TILE_KINDS[:kinds])],
+    }
 
 
 def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
@@ -474,7 +510,8 @@ def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
                 for k, v in sorted(o.props.items())
             ]
         objs.append(entry)
-    tileset = dict(_TILESET, tilewidth=int(t), tileheight=int(t), imagewidth=int(3 * t), imageheight=int(t))
+    sloped = any(k in terrain.SLOPES for row in level.tiles for k in row)
+    tileset = _tileset(t, len(TILE_KINDS) if sloped else _BASIC_KINDS)
     return {
         "type": "map", "version": "1.10", "tiledversion": "1.10.2", "orientation": "orthogonal",
         "renderorder": "right-down", "infinite": False, "compressionlevel": -1,
