@@ -108,7 +108,12 @@ def terrain_pieces(
     if t * 0.25 == 0.0:
         raise InvalidValue(f"terrain tile size must be finite and > 0 with a quarter > 0, got {tile!r}")
     ox, oy = vector2("terrain origin", origin)
-    rows = [list(r) for r in cells]
+    if isinstance(cells, (str, bytes)):
+        raise InvalidValue(f"terrain cells must be a sequence of rows of kinds, got {cells!r:.80}")
+    try:
+        rows = [[] if r is None else list(r) for r in cells]
+    except TypeError:
+        raise InvalidValue(f"terrain cells must be a sequence of rows of kinds, got {cells!r:.80}") from None
     height = len(rows)
     width = max((len(r) for r in rows), default=0)
     for edge_x, edge_y in ((ox + width * t, oy + height * t), (ox, oy)):

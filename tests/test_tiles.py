@@ -208,6 +208,12 @@ def test_a_bad_tile_size_is_an_invalid_value_naming_it(tile):
         terrain_pieces([["solid"]], tile)
 
 
+@pytest.mark.parametrize("cells", [None, 5, "##", [3]])
+def test_cells_that_are_not_rows_are_an_invalid_value(cells):
+    with pytest.raises(InvalidValue, match="terrain cells"):
+        terrain_pieces(cells, 32)
+
+
 def test_a_bad_origin_is_an_invalid_value():
     with pytest.raises(InvalidValue, match="origin"):
         terrain_pieces([["solid"]], 32, origin=(0, math.nan))
