@@ -19,12 +19,13 @@ EFFECTS: dict[str, tuple[str, ...]] = {
     "friction": ("response",),               # Coulomb friction between hitboxes that have some
     "rotation": ("response",),               # contacts turn bodies: boxes and polygons tip, circles roll
     "continuous": ("movement", "detection"),  # sweep Hitbox(ccd=True) bodies
+    "character": (),                         # move CharacterController bodies (move and slide)
     "rendering": (),                         # the render stage (a renderer must be attached)
     "debug_overlay": ("rendering",),         # hitboxes, contacts, cells, rays on screen
     "sleeping": (),                          # bodies at rest sleep: no work until woken
 }
 DEFAULT_EFFECTS = frozenset({"movement", "gravity", "detection", "events", "response", "friction", "rotation",
-                             "continuous", "sleeping"})
+                             "continuous", "character", "sleeping"})
 
 
 def resolve_effects(effects: Iterable[str] | None) -> frozenset[str]:

@@ -1,4 +1,4 @@
-"""Spatial queries over a scene's hitboxes: rays, boxes, points and shapes.
+"""Spatial queries over a scene's hitboxes: rays, shape casts, boxes, points and shapes.
 
 Candidates come from the static hash (static bodies) and one vectorised bounds test (everything
 that moves); the exact answer from the collision functions of :mod:`framework.collision`. Rays
@@ -8,11 +8,13 @@ cast during a step are logged in the step's frame for the debug overlay.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from .collision import batch
+from .casting import ShapeHit, cast_rows, touch_point
+from .collision import batch, collide
 from .collision.placement import check_shape
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
@@ -21,7 +23,7 @@ from .store import STATIC
 from .systems.stage import Pipeline
 from .validation import InvalidValue, finite, vector2
 
-__all__ = ["ALL_LAYERS", "SceneHit", "SpatialQueries"]
+__all__ = ["ALL_LAYERS", "SceneHit", "ShapeHit", "SpatialQueries"]
 
 ALL_LAYERS = 0xFFFFFFFF
 
@@ -85,6 +87,39 @@ class SpatialQueries:
         hits.sort(key=lambda h: (h.distance, h.entity))
         self.pipeline.frame.ray_log.append(((ox, oy), (ex, ey), hits[0] if hits else None))
         return hits
+
+    def shape_cast(self, shape: Any, start: tuple[float, float], end: tuple[float, float], rotation: float = 0.0,
+                   mask: int = ALL_LAYERS, ignore: Iterable[int] = ()) -> ShapeHit | None:
+        """The first hitbox ``shape`` would enter moving (without turning) from ``start`` to
+        ``end`` (its hitbox origin's positions), or ``None``; sensors and the ``ignore``-d
+        entities are passed through (see :mod:`framework.casting`)."""
+        check_shape("shape", shape)
+        x0, y0 = vector2("start", start)
+        x1, y1 = vector2("end", end)
+        rot = finite("rotation", rotation)
+        skip_entities = np.array(sorted({int(e) for e in ignore}), dtype=np.int64)
+        mx, my = x1 - x0, y1 - y0
+        if not (math.isfinite(mx) and math.isfinite(my)):
+            raise InvalidValue(f"the motion from {start!r} to {end!r} is too long for floats")
+        store = self.bodies.store
+
+        def skip(rows: np.ndarray) -> np.ndarray:
+            return ~np.isin(store.entity[rows], skip_entities)
+
+        hit = cast_rows(self, shape, x0, y0, rot, mx, my, mask=mask, skip=skip if skip_entities.size else None)
+        if hit is None:
+            return None
+        r, fraction, nx, ny = hit
+        geom = self.bodies.geometry
+        pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
+        entity = int(store.entity[r])
+        if fraction == 0.0:
+            contact = collide(shape, (x0, y0, rot), store.hitboxes[r].shape, pose_b)
+            if contact is not None:
+                return ShapeHit(entity, 0.0, contact.point, Vec2(nx, ny))
+        at = (x0 + mx * fraction, y0 + my * fraction, rot)
+        return ShapeHit(entity, fraction, touch_point(shape, at, store.hitboxes[r].shape, pose_b, -nx, -ny),
+                        Vec2(nx, ny))
 
     def _world_extent(self, ox: float, oy: float) -> float:
         g = self.bodies.ensure_geometry()

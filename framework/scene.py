@@ -27,7 +27,8 @@ from .entities import check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
 from .frame import StepFrame, add_counters
 from .input import Input
-from .queries import ALL_LAYERS, SceneHit, SpatialQueries
+from .queries import ALL_LAYERS, SceneHit, ShapeHit, SpatialQueries
+from .shapes import Shape
 from .systems import pipeline_stages
 from .systems.geometry import Geometry
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
@@ -35,7 +36,7 @@ from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister
 from .validation import InvalidValue, positive, vector2
 
 __all__ = ["DEFAULT_EFFECTS", "EFFECTS", "SLEEP_SPEED", "SLEEP_STEPS", "STAGES", "Scene", "SceneClosed", "SceneHit",
-           "resolve_effects"]
+           "ShapeHit", "resolve_effects"]
 
 _scene_ids = itertools.count(1)
 
@@ -371,6 +372,8 @@ class Scene:
         dt = positive("dt", dt)
         store = self.bodies.store
         store.check()
+        if self._stages["character"].wanted():
+            self._stages["character"].check()
         self._totals = None
         n = self.substeps
         if n == 1:
@@ -440,6 +443,16 @@ class Scene:
         """The first hitbox the ray enters within ``max_distance``, or ``None``."""
         hits = self.raycast_all(origin, direction, max_distance, mask)
         return hits[0] if hits else None
+
+    def shape_cast(self, shape: Shape, start: tuple[float, float], end: tuple[float, float], *,
+                   rotation: float = 0.0, mask: int = ALL_LAYERS, ignore: Iterable[int] = ()) -> ShapeHit | None:
+        """The first hitbox ``shape`` would enter moving from ``start`` to ``end`` (positions of
+        its hitbox origin, turned by ``rotation``): a :class:`~framework.casting.ShapeHit` (entity,
+        fraction of the way, touching point, surface normal facing the shape), or ``None``.
+        Grazing is a miss; overlapping at ``start`` is a hit at fraction 0. Sensors and the
+        ``ignore``-d entities (the caster's own, say) are passed through."""
+        self._activate()
+        return self._queries.shape_cast(shape, start, end, rotation, mask, ignore)
 
     def query_box(self, minx: float, miny: float, maxx: float, maxy: float, mask: int = ALL_LAYERS) -> list[int]:
         """Entities whose hitbox interiors overlap the box's interior, sorted."""

@@ -1,4 +1,4 @@
-"""The pipeline's stages, one module each, each an esper processor: movement, continuous detection,
+"""The pipeline's stages, one module each, each an esper processor: movement, characters, continuous detection,
 broad phase, narrow phase (contacts and their events), response, sleeping and render. Each reads
 the step's frame that the stages before it wrote (see :mod:`framework.frame`)."""
 
@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from .broad_phase import BroadPhase
 from .ccd import ContinuousDetection
+from .character import CharacterStage
 from .movement import Movement
 from .narrow_phase import NarrowPhase
 from .render import Render
@@ -13,10 +14,11 @@ from .response import Response
 from .sleeping import Sleeping
 from .stage import STAGES, Pipeline, Stage
 
-__all__ = ["BroadPhase", "ContinuousDetection", "Movement", "NarrowPhase", "Pipeline", "Render", "Response",
+__all__ = ["BroadPhase", "CharacterStage", "ContinuousDetection", "Movement", "NarrowPhase", "Pipeline", "Render",
+           "Response",
            "STAGES", "Sleeping", "Stage", "pipeline_stages"]
 
-_ORDER = (Movement, ContinuousDetection, BroadPhase, NarrowPhase, Response, Sleeping, Render)
+_ORDER = (Movement, CharacterStage, ContinuousDetection, BroadPhase, NarrowPhase, Response, Sleeping, Render)
 
 
 def pipeline_stages(pipeline: Pipeline) -> list[Stage]:

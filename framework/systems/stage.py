@@ -23,7 +23,7 @@ if TYPE_CHECKING:  # (bodies imports the geometry of this package)
 
 __all__ = ["PRIORITY", "STAGES", "Pipeline", "Stage", "SystemProcessor", "place", "unregister"]
 
-STAGES = ("movement", "ccd", "broad_phase", "narrow_phase", "response", "sleeping", "render")
+STAGES = ("movement", "character", "ccd", "broad_phase", "narrow_phase", "response", "sleeping", "render")
 # esper runs higher priorities first; a game's processor goes 300 above ("before") or below
 # ("after") a stage, so "after A" comes before "before B" for consecutive stages A and B. A
 # processor added with esper's default priority 0 runs after the whole pipeline.

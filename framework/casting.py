@@ -1,0 +1,157 @@
+"""Shape casts: sweep a shape through a scene and find the first hitbox it would enter.
+
+A cast is :func:`~framework.collision.time_of_impact` of the moving shape against every hitbox
+whose bounds meet the swept box (the static hash for statics, one vectorised bounds test for the
+rest), the earliest impact winning (ties: the lowest entity). The scene's ``shape_cast`` query and
+the character controller (:mod:`framework.character`) both cast through :func:`cast_rows`.
+
+Conventions follow the ray queries: the hit's ``normal`` is the unit normal of the surface that
+was hit, facing the cast shape (so a shape cast down onto a floor gets ``(0, 1)``); grazing a
+surface (moving along it at gap 0) is a miss; a shape that already overlaps a hitbox at the start
+hits it at fraction 0 with the push-out normal of :func:`~framework.collision.collide`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from .collision import collide, time_of_impact
+from .collision.results import Vec2
+from .shapes import AABB, Circle, Polygon, Shape
+
+if TYPE_CHECKING:
+    from .queries import SpatialQueries
+
+__all__ = ["ShapeHit", "cast_rows", "shape_bounds", "touch_point"]
+
+
+class ShapeHit(NamedTuple):
+    """A shape cast's first hit: the ``entity`` hit, the ``fraction`` of the motion travelled
+    before the interiors would overlap (time of impact, in [0, 1)), the ``point`` where the two
+    touch and the unit ``normal`` of the hit surface there, facing the cast shape."""
+
+    entity: int
+    fraction: float
+    point: Vec2
+    normal: Vec2
+
+
+def shape_bounds(shape: Shape, x: float, y: float, rotation: float) -> tuple[float, float, float, float]:
+    """``(minx, miny, maxx, maxy)`` of ``shape`` with its hitbox origin at ``(x, y)``, turned by
+    ``rotation`` (AABBs never turn)."""
+    if isinstance(shape, AABB):
+        hw, hh = shape.width * 0.5, shape.height * 0.5
+        return x - hw, y - hh, x + hw, y + hh
+    if isinstance(shape, Polygon):
+        c, s = math.cos(rotation), math.sin(rotation)
+        xs = [x + px * c - py * s for px, py in shape.points]
+        ys = [y + px * s + py * c for px, py in shape.points]
+        return min(xs), min(ys), max(xs), max(ys)
+    r = shape.bounding_radius
+    return x - r, y - r, x + r, y + r
+
+
+def _support(shape: Shape, x: float, y: float, rotation: float, nx: float, ny: float) -> list[tuple[float, float]]:
+    """The points of ``shape`` furthest along ``(nx, ny)`` (one, or the two ends of a face)."""
+    if isinstance(shape, Circle):
+        return [(x + nx * shape.radius, y + ny * shape.radius)]
+    if isinstance(shape, AABB):
+        hw, hh = shape.width * 0.5, shape.height * 0.5
+        pts = [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)]
+    elif isinstance(shape, Polygon):
+        c, s = math.cos(rotation), math.sin(rotation)
+        pts = [(x + px * c - py * s, y + px * s + py * c) for px, py in shape.points]
+    else:  # a rounded segment (a capsule): its segment's ends pushed out by the radius
+        c, s = math.cos(rotation), math.sin(rotation)
+        h = shape.length * 0.5  # type: ignore[attr-defined]
+        r = shape.radius  # type: ignore[attr-defined]
+        pts = [(x + h * s + nx * r, y - h * c + ny * r), (x - h * s + nx * r, y + h * c + ny * r)]
+    proj = [px * nx + py * ny for px, py in pts]
+    top = max(proj)
+    tol = 1e-9 * (max(abs(v) for v in proj) + shape.bounding_radius)
+    return [p for p, v in zip(pts, proj) if v >= top - tol]
+
+
+def touch_point(shape_a: Shape, pose_a: tuple[float, float, float], shape_b: Shape,
+                pose_b: tuple[float, float, float], nx: float, ny: float) -> Vec2:
+    """Where A and B touch, given the unit normal ``(nx, ny)`` from A toward B: the middle of the
+    common part of A's support toward B and B's support toward A (a point, or the shared stretch
+    of two faces lying on each other)."""
+    sa = _support(shape_a, *pose_a, nx, ny)
+    sb = _support(shape_b, *pose_b, -nx, -ny)
+    tx, ty = -ny, nx
+    ta = [px * tx + py * ty for px, py in sa]
+    tb = [px * tx + py * ty for px, py in sb]
+    lo, hi = max(min(ta), min(tb)), min(max(ta), max(tb))
+    if lo > hi:  # rounding: the supports just miss each other; take the nearer ends
+        lo = hi = (lo + hi) * 0.5
+    mid = (lo + hi) * 0.5
+    # Along the normal: halfway between the two supports (equal when touching exactly).
+    da = sum(px * nx + py * ny for px, py in sa) / len(sa)
+    db = sum(px * nx + py * ny for px, py in sb) / len(sb)
+    d = (da + db) * 0.5
+    return Vec2(d * nx + mid * tx + 0.0, d * ny + mid * ty + 0.0)
+
+
+def cast_rows(
+    queries: SpatialQueries, shape: Shape, x: float, y: float, rotation: float, mx: float, my: float,
+    accept: Callable[[int, float, float, float], bool] | None = None, *, mask: int = 0xFFFFFFFF,
+    skip: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> tuple[int, float, float, float] | None:
+    """The first hit of ``shape`` (hitbox origin at ``(x, y)``, turned by ``rotation``) moving by
+    ``(mx, my)``: ``(row, fraction, nx, ny)`` with the surface normal facing the shape, or None.
+
+    Candidates are rows with a hitbox in ``mask`` (sensors never block), minus those ``skip``
+    (rows -> keep mask) removes; ``accept(row, fraction, nx, ny)`` may refuse a hit (a one-way
+    platform hit from below), and the next earliest counts instead."""
+    bodies = queries.bodies
+    store = bodies.store
+    x0, y0, x1, y1 = shape_bounds(shape, x, y, rotation)
+    pad = 1e-9 * (abs(x) + abs(y) + shape.bounding_radius + abs(mx) + abs(my))
+    rows = queries._candidate_rows(min(x0, x0 + mx) - pad, min(y0, y0 + my) - pad,
+                                   max(x1, x1 + mx) + pad, max(y1, y1 + my) + pad)
+    rows = rows[((store.layer[rows] & mask) != 0) & ~store.sensor[rows]]
+    if skip is not None and rows.size:
+        rows = rows[skip(rows)]
+    if rows.size == 0:
+        return None
+    geom = bodies.geometry
+    found = []
+    for r in rows.tolist():
+        other = store.hitboxes[r].shape
+        pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
+        hit = time_of_impact(shape, (x, y, rotation), (mx, my), other, pose_b)
+        if hit is not None:
+            found.append((hit.fraction, int(store.entity[r]), r, -hit.normal.x + 0.0, -hit.normal.y + 0.0))
+    found.sort()
+    for fraction, _e, r, nx, ny in found:
+        if accept is None or accept(r, fraction, nx, ny):
+            return r, fraction, nx, ny
+    return None
+
+
+def overlapping_rows(queries: SpatialQueries, shape: Shape, x: float, y: float, rotation: float,
+                     mask: int, skip: Callable[[np.ndarray], np.ndarray] | None = None,
+                     ) -> list[tuple[int, float, float, float]]:
+    """Rows (in ``mask``, not sensors, not ``skip``-ped) whose hitboxes ``shape`` overlaps at
+    ``(x, y)``: ``(row, nx, ny, depth)``, the normal pointing from the row's hitbox toward the
+    shape (the way out)."""
+    bodies = queries.bodies
+    store = bodies.store
+    x0, y0, x1, y1 = shape_bounds(shape, x, y, rotation)
+    rows = queries._candidate_rows(x0, y0, x1, y1)
+    rows = rows[((store.layer[rows] & mask) != 0) & ~store.sensor[rows]]
+    if skip is not None and rows.size:
+        rows = rows[skip(rows)]
+    geom = bodies.geometry
+    out = []
+    for r in rows.tolist():
+        c = collide(store.hitboxes[r].shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
+                    shape, (x, y, rotation))
+        if c is not None:
+            out.append((r, c.normal.x, c.normal.y, c.depth))
+    return out

@@ -1,0 +1,400 @@
+"""The character stage: moves every body with a :class:`~framework.character.CharacterController`
+(the rules: :mod:`framework.character`), right after the movement stage, by swept shape casts
+(:mod:`framework.casting`) against what blocks it. A Python loop over the characters (a game has a
+few); each cast is a handful of exact time-of-impact tests against the nearby hitboxes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import esper
+import numpy as np
+
+from ..casting import cast_rows, overlapping_rows, shape_bounds
+from ..character import CharacterController
+from ..collision import collide
+from ..components import Velocity
+from ..frame import StepFrame
+from ..store import DYNAMIC, KINEMATIC
+from ..validation import InvalidValue
+from .stage import Stage
+
+if TYPE_CHECKING:
+    from ..queries import SpatialQueries
+    from ..shapes import Shape
+
+__all__ = ["CharacterStage"]
+
+
+@dataclass
+class _Move:
+    """One body's move under way: its hitbox origin, what blocks it and what it met."""
+
+    shape: Shape
+    x: float
+    y: float
+    rot: float
+    row: int
+    mask: int
+    skin: float
+    floor_cos: float
+    dropping: set[int]
+    ignore: set[int] = field(default_factory=set)
+    floor: tuple[int, float, float] | None = None  # (row, nx, ny)
+    wall: tuple[int, float, float] | None = None
+    ceiling: bool = False
+    pushed: list[tuple[int, float, float]] = field(default_factory=list)
+
+
+class CharacterStage(Stage):
+    """The pipeline's character stage: moves every body with a :class:`CharacterController`."""
+
+    name = "character"
+    needs = frozenset({"character"})
+
+    def __init__(self, pipeline: Any) -> None:
+        super().__init__(pipeline)
+        from ..queries import SpatialQueries
+
+        self.queries: SpatialQueries = SpatialQueries(pipeline)
+
+    # --- checks before the step ------------------------------------------------------------------
+
+    def check(self) -> None:
+        """Raise :class:`InvalidValue` naming the first entity whose controller cannot run: it
+        needs a Velocity and a kinematic hitbox. Called before a step changes anything."""
+        store = self.bodies.store
+        for e, _ctrl in sorted(esper.get_component(CharacterController), key=lambda p: p[0]):
+            row = store.row_of.get(e)
+            hb = store.hitboxes[row] if row is not None else None
+            if hb is None:
+                raise InvalidValue(f"entity {e}: a CharacterController needs a Transform and a Hitbox")
+            if not store.has_vel[row]:
+                raise InvalidValue(f"entity {e}: a CharacterController needs a Velocity (the velocity it wants)")
+            if store.body[row] != KINEMATIC:
+                raise InvalidValue(f"entity {e}: a CharacterController moves a kinematic body; "
+                                   f"give its Hitbox body='kinematic' (it has {hb.body.value!r})")
+
+    # --- the stage ----------------------------------------------------------------------------
+
+    def run(self, frame: StepFrame) -> bool:
+        found = sorted(esper.get_component(CharacterController), key=lambda p: p[0])
+        if not found:
+            return False
+        store = self.bodies.store
+        moved = "movement" in frame.counters["systems"]
+        for e, ctrl in found:
+            row = store.row_of.get(e)
+            if row is None or store.hitboxes[row] is None:
+                continue
+            if moved and row < frame.start_x.size:
+                store.place(row, frame.start_x[row], frame.start_y[row])  # undo movement: ours to move
+            self._move(frame, e, row, ctrl, moved)
+        frame.counters["characters"] = len(found)
+        return True
+
+    def _move(self, frame: StepFrame, entity: int, row: int, ctrl: CharacterController, moved: bool) -> None:
+        store = self.bodies.store
+        geom = self.bodies.ensure_geometry()
+        hb = store.hitboxes[row]
+        shape = hb.shape
+        dt = frame.dt
+        ox, oy = float(geom.hx[row] - store.x[row]), float(geom.hy[row] - store.y[row])
+        x0, y0 = float(geom.hx[row]), float(geom.hy[row])
+        size = min(_extent(shape))
+        skin = ctrl.skin if ctrl.skin is not None else size * 2.0**-12
+        mask = ctrl.solid_mask if ctrl.solid_mask is not None else int(hb.mask)
+        mv = _Move(shape, x0, y0, float(store.rot[row]), row, mask, skin, ctrl.floor_cos, ctrl.dropping)
+        vel: Velocity = esper.component_for_entity(entity, Velocity)
+        vx, vy = float(store.vx[row]), float(store.vy[row])
+        was_on_floor, floor_row = ctrl.on_floor, self._row_of(ctrl.floor_entity)
+        start_bottom = shape_bottom(shape, x0, y0, mv.rot)
+        ctrl.crushed = False
+
+        if ctrl.drop_through:
+            ctrl.drop_through = False
+            if floor_row is not None and store.one_way[floor_row]:
+                ctrl.dropping.add(int(store.entity[floor_row]))
+                was_on_floor, floor_row = False, None
+        self._forget_dropped(mv, ctrl)
+
+        # 1. Ride: the displacement of what it stood on, this step.
+        carried = (0.0, 0.0)
+        if was_on_floor and floor_row is not None and moved and floor_row < frame.start_x.size:
+            carried = (float(store.x[floor_row] - frame.start_x[floor_row]),
+                       float(store.y[floor_row] - frame.start_y[floor_row]))
+            if carried != (0.0, 0.0):
+                mv.ignore.add(floor_row)
+                self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
+                mv.ignore.discard(floor_row)
+                mv.floor = mv.wall = None
+                mv.ceiling = False
+        # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
+        if not self._depenetrate(mv, start_bottom, frame, moved):
+            ctrl.crushed = True
+
+        # 3. Its own motion.
+        cos_f = mv.floor_cos
+        jumping = vy > 0.0
+        if was_on_floor and jumping and floor_row is not None and dt > 0.0:
+            vx += carried[0] / dt  # leaving a moving platform: keep its velocity
+            vy += carried[1] / dt
+        if was_on_floor and not jumping:
+            vy = 0.0
+            nx, ny = ctrl.floor_normal
+            if ny < cos_f:  # (the floor it stood on was re-measured this step)
+                nx, ny = 0.0, 1.0
+            mx, my = vx * dt, vx * dt * (nx / ny) * -1.0  # along the floor, x advancing vx * dt
+        else:
+            gx, gy = self.pipeline.active_gravity()
+            vx += gx * ctrl.gravity_scale * dt
+            vy += gy * ctrl.gravity_scale * dt
+            mx, my = vx * dt, vy * dt
+        on_floor_now = was_on_floor and not jumping
+        px = mv.x
+        self._slide(mv, mx, my, on_floor=on_floor_now, step=ctrl.step_height, max_slides=ctrl.max_slides)
+        # 4. Snap down onto the floor (down slopes, over crests, down small steps).
+        if on_floor_now and mv.floor is None:
+            snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
+            reach = snap + abs(mv.x - px) * math.tan(math.radians(ctrl.max_floor_angle)) + 2.0 * skin
+            hit = self._cast(mv, 0.0, -reach)
+            if hit is not None and hit[3] >= cos_f:
+                r, f, nx, ny = hit
+                self._advance(mv, 0.0, -reach, f, nx, ny)
+                mv.floor = (r, nx, ny)
+        # 5. State and velocity.
+        ctrl.on_floor = mv.floor is not None
+        if mv.floor is not None:
+            r, nx, ny = mv.floor
+            ctrl.floor_normal, ctrl.floor_entity = (nx, ny), int(store.entity[r])
+            vy = min(vy, 0.0) if jumping else 0.0
+        else:
+            ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
+        ctrl.on_wall = mv.wall is not None
+        ctrl.wall_normal = (mv.wall[1], mv.wall[2]) if mv.wall is not None else (0.0, 0.0)
+        if mv.wall is not None and vx * mv.wall[1] < 0.0:
+            vx = 0.0
+        ctrl.on_ceiling = mv.ceiling
+        if mv.ceiling and vy > 0.0:
+            vy = 0.0
+        if ctrl.push_mass > 0.0 and dt > 0.0:
+            self._push(mv, ctrl.push_mass, mx / dt, my / dt)
+        store.place(row, mv.x - ox, mv.y - oy)
+        if vel.x != vx:
+            vel.x = vx
+        if vel.y != vy:
+            vel.y = vy
+
+    # --- moving ----------------------------------------------------------------------------
+
+    def _row_of(self, entity: int | None) -> int | None:
+        if entity is None:
+            return None
+        return self.bodies.store.row_of.get(entity)
+
+    def _forget_dropped(self, mv: _Move, ctrl: CharacterController) -> None:
+        """Stop ignoring one-way platforms the body has fallen clear of (or that are gone)."""
+        if not ctrl.dropping:
+            return
+        store, geom = self.bodies.store, self.bodies.ensure_geometry()
+        x0, y0, x1, y1 = _bounds(mv)
+        keep = set()
+        for e in ctrl.dropping:
+            r = store.row_of.get(e)
+            if r is None:
+                continue
+            if geom.maxx[r] > x0 and geom.minx[r] < x1 and geom.maxy[r] > y0 - mv.skin and geom.miny[r] < y1:
+                keep.add(e)
+        ctrl.dropping = keep
+        mv.dropping = keep
+
+    def _skip(self, mv: _Move):
+        store = self.bodies.store
+        drop = np.array(sorted(mv.dropping), dtype=np.int64)
+        ignore = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64)
+
+        def skip(rows: np.ndarray) -> np.ndarray:
+            keep = ~np.isin(rows, ignore)
+            if drop.size:
+                keep &= ~np.isin(store.entity[rows], drop)
+            return keep
+
+        return skip
+
+    def _cast(self, mv: _Move, mx: float, my: float) -> tuple[int, float, float, float] | None:
+        store = self.bodies.store
+
+        def accept(r: int, f: float, nx: float, ny: float) -> bool:
+            if not store.one_way[r]:
+                return True
+            # A one-way platform blocks only a body coming down onto its top.
+            if ny < mv.floor_cos or (my > 0.0 and f == 0.0):
+                return False
+            if f == 0.0:  # touching, or already inside it (then it does not hold the body)
+                geom = self.bodies.geometry
+                return collide(mv.shape, (mv.x, mv.y, mv.rot), store.hitboxes[r].shape,
+                               (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))) is None
+            return True
+
+        return cast_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mx, my, accept, mask=mv.mask,
+                         skip=self._skip(mv))
+
+    def _advance(self, mv: _Move, mx: float, my: float, f: float, nx: float, ny: float) -> None:
+        """Move by ``f`` of ``(mx, my)`` (up to a contact of normal ``n``), then back along the way
+        it came until it is ``skin`` clear of that surface (never further back than it went)."""
+        length = math.hypot(mx, my)
+        if length == 0.0:
+            return
+        go = f * length
+        into = -(mx * nx + my * ny) / length  # cosine of the way in with the surface's normal
+        back = min(go, mv.skin / into) if into > 0.0 else 0.0
+        t = (go - back) / length
+        mv.x += mx * t
+        mv.y += my * t
+
+    def _slide(self, mv: _Move, mx: float, my: float, *, on_floor: bool, step: float, max_slides: int = 4) -> None:
+        """Move by ``(mx, my)``, sliding along what it hits (see the module docstring)."""
+        planes: list[tuple[float, float]] = []
+        cos_f = mv.floor_cos
+        scale = mv.skin * 1e-6
+        for _ in range(max_slides):
+            if abs(mx) <= scale and abs(my) <= scale:
+                return
+            hit = self._cast(mv, mx, my)
+            if hit is None:
+                mv.x += mx
+                mv.y += my
+                return
+            r, f, nx, ny = hit
+            self._advance(mv, mx, my, f, nx, ny)
+            rx, ry = mx * (1.0 - f), my * (1.0 - f)
+            if ny >= cos_f:  # a floor
+                mv.floor = (r, nx, ny)
+                on_floor = True
+                # Keep walking: the horizontal part goes on along the floor; the fall stops.
+                mx, my = rx, -rx * nx / ny
+            elif ny <= -cos_f:  # a ceiling: slide along it
+                mv.ceiling = True
+                d = rx * nx + ry * ny
+                mx, my = (rx - d * nx, ry - d * ny) if d < 0.0 else (rx, ry)
+            else:  # a wall, or a slope too steep to walk
+                mv.wall = (r, nx, ny)
+                if self.bodies.store.body[r] == DYNAMIC:
+                    mv.pushed.append((r, nx, ny))
+                if on_floor and step > 0.0 and rx != 0.0 and abs(ny) < cos_f and self._step_up(mv, rx, step):
+                    mv.wall = None
+                    return
+                d = rx * nx + ry * ny
+                mx, my = (rx - d * nx, ry - d * ny) if d < 0.0 else (rx, ry)
+                if on_floor and my > 0.0:
+                    mx = my = 0.0  # no climbing a steep slope from the floor
+            for px, py in planes:
+                if mx * px + my * py < -scale:
+                    mx = my = 0.0  # in a crease between two surfaces: stop
+            planes.append((nx, ny))
+
+    def _step_up(self, mv: _Move, rx: float, step: float) -> bool:
+        """Try to step up onto a ledge at most ``step`` high in the way of ``rx``: up, across,
+        down onto a floor. On success the body is on it (and True); otherwise it is untouched."""
+        x0, y0, cos_f = mv.x, mv.y, mv.floor_cos
+        up = self._cast(mv, 0.0, step)
+        rise = step
+        if up is not None:
+            rise = max(0.0, step * up[1] - mv.skin)
+        if rise <= mv.skin:
+            return False
+        mv.y += rise
+        across = self._cast(mv, rx, 0.0)
+        f = 1.0 if across is None else across[1]
+        if across is not None:
+            self._advance(mv, rx, 0.0, f, across[2], across[3])
+        else:
+            mv.x += rx
+        if abs(mv.x - x0) <= mv.skin:
+            mv.x, mv.y = x0, y0
+            return False
+        down = self._cast(mv, 0.0, -rise)
+        if down is None or down[3] < cos_f:
+            mv.x, mv.y = x0, y0
+            return False
+        r, fd, nx, ny = down
+        self._advance(mv, 0.0, -rise, fd, nx, ny)
+        mv.floor = (r, nx, ny)
+        return True
+
+    def _depenetrate(self, mv: _Move, start_bottom: float, frame: StepFrame, moved: bool) -> bool:
+        """Push the body out of what it overlaps (something that moved into it this step); a
+        one-way platform lifts it only if its feet were above the platform's top when the step
+        began. False if it is pinned (pushed out of one thing into another)."""
+        store = self.bodies.store
+        free = True
+        for _ in range(4):
+            found = overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask, self._skip(mv))
+            found = [o for o in found if self._holds(mv, o, start_bottom, frame, moved)]
+            if not found:
+                return free
+            r, nx, ny, depth = max(found, key=lambda o: (o[3], -store.entity[o[0]]))
+            push = depth + mv.skin
+            mv.ignore.add(r)
+            hit = self._cast(mv, nx * push, ny * push)
+            mv.ignore.discard(r)
+            if hit is None:
+                mv.x += nx * push
+                mv.y += ny * push
+            else:
+                self._advance(mv, nx * push, ny * push, hit[1], hit[2], hit[3])
+                free = False
+            if ny >= mv.floor_cos:
+                mv.floor = (r, nx, ny)
+        return free and not overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask,
+                                             self._skip(mv))
+
+    def _holds(self, mv: _Move, overlap: tuple[int, float, float, float], start_bottom: float,
+               frame: StepFrame, moved: bool) -> bool:
+        """Whether an overlapped body pushes this one out: anything solid; a one-way platform only
+        from below its feet (its top, when the step began, was under them)."""
+        r, _nx, ny, _depth = overlap
+        store, geom = self.bodies.store, self.bodies.geometry
+        if not store.one_way[r]:
+            return True
+        if ny < mv.floor_cos:
+            return False
+        top = float(geom.maxy[r])
+        if moved and r < frame.start_y.size:
+            top -= float(store.y[r] - frame.start_y[r])
+        return start_bottom >= top - 1e-6 * (abs(top) + _extent(mv.shape)[1])
+
+    def _push(self, mv: _Move, mass: float, vx: float, vy: float) -> None:
+        """Dynamic bodies walked into get the impulse of a body of ``mass`` moving at ``(vx, vy)``
+        meeting them (perfectly inelastic, along the contact normal)."""
+        store = self.bodies.store
+        for r, nx, ny in mv.pushed:
+            vn = -(vx * nx + vy * ny)  # the body's speed into the other one
+            other = -(float(store.vx[r]) * nx + float(store.vy[r]) * ny)
+            if vn <= other:
+                continue
+            inv = float(store.inv_mass[r])
+            share = (mass * inv) / (1.0 + mass * inv) if math.isfinite(mass) else 1.0
+            dv = (vn - other) * share
+            store.vx[r] -= dv * nx
+            store.vy[r] -= dv * ny
+            if store.asleep[r]:
+                store.wake(r)
+
+
+def _extent(shape: Shape) -> tuple[float, float]:
+    """Width and height of a shape's box at rotation 0 (a polygon's and a circle's bounds)."""
+    x0, y0, x1, y1 = shape_bounds(shape, 0.0, 0.0, 0.0)
+    return x1 - x0, y1 - y0
+
+
+def _bounds(mv: _Move) -> tuple[float, float, float, float]:
+    return shape_bounds(mv.shape, mv.x, mv.y, mv.rot)
+
+
+def shape_bottom(shape: Shape, x: float, y: float, rot: float) -> float:
+    """The lowest y of ``shape`` placed at ``(x, y, rot)``."""
+    return shape_bounds(shape, x, y, rot)[1]
