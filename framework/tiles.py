@@ -102,7 +102,8 @@ def terrain_pieces(
     surface), so a slope and the flat ground beside its high side form one surface. A piece with
     no slope (a run of solid cells, e.g. at the foot of a slope) becomes one ``AABB`` per cell,
     exactly as a grid without slopes gives. Rows may differ in length (short ones end in empty
-    cells). Raises ``InvalidValue`` (a ``ValueError``) for a tile size that is not finite and > 0.
+    cells). Raises ``InvalidValue`` (a ``ValueError``) for a tile size that is not finite and > 0, an
+    origin that is not two finite numbers, or cells that are not a sequence of rows.
     """
     t = positive("terrain tile size", tile)
     if t * 0.25 == 0.0:
