@@ -24,9 +24,9 @@ platforms have already moved). The game sets the velocity it wants (``Velocity``
 - **one-way platforms** (``Hitbox(one_way=True)``): stood on from above, passed from below and
   the sides; ``drop_through = True`` lets the body fall through the one it stands on.
 
-The body is kept ``skin`` away from what it touches (a small gap, 2**-12 of its size by default),
-so floating-point rounding never leaves it inside a surface and sliding along a row of tiles meets
-no seams. Its state after each step: ``on_floor``, ``floor_normal``, ``floor_entity``,
+The body is kept ``skin`` away from what it touches (by default a gap of 2**-40 of its size, and
+at least 256 units of rounding of its coordinates), so floating-point rounding never leaves it
+inside a surface and sliding along a row of tiles meets no seams. Its state after each step: ``on_floor``, ``floor_normal``, ``floor_entity``,
 ``on_wall``, ``wall_normal``, ``on_ceiling``, ``crushed``. Gravity (the scene's, times
 ``gravity_scale``) accelerates it while it is not on a floor. Velocity is relative to the floor
 it stands on; leaving a moving platform adds the platform's velocity.
@@ -93,7 +93,8 @@ class CharacterController:
     - ``step_height``: highest step walked up without a jump (world units, >= 0; default 0).
     - ``snap_length``: how far the body is pulled down to stay on the floor beyond what the floor
       angle needs (>= 0; default: ``step_height``, so it walks down the steps it walks up).
-    - ``skin``: the gap kept to what it touches (> 0; default 2**-12 of its hitbox's smaller size).
+    - ``skin``: the gap kept to what it touches (> 0; default None: 2**-40 of its hitbox's smaller
+      size, at least 256 units of rounding of its position).
     - ``max_slides``: casts per move (>= 1; default 4).
     - ``gravity_scale``: times the scene's gravity while not on a floor (default 1).
     - ``solid_mask``: layers that block it (default None: its hitbox's mask).

@@ -2,8 +2,8 @@
 
 Scenes use 32-unit tiles, a 1/64 s step and speeds of 128 units/s, so a step's horizontal move is
 exactly 2 units and the expected positions on 45-degree and 2:1 slopes are exact. The controller
-keeps its body ``skin`` clear of surfaces (2**-12 of the body's smaller size: 24 * 2**-12 here),
-so "feet on the surface" means a gap in [0, 2 skin] along the vertical.
+keeps its body ``skin`` clear of surfaces (2**-40 of its smaller size or 2**-44 of its coordinates,
+about 1e-11 here), so "feet on the surface" means a gap in [0, 1e-9].
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from framework.character import CharacterController
 T = 32.0
 DT = 1.0 / 64.0
 W, H = 24.0, 28.0
-SKIN = W * 2.0**-12
+SKIN = 5e-10  # twice this bounds the gap kept (see the module docstring)
 G = -1024.0
 
 

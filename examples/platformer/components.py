@@ -44,7 +44,9 @@ class Tuning:
     crate_size: float = 0.875      # tiles (a square)
     crate_mass: float = 2.0        # the player's is 1
     barrel_radius: float = 0.375   # tiles
-    prop_friction: float = 0.6     # crates and barrels (the player's hitbox has none: its speed is the game's)
+    prop_friction: float = 0.6     # crates and barrels
+    step_height: float = 0.3       # tiles: the player and walkers walk up steps this high
+    push_mass: float = 1.0         # the player pushes crates and barrels as a body of this mass
 
 
 @dataclass
@@ -59,7 +61,6 @@ class Player:
     drop_timer: float = 0.0          # > 0: falling through one-way platforms
     facing: int = 1
     prev_bottom: float = 0.0         # where the feet were when the step started (stomps)
-    vy_start: float = 0.0            # vertical velocity the step started with (after control)
     dead_frame: int = -1             # the frame the player last died (one death per frame)
 
 
@@ -85,7 +86,6 @@ class MovingPlatform:
     pause: float = 0.5                       # s it waits at each end
     toward_end: bool = True
     waiting: float = 0.0
-    start_pos: tuple[float, float] = (0.0, 0.0)  # where it began the current step
 
 
 @dataclass

@@ -17,8 +17,10 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
+from framework.character import CharacterController
 from framework.components import Visual
 from framework.input import Input
+from framework.tiles import SLOPES, terrain_pieces
 
 from . import systems
 from .components import (
@@ -56,7 +58,7 @@ PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
 ART_TILE = 32.0  # the tile images (see art.py) are drawn for 32-unit tiles; other sizes get colours
 IMAGES = {name: Path(__file__).with_name("images") / f"{name}.png" for name in (
     "ground", "ground_top", "plank", "player_right", "player_left", "enemy", "goal", "checkpoint",
-    "checkpoint_on")}
+    "checkpoint_on", *SLOPES)}
 
 
 class Game:
@@ -124,21 +126,33 @@ class Game:
         def look(image: str, color: str, z: int) -> Visual:
             return Visual(image=str(IMAGES[image]), z=z) if art else Visual(COLORS[color], z=z)
 
+        # Terrain (solid cells and slopes): framework.tiles merges slope runs into convex pieces,
+        # so nothing catches on a seam; a solid cell on its own stays one box per cell.
+        for pc in terrain_pieces(level.tiles, t):
+            if isinstance(pc.shape, AABB):
+                (col, row), = pc.cells
+                top = row == 0 or level.tiles[row - 1][col] != "solid"
+                piece("solid", Transform(pc.x, pc.y), Hitbox(pc.shape, body="static", layer=SOLID),
+                      look("ground_top" if top else "ground", "solid", 0))
+                continue
+            if not art:
+                piece("slope", Transform(pc.x, pc.y), Hitbox(pc.shape, body="static", layer=SOLID),
+                      Visual(COLORS["solid"], z=0))
+                continue
+            piece("slope", Transform(pc.x, pc.y), Hitbox(pc.shape, body="static", layer=SOLID))
+            for col, row in pc.cells:  # the pictures, cell by cell
+                kind = level.tiles[row][col]
+                image = "ground_top" if kind == "solid" else kind
+                piece("slope", Transform(*level.cell_center(col, row)), Visual(image=str(IMAGES[image]), z=0))
         for row, cells in enumerate(level.tiles):
             for col, kind in enumerate(cells):
-                if kind is None:
-                    continue
                 x, y = level.cell_center(col, row)
-                if kind == "solid":
-                    top = row == 0 or level.tiles[row - 1][col] != "solid"
-                    piece(kind, Transform(x, y), Hitbox(AABB(t, t), body="static", layer=SOLID),
-                          look("ground_top" if top else "ground", kind, 0))
-                elif kind == "oneway":
+                if kind == "oneway":
                     # A slab on the top quarter of the cell, solid only from above.
                     piece(kind, Transform(x, y + 0.375 * t), Hitbox(
                         AABB(t, 0.25 * t), body="static", layer=ONE_WAY, one_way=True),
                         look("plank", kind, 0))
-                else:  # spikes
+                elif kind == "spikes":
                     self._spikes(x, y - 0.5 * t, t, piece)
         for obj in level.objects:
             if obj.kind == "coin":
@@ -174,13 +188,16 @@ class Game:
                 w, h = tu.enemy_size[0] * t, tu.enemy_size[1] * t
                 speed = float(obj.props.get("speed", 2.0)) * t
                 piece("enemy", Transform(obj.x, obj.bottom + h * 0.5), Velocity(), Hitbox(
-                    AABB(w, h), layer=ENEMY, mask=SOLID | ONE_WAY | PLAYER | ENEMY | HAZARD),
+                    AABB(w, h), body="kinematic", layer=ENEMY, mask=SOLID | ONE_WAY | PLAYER | ENEMY | HAZARD),
+                    CharacterController(step_height=tu.step_height * t, solid_mask=SOLID | ONE_WAY | ENEMY),
                     Enemy(speed, int(obj.props.get("direction", -1))), look("enemy", "enemy", 3))
         st.coin_total_in_level = len(level.of_kind("coin"))
         w, h = tu.player_size[0] * t, tu.player_size[1] * t
         st.player = piece("player", Transform(start.x, start.bottom + h * 0.5), Velocity(),
-                          Hitbox(AABB(w, h), layer=PLAYER, mask=PLAYER_MASK, friction=0.0), Player(),
-                          look("player_right", "player", 4))
+                          Hitbox(AABB(w, h), body="kinematic", layer=PLAYER, mask=PLAYER_MASK),
+                          CharacterController(step_height=tu.step_height * t, solid_mask=SOLID | ONE_WAY,
+                                              push_mass=tu.push_mass),
+                          Player(), look("player_right", "player", 4))
         systems.follow_camera(scene, 0.0)
 
     @staticmethod

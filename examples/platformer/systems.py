@@ -3,15 +3,17 @@
 Where each runs in a step (see :func:`install`)::
 
     before movement   level_flow -> move_platforms -> control_player -> walk_enemies
-    movement          (framework: integrate velocities, gravity)
-    after movement    carry_riders      the moving platform's displacement to whoever stands on it
+    movement          (framework: integrate velocities, gravity; moving platforms move)
+    character         (framework: the player and the walkers move and slide with their
+                       CharacterController: slopes, steps, riding platforms, one-way platforms)
     ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide)
     after response    sense_player -> sense_enemies -> fall_out -> face -> follow_camera
     end of step       collision handlers: coins, spikes, enemies, checkpoints, the goal
 
-Everything collision-related comes from the pipeline: the contacts it found this step
-(``scene.contacts``), its events (``scene.on_collision``), its queries (``scene.query_point``) and
-``framework.collide`` to check a reported contact after the response.
+The game's own movement code is input -> the velocity wanted: the framework's character
+controller does the rest and reports ``on_floor``, ``floor_entity`` and ``on_wall``. Everything
+else collision-related comes from the pipeline: its events (``scene.on_collision``), its contacts
+(``scene.contacts``) and its queries (``scene.query_point``).
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from framework import AABB, Hitbox, Transform, Velocity, collide
+from framework import Hitbox, Transform, Velocity
+from framework.character import CharacterController
 from framework.components import Visual
 from framework.events import CollisionEvent
 from framework.input import Input
@@ -46,7 +49,6 @@ if TYPE_CHECKING:
 __all__ = ["install", "kill_player"]
 
 LEFT, RIGHT, JUMP, DOWN = ("left", "a"), ("right", "d"), ("space", "up", "w"), ("down", "s")
-GROUND_NORMAL = 0.7  # a contact whose normal (toward the body) has y above this is ground
 CHECKPOINT_ON = (120, 230, 255)
 
 
@@ -93,7 +95,6 @@ def level_flow(scene: Scene, dt: float) -> None:
 def move_platforms(scene: Scene, dt: float) -> None:
     """Steer each moving platform toward its current end; wait there a moment, then turn back."""
     for _e, (plat, t, v) in scene.query(MovingPlatform, Transform, Velocity):
-        plat.start_pos = (t.x, t.y)  # carry_riders and sense_player take the difference
         if plat.waiting > 0.0:
             plat.waiting -= dt
             v.x = v.y = 0.0
@@ -110,26 +111,22 @@ def move_platforms(scene: Scene, dt: float) -> None:
 
 
 def control_player(scene: Scene, dt: float) -> None:
-    """Run, jump (coyote time, buffering, variable height), drop through one-way platforms."""
+    """Input -> the velocity the player wants: run, jump (coyote time, buffering, variable
+    height), drop through one-way platforms. The character controller moves the body."""
     tu: Tuning = scene.resources[Tuning]
     tile = _tile(scene)
     keys = scene.resources[Input]
-    for _e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
+    for _e, (p, t, v, hb, ctrl) in scene.query(Player, Transform, Velocity, Hitbox, CharacterController):
         p.prev_bottom = t.y - hb.shape.height * 0.5
         p.since_ground = 0.0 if p.grounded else p.since_ground + dt
         p.since_jump_press = 0.0 if keys.was_pressed(*JUMP) else p.since_jump_press + dt
         vx, vy = v.x, v.y
 
         # Drop through a one-way platform: down + jump while standing on one.
-        if p.drop_timer > 0.0:
-            p.drop_timer -= dt
-            if p.drop_timer <= 0.0:
-                hb.mask |= ONE_WAY
         on_one_way = p.grounded and p.ground is not None and scene.exists(p.ground) and \
             scene.get(p.ground, Hitbox).one_way
         if keys.is_held(*DOWN) and p.since_jump_press == 0.0 and on_one_way:
-            hb.mask &= ~ONE_WAY
-            p.drop_timer = tu.drop_time
+            ctrl.drop_through = True
             p.since_jump_press = 1e9
             p.grounded, p.ground, p.since_ground = False, None, 1e9
 
@@ -151,7 +148,6 @@ def control_player(scene: Scene, dt: float) -> None:
         if want:
             p.facing = 1 if want > 0 else -1
         vy = max(vy, -tu.fall_speed * tile)
-        p.vy_start = vy
         if vx != v.x:
             v.x = vx
         if vy != v.y:
@@ -164,92 +160,15 @@ def walk_enemies(scene: Scene, dt: float) -> None:
         v.x = en.direction * en.speed
 
 
-# --- after movement -----------------------------------------------------------------------------
-
-
-def carry_riders(scene: Scene, dt: float) -> None:
-    """Move whoever stood on a moving platform last step by the platform's displacement."""
-    for _e, (p, t) in scene.query(Player, Transform):
-        if p.ground is None or not scene.exists(p.ground):
-            continue
-        plat = scene.try_get(p.ground, MovingPlatform)
-        if plat is None:
-            continue
-        pt = scene.get(p.ground, Transform)
-        x0, y0 = plat.start_pos
-        t.x += pt.x - x0
-        t.y += pt.y - y0
-
-
 # --- after response -----------------------------------------------------------------------------
 
 
-def _touching(scene: Scene, entity: int) -> list[tuple[int, float, float, float]]:
-    """This step's contacts of ``entity``: (other, normal x, normal y toward ``entity``, depth)."""
-    c = scene.contacts
-    out = []
-    for i in np.flatnonzero((c.a == entity) | (c.b == entity)).tolist():
-        a, b = int(c.a[i]), int(c.b[i])
-        sign = -1.0 if a == entity else 1.0  # contact normals point from a to b
-        out.append((b if a == entity else a, sign * float(c.nx[i]), sign * float(c.ny[i]), float(c.depth[i])))
-    return out
-
-
-def _on_top_of(t: Transform, hb: Hitbox, other_t: Transform, other_hb: Hitbox) -> bool:
-    """Whether ``other`` is right under the feet: it overlaps a thin box just below the body, a
-    hair narrower than the body (``framework.collide``, after the response has pushed the body out).
-
-    The pipeline's raw contacts alone are not enough: a body pushed against a wall of tiles also
-    overlaps, by a sliver, the top of the tile below the one it hits, a contact with an upward
-    normal that the response then discards (it resolves the deepest contact first and measures
-    the others again); taken as ground, it would let the player jump off walls."""
-    w, h = hb.shape.width, hb.shape.height
-    x, bottom = t.x + hb.offset[0], t.y + hb.offset[1] - h * 0.5
-    depth = 0.05 * h
-    feet = AABB(w * (1.0 - 2e-3), depth)
-    ox, oy = other_hb.offset
-    pose = (other_t.x + ox, other_t.y + oy, other_t.rotation)  # tiles and platforms: offsets never turn
-    return collide(feet, (x, bottom - depth * 0.5), other_hb.shape, pose) is not None
-
-
 def sense_player(scene: Scene, dt: float) -> None:
-    """Grounded: one of this step's contacts (``scene.contacts``) is below the player, with an
-    upward normal, and still right under the feet after the response.
-
-    A one-way platform counts only if the feet were on or above its top when the step began (the
-    pipeline's own landing rule), so rising through one or standing inside it is not standing on
-    it; nothing counts while moving up, away from it. On a moving platform the player's vertical
-    velocity is kept relative to it (zero while standing): carry_riders moves the player with it."""
-    tol = 1e-3 * _tile(scene)
-    for e, (p, t, v, hb) in scene.query(Player, Transform, Velocity, Hitbox):
-        ground, best = None, -1
-        for other, _nx, ny, _depth in _touching(scene, e):
-            if ny < GROUND_NORMAL:
-                continue
-            ohb = scene.try_get(other, Hitbox)
-            if ohb is None or ohb.sensor or scene.try_get(other, Enemy) is not None:
-                continue
-            plat = scene.try_get(other, MovingPlatform)
-            ov = scene.try_get(other, Velocity)
-            # A rider's velocity is relative to its platform; anyone else's is absolute.
-            rel = p.vy_start if other == p.ground or ov is None else v.y - ov.y
-            if rel > 1e-9:
-                continue
-            ot = scene.get(other, Transform)
-            if ohb.one_way:
-                y0 = plat.start_pos[1] if plat is not None else ot.y
-                top = y0 + ohb.offset[1] + ohb.shape.height * 0.5
-                if p.prev_bottom < top - tol:
-                    continue
-            if not _on_top_of(t, hb, ot, ohb):
-                continue
-            rank = 1 if plat is not None else 0  # on a platform and a tile at once: ride
-            if rank > best:
-                ground, best = other, rank
-        p.grounded = ground is not None
-        p.ground = ground
-        if ground is not None and scene.try_get(ground, MovingPlatform) is not None:
-            v.y = 0.0
+    """Grounded: the character controller stood the player on a floor this step (tiles, slopes,
+    one-way and moving platforms, crates); ``ground`` is what it stands on."""
+    for _e, (p, ctrl) in scene.query(Player, CharacterController):
+        p.grounded = ctrl.on_floor
+        p.ground = ctrl.floor_entity if ctrl.on_floor else None
 
 
 def sense_enemies(scene: Scene, dt: float) -> None:
@@ -258,16 +177,12 @@ def sense_enemies(scene: Scene, dt: float) -> None:
     (``scene.query_point`` just ahead of and below their feet finds no ground; moving platforms
     do not count, walkers keep off them)."""
     tile = _tile(scene)
-    for e, (en, t, v, hb) in scene.query(Enemy, Transform, Velocity, Hitbox):
-        turn = abs(v.x) < 0.5 * en.speed  # the response took away its walking speed
-        grounded = False
-        for other, _nx, ny, _depth in _touching(scene, e):
-            if scene.try_get(other, Hazard) is not None:
-                if (scene.get(other, Transform).x - t.x) * en.direction > 0:
-                    turn = True  # spikes ahead
-            elif ny >= GROUND_NORMAL and not scene.get(other, Hitbox).sensor:
-                grounded = True
-        if grounded and not turn:
+    for e, (en, t, hb, ctrl) in scene.query(Enemy, Transform, Hitbox, CharacterController):
+        turn = ctrl.on_wall and ctrl.wall_normal[0] * en.direction < 0.0  # a wall (or another walker) ahead
+        for other in _touching(scene, e):
+            if scene.try_get(other, Hazard) is not None and (scene.get(other, Transform).x - t.x) * en.direction > 0:
+                turn = True  # spikes ahead
+        if ctrl.on_floor and not turn:
             front = t.x + en.direction * (hb.shape.width * 0.5 + 0.1 * tile)
             below = t.y - hb.shape.height * 0.5 - 0.1 * tile
             # Walkers keep off moving platforms, so the ground ahead is static and changes only
@@ -282,6 +197,13 @@ def sense_enemies(scene: Scene, dt: float) -> None:
         if turn and en.turned_frame != scene.frame:
             en.direction = -en.direction
             en.turned_frame = scene.frame
+
+
+def _touching(scene: Scene, entity: int) -> list[int]:
+    """The entities ``entity`` overlaps this step (the pipeline's contacts)."""
+    c = scene.contacts
+    rows = np.flatnonzero((c.a == entity) | (c.b == entity))
+    return [int(c.b[i]) if int(c.a[i]) == entity else int(c.a[i]) for i in rows.tolist()]
 
 
 def fall_out(scene: Scene, dt: float) -> None:
@@ -337,7 +259,9 @@ def kill_player(scene: Scene, player: int) -> None:
     x, feet = state.checkpoint
     t.x, t.y = x, feet + hb.shape.height * 0.5
     v.x = v.y = 0.0
-    hb.mask |= ONE_WAY
+    ctrl = scene.get(player, CharacterController)
+    ctrl.on_floor, ctrl.floor_entity, ctrl.drop_through = False, None, False
+    ctrl.dropping.clear()
     fresh = Player(dead_frame=scene.frame, facing=p.facing)
     for name in fresh.__dataclass_fields__:
         setattr(p, name, getattr(fresh, name))
@@ -412,7 +336,6 @@ def install(scene: Scene) -> None:
 
     for system in (level_flow, move_platforms, control_player, walk_enemies):
         scene.add_system(system, before="movement")
-    scene.add_system(carry_riders, after="movement")
     for system in (sense_player, sense_enemies, fall_out, face, follow_camera):
         scene.add_system(system, after="response")
     scene.on_collision(P, Coin, on_coin)

@@ -105,7 +105,7 @@ class CharacterStage(Stage):
         ox, oy = float(geom.hx[row] - store.x[row]), float(geom.hy[row] - store.y[row])
         x0, y0 = float(geom.hx[row]), float(geom.hy[row])
         size = min(_extent(shape))
-        skin = ctrl.skin if ctrl.skin is not None else size * 2.0**-12
+        skin = ctrl.skin if ctrl.skin is not None else default_skin(size, x0, y0)
         mask = ctrl.solid_mask if ctrl.solid_mask is not None else int(hb.mask)
         mv = _Move(shape, x0, y0, float(store.rot[row]), row, mask, skin, ctrl.floor_cos, ctrl.dropping)
         vel: Velocity = esper.component_for_entity(entity, Velocity)
@@ -116,9 +116,11 @@ class CharacterStage(Stage):
 
         if ctrl.drop_through:
             ctrl.drop_through = False
-            if floor_row is not None and store.one_way[floor_row]:
-                ctrl.dropping.add(int(store.entity[floor_row]))
-                was_on_floor, floor_row = False, None
+            under = self._one_way_under(mv, size)
+            if under:
+                ctrl.dropping.update(under)
+                if floor_row is not None and int(store.entity[floor_row]) in under:
+                    was_on_floor, floor_row = False, None
         self._forget_dropped(mv, ctrl)
 
         # 1. Ride: the displacement of what it stood on, this step.
@@ -175,7 +177,7 @@ class CharacterStage(Stage):
             ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
         ctrl.on_wall = mv.wall is not None
         ctrl.wall_normal = (mv.wall[1], mv.wall[2]) if mv.wall is not None else (0.0, 0.0)
-        if mv.wall is not None and vx * mv.wall[1] < 0.0:
+        if mv.wall is not None and vx * mv.wall[1] < 0.0 and store.body[mv.wall[0]] != DYNAMIC:
             vx = 0.0
         ctrl.on_ceiling = mv.ceiling
         if mv.ceiling and vy > 0.0:
@@ -210,6 +212,17 @@ class CharacterStage(Stage):
                 keep.add(e)
         ctrl.dropping = keep
         mv.dropping = keep
+
+    def _one_way_under(self, mv: _Move, size: float) -> set[int]:
+        """The one-way platforms right under the body's feet (all of them: it may stand on the
+        seam of two)."""
+        store, geom = self.bodies.store, self.bodies.ensure_geometry()
+        x0, y0, x1, _y1 = _bounds(mv)
+        eps = max(4.0 * mv.skin, 1e-6 * size)
+        rows = self.queries._candidate_rows(x0, y0 - eps, x1, y0 + eps)
+        rows = rows[store.one_way[rows] & ((store.layer[rows] & mv.mask) != 0) & (rows != mv.row)]
+        rows = rows[np.abs(geom.maxy[rows] - y0) <= eps]
+        return {int(e) for e in store.entity[rows]}
 
     def _skip(self, mv: _Move):
         store = self.bodies.store
@@ -283,7 +296,7 @@ class CharacterStage(Stage):
             else:  # a wall, or a slope too steep to walk
                 mv.wall = (r, nx, ny)
                 if self.bodies.store.body[r] == DYNAMIC:
-                    mv.pushed.append((r, nx, ny))
+                    mv.pushed.append((r, nx, ny))  # it may give way: the walk keeps its velocity
                 if on_floor and step > 0.0 and rx != 0.0 and abs(ny) < cos_f and self._step_up(mv, rx, step):
                     mv.wall = None
                     return
@@ -383,6 +396,13 @@ class CharacterStage(Stage):
             store.vy[r] -= dv * ny
             if store.asleep[r]:
                 store.wake(r)
+
+
+def default_skin(size: float, x: float, y: float) -> float:
+    """The gap kept by default: 2**-40 of the body's smaller size, and at least 256 units of
+    rounding of its coordinates (so rounding never puts it inside what it touches): far below
+    anything visible, as exact as "on the floor" can be in floating point."""
+    return max(size * 2.0**-40, (abs(x) + abs(y)) * 2.0**-44)
 
 
 def _extent(shape: Shape) -> tuple[float, float]:
