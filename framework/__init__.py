@@ -6,11 +6,11 @@ Importing it (and running scenes without a renderer) never imports pyglet's GL m
 from typing import Any
 
 from .components import Body, Hitbox, Transform, Velocity
-from .shapes import AABB, Circle, Polygon, Shape
+from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .validation import InvalidValue
 
 __all__ = [
-    "AABB", "Body", "Circle", "CollisionEvent", "Contact", "Hitbox", "Impact", "InvalidValue", "Polygon",
+    "AABB", "Body", "Capsule", "Circle", "CollisionEvent", "Contact", "Hitbox", "Impact", "InvalidValue", "Polygon",
     "RayHit", "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Transform", "Vec2", "Velocity",
     "collide",
 ]

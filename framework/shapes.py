@@ -5,6 +5,8 @@ hitbox origin is local (0, 0): AABBs and circles are centred on it, polygons rot
 
 - :class:`AABB` is an axis-aligned box that never rotates, whatever the transform's rotation.
 - :class:`Circle` is centred on the origin.
+- :class:`Capsule` is the set of points within ``radius`` of a segment of ``length`` through the
+  origin, vertical at rotation 0 (a "stadium"); it rotates about the origin.
 - :class:`Polygon` is a convex outline, either winding; it is stored counter-clockwise, starting at
   its lowest (then leftmost) vertex, so equal outlines given in any order compare equal and give
   the same answers bit for bit.
@@ -19,7 +21,7 @@ from typing import ClassVar
 
 from .validation import InvalidValue, finite, positive
 
-__all__ = ["AABB", "Circle", "Polygon", "Shape"]
+__all__ = ["AABB", "Capsule", "Circle", "Polygon", "Shape"]
 
 # Tolerance of the "collinear" test: a vertex within this fraction of the polygon's extent (plus 16
 # units of rounding of its coordinates) of the line through its neighbours is on that line. It is a
@@ -106,6 +108,62 @@ class Circle(Shape):
     @property
     def second_moment(self) -> float:
         return 0.5 * self.radius * self.radius
+
+
+@dataclass(frozen=True, slots=True)
+class Capsule(Shape):
+    """The points within ``radius`` of the segment from (0, -length/2) to (0, +length/2): a
+    rectangle ``2 radius`` x ``length`` capped by two half discs, centred on the hitbox origin,
+    vertical at rotation 0; it rotates with its transform about the origin."""
+
+    radius: float
+    length: float
+    kind: ClassVar[str] = "capsule"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "radius", positive("Capsule radius", self.radius))
+        object.__setattr__(self, "length", _halvable("Capsule length", self.length))
+        if not math.isfinite(self.length * 0.5 + self.radius):
+            raise InvalidValue(
+                f"Capsule({self.radius!r}, {self.length!r}) is too large: its half height overflows float64"
+            )
+
+    @property
+    def half_length(self) -> float:
+        """Half the length of the core segment: its ends are (0, -half_length) and (0, half_length)."""
+        return self.length * 0.5
+
+    @property
+    def height(self) -> float:
+        """Height at rotation 0: ``length + 2 radius``."""
+        return self.length + 2.0 * self.radius
+
+    @property
+    def width(self) -> float:
+        """Width at rotation 0: ``2 radius``."""
+        return 2.0 * self.radius
+
+    @property
+    def bounding_radius(self) -> float:
+        return self.length * 0.5 + self.radius
+
+    @property
+    def area(self) -> float:
+        r, ln = self.radius, self.length
+        return 2.0 * r * ln + math.pi * r * r
+
+    @property
+    def second_moment(self) -> float:
+        # The rectangle 2r x L about its centre: 2rL (4r^2 + L^2) / 12. Each half disc, its flat
+        # side at distance L/2 from the origin (v: the distance past it): the integral of
+        # x^2 + v^2 (pi r^4 / 4), plus L times that of v (2 r^3 / 3), plus L^2/4 times its area
+        # (pi r^2 / 2). Summed: r L^3 / 6 + 2 L r^3 + pi r^4 / 2 + pi L^2 r^2 / 4, over the area.
+        # Worked on the sizes over the larger one (no overflow), times its square at the end.
+        scale = max(self.radius, self.length)
+        r, ln = self.radius / scale, self.length / scale
+        moment = r * ln * ln * ln / 6.0 + 2.0 * ln * r * r * r + math.pi * r * r * r * r / 2.0 \
+            + math.pi * ln * ln * r * r / 4.0
+        return moment / (2.0 * r * ln + math.pi * r * r) * scale * scale
 
 
 @dataclass(frozen=True, slots=True)

@@ -16,6 +16,7 @@ arithmetic (none for AABB pairs).
 ``polygon_circle``             polygon (or any box, via :func:`outlines`) A, circle B; with
                                ``flip=True`` the circle is shape A of the pair
 ``polygon_polygon``            polygons and boxes in any mix but AABB / AABB
+``capsule_many``               a capsule against any shape's core (:mod:`.capsule`)
 =============================  ===============================================================
 
 Polygon kernels take each shape's hitbox origin in world coordinates and its outline relative
@@ -40,18 +41,20 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..shapes import AABB, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue
 from .batch_box import aabb_aabb, aabb_aabb_fast
 from .batch_circle import circle_circle, polygon_circle
 from .batch_common import F64, ContactArrays, no_contacts
 from .batch_polygon import polygon_polygon
-from .kinds import BOXES, CIRCLES, PAIRS, POLYGON_CIRCLE, POLYGONS, kind_of, pair_code
+from .capsule import capsule_first, capsule_many, half_segments
+from .kinds import BOXES, CAPSULES, CIRCLES, PAIRS, POLYGON_CIRCLE, POLYGONS, kind_of, pair_code
 from .placement import check_shape, pose
 
 __all__ = [
     "ContactArrays",
     "aabb_aabb",
+    "capsule_many",
     "aabb_aabb_fast",
     "circle_circle",
     "collide_many",
@@ -173,7 +176,60 @@ def collide_many(
     run((family == POLYGON_CIRCLE) & flip, lambda r: polygon_circle(
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r),
         pa[r, 0], pa[r, 1], radius(sa, r), flip=True, size=ra[r] + rb[r]))
+    caps = np.flatnonzero(family == CAPSULES)
+    if caps.size:
+        # The capsule first: the caller's B where the pair rule flips it, and of two capsules the
+        # one placed first (as collide orders them).
+        swap = flip[caps].copy()
+        for j, i in enumerate(caps.tolist()):
+            if not swap[j] and isinstance(sb[i], Capsule):
+                swap[j] = not capsule_first(sa[i], tuple(pa[i]), sb[i], tuple(pb[i]))  # type: ignore[arg-type]
+        res = _capsule_rows(
+            [sb[i] if w else sa[i] for i, w in zip(caps.tolist(), swap.tolist(), strict=True)],
+            np.where(swap[:, None], pb[caps], pa[caps]),
+            [sa[i] if w else sb[i] for i, w in zip(caps.tolist(), swap.tolist(), strict=True)],
+            np.where(swap[:, None], pa[caps], pb[caps]), swap)
+        for dst, src in zip(out, res, strict=True):
+            dst[caps] = src
     run(family == POLYGONS, lambda r: polygon_polygon(
         pa[r, 0], pa[r, 1], *shape_outlines(sa, pa[:, 2], r),
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r), size=ra[r] + rb[r]))
     return out
+
+
+def core_rows(shapes: Sequence[Shape], rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cores of shapes for :func:`capsule_many`, rotated, about their hitbox origins:
+    ``(verts [N, K, 2], counts [N], radii [N])`` (a circle: its centre; a capsule: its ends ``-u``,
+    ``+u``; a box or polygon: its outline, radius 0)."""
+    n = len(shapes)
+    rot = np.broadcast_to(np.asarray(rotations, dtype=F64), (n,))
+    outl = [i for i, s in enumerate(shapes) if isinstance(s, (AABB, Polygon))]
+    caps = [i for i, s in enumerate(shapes) if isinstance(s, Capsule)]
+    verts_o, count_o = outlines([shapes[i] for i in outl], rot[outl]) if outl else (np.zeros((0, 2, 2)), None)
+    k = max(2, verts_o.shape[1])
+    verts = np.zeros((n, k, 2))
+    counts = np.ones(n, dtype=np.int64)
+    radii = np.zeros(n)
+    if outl:
+        verts[outl, : verts_o.shape[1]] = verts_o
+        verts[outl, verts_o.shape[1]:] = verts_o[:, -1:]
+        counts[outl] = count_o
+    if caps:
+        ux, uy = half_segments([shapes[i].half_length for i in caps], rot[caps])  # type: ignore[attr-defined]
+        verts[caps, 0, 0], verts[caps, 0, 1] = -ux, -uy
+        verts[caps, 1:, 0], verts[caps, 1:, 1] = ux[:, None], uy[:, None]
+        counts[caps] = 2
+    for i, s in enumerate(shapes):
+        if isinstance(s, (Circle, Capsule)):
+            radii[i] = s.radius
+    return verts, counts, radii
+
+
+def _capsule_rows(caps: list[Shape], pc: np.ndarray, others: list[Shape], po: np.ndarray,
+                  flip: np.ndarray) -> ContactArrays:
+    """:func:`capsule_many` of capsules ``caps`` at poses ``pc [P, 3]`` against ``others`` at ``po``."""
+    ux, uy = half_segments([c.half_length for c in caps], pc[:, 2])  # type: ignore[attr-defined]
+    verts, counts, radii = core_rows(others, po[:, 2])
+    return capsule_many(pc[:, 0], pc[:, 1], ux, uy, np.array([c.radius for c in caps]),  # type: ignore[attr-defined]
+                        np.array([c.bounding_radius for c in caps]), po[:, 0], po[:, 1], verts, counts, radii,
+                        np.array([o.bounding_radius for o in others]), flip)

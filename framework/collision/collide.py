@@ -28,8 +28,9 @@ from __future__ import annotations
 
 import math
 
-from ..shapes import Circle, Shape
+from ..shapes import Capsule, Circle, Shape
 from ..validation import InvalidValue
+from .capsule import capsule_first, capsule_pair
 from .exact import (
     BAND,
     TINY,
@@ -41,7 +42,7 @@ from .exact import (
     ratio_approx,
     vertex_contact,
 )
-from .kinds import CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
+from .kinds import CAPSULES, CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
 from .placement import check_shape, local_outline, pose
 from .results import Contact, Vec2
 from .tiebreak import pick
@@ -65,10 +66,15 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
     ax, ay, ar = pose("transform_a", transform_a)
     bx, by, br = pose("transform_b", transform_b)
     rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
-    if rule.flip:
-        # Polygon-circle pairs are worked in the polygon's frame whichever comes first.
+    flip = rule.flip
+    if rule.family == CAPSULES and not flip and isinstance(shape_b, Capsule):
+        # Two capsules: in the frame of the one placed first, whichever comes first.
+        flip = not capsule_first(shape_a, (ax, ay, ar), shape_b, (bx, by, br))  # type: ignore[arg-type]
+    if flip:
+        # Polygon-circle pairs are worked in the polygon's frame whichever comes first (pairs
+        # with a capsule in the capsule's).
         ox, oy = bx, by
-        found = _pair(rule.family, shape_b, bx, by, br, shape_a, ax, ay, flip=True)
+        found = _pair(rule.family, shape_b, bx, by, br, shape_a, ax, ay, ar, flip=True)
     else:
         ox, oy = ax, ay
         found = _pair(rule.family, shape_a, ax, ay, ar, shape_b, bx, by, br)
@@ -98,7 +104,8 @@ def _pair(
     """``sa`` at (ox, oy) against ``sb`` at (qx, qy), computed by ``family``
     (:data:`~framework.collision.kinds.PAIRS`): the result in ``sa``'s frame scaled by 2**-k.
 
-    With ``flip`` the caller's A is ``sb`` (a circle): normals are turned to point from it.
+    With ``flip`` the caller's A is ``sb`` (a circle, or the shape paired with a capsule): normals
+    are turned to point from it.
     """
     ra, rb = sa.bounding_radius, sb.bounding_radius
     # Halves first: 0.5 * q - 0.5 * o never overflows, and halving is exact above the subnormals.
@@ -108,7 +115,10 @@ def _pair(
     # The exact offset (q - o) * 2**-k, for the exact fallback.
     off = (ox, oy, qx, qy, k)
     size = math.ldexp(ra, -k) + math.ldexp(rb, -k)
-    if family == CIRCLES:
+    if family == CAPSULES:
+        assert isinstance(sa, Capsule)
+        res = capsule_pair(sa, rot_a, sb, rot_b, dx, dy, off, k, size, flip)
+    elif family == CIRCLES:
         assert isinstance(sa, Circle) and isinstance(sb, Circle)
         res = circle_circle(math.ldexp(sa.radius, -k), math.ldexp(sb.radius, -k), dx, dy, off)
     elif family == POLYGON_CIRCLE:

@@ -24,7 +24,8 @@ from typing import NamedTuple
 
 __all__ = [
     "BAND", "TINY", "Offset", "PolygonCircleExact", "circle_circle_exact", "exact_ints", "float_approx",
-    "float_rounded", "polygon_circle_exact", "polygon_polygon_exact", "ratio_approx", "vertex_contact",
+    "float_rounded", "polygon_circle_exact", "polygon_polygon_exact", "ratio_approx", "rounded_exact",
+    "vertex_contact",
 ]
 
 # Half-width of the band, relative to the magnitudes involved, inside which a float decision is not
@@ -176,3 +177,79 @@ def polygon_polygon_exact(
                 return None
             found[which, i] = (fwd, bwd)
     return found, 2 * e
+
+
+# --- rounded cores (pairs with a capsule) ---------------------------------------------------------
+
+def _point_segment_excess(px: int, py: int, s0: tuple[int, int], s1: tuple[int, int], r2: int) -> tuple[int, int]:
+    """``(num, den)`` with ``num / den = R^2 - d^2``, ``d`` the distance from p to the segment
+    s0 s1 (a point if s0 == s1), ``r2 = R^2``."""
+    ex, ey = s1[0] - s0[0], s1[1] - s0[1]
+    e2 = ex * ex + ey * ey
+    wx, wy = px - s0[0], py - s0[1]
+    t = wx * ex + wy * ey
+    if e2 == 0 or t <= 0:
+        return r2 - wx * wx - wy * wy, 1
+    if t >= e2:
+        vx, vy = px - s1[0], py - s1[1]
+        return r2 - vx * vx - vy * vy, 1
+    cross = ex * wy - ey * wx
+    return r2 * e2 - cross * cross, e2
+
+
+def rounded_exact(
+    pa: Pts, lb: Pts, offset: Offset, ra: float, rb: float
+) -> tuple[str] | tuple[str, int, int, int, int] | None:
+    """A segment (``pa``: its two ends, about the origin) rounded by ``ra`` against B's core
+    (``lb`` about B's own origin, at the offset: one point, a segment's two ends, or a convex CCW
+    outline) rounded by ``rb``, on exact integers: ``None`` if they do not overlap (the cores are
+    ``R = ra + rb`` or more apart: touching is no overlap), ``("meet",)`` if the cores meet, else
+    ``("apart", i, num, den, u)``: the closest points are pair ``i`` (numbered as
+    :func:`framework.collision.capsule._pair_points` numbers them: each end of the segment against
+    each edge of B, then each vertex of B against the segment) and ``R^2 - d^2 = num / den * 2**u > 0``.
+    """
+    nb = len(lb)
+    ox, oy, rest, e = exact_ints(offset, [ra, rb, *(c for p in (*pa, *lb) for c in p)])
+    r = rest[0] + rest[1]
+    a = [(rest[2], rest[3]), (rest[4], rest[5])]
+    b = [(rest[6 + 2 * j] + ox, rest[7 + 2 * j] + oy) for j in range(nb)]
+    # Separating axes of the cores (complete for two convex sets, degenerate ones included: a
+    # segment's normal and direction).
+    ex, ey = a[1][0] - a[0][0], a[1][1] - a[0][1]
+    axes = [(ey, -ex), (ex, ey)]
+    if nb == 2:
+        fx, fy = b[1][0] - b[0][0], b[1][1] - b[0][1]
+        axes += [(fy, -fx), (fx, fy)]
+    elif nb >= 3:
+        axes += [(b[(j + 1) % nb][1] - b[j][1], b[j][0] - b[(j + 1) % nb][0]) for j in range(nb)]
+    axes = [u for u in axes if u != (0, 0)]
+    if axes:
+        meet = True
+        for ux, uy in axes:
+            amin, amax = _extent(a, ux, uy)
+            bmin, bmax = _extent(b, ux, uy)
+            if amax < bmin or bmax < amin:
+                meet = False
+                break
+    else:  # both cores scaled away to points
+        meet = a[0] == b[0]
+    if meet:
+        return ("meet",)
+    r2 = r * r
+    ne = nb if nb >= 3 else 1
+    pairs = []
+    for k in range(2):
+        for j in range(ne):
+            pairs.append(_point_segment_excess(a[k][0], a[k][1], b[j], b[(j + 1) % nb], r2))
+    for j in range(nb):
+        pairs.append(_point_segment_excess(b[j][0], b[j][1], a[0], a[1], r2))
+    best = 0
+    for i in range(1, len(pairs)):
+        num, den = pairs[i]
+        bnum, bden = pairs[best]
+        if num * bden > bnum * den:
+            best = i
+    num, den = pairs[best]
+    if num <= 0:
+        return None
+    return "apart", best, num, den, 2 * e

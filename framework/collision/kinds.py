@@ -17,53 +17,61 @@ family               ``collide``                 batch kernel                   
 ``CIRCLES``          ``circle_circle``           ``circle_circle``              ``_circle_circle``
 ``POLYGON_CIRCLE``   ``polygon_circle``          ``polygon_circle``             ``_polygon_circle``
 ``POLYGONS``         ``polygon_polygon``         ``polygon_polygon``            ``_polygon_polygon``
+``CAPSULES``         ``capsule.capsule_pair``    ``capsule.capsule_many``       ``_capsule_pair``
+                     (every pair with a capsule)
 ===================  ==========================  =============================  ====================
 
-``flip``: the family's functions take the polygon first, so a circle-first pair is computed with
-the shapes swapped (in the polygon's frame) and its normals turned round to point from A to B.
+``flip``: the family's functions take the polygon first (``CAPSULES``: the capsule first), so a
+circle-first pair (a pair with one capsule, second) is computed with the shapes swapped (in the
+polygon's, or the capsule's, frame) and its normals turned round to point from A to B. A pair of
+two capsules is not flipped: :mod:`~framework.collision.capsule` orders the two itself.
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
-from ..shapes import AABB, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 
 __all__ = [
-    "BOXES", "CIRCLES", "KINDS", "KIND_AABB", "KIND_CIRCLE", "KIND_NAMES", "KIND_NONE", "KIND_POLYGON",
-    "PAIRS", "POLYGONS", "POLYGON_CIRCLE", "PairRule", "kind_of", "pair_code",
+    "BOXES", "CAPSULES", "CIRCLES", "KINDS", "KIND_AABB", "KIND_CAPSULE", "KIND_CIRCLE", "KIND_NAMES", "KIND_NONE",
+    "KIND_POLYGON", "PAIRS", "POLYGONS", "POLYGON_CIRCLE", "PairRule", "kind_of", "pair_code",
 ]
 
 # Kind codes, as the store's int8 ``kind`` column holds them; KIND_NONE: a row without a hitbox.
-KIND_NONE, KIND_AABB, KIND_CIRCLE, KIND_POLYGON = -1, 0, 1, 2
-KINDS = (KIND_AABB, KIND_CIRCLE, KIND_POLYGON)
+KIND_NONE, KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_CAPSULE = -1, 0, 1, 2, 3
+KINDS = (KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_CAPSULE)
 # The shapes' own names for their kinds (``Shape.kind``), by code.
-KIND_NAMES = {KIND_AABB: AABB.kind, KIND_CIRCLE: Circle.kind, KIND_POLYGON: Polygon.kind}
+KIND_NAMES = {KIND_AABB: AABB.kind, KIND_CIRCLE: Circle.kind, KIND_POLYGON: Polygon.kind, KIND_CAPSULE: Capsule.kind}
 
 
 def kind_of(shape: Shape) -> int:
-    """The kind code of a shape (any shape that is neither an AABB nor a circle is a polygon)."""
+    """The kind code of a shape (any shape that is not an AABB, a circle or a capsule is a
+    polygon)."""
     if isinstance(shape, AABB):
         return KIND_AABB
-    return KIND_CIRCLE if isinstance(shape, Circle) else KIND_POLYGON
+    if isinstance(shape, Circle):
+        return KIND_CIRCLE
+    return KIND_CAPSULE if isinstance(shape, Capsule) else KIND_POLYGON
 
 
 def pair_code(kind_a, kind_b):
-    """One code per ordered pair of kinds, ``0 .. 8`` (ints or integer arrays): the position of
+    """One code per ordered pair of kinds, ``0 .. 15`` (ints or integer arrays): the position of
     the pair in :data:`PAIRS`."""
     return kind_a * len(KINDS) + kind_b
 
 
 # Families of functions that compute a pair (module docstring).
-BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS = 0, 1, 2, 3
+BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS, CAPSULES = 0, 1, 2, 3, 4
 
 
 class PairRule(NamedTuple):
     """How an ordered pair of kinds (A, B) is computed."""
 
     name: str  # "circle-polygon": the narrow phase's pair counters
-    family: int  # BOXES, CIRCLES, POLYGON_CIRCLE or POLYGONS
-    flip: bool  # computed as (B, A), normals turned round: the circle of a polygon-circle pair is A
+    family: int  # BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS or CAPSULES
+    flip: bool  # computed as (B, A), normals turned round: the circle of a polygon-circle pair is A,
+    # or the capsule of a pair with one capsule is B
 
 
 # (kind_a, kind_b) -> how the pair is computed, in pair_code order.
@@ -71,10 +79,17 @@ PAIRS: dict[tuple[int, int], PairRule] = {
     (KIND_AABB, KIND_AABB): PairRule("aabb-aabb", BOXES, False),
     (KIND_AABB, KIND_CIRCLE): PairRule("aabb-circle", POLYGON_CIRCLE, False),
     (KIND_AABB, KIND_POLYGON): PairRule("aabb-polygon", POLYGONS, False),
+    (KIND_AABB, KIND_CAPSULE): PairRule("aabb-capsule", CAPSULES, True),
     (KIND_CIRCLE, KIND_AABB): PairRule("circle-aabb", POLYGON_CIRCLE, True),
     (KIND_CIRCLE, KIND_CIRCLE): PairRule("circle-circle", CIRCLES, False),
     (KIND_CIRCLE, KIND_POLYGON): PairRule("circle-polygon", POLYGON_CIRCLE, True),
+    (KIND_CIRCLE, KIND_CAPSULE): PairRule("circle-capsule", CAPSULES, True),
     (KIND_POLYGON, KIND_AABB): PairRule("polygon-aabb", POLYGONS, False),
     (KIND_POLYGON, KIND_CIRCLE): PairRule("polygon-circle", POLYGON_CIRCLE, False),
     (KIND_POLYGON, KIND_POLYGON): PairRule("polygon-polygon", POLYGONS, False),
+    (KIND_POLYGON, KIND_CAPSULE): PairRule("polygon-capsule", CAPSULES, True),
+    (KIND_CAPSULE, KIND_AABB): PairRule("capsule-aabb", CAPSULES, False),
+    (KIND_CAPSULE, KIND_CIRCLE): PairRule("capsule-circle", CAPSULES, False),
+    (KIND_CAPSULE, KIND_POLYGON): PairRule("capsule-polygon", CAPSULES, False),
+    (KIND_CAPSULE, KIND_CAPSULE): PairRule("capsule-capsule", CAPSULES, False),
 }

@@ -8,15 +8,15 @@ from __future__ import annotations
 
 import math
 
-from ..shapes import AABB, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue, finite
 
 __all__ = ["pose", "local_outline", "check_shape"]
 
 
 def check_shape(name: str, shape: object) -> Shape:
-    if not isinstance(shape, (AABB, Circle, Polygon)):
-        raise InvalidValue(f"{name} must be an AABB, Circle or Polygon, got {shape!r}")
+    if not isinstance(shape, (AABB, Capsule, Circle, Polygon)):
+        raise InvalidValue(f"{name} must be an AABB, Capsule, Circle or Polygon, got {shape!r}")
     return shape
 
 

@@ -1,0 +1,318 @@
+"""Capsules: the shape, and its exact answers with every other shape (collide, the batch kernel).
+
+Coordinates are dyadic and capsules upright (rotation 0), so the touching cases are exact: a gap
+of exactly 0 is no collision, an overlap of one ulp is one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import framework
+from framework import AABB, Capsule, Circle, Polygon
+from framework.collision import collide
+from framework.collision.batch import collide_many
+from framework.collision.kinds import KIND_CAPSULE, KIND_NAMES, PAIRS, kind_of
+
+below = math.nextafter  # below(x, -inf): one ulp below x
+
+
+# --- the shape ---------------------------------------------------------------------------------
+
+def test_capsule_is_exported_and_is_a_frozen_slotted_shape() -> None:
+    assert framework.Capsule is Capsule and framework.shapes.Capsule is Capsule
+    assert "Capsule" in framework.__all__ and "Capsule" in framework.shapes.__all__
+    c = Capsule(1, 2)
+    assert c == Capsule(1.0, 2.0) and hash(c) == hash(Capsule(1.0, 2.0))
+    assert c.kind == "capsule" and KIND_NAMES[kind_of(c)] == "capsule" and kind_of(c) == KIND_CAPSULE
+    with pytest.raises(AttributeError):
+        c.radius = 2.0  # type: ignore[misc]
+    assert not hasattr(c, "__dict__")
+    assert isinstance(c.radius, float) and isinstance(c.length, float)
+
+
+@pytest.mark.parametrize(("args", "bad"), [
+    ((0, 1), "0"), ((-1, 1), "-1"), ((math.nan, 1), "nan"), ((math.inf, 1), "inf"), (("1", 1), "'1'"),
+    ((None, 1), "None"), ((True, 1), "True"),
+    ((1, 0), "0"), ((1, -2.5), "-2.5"), ((1, math.nan), "nan"), ((1, -math.inf), "-inf"), ((1, 5e-324), "5e-324"),
+])
+def test_bad_sizes_raise_value_errors_naming_the_value(args, bad) -> None:
+    with pytest.raises(ValueError, match="Capsule") as err:
+        Capsule(*args)
+    assert bad in str(err.value)
+
+
+def test_a_capsule_whose_half_height_overflows_is_refused() -> None:
+    with pytest.raises(ValueError, match="too large"):
+        Capsule(1.7e308, 1.7e308)
+
+
+def test_sizes_area_and_bounding_radius() -> None:
+    c = Capsule(0.5, 3)
+    assert (c.half_length, c.height, c.width, c.bounding_radius) == (1.5, 4.0, 1.0, 2.0)
+    assert c.area == 3.0 + math.pi * 0.25
+    # A capsule of length -> 0 is a circle; of radius -> 0 a thin rectangle.
+    assert Capsule(2, 1e-300).area == pytest.approx(Circle(2).area, rel=1e-15)
+    assert Capsule(1e-9, 4).area == pytest.approx(8e-9, rel=1e-8)
+
+
+def _simpson(f, a: float, b: float, n: int = 4000) -> float:
+    xs = np.linspace(a, b, n + 1)
+    w = np.ones(n + 1)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    return float((f(xs) * w).sum() * (b - a) / (3 * n))
+
+
+def _numeric_second_moment(r: float, length: float) -> float:
+    """The integrals of 1 and x^2 + y^2 over the capsule by horizontal slices (half width w at
+    height y: the slice gives 2 w and 2 (w^3 / 3 + y^2 w)), by Simpson's rule: over the rectangle
+    in y, over each cap in the angle t (y = L/2 + r sin t, w = r cos t), where the integrand is
+    smooth."""
+    hl = length / 2
+
+    def slab(y, w):
+        return 2.0 * (w**3 / 3.0 + y * y * w)
+
+    rect_m = _simpson(lambda y: slab(y, np.full_like(y, r)), -hl, hl)
+    cap_m = _simpson(lambda t: slab(hl + r * np.sin(t), r * np.cos(t)) * r * np.cos(t), 0.0, math.pi / 2)
+    cap_a = _simpson(lambda t: 2.0 * r * np.cos(t) * r * np.cos(t), 0.0, math.pi / 2)
+    return (rect_m + 2 * cap_m) / (2 * r * length + 2 * cap_a)
+
+
+@pytest.mark.parametrize(("r", "length"), [(1, 2), (0.5, 3), (2, 0.25), (1e-3, 1), (3, 1e-6), (1e6, 2e6)])
+def test_second_moment_matches_a_numeric_integration(r, length) -> None:
+    c = Capsule(r, length)
+    assert c.second_moment == pytest.approx(_numeric_second_moment(r, length), rel=1e-6)
+
+
+def test_second_moment_limits() -> None:
+    assert Capsule(2, 1e-12).second_moment == pytest.approx(Circle(2).second_moment, rel=1e-9)
+    # A thin rod of length L about its middle: L^2 / 12.
+    assert Capsule(1e-9, 6).second_moment == pytest.approx(36 / 12, rel=1e-6)
+    assert math.isfinite(Capsule(1e300, 1e300).bounding_radius)
+
+
+# --- collide: exact answers ----------------------------------------------------------------------
+
+CAP = Capsule(0.5, 2)  # core from (0, -1) to (0, 1); reaches y = +-1.5 and x = +-0.5 upright
+
+
+def both_orders(a, ta, b, tb):
+    """collide both ways; asserts the symmetry (same depth bit for bit, negated normal)."""
+    c, s = collide(a, ta, b, tb), collide(b, tb, a, ta)
+    assert (c is None) == (s is None)
+    if c is not None:
+        assert s.depth == c.depth
+        assert (s.normal.x, s.normal.y) == (-c.normal.x + 0.0, -c.normal.y + 0.0)
+    return c
+
+
+@pytest.mark.parametrize("other", [Circle(0.25), AABB(1, 0.5), Polygon.box(1, 0.5), CAP, Capsule(0.25, 1),
+                                   Polygon([(-0.5, -0.25), (0.5, -0.25), (0, 0.25)])])
+def test_touching_is_not_a_collision_and_one_ulp_of_overlap_is(other) -> None:
+    # B below the capsule: its top at y = -1.5 exactly.
+    if isinstance(other, Circle):
+        top = other.radius
+    elif isinstance(other, Capsule):
+        top = other.half_length + other.radius
+    elif isinstance(other, AABB):
+        top = other.height / 2
+    else:
+        top = max(p[1] for p in other.points)
+    y = -1.5 - top
+    assert both_orders(CAP, (0, 0), other, (0, y)) is None
+    c = both_orders(CAP, (0, 0), other, (0, below(y, math.inf)))
+    assert c is not None and 0 < c.depth < 1e-15 and c.normal == (0, -1)
+    # Beside it: B's left side at x = +0.5 exactly (upright shapes: the half widths are exact).
+    if isinstance(other, (Circle, Capsule)):
+        half = other.radius
+    elif isinstance(other, AABB):
+        half = other.width / 2
+    else:
+        half = max(p[0] for p in other.points)
+    x = 0.5 + half
+    assert both_orders(CAP, (0, 0), other, (x, 0.125)) is None
+    c = both_orders(CAP, (0, 0), other, (below(x, -math.inf), 0.125))
+    assert c is not None and 0 < c.depth < 1e-15 and c.normal == (1, 0)
+    # At a large offset the same (the local frame)
+    assert both_orders(CAP, (2.0**30, -(2.0**30)), other, (2.0**30 + x, 0.125 - 2.0**30)) is None
+
+
+def test_end_caps_touch_diagonally_exactly() -> None:
+    # A dyadic Pythagorean triple: (3/4, 1) from the core's end (0, 1), distance 5/4.
+    r = 1.25 - 0.5
+    assert both_orders(CAP, (0, 0), Circle(r), (0.75, 2.0)) is None
+    c = both_orders(CAP, (0, 0), Circle(below(r, math.inf) + 2**-50), (0.75, 2.0))
+    assert c is not None and c.normal == pytest.approx((0.6, 0.8), abs=1e-15)
+    # Two capsules end to end along a diagonal: cores' ends (0, 1) and (0.75, 2) apart 5/4 = rsum.
+    assert both_orders(CAP, (0, 0), Capsule(0.75, 2), (0.75, 3.0)) is None
+    c = both_orders(CAP, (0, 0), Capsule(0.75, 2), (0.75, below(3.0, -math.inf)))
+    assert c is not None and c.depth > 0
+
+
+def test_capsule_and_circle_depths_and_normals() -> None:
+    # beside the core: depth rsum - d, normal across
+    c = both_orders(CAP, (1, 1), Circle(0.25), (1.5, 1.5))
+    assert c.normal == (1, 0) and c.depth == 0.25
+    assert c.point == pytest.approx((1.375, 1.5))
+    # beyond the top end: along the axis
+    c = both_orders(CAP, (0, 0), Circle(0.25), (0, 2.5))
+    assert c is None
+    c = both_orders(CAP, (0, 0), Circle(0.25), (0, 1.5))
+    assert c.normal == (0, 1) and c.depth == 0.25
+    # a circle inside the capsule, off the core: pushed out sideways, all the way
+    big = Capsule(2, 4)
+    c = both_orders(big, (0, 0), Circle(0.5), (0.5, 0.25))
+    assert c.normal == (1, 0) and c.depth == 2.0
+    # centre on the core: the direction is undefined between left and right: right, either order
+    c, s = collide(big, (0, 0), Circle(0.5), (0, 0.25)), collide(Circle(0.5), (0, 0.25), big, (0, 0))
+    assert c.depth == s.depth == 2.5 and c.normal == s.normal == (1, 0)
+    # centre at the core's end: up (the closest to vertical of the equally short push-outs)
+    c, s = collide(big, (0, 0), Circle(0.5), (0, 2)), collide(Circle(0.5), (0, 2), big, (0, 0))
+    assert c.depth == 2.5 and c.normal == (0, 1)
+    assert s.depth == 2.5 and s.normal == (0, -1)
+
+
+def test_capsule_on_a_box_and_inside_a_box() -> None:
+    # resting on a box, overlapping by 1/8: pushed straight up
+    c = both_orders(AABB(4, 1), (0, 0), CAP, (1, 0.5 + 1.5 - 0.125))
+    assert c.normal == (0, 1) and c.depth == 0.125 and c.point == (1, 0.5)  # on the box, in the capsule
+    # the round end over the box's corner (2, 0.5), 3/4 and 1 from it, radius 1/2: apart by 3/4;
+    # closer along the diagonal (3/5, 4/5): depth exactly as the circle's
+    c = collide(AABB(4, 1), (0, 0), Capsule(1.5, 2), (2.75, 2.5))
+    assert c.normal == pytest.approx((0.6, 0.8), abs=1e-15) and c.depth == pytest.approx(0.25, abs=1e-15)
+    # containment: the full push-out, not the overlap of the shadows
+    # (centred: left and right tie, an undefined direction: rightward, whichever comes first)
+    c, s = collide(AABB(10, 10), (0, 0), CAP, (0, 0)), collide(CAP, (0, 0), AABB(10, 10), (0, 0))
+    assert c.depth == s.depth == 5.5 and c.normal == s.normal == (1, 0)
+    c = both_orders(AABB(10, 10), (0, 0), CAP, (1, 3))
+    assert c.depth == 3.5 and c.normal == (0, 1)  # up: 5 - 3 + 1.5
+    c, s = collide(CAP, (0, 0), AABB(0.25, 0.25), (0, 0.5)), collide(AABB(0.25, 0.25), (0, 0.5), CAP, (0, 0))
+    assert c.depth == s.depth == 0.5 + 0.125 and c.normal == s.normal == (1, 0)
+
+
+def test_capsule_and_polygon() -> None:
+    tri = Polygon([(-1, 0), (1, 0), (0, 1)])
+    # a capsule standing on the triangle's flat bottom from below: touching, then an ulp in
+    assert both_orders(tri, (0, 0), CAP, (0, -1.5)) is None
+    c = both_orders(tri, (0, 0), CAP, (0, below(-1.5, math.inf)))
+    assert c.normal == (0, -1) and c.depth > 0
+    # a capsule through the triangle's apex: the shortest push-out
+    c = both_orders(tri, (0, 0), CAP, (0, 2.25))
+    assert c.normal == (0, 1) and c.depth == pytest.approx(0.25)
+    # a lying capsule on a slope: the slope's normal
+    slope = Polygon([(-4, -4), (4, -4), (4, 4)])  # the face y = x, outward normal (-1, 1) / sqrt 2
+    # lying along the face (its core on the line y = x, 1/4 outside it): depth 1/2 - 1/4
+    c = both_orders(slope, (0, 0), Capsule(0.5, 2), (-0.125, 0.125, -math.pi / 4))
+    assert c.normal == pytest.approx((-math.sqrt(0.5), math.sqrt(0.5)), abs=1e-14)
+    assert c.depth == pytest.approx(0.5 - math.sqrt(2) / 8, abs=1e-15)
+    moved = collide(slope, (0, 0), Capsule(0.5, 2), (-0.125 + c.normal.x * c.depth, 0.125 + c.normal.y * c.depth,
+                                                     -math.pi / 4))
+    assert moved is None or moved.depth < 1e-12
+
+
+def test_capsule_and_capsule() -> None:
+    # side by side, overlapping by 1/4
+    c = both_orders(CAP, (0, 0), CAP, (0.75, 0.5))
+    assert c.normal == (1, 0) and c.depth == 0.25 and c.point == (0.375, 1.0)  # in both
+    # end to end
+    c = both_orders(CAP, (0, 0), CAP, (0, 2.75))
+    assert c.normal == (0, 1) and c.depth == 0.25
+    # crossed at one place: the cores cross; push out across the wider shadow's shortest way
+    # (the four ways out tie: up, whichever comes first)
+    c, s = collide(CAP, (0, 0), CAP, (0, 0, math.pi / 2)), collide(CAP, (0, 0, math.pi / 2), CAP, (0, 0))
+    assert c.depth == s.depth == pytest.approx(2.0) and c.normal == s.normal == (0, 1)
+    # identical capsules at one place: out sideways (left and right tie: rightward)
+    c = collide(CAP, (3, 3), CAP, (3, 3))
+    assert c.depth == 1.0 and c.normal == (1, 0)
+    # parallel, overlapping cores side by side (a tie across the long sides): across
+    c = both_orders(CAP, (0, 0), CAP, (0.5, 0))
+    assert c.normal == (1, 0) and c.depth == 0.5
+
+
+def test_huge_and_far_scenes_give_the_same_answers() -> None:
+    for shift in (0.0, 1e9, -(2.0**40)):
+        c = collide(CAP, (shift, shift), CAP, (shift + 0.75, shift + 0.5))
+        assert c.normal == (1, 0) and c.depth == 0.25
+    # scale invariance by powers of two
+    for k in (-500, -40, 40, 500):
+        s = 2.0**k
+        c = collide(Capsule(0.5 * s, 2 * s), (0, 0), Capsule(0.5 * s, 2 * s), (0.75 * s, 0.5 * s))
+        assert c.normal == (1, 0) and c.depth == 0.25 * s
+        assert collide(Capsule(0.5 * s, 2 * s), (0, 0), Circle(0.5 * s), (s, 0)) is None
+        assert collide(Capsule(0.5 * s, 2 * s), (0, 0), Circle(0.5 * s), (below(s, 0.0), 0)) is not None
+
+
+def test_collide_validates_and_lists_capsules_in_its_messages() -> None:
+    with pytest.raises(ValueError, match="Capsule"):
+        collide("capsule", (0, 0), CAP, (0, 0))  # type: ignore[arg-type]
+    with pytest.raises(ValueError):
+        collide(CAP, (0, math.nan), CAP, (0, 0))
+
+
+def test_pair_table_has_every_capsule_pair() -> None:
+    for k in (0, 1, 2, 3):
+        assert (KIND_CAPSULE, k) in PAIRS and (k, KIND_CAPSULE) in PAIRS
+    assert PAIRS[KIND_CAPSULE, KIND_CAPSULE].name == "capsule-capsule"
+
+
+# --- the batch kernel gives collide's answers bit for bit -------------------------------------------
+
+def _random_pairs(rng, n):
+    def shape():
+        k = rng.integers(5)
+        if k == 0:
+            return AABB(*rng.uniform(0.25, 3, 2))
+        if k == 1:
+            return Circle(rng.uniform(0.25, 2))
+        if k == 2:
+            return Polygon.box(*rng.uniform(0.25, 3, 2))
+        if k == 3:
+            return Polygon([(0, 0), (2, 0.5), (1, 2), (-0.5, 1)])
+        return Capsule(rng.uniform(0.125, 1.5), rng.uniform(0.125, 3))
+
+    sa, ta, sb, tb = [], [], [], []
+    for _ in range(n):
+        a, b = shape(), shape()
+        if not isinstance(a, Capsule) and not isinstance(b, Capsule):
+            b = Capsule(0.5, 1)
+        sa.append(a)
+        sb.append(b)
+        # dyadic positions now and then (exact touching), random rotations or none
+        ta.append((float(rng.integers(-16, 16)) / 8 if rng.random() < 0.3 else rng.uniform(-2, 2),
+                   rng.uniform(-2, 2), float(rng.choice([0.0, rng.uniform(-4, 4)]))))
+        tb.append((rng.uniform(-2, 2), float(rng.integers(-16, 16)) / 8 if rng.random() < 0.3 else rng.uniform(-2, 2),
+                   float(rng.choice([0.0, rng.uniform(-4, 4)]))))
+    return sa, ta, sb, tb
+
+
+def test_collide_many_equals_collide_bit_for_bit() -> None:
+    sa, ta, sb, tb = _random_pairs(np.random.default_rng(7), 1500)
+    res = collide_many(sa, ta, sb, tb)
+    hits = 0
+    for i in range(len(sa)):
+        c = collide(sa[i], ta[i], sb[i], tb[i])
+        assert (c is not None) == bool(res.hit[i]), i
+        if c is not None:
+            hits += 1
+            assert (c.normal.x, c.normal.y, c.depth, c.point.x, c.point.y) == (
+                res.nx[i], res.ny[i], res.depth[i], res.px[i], res.py[i]), i
+    assert 300 < hits < 1400
+
+
+def test_collide_many_decides_touching_exactly() -> None:
+    others = [Circle(0.25), AABB(1, 0.5), Polygon.box(1, 0.5), CAP]
+    tops = [0.25, 0.25, 0.25, 1.5]
+    sa, ta, sb, tb = [], [], [], []
+    for o, top in zip(others, tops, strict=True):
+        for y in (-1.5 - top, below(-1.5 - top, math.inf)):
+            sa += [CAP, o]
+            ta += [(0, 0), (0, y)]
+            sb += [o, CAP]
+            tb += [(0, y), (0, 0)]
+    res = collide_many(sa, ta, sb, tb)
+    assert res.hit.tolist() == [False, False, True, True] * 4
+    assert (res.depth[res.hit] > 0).all()
