@@ -316,3 +316,108 @@ def test_collide_many_decides_touching_exactly() -> None:
     res = collide_many(sa, ta, sb, tb)
     assert res.hit.tolist() == [False, False, True, True] * 4
     assert (res.depth[res.hit] > 0).all()
+
+
+# --- raycast -----------------------------------------------------------------------------------------
+
+from framework.collision import raycast, time_of_impact  # noqa: E402
+
+
+def test_raycast_hits_the_sides_and_the_caps_exactly() -> None:
+    hit = raycast(CAP, (1, 1), (-4, 1.5), (1, 0))
+    assert hit.distance == 4.5 and hit.point == (0.5, 1.5) and hit.normal == (-1, 0)
+    hit = raycast(CAP, (0, 0), (0, -5), (0, 2))  # direction not unit: world units
+    assert hit.distance == 3.5 and hit.point == (0, -1.5) and hit.normal == (0, -1)
+    # the cap: from (3/8, -5) up, entering the bottom disc of radius 1/2 about (0, -1) at y = -1.3 ...
+    hit = raycast(CAP, (0, 0), (0.375, -5), (0, 1))
+    assert hit.distance == pytest.approx(5 - 1 - math.sqrt(0.25 - 0.375**2))
+    assert hit.normal == pytest.approx((0.75, -math.sqrt(1 - 0.75**2)))
+
+
+def test_raycast_grazing_misses_and_max_distance_counts() -> None:
+    assert raycast(CAP, (0, 0), (-0.5, -5), (0, 1)) is None  # along the left side
+    assert raycast(CAP, (0, 0), (-5, 1.5), (1, 0)) is None  # tangent to the top cap
+    assert raycast(CAP, (0, 0), (-5, -1.5), (1, 0)) is None  # tangent to the bottom cap
+    assert raycast(CAP, (0, 0), (0, -5), (0, 1), 3.5).distance == 3.5
+    assert raycast(CAP, (0, 0), (0, -5), (0, 1), below(3.5, 0.0)) is None
+    assert raycast(CAP, (0, 0), (0, -5), (0, -1)) is None  # away
+
+
+def test_raycast_from_inside_and_from_the_boundary() -> None:
+    hit = raycast(CAP, (0, 0), (0.25, 1.25), (3, 4), 0.0)
+    assert hit.distance == 0 and hit.point == (0.25, 1.25) and hit.normal == pytest.approx((-0.6, -0.8))
+    hit = raycast(CAP, (0, 0), (0.5, 0), (-1, 0))  # on the side, heading in
+    assert hit.distance == 0 and hit.normal == (1, 0)
+    hit = raycast(CAP, (0, 0), (0, 1.5), (0, -1))  # on the top, heading in
+    assert hit.distance == 0 and hit.normal == (0, 1)
+    assert raycast(CAP, (0, 0), (0.5, 0), (1, 0)) is None  # on the side, heading out
+
+
+def test_raycast_on_a_turned_and_far_capsule() -> None:
+    # lying (a quarter turn): its core from (1, 0) to (-1, 0) about the origin
+    hit = raycast(CAP, (1e9, 5, math.pi / 2), (1e9 - 3, 5), (1, 0))
+    assert hit.distance == pytest.approx(1.5, abs=1e-6) and hit.normal == pytest.approx((-1, 0))
+    hit = raycast(CAP, (0, 0, math.pi / 2), (0.25, 3), (0, -1))
+    assert hit.distance == pytest.approx(2.5) and hit.normal == pytest.approx((0, 1))
+
+
+# --- time of impact ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("other", [Circle(0.5), AABB(1, 1), Polygon.box(1, 1), CAP,
+                                   Polygon([(-0.5, -0.5), (0.5, -0.5), (0, 0.5)])])
+def test_time_of_impact_exact_fractions_and_grazing(other) -> None:
+    # B (half width 1/2 upright) 3 to the right, moving left by 4: contact at gap 2 -> 1/2
+    imp = time_of_impact(CAP, (0, 0), (0, 0), other, (3, 0.25), (-4, 0))
+    assert imp.fraction == 0.5 and imp.normal == (1, 0)
+    swapped = time_of_impact(other, (3, 0.25), (-4, 0), CAP, (0, 0), (0, 0))
+    assert swapped.fraction == 0.5 and swapped.normal == (-1, 0)
+    # the same motion split between the two
+    imp = time_of_impact(CAP, (0, 0), (2, 0), other, (3, 0.25), (-2, 0))
+    assert imp.fraction == 0.5 and imp.normal == (1, 0)
+    # first touch at exactly the end of the step: None
+    assert time_of_impact(CAP, (0, 0), (0, 0), other, (3, 0.25), (-2, 0)) is None
+    # sliding along at gap 0: a graze
+    assert time_of_impact(CAP, (0, 0), (0, 0), other, (1, -4), (0, 8)) is None
+    # already overlapping: fraction 0 with collide's normal
+    imp = time_of_impact(CAP, (0, 0), (0, 0), other, (0.75, 0), (5, 5))
+    assert imp.fraction == 0.0 and imp.normal == collide(CAP, (0, 0), other, (0.75, 0)).normal
+    # no relative motion
+    assert time_of_impact(CAP, (0, 0), (1, 1), other, (3, 0.25), (1, 1)) is None
+
+
+def test_time_of_impact_end_to_end_and_through_a_corner() -> None:
+    # falling onto a box: the bottom cap meets the top face
+    imp = time_of_impact(CAP, (0, 4), (0, -8), AABB(4, 1), (0, 0))
+    assert imp.fraction == 0.25 and imp.normal == (0, -1)  # from A (above) toward B
+    # a capsule falling past a box's corner, its side 0 away: a graze
+    assert time_of_impact(CAP, (2.5, 4), (0, -8), AABB(4, 1), (0, 0)) is None
+    # two capsules, one lying, the other falling onto its middle
+    imp = time_of_impact(CAP, (0, 4), (0, -8), CAP, (0, 0, math.pi / 2))
+    assert imp.fraction == pytest.approx(0.25) and imp.normal == pytest.approx((0, -1))
+
+
+def _collides_at(sa, ta, ma, sb, tb, mb, f):
+    return collide(sa, (ta[0] + ma[0] * f, ta[1] + ma[1] * f, ta[2]), sb, (tb[0] + mb[0] * f, tb[1] + mb[1] * f, tb[2]))
+
+
+def test_time_of_impact_agrees_with_collide_along_the_way() -> None:
+    rng = np.random.default_rng(11)
+    sa, ta, sb, tb = _random_pairs(rng, 400)
+    seen = 0
+    for a, pa, b, pb in zip(sa, ta, sb, tb, strict=True):
+        pa = (pa[0] * 3, pa[1] * 3, pa[2])
+        ma = tuple(rng.uniform(-6, 6, 2))
+        imp = time_of_impact(a, pa, ma, b, pb, (0, 0))
+        if imp is None:
+            # never overlapping at a sample of the step
+            assert not any(_collides_at(a, pa, ma, b, pb, (0, 0), f) for f in np.linspace(0, 1, 41)[1:-1])
+            continue
+        seen += 1
+        f = imp.fraction
+        assert 0.0 <= f < 1.0
+        if f > 1e-6:
+            assert _collides_at(a, pa, ma, b, pb, (0, 0), f * (1 - 1e-9)) is None
+            c = _collides_at(a, pa, ma, b, pb, (0, 0), min(f + 1e-7, 1.0))
+            assert c is not None
+            assert imp.normal == pytest.approx(tuple(c.normal), abs=1e-3)
+    assert seen > 50

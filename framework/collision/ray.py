@@ -9,7 +9,10 @@ integer / dyadic input keeps its exact decisions.
 Boxes and polygons are clipped with Cyrus-Beck on *unnormalised* edge normals: the sign tests
 ``n . (v - o)`` and ``n . d`` are exact for dyadic input, so a ray along an edge line or exactly
 through a corner is a graze, hence a miss. Circles use the discriminant written as
-``|d|^2 r^2 - (m x d)^2`` (no cancellation) and the numerically stable root ``c / q``.
+``|d|^2 r^2 - (m x d)^2`` (no cancellation) and the numerically stable root ``c / q``. A capsule
+is the union of an open rectangle (its segment pushed out both ways by the radius) and two open
+discs at the segment's ends: the ray enters it where it first enters one of those
+(:func:`rounded_segment`).
 
 The helpers below (local frames, clipping, disc intervals, normal tie-breaks) are shared with
 :mod:`framework.collision.sweep`, which casts the relative motion against a Minkowski difference.
@@ -20,7 +23,7 @@ from __future__ import annotations
 import math
 from numbers import Real
 
-from ..shapes import AABB, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue, vector2
 from .placement import check_shape, pose
 from .results import RayHit, Vec2
@@ -68,6 +71,8 @@ def raycast(
     mx, my = math.ldexp(rx, e - k), math.ldexp(ry, e - k)
     if isinstance(shape, Circle):
         res = _ray_circle(mx, my, math.ldexp(shape.radius, -k), ux, uy)
+    elif isinstance(shape, Capsule):
+        res = _ray_capsule(mx, my, shape, rot, k, ux, uy)
     else:
         res = _ray_polygon(scaled_outline(shape, 0.0, 0.0, rot, k), mx, my, ux, uy, ulen)
     if res is None:
@@ -144,7 +149,86 @@ def _ray_circle(mx: float, my: float, r: float, dx: float, dy: float) -> _Res | 
     return t, (hx / ln, hy / ln)
 
 
+def _ray_capsule(mx: float, my: float, shape: Capsule, rot: float, k: int, dx: float, dy: float) -> _Res | None:
+    from .capsule import segment
+
+    sx, sy = segment(shape, rot, k)
+    r = math.ldexp(shape.radius, -k)
+    # Strictly inside: nearer the segment than r.
+    cx, cy = closest_on_segment(mx, my, -sx, -sy, sx, sy)
+    if (mx - cx) ** 2 + (my - cy) ** 2 < r * r:
+        return 0.0, None
+    found = rounded_segment(mx, my, -sx, -sy, sx, sy, r, dx, dy)
+    if found is None:
+        return None
+    t_in, t_out, cands = found
+    if not t_out > 0.0:
+        return None
+    t_in = max(t_in, 0.0)  # (< 0 only by rounding: on the boundary, heading in)
+    tol = TIE * max(1.0, t_in)
+    _, nx, ny = pick([(0.0, nx, ny) for t, nx, ny in cands if t <= t_in + tol or t <= 0.0], 1.0)
+    return t_in, (nx, ny)
+
+
 # --- shared helpers (also used by sweep.py) ---------------------------------------------------
+
+def closest_on_segment(px: float, py: float, s0x: float, s0y: float, s1x: float, s1y: float) -> tuple[float, float]:
+    """The point of the segment s0 s1 closest to p."""
+    ex, ey = s1x - s0x, s1y - s0y
+    e2 = ex * ex + ey * ey
+    if e2 == 0.0:
+        return s0x, s0y
+    t = ((px - s0x) * ex + (py - s0y) * ey) / e2
+    if t <= 0.0:
+        return s0x, s0y
+    if t >= 1.0:
+        return s1x, s1y
+    return s0x + t * ex, s0y + t * ey
+
+
+def rounded_segment(
+    cx: float, cy: float, s0x: float, s0y: float, s1x: float, s1y: float, r: float, vx: float, vy: float
+) -> tuple[float, float, list[tuple[float, float, float]]] | None:
+    """The open interval ``(t_in, t_out)`` where ``c + t v`` is strictly inside the segment s0 s1
+    rounded by ``r`` (an open rectangle and two open discs), with the entry normals ``(t, nx, ny)``
+    of the pieces entered (unit, outward), or ``None`` if it never is (a graze). ``v`` non-zero."""
+    t_in, t_out = math.inf, -math.inf
+    cands: list[tuple[float, float, float]] = []
+    ex, ey = s1x - s0x, s1y - s0y
+    e2 = ex * ex + ey * ey
+    if e2 > 0.0:
+        nx, ny = ey, -ex
+        ln = math.sqrt(e2)
+        rl = r * ln
+        qx, qy = cx - s0x, cy - s0y
+        along, across = ex * qx + ey * qy, nx * qx + ny * qy
+        ev, nv = ex * vx + ey * vy, nx * vx + ny * vy
+        # 0 < e.(x - s0) < e.e and -r|e| < n.(x - s0) < r|e|, each as f0 + t f1 < 0.
+        from .sweep import clip_constraints
+
+        rect = clip_constraints([(-along, -ev, "start"), (along - e2, ev, "end"), (across - rl, nv, "pos"),
+                                 (-across - rl, -nv, "neg")])
+        if rect is not None:
+            a, b, tags = rect
+            t_in, t_out = min(t_in, a), max(t_out, b)
+            if "pos" in tags:
+                cands.append((a, nx / ln, ny / ln))
+            elif "neg" in tags:
+                cands.append((a, -nx / ln, -ny / ln))
+            # (entered through an end only: next to a disc, entered no later, which gives the normal)
+    for px, py in ((s0x, s0y), (s1x, s1y)):
+        iv = disc_interval(cx - px, cy - py, r, vx, vy)
+        if iv is not None:
+            a, b = iv
+            t_in, t_out = min(t_in, a), max(t_out, b)
+            t = a if a > 0.0 else 0.0
+            hx, hy = cx - px + t * vx, cy - py + t * vy
+            hl = math.hypot(hx, hy)
+            cands.append((a, hx / hl, hy / hl) if hl > 0.0 else (a, 0.0, 1.0))
+    if not t_in < t_out:
+        return None
+    return t_in, t_out, cands
+
 
 def safe_ldexp(x: float, e: int) -> float:
     """``x * 2**e``, or a signed inf on overflow (math.ldexp raises instead)."""
@@ -166,6 +250,8 @@ def extent(shape: Shape) -> float:
     """A size of the shape in its own frame, to choose the local scale (any factor of 2 will do)."""
     if isinstance(shape, Circle):
         return shape.radius
+    if isinstance(shape, Capsule):
+        return shape.bounding_radius
     if isinstance(shape, AABB):
         return max(shape.width, shape.height)
     assert isinstance(shape, Polygon)

@@ -10,7 +10,11 @@ a sweep is a ray cast of B's offset against ``M``, with the same grazing rules:
 - circle vs circle: ``M`` is a disc of the radius sum;
 - box/polygon vs circle: ``M`` is the polygon rounded by the radius, the union of one open
   rectangle per face (the face pushed out and in by the radius) and one open disc per vertex;
-  the first entry into ``M`` is the first entry into any of those pieces.
+  the first entry into ``M`` is the first entry into any of those pieces;
+- a capsule vs anything: ``M`` is the cores' Minkowski difference (the convex hull of the
+  differences of their points: a polygon, or a segment where both cores are parallel segments or
+  one is a point) rounded by the radii summed: the same pieces (for a segment, one rectangle and
+  two discs, :func:`~framework.collision.ray.rounded_segment`).
 
 Positions are scaled by one power of two and the motion by another (both exact); times are kept
 in the scaled frame (``tau = t * 2**(j - k)``) and turned into a step fraction at the end. Swapping
@@ -22,12 +26,22 @@ from __future__ import annotations
 
 import math
 
-from ..shapes import AABB, Circle, Shape
+from ..shapes import AABB, Capsule, Circle, Shape
 from ..validation import vector2
+from .capsule import capsule_first, core_points
 from .collide import collide
-from .kinds import CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
+from .kinds import CAPSULES, CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
 from .placement import check_shape, pose
-from .ray import TIE, disc_interval, extent, local_exponent, relative, scale_exponent, scaled_outline
+from .ray import (
+    TIE,
+    disc_interval,
+    extent,
+    local_exponent,
+    relative,
+    rounded_segment,
+    scale_exponent,
+    scaled_outline,
+)
 from .results import Impact, Vec2
 from .tiebreak import pick
 
@@ -100,6 +114,12 @@ def _sweep_pair(
     (vx, vy), sizes scaled by ``2**-k``), computed as :data:`~framework.collision.kinds.PAIRS` says."""
     (ax, ay, ar), (bx, by, br) = pose_a, pose_b
     rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
+    if rule.family == CAPSULES:
+        # The capsule first (of two, the one placed first), as collide does; then turned round.
+        flip = rule.flip or (isinstance(shape_b, Capsule) and not capsule_first(shape_a, pose_a, shape_b, pose_b))
+        if flip:
+            return _turned_round(_capsule_pair(shape_b, br, shape_a, ar, -dx, -dy, -vx, -vy, k))
+        return _capsule_pair(shape_a, ar, shape_b, br, dx, dy, vx, vy, k)
     if rule.family == CIRCLES:
         assert isinstance(shape_a, Circle) and isinstance(shape_b, Circle)
         return _circle_circle(dx, dy, math.ldexp(shape_a.radius, -k) + math.ldexp(shape_b.radius, -k),
@@ -257,6 +277,41 @@ def _polygon_circle(poly: Pts, cx: float, cy: float, r: float, vx: float, vy: fl
     if not t_in < t_out:
         return None
     return t_in, t_out, cands
+
+
+def _hull(pts: Pts) -> Pts:
+    """Convex hull, counter-clockwise, without collinear points (monotone chain)."""
+    pts = sorted(set(pts))
+    if len(pts) <= 2:
+        return pts
+
+    def half(seq: Pts) -> Pts:
+        out: Pts = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0.0:
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(pts), half(pts[::-1])
+    return lower[:-1] + upper[:-1]
+
+
+def _capsule_pair(sa: Shape, rot_a: float, sb: Shape, rot_b: float, dx: float, dy: float, vx: float, vy: float,
+                  k: int) -> _Sweep | None:
+    """Capsule A at the origin, B's core at (dx, dy) moving by ``tau v``: B's offset against the cores'
+    Minkowski difference rounded by the radii summed."""
+    pa, ra = core_points(sa, rot_a, k)
+    pb, rb = core_points(sb, rot_b, k)
+    hull = _hull([(ax - bx, ay - by) for ax, ay in pa for bx, by in pb])
+    if len(hull) >= 3:
+        return _polygon_circle(hull, dx, dy, ra + rb, vx, vy)
+    (s0x, s0y), (s1x, s1y) = hull if len(hull) == 2 else hull * 2
+    found = rounded_segment(dx, dy, s0x, s0y, s1x, s1y, ra + rb, vx, vy)
+    if found is None or not found[2]:
+        return None
+    return found
 
 
 def clip_constraints(cons: list[tuple[float, float, str]]) -> tuple[float, float, set[str]] | None:
