@@ -26,8 +26,9 @@ platforms have already moved). The game sets the velocity it wants (``Velocity``
 
 The body is kept ``skin`` away from what it touches (by default a gap of 2**-40 of its size, and
 at least 256 units of rounding of its coordinates), so floating-point rounding never leaves it
-inside a surface and sliding along a row of tiles meets no seams. Its state after each step: ``on_floor``, ``floor_normal``, ``floor_entity``,
-``on_wall``, ``wall_normal``, ``on_ceiling``, ``crushed``. Gravity (the scene's, times
+inside a surface and sliding along a row of tiles meets no seams. Its state after each step:
+``on_floor``, ``floor_normal``, ``floor_entity``, ``on_wall``, ``wall_normal``, ``on_ceiling``,
+``crushed``. Gravity (the scene's, times
 ``gravity_scale``) accelerates it while it is not on a floor. Velocity is relative to the floor
 it stands on; leaving a moving platform adds the platform's velocity.
 

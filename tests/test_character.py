@@ -188,7 +188,8 @@ def test_a_step_higher_than_step_height_is_a_wall():
 
 
 V_LEVEL = floor_row(8) + floor_row(3, 48.0) + floor_row(3, 48.0, start=5) + [
-    (112.0, 48.0, Polygon([(-16, -16), (16, -16), (-16, 16)])), (144.0, 48.0, Polygon([(-16, -16), (16, -16), (16, 16)]))]
+    (112.0, 48.0, Polygon([(-16, -16), (16, -16), (-16, 16)])),
+    (144.0, 48.0, Polygon([(-16, -16), (16, -16), (16, 16)]))]
 """Ground at 64 on both sides of a V: a 45-degree slope down from x = 96 to 128, up to 160."""
 
 

@@ -72,8 +72,6 @@ class Enemy:
     direction: int = -1
     prev_top: float = 0.0
     turned_frame: int = -1
-    probe_cell: tuple[int, int] | None = None  # where the ledge probe last looked ...
-    probe_ground: bool = True                  # ... and whether it found ground there
 
 
 @dataclass

@@ -13,7 +13,7 @@ from framework import Transform
 
 from .components import Enemy, MovingPlatform
 
-__all__ = ["Autoplay", "SCRIPTS", "level1", "level2", "play_all"]
+__all__ = ["Autoplay", "SCRIPTS", "level1", "level2", "level3", "play_all"]
 
 Keys = set[str]
 TIMEOUT = 600  # steps any one wait may take before the script gives up on it
@@ -179,7 +179,19 @@ def level2(game) -> Iterator[Keys]:
     yield from run_to(game, 87.0)
 
 
-SCRIPTS = (level1, level2)
+def level3(game) -> Iterator[Keys]:
+    """Plays ``03-hills.tmj``: up a 2:1 and a 45-degree slope, over the hill, through the V, the
+    lift over the pit, a walker, the wall before the goal."""
+    yield from jump_from(game, 16.0, 20)        # the coins over the hilltop
+    yield from jump_from(game, 31.6, 22)        # the coins over the V
+    yield from run_to(game, 40.3)               # the pit's edge
+    yield from lift(game, 50.5)
+    yield from stomp(game)
+    yield from jump_from(game, 56.8, 30)        # over the wall
+    yield from run_to(game, 62.0)
+
+
+SCRIPTS = (level1, level2, level3)
 
 
 def play_all(game) -> Iterator[Keys]:

@@ -18,7 +18,6 @@ else collision-related comes from the pipeline: its events (``scene.on_collision
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -49,6 +48,7 @@ if TYPE_CHECKING:
 __all__ = ["install", "kill_player"]
 
 LEFT, RIGHT, JUMP, DOWN = ("left", "a"), ("right", "d"), ("space", "up", "w"), ("down", "s")
+LEDGE_PROBE = 0.8  # tiles: a walker turns where the ground ahead drops further than this
 CHECKPOINT_ON = (120, 230, 255)
 
 
@@ -172,27 +172,23 @@ def sense_player(scene: Scene, dt: float) -> None:
 
 
 def sense_enemies(scene: Scene, dt: float) -> None:
-    """Walkers turn where the response stopped them (a wall, another enemy), where they touch
-    spikes ahead (the pipeline's contacts with the sensor), and before a ledge
-    (``scene.query_point`` just ahead of and below their feet finds no ground; moving platforms
-    do not count, walkers keep off them)."""
+    """Walkers turn where their controller met a wall (or another walker) ahead, where they touch
+    spikes ahead (the pipeline's contacts with the sensor), and before a ledge: a ray down from
+    just past their front foot finds no ground within LEDGE_PROBE tiles (deep enough for the
+    ground under the front foot on a 45-degree slope, 0.75 tiles; moving platforms do not count,
+    walkers keep off them)."""
     tile = _tile(scene)
     for e, (en, t, hb, ctrl) in scene.query(Enemy, Transform, Hitbox, CharacterController):
-        turn = ctrl.on_wall and ctrl.wall_normal[0] * en.direction < 0.0  # a wall (or another walker) ahead
+        turn = ctrl.on_wall and ctrl.wall_normal[0] * en.direction < 0.0
         for other in _touching(scene, e):
             if scene.try_get(other, Hazard) is not None and (scene.get(other, Transform).x - t.x) * en.direction > 0:
                 turn = True  # spikes ahead
         if ctrl.on_floor and not turn:
-            front = t.x + en.direction * (hb.shape.width * 0.5 + 0.1 * tile)
-            below = t.y - hb.shape.height * 0.5 - 0.1 * tile
-            # Walkers keep off moving platforms, so the ground ahead is static and changes only
-            # where the probe enters another tile: the query is asked again only then.
-            cell = (math.floor(front / tile), math.floor(below / tile))
-            if cell != en.probe_cell:
-                en.probe_cell = cell
-                en.probe_ground = any(scene.try_get(o, MovingPlatform) is None
-                                      for o in scene.query_point(front, below, mask=SOLID | ONE_WAY))
-            if not en.probe_ground:
+            front = t.x + en.direction * (hb.shape.width * 0.5 + 0.02 * tile)
+            feet = t.y - hb.shape.height * 0.5
+            hits = scene.raycast_all((front, feet + 0.05 * tile), (0.0, -1.0), (LEDGE_PROBE + 0.05) * tile,
+                                     mask=SOLID | ONE_WAY)
+            if not any(scene.try_get(h.entity, MovingPlatform) is None for h in hits):
                 turn = True  # a ledge ahead
         if turn and en.turned_frame != scene.frame:
             en.direction = -en.direction

@@ -1,0 +1,141 @@
+"""The platformer on slopes: its player and walkers move with the framework's character controller."""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import pytest
+
+from examples.platformer import Game, builtin_levels, parse_text
+from examples.platformer.components import Enemy, LevelPiece, Tuning
+from examples.platformer.demo import Autoplay, level3
+from framework import Hitbox, Polygon, Transform
+from framework.character import CharacterController
+
+T = 32.0
+TU = Tuning()
+HALF_H = TU.player_size[1] * T / 2
+RUN = TU.run_speed * T
+DT = 1.0 / 60.0
+
+
+@pytest.fixture(autouse=True)
+def _close_scenes():
+    games: list[Game] = []
+    orig = Game.__init__
+
+    def track(self, *a, **k):
+        orig(self, *a, **k)
+        games.append(self)
+
+    Game.__init__ = track
+    yield
+    Game.__init__ = orig
+    for g in games:
+        g.close()
+
+
+def feet(g: Game) -> float:
+    return g.player_transform.y - HALF_H
+
+
+def test_the_hills_level_has_slopes_a_v_and_a_lift_over_a_pit():
+    g = Game([builtin_levels()[2]])
+    kinds = {k for row in g.level.tiles for k in row}
+    assert {"slope_up", "slope_down", "slope_up_low", "slope_up_high", "slope_down_high", "slope_down_low"} <= kinds
+    assert any(a == "slope_down" and b == "slope_up" for row in g.level.tiles for a, b in zip(row, row[1:]))  # a V
+    assert len(g.level.of_kind("platform")) == 1
+    slopes = [e for e, (lp, hb) in g.scene.query(LevelPiece, Hitbox) if lp.kind == "slope"]
+    assert slopes and all(isinstance(g.scene.get(e, Hitbox).shape, Polygon) for e in slopes)
+
+
+def test_demo_plays_the_hills_to_the_goal():
+    g = Game([builtin_levels()[2]], autoplay=Autoplay(level3))
+    while not g.state.reached_goal and g.scene.frame < 2000:
+        g.step()
+    assert g.state.reached_goal and g.state.deaths == 0 and g.state.stomps == 1
+
+
+HILL = """
+#..............................#
+#..............................#
+#.........../###\\..............#
+#.P.....rR######################
+################################
+"""
+
+
+def test_player_runs_up_and_over_the_hill_with_its_feet_on_the_ground():
+    g = Game([parse_text(HILL, "hill.txt")])
+    for _ in range(20):
+        g.step(set())
+    ctrl = g.scene.get(g.player, CharacterController)
+
+    def ground(x: float) -> float:
+        c = x / T
+        if c < 8:
+            return T
+        if c < 10:
+            return T + (c - 8) * T / 2
+        if c < 12:
+            return 2 * T
+        if c < 13:
+            return 2 * T + (c - 12) * T
+        if c < 16:
+            return 3 * T
+        if c < 17:
+            return 3 * T - (c - 16) * T
+        return 2 * T
+
+    half_w = TU.player_size[0] * T / 2
+    for _ in range(150):
+        g.step({"right"})
+        x = g.player_transform.x
+        under = max(ground(x - half_w), ground(x + half_w))
+        assert ctrl.on_floor and g.player_state.grounded
+        assert 0.0 <= feet(g) - under <= 1e-9, (x / T, feet(g) - under)
+    assert g.player_transform.x > 18 * T  # 150 steps at up to 7 tiles/s, never held up
+
+
+def test_walker_walks_up_and_down_slopes_and_turns_at_walls():
+    g = Game([parse_text("""
+#...............................#
+#P..............................#
+###.............................#
+#.....................E.........#
+#......./##\\..............rR####
+#################################
+""", "walker.txt")])
+    xs = []
+    for _ in range(1800):
+        g.step(set())
+        ((e, (_en, t)),) = g.scene.query(Enemy, Transform)
+        ctrl = g.scene.get(e, CharacterController)
+        xs.append(t.x / T)
+        assert ctrl.on_floor or g.scene.frame < 30
+    assert min(xs) < 1.5 and max(xs) > 31.5  # over the hill to the left wall, up the 2:1 slope to the right wall
+    assert g.state.deaths == 0
+
+
+def test_random_input_on_the_hills_for_10000_frames_never_enters_terrain_or_leaves_the_level():
+    g = Game([builtin_levels()[2]])
+    scene = g.scene
+    terrain = {e for e, lp in scene.query(LevelPiece) if lp.kind in ("solid", "slope")}
+    width, height = g.level.size
+    rng = random.Random(20)
+    keys: set[str] = set()
+    reached = 0.0
+    for k in range(10_000):
+        if k % 12 == 0:
+            keys = set(rng.choices(["right", "left", "space", "down", "up"], weights=[5, 2, 3, 1, 1],
+                                   k=rng.randint(0, 2)))
+        g.step(keys)
+        p, t = g.player, g.player_transform
+        assert 0.0 < t.x < width and t.y < height
+        c = scene.contacts
+        for i in np.flatnonzero((c.a == p) | (c.b == p)).tolist():
+            other = int(c.b[i]) if int(c.a[i]) == p else int(c.a[i])
+            assert other not in terrain, (k, t.x, t.y, float(c.depth[i]))  # never inside ground or slope
+        reached = max(reached, t.x / T)
+    assert reached > 40.0  # it got over the hill and the V to the pit
