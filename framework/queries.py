@@ -16,9 +16,10 @@ import numpy as np
 from .casting import ShapeHit, cast_rows, touch_point
 from .collision import batch, collide
 from .collision.placement import check_shape
+from .collision.ray import closest_on_segment
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
-from .shapes import AABB, Circle
+from .shapes import AABB, Capsule, Circle
 from .store import STATIC
 from .systems.stage import Pipeline
 from .validation import InvalidValue, finite, vector2
@@ -150,6 +151,10 @@ class SpatialQueries:
         shape = hb.shape
         if isinstance(shape, Circle):
             return dx * dx + dy * dy <= shape.radius * shape.radius
+        if isinstance(shape, Capsule):  # within the radius of its segment
+            ux, uy = float(geom.cap_ux[r]), float(geom.cap_uy[r])
+            cx, cy = closest_on_segment(dx, dy, -ux, -uy, ux, uy)
+            return (dx - cx) ** 2 + (dy - cy) ** 2 <= shape.radius * shape.radius
         verts, count = geom.outlines(store, np.array([r]))
         pts = verts[0, : int(count[0])]
         for i in range(len(pts)):
