@@ -361,7 +361,7 @@ def test_slopes_round_trip_text_to_level_to_tiled_and_back(tmp_path):
         [p.cells for p in terrain_pieces(level.tiles, level.tile)]
 
 
-def test_levels_without_slopes_keep_the_original_three_tile_tileset():
+def test_levels_without_slopes_keep_the_three_tile_tileset_and_shipped_tilesets_are_regenerated():
     (ts,) = to_tmj(parse_text("P.\n##", "flat.txt"))["tilesets"]
     assert ts["tilecount"] == 3 and [t["type"] for t in ts["tiles"]] == ["solid", "oneway", "spikes"]
     assert (ts["imagewidth"], ts["imageheight"]) == (96, 32)
