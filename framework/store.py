@@ -18,13 +18,13 @@ from typing import Any
 
 import numpy as np
 
-from .collision.kinds import KIND_AABB, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
+from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field, check_mass_and_density
-from .shapes import AABB, Circle
+from .shapes import AABB, Capsule, Circle
 from .validation import InvalidValue
 
-__all__ = ["BodyStore", "KIND_AABB", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "as_selector"]
+__all__ = ["BodyStore", "KIND_AABB", "KIND_CAPSULE", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "as_selector"]
 
 BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
 DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
@@ -34,7 +34,8 @@ _FLOATS = (
     "x", "y", "rot", "vx", "vy", "w",  # transform and velocity (component views)
     "ox", "oy", "hw", "hh", "radius", "bound", "inv_mass", "restitution",  # hitbox, derived
     "friction",  # the hitbox's friction coefficient; NO_FRICTION where it gives none
-    "inv_inertia",  # 1 / moment of inertia of a body contacts turn (dynamic, centred, not an AABB), else 0
+    "inv_inertia",  # 1 / moment of inertia of a body contacts turn (dynamic, centred, a circle, box or polygon),
+    # else 0
 )
 _INTS = {
     "kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64,
@@ -151,7 +152,8 @@ class BodyStore:
         a scene of boxes alone skips sorting its pairs by kind."""
         if self._kinds_key != self.version:
             kind = self.cols["kind"][: self.n]
-            self._kinds = frozenset(int(k) for k in (KIND_AABB, KIND_CIRCLE, KIND_POLYGON) if (kind == k).any())
+            self._kinds = frozenset(int(k) for k in (KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_CAPSULE)
+                                    if (kind == k).any())
             self._kinds_key = self.version
         return self._kinds
 
@@ -346,6 +348,11 @@ class BodyStore:
         elif isinstance(shape, Circle):
             c["kind"][row] = KIND_CIRCLE
             c["hw"][row] = c["hh"][row] = c["radius"][row] = shape.radius
+        elif isinstance(shape, Capsule):
+            # hw, hh: the half extents upright (the geometry turns them); radius: the capsule's
+            c["kind"][row] = KIND_CAPSULE
+            c["hw"][row] = c["radius"][row] = shape.radius
+            c["hh"][row] = shape.half_length + shape.radius
         else:
             c["kind"][row] = KIND_POLYGON
             c["hw"][row] = c["hh"][row] = c["radius"][row] = 0.0
@@ -476,9 +483,10 @@ def _inverse_inertia(hb: Hitbox) -> float:
     0: a dynamic circle, box or polygon centred on its entity (it turns about its entity's
     position), of finite mass and inertia; the inertia given, or the mass times the shape's second
     moment about that point (a solid disk's ``m r^2 / 2``, a box's ``m (w^2 + h^2) / 12``). An
-    ``AABB`` never turns."""
+    ``AABB`` never turns, and neither does a ``Capsule`` (contacts push it like an AABB; its
+    rotation is the game's to set)."""
     shape = hb._shape
-    if hb._body is not Body.DYNAMIC or isinstance(shape, AABB) or hb._offset != (0.0, 0.0):
+    if hb._body is not Body.DYNAMIC or isinstance(shape, (AABB, Capsule)) or hb._offset != (0.0, 0.0):
         return 0.0
     inertia = hb._inertia if hb._inertia is not None else hb.effective_mass * shape.second_moment
     return 0.0 if math.isinf(inertia) else 1.0 / inertia

@@ -16,7 +16,7 @@ import pyglet
 from pyglet.graphics import Batch, Group
 from pyglet.shapes import ShapeBase
 
-from ..shapes import AABB, Circle, Polygon
+from ..shapes import AABB, Capsule, Circle, Polygon
 
 __all__ = ["ConvexFill", "Drawable", "circle_segments", "fill_triangles", "load_image"]
 
@@ -76,6 +76,15 @@ def _fan(points: Sequence[tuple[float, float]]) -> list[float]:
     return out
 
 
+def capsule_outline(shape: Capsule, zoom: float = 1.0) -> list[tuple[float, float]]:
+    """A capsule's outline (upright, local coordinates, counter-clockwise) as a convex polygon: each
+    round end a half circle of as many chords as half a circle of its radius on screen."""
+    r, h = shape.radius, shape.half_length
+    n = max(8, circle_segments(r * zoom) // 2)
+    top = [(r * math.cos(math.pi * i / n), h + r * math.sin(math.pi * i / n)) for i in range(n + 1)]
+    return top + [(-x, -y) for x, y in top]
+
+
 def fill_triangles(shape: Any, zoom: float = 1.0) -> list[float]:
     """The triangles (flat, local coordinates) filling a hitbox shape."""
     if isinstance(shape, AABB):
@@ -86,6 +95,8 @@ def fill_triangles(shape: Any, zoom: float = 1.0) -> list[float]:
         n = circle_segments(r * zoom)
         pts = [(r * math.cos(2.0 * math.pi * i / n), r * math.sin(2.0 * math.pi * i / n)) for i in range(n)]
         return _fan(pts)
+    if isinstance(shape, Capsule):
+        return _fan(capsule_outline(shape, zoom))
     if isinstance(shape, Polygon):
         return _fan(shape.points)
     raise TypeError(f"cannot fill a {type(shape).__name__}")
@@ -106,7 +117,8 @@ class Drawable:
         self.color = color
         self.shown = True
         self.last_seen = 0
-        self.rotates = rotates
+        # (a capsule's fill turns with its transform, as a polygon's)
+        self.rotates = rotates or (kind == "fill" and isinstance(shape, Capsule))
 
     def place(self, hx: float, hy: float, x: float, y: float, rot: float) -> None:
         """Put the drawable where the entity is: a fill at its hitbox origin, a sprite at its

@@ -33,7 +33,7 @@ from pyglet import gl
 from pyglet.graphics import Batch, Group
 
 from ..events import pair_keys, sorted_find
-from ..store import KIND_AABB, KIND_CIRCLE, KIND_POLYGON
+from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 
 __all__ = ["OVERLAY_COLORS", "DebugOverlay"]
 
@@ -113,7 +113,7 @@ def _body_colors(store: Any, rows: np.ndarray) -> np.ndarray:
 def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segments]:
     """The outlines of the hitboxes of ``rows`` (rows with a hitbox), coloured by body type: boxes
     and polygons edge by edge, circles as :data:`CIRCLE_SEGMENTS` chords and a radius showing
-    their rotation."""
+    their rotation, capsules as two half circles of as many chords joined by their sides."""
     out: list[Segments] = []
     if rows.size == 0:
         return out
@@ -141,6 +141,24 @@ def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segme
         rot = store.rot[rows[circles]]
         spokes = np.stack([cx, cy, cx + radius * np.cos(rot), cy + radius * np.sin(rot)], axis=1)
         out.append((spokes, colors[circles]))
+    capsules = np.flatnonzero(kind == KIND_CAPSULE)
+    if capsules.size:
+        # Half a circle about each end of the segment (the far side first), joined by the sides.
+        cx, cy = hx[capsules], hy[capsules]
+        r = store.radius[rows[capsules]][:, None]
+        ux, uy = geometry.cap_ux[rows[capsules]], geometry.cap_uy[rows[capsules]]
+        theta = np.arctan2(uy, ux)[:, None]
+        half = np.linspace(-0.5 * math.pi, 0.5 * math.pi, CIRCLE_SEGMENTS // 2 + 1)[None, :]
+        ends = []
+        for sign in (1.0, -1.0):
+            ang = theta + half + (0.0 if sign > 0 else math.pi)
+            ends.append((cx[:, None] + sign * ux[:, None] + r * np.cos(ang),
+                         cy[:, None] + sign * uy[:, None] + r * np.sin(ang)))
+        loop_x = np.concatenate([ends[0][0], ends[1][0], ends[0][0][:, :1]], axis=1)
+        loop_y = np.concatenate([ends[0][1], ends[1][1], ends[0][1][:, :1]], axis=1)
+        segs = np.stack([loop_x[:, :-1], loop_y[:, :-1], loop_x[:, 1:], loop_y[:, 1:]], axis=2)
+        seg_colors = np.broadcast_to(colors[capsules][:, None, :], segs.shape[:2] + (4,))
+        out.append((segs.reshape(-1, 4), seg_colors.reshape(-1, 4)))
     return out
 
 

@@ -1,4 +1,5 @@
-"""Per-step geometry of the hitboxes, as columns: hitbox origins, bounds and polygon outlines.
+"""Per-step geometry of the hitboxes, as columns: hitbox origins, bounds, polygon outlines and
+capsules' half segments.
 
 Derived from the store each step for the rows that can move; static rows are derived once and
 cached until the static set changes.
@@ -8,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..shapes import Polygon
-from ..store import KIND_AABB, KIND_POLYGON, BodyStore
+from ..shapes import Capsule, Polygon
+from ..store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, BodyStore
 
 __all__ = ["Geometry", "widen_down", "widen_up"]
 
@@ -40,13 +41,16 @@ def widen_up(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
 
 
 class Geometry:
-    """Hitbox origins ``hx, hy``, bounds and outlines of every row with a hitbox."""
+    """Hitbox origins ``hx, hy``, bounds and outlines of every row with a hitbox; for capsule rows
+    the half segment ``cap_ux, cap_uy`` (its ends are the origin -+ it), turned as the transform."""
 
     def __init__(self) -> None:
         self.version = -1
         self.local = np.zeros((0, 4, 2))  # padded local outlines, one per row (polygon rows only)
         self.count = np.zeros(0, dtype=np.int64)
         self.poly_rows = np.zeros(0, dtype=np.int64)
+        self.cap_rows = np.zeros(0, dtype=np.int64)
+        self.cap_half = np.zeros(0)  # per row: a capsule's half length (0 elsewhere)
         self.K = 4
 
     def rebuild_tables(self, store: BodyStore) -> None:
@@ -64,6 +68,10 @@ class Geometry:
             local[r, m:] = pts[-1]  # pad by repeating the last vertex
             count[r] = m
         self.local, self.count, self.K = local, count, K
+        self.cap_rows = np.flatnonzero(store.kind[:n] == KIND_CAPSULE)
+        self.cap_half = np.zeros(n)
+        caps: list[Capsule] = [store.shapes[r] for r in self.cap_rows.tolist()]
+        self.cap_half[self.cap_rows] = [c.half_length for c in caps]
         self.version = store.version
 
     def update(self, store: BodyStore) -> None:
@@ -101,12 +109,17 @@ class Geometry:
             self.poly_slot = np.full(n, -1, dtype=np.int64)
             self.poly_slot[self.poly_rows] = np.arange(self.poly_rows.size)
             self.world_poly = np.zeros((self.poly_rows.size, self.K, 2))
+            self.cap_ux, self.cap_uy = np.zeros(n), self.cap_half.copy()
             if self.has_offset:
                 self.hx, self.hy = x.copy(), y.copy()
         offset = rows[(ox[sel] != 0.0) | (oy[sel] != 0.0)] if self.has_offset else rows[:0]
         polys = rows[store.kind[sel] == KIND_POLYGON] if self.poly_rows.size else rows[:0]
-        # Rotations matter only to polygons and to offset hitboxes (AABBs and circles ignore them).
+        caps = rows[store.kind[sel] == KIND_CAPSULE] if self.cap_rows.size else rows[:0]
+        # Rotations matter only to polygons, capsules and offset hitboxes (AABBs and circles ignore
+        # them).
         turned = np.union1d(polys, offset) if offset.size else polys
+        if caps.size:
+            turned = np.union1d(turned, caps)
         if turned.size:
             self.cos[turned], self.sin[turned] = np.cos(rot[turned]), np.sin(rot[turned])
         if self.has_offset:
@@ -136,6 +149,14 @@ class Geometry:
             self.maxx[polys] = self.hx[polys] + wx.max(axis=1)
             self.miny[polys] = self.hy[polys] + wy.min(axis=1)
             self.maxy[polys] = self.hy[polys] + wy.max(axis=1)
+        if caps.size:
+            # The half segment (0, h) turned; the bounds: its ends, pushed out by the radius.
+            h, r = self.cap_half[caps], store.radius[caps]
+            ux, uy = -(self.sin[caps] * h), self.cos[caps] * h
+            self.cap_ux[caps], self.cap_uy[caps] = ux, uy
+            ex, ey = np.abs(ux) + r, np.abs(uy) + r
+            self.minx[caps], self.maxx[caps] = self.hx[caps] - ex, self.hx[caps] + ex
+            self.miny[caps], self.maxy[caps] = self.hy[caps] - ey, self.hy[caps] + ey
         # Widen by an ulp or two: a bound is a rounded sum, so two shapes overlapping by less than
         # the rounding (boxes stacked at non-dyadic heights) could have strictly disjoint bounds
         # and never reach the (exact) narrow phase. The broad phase may now also pair shapes that

@@ -11,7 +11,18 @@ import numpy as np
 
 from ..arrays import distinct
 from ..collision import batch
-from ..collision.kinds import BOXES, CIRCLES, KIND_POLYGON, PAIRS, POLYGON_CIRCLE, pair_code
+from ..collision.kinds import (
+    BOXES,
+    CAPSULES,
+    CIRCLES,
+    KIND_AABB,
+    KIND_CAPSULE,
+    KIND_CIRCLE,
+    KIND_POLYGON,
+    PAIRS,
+    POLYGON_CIRCLE,
+    pair_code,
+)
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
 from ..store import STATIC, BodyStore
@@ -47,7 +58,7 @@ def pair_contacts(
     if P == 0:
         return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))
     kinds = store.kinds_present()
-    if len(kinds) == 1 and KIND_POLYGON not in kinds:  # boxes alone, or circles alone: one family
+    if len(kinds) == 1 and not kinds & {KIND_POLYGON, KIND_CAPSULE}:  # boxes alone, or circles alone
         k = next(iter(kinds))
         rule = PAIRS[k, k]
         if counts is not None:
@@ -86,6 +97,8 @@ def pair_contacts(
             vp, np_ = geom.outlines(store, poly)
             res = batch.polygon_circle(hx[poly], hy[poly], vp, np_, hx[circ], hy[circ], store.radius[circ],
                                       flip=flip, exact=not remeasure)
+        elif f == CAPSULES:
+            res = _capsule_pairs(store, geom, a, b, code if idx is None else code[idx], remeasure)
         else:
             va, na = geom.outlines(store, a)
             vb, nb = geom.outlines(store, b)
@@ -95,6 +108,47 @@ def pair_contacts(
             return res
         hit[idx], nx[idx], ny[idx], depth[idx], px[idx], py[idx] = res
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
+def _capsule_pairs(store: BodyStore, geom: Geometry, a: np.ndarray, b: np.ndarray, code: np.ndarray,
+                   remeasure: bool) -> batch.ContactArrays:
+    """:func:`~framework.collision.capsule.capsule_many` of pairs with a capsule: the capsule
+    first (the pair rule's flip; of two capsules, the one placed first, as ``collide``), the other
+    shape as its core (a circle's centre, a capsule's ends, a box's or polygon's outline)."""
+    kind = store.kind
+    flip = _PAIR_FLIP[code].copy()
+    two = np.flatnonzero((kind[a] == KIND_CAPSULE) & (kind[b] == KIND_CAPSULE))
+    if two.size:
+        hx, hy, rot, radius, half = geom.hx, geom.hy, store.rot, store.radius, geom.cap_half
+        ka = [v[a[two]] for v in (hx, hy, rot, radius, half)]
+        kb = [v[b[two]] for v in (hx, hy, rot, radius, half)]
+        # A's key (x, y, rotation, radius, length) after B's, lexicographically: B is placed first
+        later = np.zeros(two.size, dtype=bool)
+        tied = np.ones(two.size, dtype=bool)
+        for va, vb in zip(ka, kb, strict=True):
+            later |= tied & (va > vb)
+            tied &= va == vb
+        flip[two] = later
+    cap, oth = np.where(flip, b, a), np.where(flip, a, b)
+    ko = kind[oth]
+    k = max(geom.K, 2)
+    verts = np.zeros((oth.size, k, 2))
+    counts = np.ones(oth.size, dtype=np.int64)
+    outl = np.flatnonzero((ko == KIND_AABB) | (ko == KIND_POLYGON))
+    if outl.size:
+        v, n = geom.outlines(store, oth[outl])
+        verts[outl, : v.shape[1]] = v
+        counts[outl] = n
+    caps = np.flatnonzero(ko == KIND_CAPSULE)
+    if caps.size:
+        ux, uy = geom.cap_ux[oth[caps]], geom.cap_uy[oth[caps]]
+        verts[caps, 0, 0], verts[caps, 0, 1] = -ux, -uy
+        verts[caps, 1:, 0], verts[caps, 1:, 1] = ux[:, None], uy[:, None]
+        counts[caps] = 2
+    radius = np.where((ko == KIND_CIRCLE) | (ko == KIND_CAPSULE), store.radius[oth], 0.0)
+    return batch.capsule_many(geom.hx[cap], geom.hy[cap], geom.cap_ux[cap], geom.cap_uy[cap], store.radius[cap],
+                              store.bound[cap], geom.hx[oth], geom.hy[oth], verts, counts, radius, store.bound[oth],
+                              flip, exact=not remeasure)
 
 
 class NarrowPhase(Stage):

@@ -12,6 +12,10 @@ i_b (r_b x n)^2``, so that a unit changes the point's separation (speed) by exac
 in the translational solve. Pairs with no turning polygon keep one row with their narrow-phase
 point (a circle's lever arm along the normal is 0; along the contact, its radius: it rolls).
 
+Capsules never turn (their inverse inertia is 0, as an AABB's): a dynamic capsule is pushed like
+an AABB. A pair of a turning polygon and a capsule keeps one row with its narrow-phase point, as a
+pair with a circle does, whose lever arm turns the polygon.
+
 Each point's push, impulse and friction's are kept for the next step by pair and slot (the
 points are ordered along the contact's tangent), in ``frame.points``.
 """
@@ -21,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..collision.batch_manifold import pair_manifolds
-from ..collision.kinds import KIND_CIRCLE, KIND_POLYGON
+from ..collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys
 from ..store import BodyStore
 
@@ -39,8 +43,25 @@ def manifold_points(store: BodyStore, geom, ra: np.ndarray, rb: np.ndarray, nx: 
     the step's geometry, keeping the points less than ``gap`` times the smaller body's size
     apart: ``(count, px, py, sep)``."""
     margin = gap * np.minimum(store.bound[ra], store.bound[rb])
-    return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh, geom.poly_slot,
-                          geom.world_poly, geom.count)
+    caps = np.flatnonzero((store.kind[ra] == KIND_CAPSULE) | (store.kind[rb] == KIND_CAPSULE))
+    if caps.size == 0:
+        return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh,
+                              geom.poly_slot, geom.world_poly, geom.count)
+    # A pair with a capsule has no outline to clip: its one point is the narrow phase's, where
+    # they overlap (none where they do not).
+    rest = np.flatnonzero((store.kind[ra] != KIND_CAPSULE) & (store.kind[rb] != KIND_CAPSULE))
+    n_pts, px, py, sep = (np.zeros(ra.size, dtype=np.int64), np.zeros((ra.size, 2)), np.zeros((ra.size, 2)),
+                          np.zeros((ra.size, 2)))
+    if rest.size:
+        got = pair_manifolds(ra[rest], rb[rest], nx[rest], ny[rest], margin[rest], store.kind, geom.hx, geom.hy,
+                             store.hw, store.hh, geom.poly_slot, geom.world_poly, geom.count)
+        n_pts[rest], px[rest], py[rest], sep[rest] = got
+    from .narrow_phase import pair_contacts
+
+    r = pair_contacts(store, geom, ra[caps], rb[caps], remeasure=True)
+    n_pts[caps] = r.hit
+    px[caps, 0], py[caps, 0], sep[caps, 0] = r.px, r.py, -r.depth
+    return n_pts, px, py, sep
 
 
 def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: float):
@@ -50,8 +71,9 @@ def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: f
     row's lever arms set (``cs.arms``)."""
     ra, rb = cs.ra, cs.rb
     turn = turning_polygons(store, ra) | turning_polygons(store, rb)
-    circle = (store.kind[ra] == KIND_CIRCLE) | (store.kind[rb] == KIND_CIRCLE)
-    clip = np.flatnonzero(turn & ~circle)
+    round_ = ((store.kind[ra] == KIND_CIRCLE) | (store.kind[rb] == KIND_CIRCLE) | (store.kind[ra] == KIND_CAPSULE)
+              | (store.kind[rb] == KIND_CAPSULE))
+    clip = np.flatnonzero(turn & ~round_)
     n_pts, px, py, sep = manifold_points(store, geom, ra[clip], rb[clip], cs.nx[clip], cs.ny[clip], margin)
     # rows: every pair once (a pair with no manifold point keeps its own row if it overlaps), then
     # each clipped pair's second point
@@ -70,15 +92,25 @@ def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: f
     k, s = c[has], slot[has]
     out.px[has], out.py[has] = px[k, s], py[k, s]
     out.depth[has] = -sep[k, s]
-    # kept pairs with a circle: the point on the circle's rim facing the other body
+    # kept pairs with a circle (or a capsule): the point on its rim facing the other body
     rim = ~out.alive0 & ~has
     if rim.any():
-        ca = rim & (store.kind[out.ra] == KIND_CIRCLE)
+        ka, kb = store.kind[out.ra], store.kind[out.rb]
+        ca = rim & ((ka == KIND_CIRCLE) | ((ka == KIND_CAPSULE) & (kb != KIND_CIRCLE)))
         cb = rim & ~ca
         for m, rows, sign in ((ca, out.ra, 1.0), (cb, out.rb, -1.0)):
             r = rows[m]
-            out.px[m] = store.x[r] + sign * store.radius[r] * out.nx[m]
-            out.py[m] = store.y[r] + sign * store.radius[r] * out.ny[m]
+            nx, ny = sign * out.nx[m], sign * out.ny[m]
+            cx, cy = store.x[r], store.y[r]
+            cap = store.kind[r] == KIND_CAPSULE
+            if cap.any():
+                # the end of the capsule's segment farther along the normal (its middle if square on)
+                ux, uy = geom.cap_ux[r], geom.cap_uy[r]
+                along = np.sign(ux * nx + uy * ny)
+                cx = np.where(cap, geom.hx[r] + along * ux, cx)
+                cy = np.where(cap, geom.hy[r] + along * uy, cy)
+            out.px[m] = cx + store.radius[r] * nx
+            out.py[m] = cy + store.radius[r] * ny
     _warm_points(out, count[src], points)
     out.arms = (out.px - store.x[out.ra], out.py - store.y[out.ra], out.px - store.x[out.rb], out.py - store.y[out.rb])
     return out
