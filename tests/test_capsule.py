@@ -575,3 +575,13 @@ def test_a_capsule_is_drawn_where_it_is_and_turns(capsule_hitboxes) -> None:
         # the outline (green: a dynamic body) along the top side and around the round ends
         assert at(32, 30)[1] > 0 and at(32, 30)[2] == 0 and at(32, 36)[1] == 0
         assert at(14, 26)[1] > 0 and at(50, 26)[1] > 0  # (lower down, the overlay text line)
+
+
+def test_manifold_of_a_pair_with_a_capsule_is_collides_point() -> None:
+    from framework.collision import manifold
+
+    for other in (AABB(4, 1), Polygon.box(4, 1), Circle(0.5), CAP):
+        c = collide(other, (0, 0), CAP, (0.25, 1.75))
+        m = manifold(other, (0, 0), CAP, (0.25, 1.75))
+        assert m.normal == c.normal and len(m.points) == 1
+        assert m.points[0].point == c.point and m.points[0].depth == c.depth

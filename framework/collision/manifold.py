@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from ..shapes import AABB, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from .collide import collide
 from .placement import local_outline, pose
 from .results import Manifold, ManifoldPoint, Vec2
@@ -28,15 +28,15 @@ Pts = list[tuple[float, float]]
 def manifold(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: object) -> Manifold | None:
     """The manifold of B against A, or ``None`` unless their interiors overlap (as ``collide``).
 
-    Transforms as for :func:`~framework.collision.collide`. The normal is collide's; a circle in
-    the pair gives collide's point alone; two boxes or polygons give one point (a corner in a face)
+    Transforms as for :func:`~framework.collision.collide`. The normal is collide's; a circle or a
+    capsule in the pair gives collide's point alone; two boxes or polygons give one point (a corner in a face)
     or two (a face on a face: the ends of the segment they share)."""
     c = collide(shape_a, transform_a, shape_b, transform_b)
     if c is None:
         return None
     single = Manifold(c.normal, (ManifoldPoint(c.point, c.depth),))
-    if isinstance(shape_a, Circle) or isinstance(shape_b, Circle):
-        return single
+    if isinstance(shape_a, (Circle, Capsule)) or isinstance(shape_b, (Circle, Capsule)):
+        return single  # (a round shape touches at one point)
     pa = _world(shape_a, *pose("transform_a", transform_a))
     pb = _world(shape_b, *pose("transform_b", transform_b))
     nx, ny = c.normal
