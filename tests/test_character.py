@@ -394,3 +394,19 @@ def test_a_scene_without_characters_runs_no_character_stage():
     character(s, 60.0, 32.0)
     s.step(DT)
     assert "character" in s.counters["systems"]
+
+
+@pytest.mark.parametrize("case", ["slope-45-up", "slope-45-down", "slope-2:1-up", "slope-2:1-down", "step-up",
+                                  "ride-reverse"])
+def test_the_accuracy_reports_controller_claims(case):
+    """docs/accuracy.md's controller rows: feet on the slope to rounding, exact speed, no lost step
+    at a quarter-tile step, no drift riding a platform that turns back."""
+    from framework.bench.accuracy import run_controller
+
+    row = run_controller(case, "substeps-1")
+    if case.startswith("slope"):
+        assert 0.0 <= row["gap_min"] and row["gap_max"] <= 1e-11 and row["speed_error"] <= 1e-11
+    elif case == "step-up":
+        assert row["measured"] == row["expected"] == 80.0 and row["speed_error"] <= 1e-11
+    else:
+        assert row["measured"] <= 1e-12

@@ -44,6 +44,18 @@ Scenarios (each has an exact reference, so every error is measured, not judged b
   2 s over 2 s) or the resting height after 3 s; ``rel_error``: their relative difference
   (``slope-hold``: the distance itself). Modes ``substeps-N``.
 
+- **controller**: the character controller (``framework.character``) on unit tiles built by
+  ``framework.tiles.terrain_pieces``: a 0.75 x 0.875 character walking at 6 units/s (gravity 20).
+  ``slope-45-up`` / ``-down`` and ``slope-2:1-up`` / ``-down``: over flat ground, a slope four
+  tiles high and flat ground again; exact answer: the feet on the surface every step, the x advance
+  every step exactly the commanded 0.1. ``gap_max`` / ``gap_min``: the largest and the smallest
+  distance of the feet above the surface under them (the highest ground below the feet's width)
+  over the walk; ``speed_error``: the largest difference of a step's x advance from 0.1.
+  ``step-up``: a step of a quarter tile in the way (``step_height`` 0.3); ``measured``: steps
+  taken to reach x = 10 from x = 2, ``expected``: at constant speed (80). ``ride-reverse``: standing
+  on a platform that turns back every 20 steps and up and down every 15 (``measured``: the largest
+  drift of the character from where it stood on it). Modes ``substeps-N``.
+
 Sleeping is off in every scene (except ``default-sleeping``) so the solver is measured, not the
 sleep. ``ms_per_step``: median over the steps of every repeated run, timed in the same process
 (the scene's whole step, for the scenario's scene). All scenes use ``dt = 1/60`` s, gravity
@@ -66,9 +78,10 @@ from .progress import Progress
 from .report import Column, format_table, frozen_gc, machine_info, median
 
 __all__ = [
-    "BULLET_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES", "FRICTION_CASES", "FRICTION_MODES", "ROW_KEYS",
+    "BULLET_MODES", "CONTROLLER_CASES", "CONTROLLER_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES",
+    "FRICTION_CASES", "FRICTION_MODES", "ROW_KEYS",
     "analytic_bullet_toi", "bullet_lanes", "crate_placements", "crates_overlap_exact", "markdown", "run_accuracy",
-    "run_ball", "run_bullets", "run_crates", "run_friction", "run_rest", "text_report",
+    "run_ball", "run_bullets", "run_controller", "run_crates", "run_friction", "run_rest", "text_report",
 ]
 
 DT = 1.0 / 60.0
@@ -87,7 +100,9 @@ REST_MODES = ("response-iterations-1", "response-iterations-2", "response-iterat
 BALL_MODES = ("substeps-1", "substeps-2", "substeps-4", "substeps-8")
 FRICTION_MODES = ("substeps-1", "substeps-2", "substeps-4")
 FRICTION_CASES = ("crate-stop", "slope-hold", "slope-slide", "disk-roll", "disk-slip", "box-tip", "box-tip-one-point")
-SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction")
+CONTROLLER_CASES = ("slope-45-up", "slope-45-down", "slope-2:1-up", "slope-2:1-down", "step-up", "ride-reverse")
+CONTROLLER_MODES = ("substeps-1", "substeps-4")
+SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction", "controller")
 DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
 
 FULL = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3, "crate_steps": 10,
@@ -99,7 +114,7 @@ CROWD_BOXES = 64
 
 ROW_KEYS = ["scenario", "mode", "speed", "ms_per_step", "missed", "undetected", "stop_error", "fp_rate", "fn_rate",
             "max_depth", "jitter", "sink", "snags", "residual", "energy_drift", "apex_drop", "case", "measured",
-            "expected", "rel_error", "samples", "steps"]
+            "expected", "rel_error", "samples", "steps", "gap_max", "gap_min", "speed_error"]
 
 
 def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
@@ -520,6 +535,120 @@ def _friction_run(case: str, mode: str) -> tuple[list[float], float, float, int]
         scene.close()
 
 
+# --- the character controller -------------------------------------------------------------------------
+
+WALK = 6.0  # units/s: 0.1 a step
+CHAR_W, CHAR_H = 0.75, 0.875
+
+
+def _slope_cells(case: str) -> tuple[list[list[str | None]], Callable[[float], float]]:
+    """Terrain cells (rows top down, unit tiles, 6 rows) and the exact surface height y(x):
+    flat at 1 to x = 6, then four tiles of rise (45 degrees over 4 columns, 2:1 over 8), flat."""
+    width, rows = 28, 6
+    cells: list[list[str | None]] = [[None] * width for _ in range(rows)]
+    run = 4 if "45" in case else 8
+    for c in range(width):
+        h = 1 if c < 6 else min(5, 1 + (c - 6) * 4 // run)
+        for k in range(h):
+            cells[rows - 1 - k][c] = "solid"
+        if 6 <= c < 6 + run:
+            if run == 4:
+                cells[rows - 1 - h][c] = "slope_up"
+            else:
+                cells[rows - 1 - h][c] = "slope_up_low" if (c - 6) % 2 == 0 else "slope_up_high"
+
+    def surface(x: float) -> float:
+        return 1.0 + min(max(x - 6.0, 0.0), float(run)) * 4.0 / run
+
+    return cells, surface
+
+
+def run_controller(case: str, mode: str, runs: int = 1) -> dict[str, Any]:
+    """One controller case (see the module's docstring) in one mode; the row."""
+    times: list[float] = []
+    out: dict[str, Any] = {}
+    for _ in range(runs):
+        ms, out = _controller_run(case, mode)
+        times += ms
+    return _row("controller", mode, case=case, ms_per_step=median(times), samples=1, **out)
+
+
+def _controller_run(case: str, mode: str) -> tuple[list[float], dict[str, Any]]:
+    from ..character import CharacterController
+    from ..tiles import terrain_pieces
+
+    scene = _scene_for(mode, gravity=GRAVITY)
+    try:
+        if case.startswith("slope"):
+            cells, surface = _slope_cells(case)
+        else:
+            cells = [[None] * 28, ["solid"] * 28]
+
+            def surface(x: float) -> float:
+                return 1.0
+
+        for pc in terrain_pieces(cells, 1.0):
+            scene.spawn(Transform(pc.x, pc.y), Hitbox(pc.shape, body="static"))
+        up = not case.endswith("down")
+        x0 = 2.0 if up else 20.0
+        kw = {"step_height": 0.3} if case == "step-up" else {}
+        if case == "step-up":
+            scene.spawn(Transform(7.0, 1.125), Hitbox(AABB(2.0, 0.25), body="static"))  # 6 .. 8, top 1.25
+        plat = None
+        if case == "ride-reverse":
+            plat = scene.spawn(Transform(10.0, 3.0), Velocity(), Hitbox(AABB(3.0, 0.5), body="kinematic"))
+            x0 = 10.0
+        feet0 = surface(x0) + (2.25 if case == "ride-reverse" else 0.0)
+        body = scene.spawn(Transform(x0, feet0 + CHAR_H / 2), Velocity(),
+                           Hitbox(AABB(CHAR_W, CHAR_H), body="kinematic"), CharacterController(**kw))
+        t, v = scene.get(body, Transform), scene.get(body, Velocity)
+        for _ in range(30):
+            scene.step(DT)
+        hw = CHAR_W / 2
+        if case == "ride-reverse":
+            pt, pv = scene.get(plat, Transform), scene.get(plat, Velocity)
+            off0 = (t.x - pt.x, t.y - pt.y)
+            drift = [0.0]
+
+            def steer(k: int) -> None:
+                pv.x = 2.0 if (k // 20) % 2 == 0 else -2.0
+                pv.y = 1.0 if (k // 15) % 2 == 0 else -1.0
+
+            def watch(_k: int) -> None:
+                drift[0] = max(drift[0], abs(t.x - pt.x - off0[0]), abs(t.y - pt.y - off0[1]))
+
+            times = _timed_steps(scene, 240, steer, watch)
+            return times, {"measured": drift[0], "expected": 0.0, "rel_error": drift[0], "steps": 240}
+        speed = WALK if up else -WALK
+        gaps: list[float] = []
+        advances: list[float] = []
+        last = [t.x]
+        reached = [0]
+
+        def walk(_k: int) -> None:
+            v.x = speed
+
+        def watch(k: int) -> None:
+            xs = [t.x - hw, t.x + hw] + [b for b in (6.0, 10.0, 14.0) if t.x - hw < b < t.x + hw]
+            gaps.append(t.y - CHAR_H / 2 - max(surface(x) for x in xs))
+            advances.append(t.x - last[0])
+            last[0] = t.x
+            if not reached[0] and t.x >= 10.0 - 1e-9:
+                reached[0] = k + 1
+
+        steps = 80 if case == "step-up" else 170
+        times = _timed_steps(scene, steps, walk, watch)
+        err = max(abs(a - speed * DT) for a in advances)
+        if case == "step-up":
+            expected = (10.0 - x0) / (WALK * DT)
+            measured = float(reached[0] or steps + 1)
+            return times, {"measured": measured, "expected": expected, "rel_error": abs(measured - expected) / expected,
+                           "speed_error": err, "steps": steps}
+        return times, {"gap_max": max(gaps), "gap_min": min(gaps), "speed_error": err, "steps": steps}
+    finally:
+        scene.close()
+
+
 # --- the whole benchmark ------------------------------------------------------------------------------
 
 
@@ -552,6 +681,10 @@ def run_accuracy(config: dict[str, Any] | None = None, progress: bool = True, qu
         for case in FRICTION_CASES:
             for mode in FRICTION_MODES:
                 jobs.append((f"friction {case} {mode}", lambda c=case, m=mode: run_friction(c, m, cfg["runs"])))
+    if "controller" in want:
+        for case in CONTROLLER_CASES:
+            for mode in CONTROLLER_MODES:
+                jobs.append((f"controller {case} {mode}", lambda c=case, m=mode: run_controller(c, m, cfg["runs"])))
     rows = []
     with Progress(len(jobs), "accuracy", enabled=progress) as bar:
         for name, job in jobs:
@@ -594,6 +727,10 @@ TABLES: dict[str, tuple[str, list[Column]]] = {
     "friction": ("Friction and rolling against the analytic answers (g = 10; slope 30 degrees)",
                  [("case", "case", "str"), *_COMMON, ("measured", "measured", "g"), ("expected", "exact", "g"),
                   ("rel_error", "relative error (hold: distance)", "sci")]),
+    "controller": ("The character controller on slopes, a step and a platform that turns back (6 units/s)",
+                   [("case", "case", "str"), *_COMMON, ("gap_max", "feet above surface, max", "sci"),
+                    ("gap_min", "min", "sci"), ("speed_error", "x advance error", "sci"),
+                    ("measured", "steps / drift", "g"), ("expected", "exact", "g")]),
 }
 
 

@@ -45,6 +45,7 @@ class _Move:
     ignore: set[int] = field(default_factory=set)
     floor: tuple[int, float, float] | None = None  # (row, nx, ny)
     wall: tuple[int, float, float] | None = None
+    wall_stopped: bool = False  # a wall took motion away (not only touched at the end of the move)
     ceiling: bool = False
     pushed: list[tuple[int, float, float]] = field(default_factory=list)
 
@@ -133,7 +134,7 @@ class CharacterStage(Stage):
                 self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
                 mv.ignore.discard(floor_row)
                 mv.floor = mv.wall = None
-                mv.ceiling = False
+                mv.ceiling = mv.wall_stopped = False
         # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
         if not self._depenetrate(mv, start_bottom, frame, moved):
             ctrl.crushed = True
@@ -158,8 +159,9 @@ class CharacterStage(Stage):
         on_floor_now = was_on_floor and not jumping
         px = mv.x
         self._slide(mv, mx, my, on_floor=on_floor_now, step=ctrl.step_height, max_slides=ctrl.max_slides)
-        # 4. Snap down onto the floor (down slopes, over crests, down small steps).
-        if on_floor_now and mv.floor is None:
+        # 4. Snap down onto the floor (down slopes, over crests, down small steps); also after a
+        # floor was met on the way, since the walk may have gone on along it past a crest.
+        if on_floor_now or (mv.floor is not None and not jumping):
             snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
             reach = snap + abs(mv.x - px) * math.tan(math.radians(ctrl.max_floor_angle)) + 2.0 * skin
             hit = self._cast(mv, 0.0, -reach)
@@ -177,7 +179,7 @@ class CharacterStage(Stage):
             ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
         ctrl.on_wall = mv.wall is not None
         ctrl.wall_normal = (mv.wall[1], mv.wall[2]) if mv.wall is not None else (0.0, 0.0)
-        if mv.wall is not None and vx * mv.wall[1] < 0.0 and store.body[mv.wall[0]] != DYNAMIC:
+        if mv.wall_stopped and vx * mv.wall[1] < 0.0 and store.body[mv.wall[0]] != DYNAMIC:
             vx = 0.0
         ctrl.on_ceiling = mv.ceiling
         if mv.ceiling and vy > 0.0:
@@ -302,6 +304,7 @@ class CharacterStage(Stage):
                     return
                 d = rx * nx + ry * ny
                 mx, my = (rx - d * nx, ry - d * ny) if d < 0.0 else (rx, ry)
+                mv.wall_stopped |= d < -mv.skin
                 if on_floor and my > 0.0:
                     mx = my = 0.0  # no climbing a steep slope from the floor
             for px, py in planes:
