@@ -585,3 +585,14 @@ def test_manifold_of_a_pair_with_a_capsule_is_collides_point() -> None:
         m = manifold(other, (0, 0), CAP, (0.25, 1.75))
         assert m.normal == c.normal and len(m.points) == 1
         assert m.points[0].point == c.point and m.points[0].depth == c.depth
+
+
+def test_a_capsule_slides_over_tile_seams_without_snagging(capsule_hitboxes) -> None:
+    with Scene(gravity=(0.0, -10.0)) as s:
+        tiles(s, 40, x0=0.0)
+        cap = s.spawn(Transform(2.0, 1.25), Velocity(4.0, 0.0), Hitbox(Capsule(0.25, 1.0)))
+        for _ in range(300):
+            s.step(1 / 60)
+            assert s.get(cap, Velocity).x == 4.0  # no push from a seam, ever
+        assert s.get(cap, Transform).x == pytest.approx(2.0 + 4.0 * 300 / 60)
+        assert s.get(cap, Transform).y == pytest.approx(1.25, abs=10 / 60**2 + 1e-9)
