@@ -16,6 +16,7 @@ also hold a game's one-way platforms, spikes, ladders...):
 | ``"slope_down"`` | 1 to 0: 45 degrees, falling left to right |
 | ``"slope_up_low"``, ``"slope_up_high"`` | 0 to 1/2, then 1/2 to 1: a gentle slope two cells long |
 | ``"slope_down_high"``, ``"slope_down_low"`` | 1 to 1/2, then 1/2 to 0 |
+| ``"step"`` | 1/4 to 1/4: a quarter-tile step (what a character's ``step_height`` walks up) |
 
 The gentle slope rises one tile over two. Game makers often call it the "22.5 degree" slope; it is
 atan(1/2) = 26.57 degrees.
@@ -37,7 +38,7 @@ from .validation import InvalidValue, positive, vector2
 
 __all__ = [
     "HEIGHTS", "MIRRORED", "SLOPES", "SLOPE_DOWN", "SLOPE_DOWN_HIGH", "SLOPE_DOWN_LOW", "SLOPE_UP",
-    "SLOPE_UP_HIGH", "SLOPE_UP_LOW", "SOLID", "TERRAIN", "TerrainPiece", "terrain_pieces",
+    "SLOPE_UP_HIGH", "SLOPE_UP_LOW", "SOLID", "STEP", "TERRAIN", "TerrainPiece", "terrain_pieces",
 ]
 
 SOLID = "solid"
@@ -47,11 +48,12 @@ SLOPE_UP_LOW = "slope_up_low"
 SLOPE_UP_HIGH = "slope_up_high"
 SLOPE_DOWN_HIGH = "slope_down_high"
 SLOPE_DOWN_LOW = "slope_down_low"
+STEP = "step"
 
 #: The slope kinds, in this order.
 SLOPES = (SLOPE_UP, SLOPE_DOWN, SLOPE_UP_LOW, SLOPE_UP_HIGH, SLOPE_DOWN_HIGH, SLOPE_DOWN_LOW)
-#: Every terrain kind: ``"solid"`` and the slopes.
-TERRAIN = (SOLID, *SLOPES)
+#: Every terrain kind: ``"solid"``, the slopes and the quarter-tile step.
+TERRAIN = (SOLID, *SLOPES, STEP)
 
 #: Each terrain kind's surface height at the cell's left and right edges, in tiles above its bottom.
 HEIGHTS: dict[str, tuple[float, float]] = {
@@ -62,6 +64,7 @@ HEIGHTS: dict[str, tuple[float, float]] = {
     SLOPE_UP_HIGH: (0.5, 1.0),
     SLOPE_DOWN_HIGH: (1.0, 0.5),
     SLOPE_DOWN_LOW: (0.5, 0.0),
+    STEP: (0.25, 0.25),
 }
 
 #: Each terrain kind seen in a mirror (flipped left to right): a rising slope becomes a falling one.
@@ -70,6 +73,7 @@ MIRRORED: dict[str, str] = {
     SLOPE_UP: SLOPE_DOWN, SLOPE_DOWN: SLOPE_UP,
     SLOPE_UP_LOW: SLOPE_DOWN_LOW, SLOPE_DOWN_LOW: SLOPE_UP_LOW,
     SLOPE_UP_HIGH: SLOPE_DOWN_HIGH, SLOPE_DOWN_HIGH: SLOPE_UP_HIGH,
+    STEP: STEP,
 }
 
 

@@ -40,10 +40,11 @@ def feet(g: Game) -> float:
     return g.player_transform.y - HALF_H
 
 
-def test_the_hills_level_has_slopes_a_v_and_a_lift_over_a_pit():
+def test_the_hills_level_has_slopes_a_step_a_v_and_a_lift_over_a_pit():
     g = Game([builtin_levels()[2]])
     kinds = {k for row in g.level.tiles for k in row}
-    assert {"slope_up", "slope_down", "slope_up_low", "slope_up_high", "slope_down_high", "slope_down_low"} <= kinds
+    assert {"slope_up", "slope_down", "slope_up_low", "slope_up_high", "slope_down_high", "slope_down_low",
+            "step"} <= kinds
     assert any(a == "slope_down" and b == "slope_up" for row in g.level.tiles for a, b in zip(row, row[1:]))  # a V
     assert len(g.level.of_kind("platform")) == 1
     slopes = [e for e, (lp, hb) in g.scene.query(LevelPiece, Hitbox) if lp.kind == "slope"]

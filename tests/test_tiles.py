@@ -88,7 +88,8 @@ def cell_region(kind: str, col: int, row: int, rows: int, tile: float, origin=(0
 def test_kind_names_and_profiles():
     assert SLOPES == ("slope_up", "slope_down", "slope_up_low", "slope_up_high", "slope_down_high",
                       "slope_down_low")
-    assert TERRAIN == ("solid", *SLOPES) and set(HEIGHTS) == set(TERRAIN)
+    assert TERRAIN == ("solid", *SLOPES, "step") and set(HEIGHTS) == set(TERRAIN)
+    assert HEIGHTS["step"] == (0.25, 0.25)
     assert HEIGHTS[SLOPE_UP_LOW][1] == HEIGHTS[SLOPE_UP_HIGH][0] == 0.5
     for kind in TERRAIN:
         assert MIRRORED[MIRRORED[kind]] == kind
@@ -247,7 +248,7 @@ def test_random_grids_give_convex_pieces_that_tile_the_cells_exactly(seed):
         if isinstance(p.shape, AABB):
             assert all(rows[r][c] == SOLID for c, r in p.cells)
         else:
-            assert any(rows[r][c] in SLOPES for c, r in p.cells)
+            assert any(rows[r][c] != SOLID for c, r in p.cells)  # a slope or a step
     union = unary_union([world(p) for p in got])
     cells = unary_union(list(regions.values()))
     assert union.symmetric_difference(cells).area == 0.0
@@ -374,5 +375,14 @@ def test_the_tileset_image_holds_every_tile_kind():
     png = (LEVEL_DIR / "tiles.png").read_bytes()
     width, height = struct.unpack(">II", png[16:24])
     (ts,) = to_tmj(parse_text("P/\n##", "s.txt"))["tilesets"]
-    assert (width, height) == (ts["imagewidth"], ts["imageheight"]) == (96, 96)
+    assert (width, height) == (ts["imagewidth"], ts["imageheight"]) == (96, 128)
     assert ts["tilecount"] <= (width // 32) * (height // 32)
+
+
+def test_a_quarter_tile_step_is_a_slab_on_the_bottom_of_its_cell():
+    (piece,) = terrain_pieces([[None, "step", None], ["solid"] * 0], 32.0)
+    assert piece.cells == ((1, 0),) and piece.top == (40.0, 40.0)  # the row's bottom is 32: one row above it
+    assert sorted(piece.shape.points) == sorted([(-16.0, -4.0), (16.0, -4.0), (16.0, 4.0), (-16.0, 4.0)])
+    assert (piece.x, piece.y) == (48.0, 36.0)
+    level = parse_text("#P_.G#\n######", "step.txt")
+    assert level.tiles[0][2] == "step"

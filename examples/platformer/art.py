@@ -6,7 +6,8 @@ the goal's and the checkpoints' flags, and ``slope_<kind>.png`` for each slope k
 :mod:`framework.tiles` (ground under the slope, grass along its surface, transparent above);
 ``levels/tiles.png``: the tileset the ``.tmj`` maps name, so they open in Tiled with pictures,
 three tiles a row in the order of ``levels.TILE_KINDS`` (solid, one-way, spikes, then the six
-slopes; the first row is the original three-tile tileset, so its tile ids keep their meaning).
+slopes and the step; the first row is the original three-tile tileset, so its tile ids keep their
+meaning), and ``step.png``.
 The game uses the images for 32-unit tiles and plain colours otherwise; runs without a renderer
 never load them.
 """
@@ -82,6 +83,14 @@ def slope(kind: str) -> np.ndarray:
     img[grass, :3] = GRASS
     img[grass & (below > depth - 1.0 * stretch), :3] = GRASS_DARK
     img[(below > 0.0) & (below <= 1.0 * stretch), :3] = (150, 220, 130)
+    return img
+
+
+def step() -> np.ndarray:
+    """A quarter-tile step: the ground tile's top quarter (grass included) on the cell's bottom
+    quarter, transparent above."""
+    img = np.zeros((TILE, TILE, 4), dtype=np.uint8)
+    img[-TILE // 4:] = ground(True)[: TILE // 4]
     return img
 
 
@@ -169,10 +178,10 @@ def flag(width: int, color: tuple[int, int, int]) -> np.ndarray:
 
 
 def tileset() -> np.ndarray:
-    """96 x 96, for Tiled: solid, one-way (a plank on the top quarter), spikes; then the slopes, in
-    the order of ``framework.tiles.SLOPES``, three a row."""
+    """96 wide, for Tiled: solid, one-way (a plank on the top quarter), spikes; then the slopes, in
+    the order of ``framework.tiles.SLOPES``, then the quarter-tile step, three a row."""
     tiles = [ground(True), np.pad(plank(), ((0, TILE - 8), (0, 0), (0, 0))), spikes()]
-    tiles += [slope(k) for k in SLOPES]
+    tiles += [slope(k) for k in SLOPES] + [step()]
     rows = -(-len(tiles) // 3)
     img = np.zeros((rows * TILE, 3 * TILE, 4), dtype=np.uint8)
     for i, tile in enumerate(tiles):
@@ -207,6 +216,7 @@ def main() -> None:
     write_png(IMAGES / "checkpoint_on.png", flag(16, (120, 230, 255)))
     for kind in SLOPES:
         write_png(IMAGES / f"{kind}.png", slope(kind))
+    write_png(IMAGES / "step.png", step())
     write_png(HERE / "levels" / "tiles.png", tileset())
 
 

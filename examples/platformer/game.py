@@ -20,7 +20,7 @@ from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.character import CharacterController
 from framework.components import Visual
 from framework.input import Input
-from framework.tiles import SLOPES, terrain_pieces
+from framework.tiles import SLOPES, STEP, terrain_pieces
 
 from . import systems
 from .components import (
@@ -58,7 +58,7 @@ PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
 ART_TILE = 32.0  # the tile images (see art.py) are drawn for 32-unit tiles; other sizes get colours
 IMAGES = {name: Path(__file__).with_name("images") / f"{name}.png" for name in (
     "ground", "ground_top", "plank", "player_right", "player_left", "enemy", "goal", "checkpoint",
-    "checkpoint_on", *SLOPES)}
+    "checkpoint_on", *SLOPES, STEP)}
 
 
 class Game:

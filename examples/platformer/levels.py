@@ -10,6 +10,7 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
     /  slope up (45)       \\  slope down (45)
     rR gentle slope up (2:1, two cells: low half, high half)
     Ff gentle slope down (2:1, two cells: high half, low half)
+    _  a quarter-tile step (a slab on the bottom quarter of the cell)
     P  player start        C  coin                 E  enemy
     K  checkpoint          G  goal                 .  empty (so is a space)
     B  crate (pushable)    O  barrel (rolls)
@@ -59,13 +60,13 @@ __all__ = [
 
 LEVEL_DIR = Path(__file__).with_name("levels")
 # The order gives the tile ids of the tileset ``to_tmj`` writes: new kinds go at the end.
-TILE_KINDS = ("solid", "oneway", "spikes", *terrain.SLOPES)
+TILE_KINDS = ("solid", "oneway", "spikes", *terrain.SLOPES, terrain.STEP)
 OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel")
 DECORATION = ("background", "decoration")
 DEFAULT_TILE = 32.0
 
-_TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes", "/": terrain.SLOPE_UP, "\\": terrain.SLOPE_DOWN,
-               "r": terrain.SLOPE_UP_LOW, "R": terrain.SLOPE_UP_HIGH, "F": terrain.SLOPE_DOWN_HIGH,
+_TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes", "_": terrain.STEP, "/": terrain.SLOPE_UP,
+               "\\": terrain.SLOPE_DOWN, "r": terrain.SLOPE_UP_LOW, "R": terrain.SLOPE_UP_HIGH, "F": terrain.SLOPE_DOWN_HIGH,
                "f": terrain.SLOPE_DOWN_LOW}
 _TEXT_OBJECTS = {"P": "player", "C": "coin", "E": "enemy", "G": "goal", "K": "checkpoint", "B": "crate",
                  "O": "barrel"}
@@ -510,7 +511,7 @@ def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
                 for k, v in sorted(o.props.items())
             ]
         objs.append(entry)
-    sloped = any(k in terrain.SLOPES for row in level.tiles for k in row)
+    sloped = any(k in terrain.SLOPES or k == terrain.STEP for row in level.tiles for k in row)
     tileset = _tileset(t, len(TILE_KINDS) if sloped else _BASIC_KINDS)
     return {
         "type": "map", "version": "1.10", "tiledversion": "1.10.2", "orientation": "orthogonal",
