@@ -66,8 +66,8 @@ DECORATION = ("background", "decoration")
 DEFAULT_TILE = 32.0
 
 _TEXT_TILES = {"#": "solid", "-": "oneway", "^": "spikes", "_": terrain.STEP, "/": terrain.SLOPE_UP,
-               "\\": terrain.SLOPE_DOWN, "r": terrain.SLOPE_UP_LOW, "R": terrain.SLOPE_UP_HIGH, "F": terrain.SLOPE_DOWN_HIGH,
-               "f": terrain.SLOPE_DOWN_LOW}
+               "\\": terrain.SLOPE_DOWN, "r": terrain.SLOPE_UP_LOW, "R": terrain.SLOPE_UP_HIGH,
+               "F": terrain.SLOPE_DOWN_HIGH, "f": terrain.SLOPE_DOWN_LOW}
 _TEXT_OBJECTS = {"P": "player", "C": "coin", "E": "enemy", "G": "goal", "K": "checkpoint", "B": "crate",
                  "O": "barrel"}
 _TEXT_EMPTY = ". "
