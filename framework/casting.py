@@ -26,7 +26,7 @@ from .shapes import AABB, Circle, Polygon, Shape
 if TYPE_CHECKING:
     from .queries import SpatialQueries
 
-__all__ = ["ShapeHit", "cast_rows", "shape_bounds", "touch_point"]
+__all__ = ["ShapeHit", "cast_rows", "overlapping_rows", "shape_bounds", "touch_point"]
 
 
 class ShapeHit(NamedTuple):
@@ -51,6 +51,10 @@ def shape_bounds(shape: Shape, x: float, y: float, rotation: float) -> tuple[flo
         xs = [x + px * c - py * s for px, py in shape.points]
         ys = [y + px * s + py * c for px, py in shape.points]
         return min(xs), min(ys), max(xs), max(ys)
+    if shape.kind == "capsule":  # its segment's ends, grown by the radius
+        h, r = shape.length * 0.5, shape.radius  # type: ignore[attr-defined]
+        ex, ey = abs(h * math.sin(rotation)), abs(h * math.cos(rotation))
+        return x - ex - r, y - ey - r, x + ex + r, y + ey + r
     r = shape.bounding_radius
     return x - r, y - r, x + r, y + r
 

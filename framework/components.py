@@ -16,7 +16,7 @@ from __future__ import annotations
 from enum import Enum
 from typing import TYPE_CHECKING, Any
 
-from .shapes import AABB, Circle, Polygon, Shape
+from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .validation import InvalidValue, finite, vector2
 
 if TYPE_CHECKING:
@@ -125,8 +125,8 @@ _ALL_BITS = 0xFFFFFFFF
 class Hitbox:
     """The collision shape of an entity and how it takes part in collisions.
 
-    - ``shape``: an :class:`~framework.shapes.AABB`, :class:`~framework.shapes.Circle` or
-      :class:`~framework.shapes.Polygon`.
+    - ``shape``: an :class:`~framework.shapes.AABB`, :class:`~framework.shapes.Circle`,
+      :class:`~framework.shapes.Polygon` or :class:`~framework.shapes.Capsule`.
     - ``offset``: the hitbox origin relative to the entity's Transform; it turns with the
       transform's rotation (an AABB's box itself never turns).
     - ``layer`` / ``mask``: 32-bit collision filter. A pair is tested only when each one's layer
@@ -218,8 +218,8 @@ class Hitbox:
 def check_hitbox_field(name: str, value: object) -> Any:
     """Validate one Hitbox field; return its normalised value or raise :class:`InvalidValue`."""
     if name == "shape":
-        if not isinstance(value, (AABB, Circle, Polygon)):
-            raise InvalidValue(f"Hitbox shape must be an AABB, Circle or Polygon, got {value!r}")
+        if not isinstance(value, (AABB, Circle, Polygon, Capsule)):
+            raise InvalidValue(f"Hitbox shape must be an AABB, Circle, Polygon or Capsule, got {value!r}")
         return value
     if name == "offset":
         return vector2("Hitbox offset", value)

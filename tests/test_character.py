@@ -410,3 +410,26 @@ def test_the_accuracy_reports_controller_claims(case):
         assert row["measured"] == row["expected"] == 80.0 and row["speed_error"] <= 1e-11
     else:
         assert row["measured"] <= 1e-12
+
+
+def test_a_capsule_character_walks_over_the_hill():
+    """Characters are often capsules: the round feet ride over the crests, never entering a tile."""
+    from framework.shapes import Capsule
+
+    s = scene_with(hill_level())
+    cap = Capsule(10.0, 8.0)  # 20 wide, 28 tall: the box character's height
+    e = s.spawn(Transform(60.0, 47.0), Velocity(), Hitbox(cap, body="kinematic"), CharacterController())
+    settle(s, e)
+    c = s.get(e, CharacterController)
+    t = s.get(e, Transform)
+    for _ in range(140):
+        x0 = t.x
+        s.get(e, Velocity).x = 128.0
+        s.step(DT)
+        assert t.x - x0 == pytest.approx(2.0, abs=1e-9)
+        assert c.on_floor
+        for x, y, shape in hill_level():
+            assert collide(cap, (t.x, t.y), shape, (x, y)) is None
+        # Resting on the surface: a short cast down meets it at once.
+        hit = s.shape_cast(cap, (t.x, t.y), (t.x, t.y - 1.0), ignore=[e])
+        assert hit is not None and hit.fraction <= 1e-9
