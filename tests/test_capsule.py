@@ -428,36 +428,12 @@ def test_time_of_impact_agrees_with_collide_along_the_way() -> None:
 from framework import Hitbox, Scene, Transform, Velocity  # noqa: E402
 
 
-@pytest.fixture
-def capsule_hitboxes(monkeypatch):
-    """Hitboxes take capsules. (``framework.components.check_hitbox_field`` lists the shapes a
-    Hitbox takes; until it names Capsule, this test shim lets capsules through that one check,
-    and the tests below exercise everything else as it is.)"""
-    import framework.components as components
-    import framework.store as store_module
-
-    try:
-        Hitbox(Capsule(1, 1))
-        return
-    except ValueError:
-        pass
-    original = components.check_hitbox_field
-
-    def check(name, value):
-        if name == "shape" and isinstance(value, Capsule):
-            return value
-        return original(name, value)
-
-    monkeypatch.setattr(components, "check_hitbox_field", check)
-    monkeypatch.setattr(store_module, "check_hitbox_field", check)
-
-
 def tiles(scene, n, x0=-3.5):
     """A row of unit static tiles centred at y = 0: the floor's top is y = 0.5."""
     return [scene.spawn(Transform(x0 + i, 0.0), Hitbox(AABB(1, 1), body="static")) for i in range(n)]
 
 
-def test_a_capsule_falls_onto_tiles_rests_at_its_height_and_sleeps(capsule_hitboxes) -> None:
+def test_a_capsule_falls_onto_tiles_rests_at_its_height_and_sleeps() -> None:
     with Scene(gravity=(0.0, -10.0)) as s:
         tiles(s, 8)
         cap = s.spawn(Transform(0.5, 3.0), Velocity(), Hitbox(Capsule(0.25, 1.0)))  # on a seam
@@ -480,7 +456,7 @@ def test_a_capsule_falls_onto_tiles_rests_at_its_height_and_sleeps(capsule_hitbo
         assert s.get(cap, Transform).y == ys
 
 
-def test_two_capsules_stack(capsule_hitboxes) -> None:
+def test_two_capsules_stack() -> None:
     with Scene(gravity=(0.0, -10.0)) as s:
         tiles(s, 5, x0=-2.0)
         low = s.spawn(Transform(0.0, 2.0), Velocity(), Hitbox(Capsule(0.25, 1.0)))
@@ -492,7 +468,7 @@ def test_two_capsules_stack(capsule_hitboxes) -> None:
         assert s.get(high, Transform).x == pytest.approx(0.0, abs=1e-9)
 
 
-def test_capsules_collide_with_circles_boxes_and_polygons_in_a_scene(capsule_hitboxes) -> None:
+def test_capsules_collide_with_circles_boxes_and_polygons_in_a_scene() -> None:
     with Scene(gravity=(0.0, -10.0)) as s:
         tiles(s, 12, x0=-5.5)
         cap = s.spawn(Transform(0.0, 1.25), Velocity(), Hitbox(Capsule(0.25, 1.0)))
@@ -508,7 +484,7 @@ def test_capsules_collide_with_circles_boxes_and_polygons_in_a_scene(capsule_hit
         assert s.get(cap, Transform).y == pytest.approx(1.25, abs=1e-2)
 
 
-def test_a_fast_capsule_with_ccd_does_not_tunnel(capsule_hitboxes) -> None:
+def test_a_fast_capsule_with_ccd_does_not_tunnel() -> None:
     with Scene() as s:
         wall = s.spawn(Transform(10.0, 0.0), Hitbox(AABB(0.25, 4), body="static"))
         fast = s.spawn(Transform(0.0, 0.0), Velocity(600.0, 0.0), Hitbox(Capsule(0.25, 1.0), ccd=True))
@@ -520,7 +496,7 @@ def test_a_fast_capsule_with_ccd_does_not_tunnel(capsule_hitboxes) -> None:
         assert any({e.a, e.b} == {wall, fast} for e in hits)
 
 
-def test_scene_queries_see_capsules(capsule_hitboxes) -> None:
+def test_scene_queries_see_capsules() -> None:
     with Scene() as s:
         cap = s.spawn(Transform(0.0, 0.0, math.pi / 2), Hitbox(Capsule(0.5, 2.0), body="static"))
         up = s.spawn(Transform(5.0, 0.0), Hitbox(Capsule(0.5, 2.0)))
@@ -551,7 +527,7 @@ def test_fill_triangles_and_the_overlay_outline_of_a_capsule() -> None:
     assert area == pytest.approx(shape.area, rel=2e-2) and area < shape.area
 
 
-def test_a_capsule_is_drawn_where_it_is_and_turns(capsule_hitboxes) -> None:
+def test_a_capsule_is_drawn_where_it_is_and_turns() -> None:
     try:
         import framework.render as render
         render.offscreen_window()
@@ -587,7 +563,7 @@ def test_manifold_of_a_pair_with_a_capsule_is_collides_point() -> None:
         assert m.points[0].point == c.point and m.points[0].depth == c.depth
 
 
-def test_a_capsule_slides_over_tile_seams_without_snagging(capsule_hitboxes) -> None:
+def test_a_capsule_slides_over_tile_seams_without_snagging() -> None:
     with Scene(gravity=(0.0, -10.0)) as s:
         tiles(s, 40, x0=0.0)
         cap = s.spawn(Transform(2.0, 1.25), Velocity(4.0, 0.0), Hitbox(Capsule(0.25, 1.0)))
