@@ -88,7 +88,7 @@ class CharacterController:
     """Move-and-slide control of a kinematic body (see the module docstring).
 
     Settings (checked when set: a bad value raises :class:`~framework.validation.InvalidValue`
-    naming it, and nothing changes):
+    naming it, and its entity once in a scene, and nothing changes):
 
     - ``max_floor_angle``: steepest walkable surface, degrees in (0, 90); default 50.
     - ``step_height``: highest step walked up without a jump (world units, >= 0; default 0).
@@ -128,8 +128,17 @@ class CharacterController:
 
     def __setattr__(self, name: str, value: Any) -> None:
         if name in _SETTINGS:
-            value = _check(name, value)
+            try:
+                value = _check(name, value)
+            except InvalidValue as exc:
+                entity = self.__dict__.get("_entity")
+                raise (InvalidValue(f"entity {entity}: {exc}") if entity is not None else exc) from None
         object.__setattr__(self, name, value)
+
+    def bind(self, entity: int) -> None:
+        """Remember the entity this controller moves (the scene calls it), so that a bad setting
+        names it."""
+        object.__setattr__(self, "_entity", entity)
 
     @property
     def floor_cos(self) -> float:

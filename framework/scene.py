@@ -21,6 +21,7 @@ import esper
 import numpy as np
 
 from .bodies import Bodies
+from .character import CharacterController
 from .components import Hitbox, Transform, Velocity
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import check_added_component, spawn_components
@@ -215,6 +216,9 @@ class Scene:
         entity = esper.create_entity(*components)
         if t is not None:
             self.bodies.store.add(entity, t, v, h)
+        for comp in components:
+            if isinstance(comp, CharacterController):
+                comp.bind(entity)
         return entity
 
     def despawn(self, entity: int) -> None:
@@ -258,6 +262,8 @@ class Scene:
         check_added_component(store, entity, component)
         old = esper.try_component(entity, type(component))
         esper.add_component(entity, component)
+        if isinstance(component, CharacterController):
+            component.bind(entity)
         if isinstance(component, Velocity):
             if old is not None:
                 store.unbind(entity, old)  # the replaced Velocity no longer writes to the row

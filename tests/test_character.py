@@ -364,6 +364,22 @@ def test_bad_settings_are_refused_naming_the_field(field, value):
     assert getattr(c, field) == before or (before is None and getattr(c, field) is None)
 
 
+def test_a_bad_setting_on_a_spawned_character_names_the_entity_and_changes_nothing():
+    s = scene_with(floor_row(4))
+    e = character(s, 60.0, 32.0, step_height=4.0)
+    c = s.get(e, CharacterController)
+    for field, value in (("step_height", -1.0), ("max_floor_angle", 90.0), ("max_floor_angle", math.nan)):
+        with pytest.raises(InvalidValue, match=rf"entity {e}: CharacterController {field}"):
+            setattr(c, field, value)
+    assert (c.step_height, c.max_floor_angle) == (4.0, 50.0)
+    other = s.spawn(Transform(0.0, 100.0), Velocity(), Hitbox(AABB(4.0, 4.0), body="kinematic"))
+    added = CharacterController()
+    s.add_component(other, added)
+    with pytest.raises(InvalidValue, match=rf"entity {other}: CharacterController skin"):
+        added.skin = -1.0
+    s.step(DT)
+
+
 def test_nan_velocity_and_a_dynamic_body_are_refused_before_the_step():
     s = scene_with(floor_row(4))
     e = character(s, 60.0, 32.0)

@@ -140,3 +140,23 @@ def test_random_input_on_the_hills_for_10000_frames_never_enters_terrain_or_leav
             assert other not in terrain, (k, t.x, t.y, float(c.depth[i]))  # never inside ground or slope
         reached = max(reached, t.x / T)
     assert reached > 40.0  # it got over the hill and the V to the pit
+
+
+def test_a_lift_that_carries_the_player_into_a_ceiling_kills_it():
+    g = Game([parse_text("""
+#########
+#..~....#
+#..~....#
+#..~P...#
+#..MMM..#
+#.......#
+#.....G.#
+#########
+""", "crush.txt")])
+    ceiling = 7 * T
+    for _ in range(300):
+        g.step(set())
+        assert g.player_transform.y + HALF_H <= ceiling + 1e-9
+        if g.state.deaths:
+            break
+    assert g.state.deaths == 1

@@ -165,8 +165,12 @@ def walk_enemies(scene: Scene, dt: float) -> None:
 
 def sense_player(scene: Scene, dt: float) -> None:
     """Grounded: the character controller stood the player on a floor this step (tiles, slopes,
-    one-way and moving platforms, crates); ``ground`` is what it stands on."""
-    for _e, (p, ctrl) in scene.query(Player, CharacterController):
+    one-way and moving platforms, crates); ``ground`` is what it stands on. A player crushed (a
+    platform carried it into a ceiling) dies."""
+    for e, (p, ctrl) in scene.query(Player, CharacterController):
+        if ctrl.crushed:
+            kill_player(scene, e)
+            continue
         p.grounded = ctrl.on_floor
         p.ground = ctrl.floor_entity if ctrl.on_floor else None
 
