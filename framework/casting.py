@@ -26,7 +26,7 @@ from .shapes import AABB, Circle, Polygon, Shape
 if TYPE_CHECKING:
     from .queries import SpatialQueries
 
-__all__ = ["ShapeHit", "cast_rows", "overlapping_rows", "shape_bounds", "touch_point"]
+__all__ = ["ShapeHit", "candidate_rows", "cast_rows", "overlapping_rows", "shape_bounds", "touch_point"]
 
 
 class ShapeHit(NamedTuple):
@@ -101,29 +101,46 @@ def touch_point(shape_a: Shape, pose_a: tuple[float, float, float], shape_b: Sha
     return Vec2(d * nx + mid * tx + 0.0, d * ny + mid * ty + 0.0)
 
 
+def _in_box(queries: SpatialQueries, rows: np.ndarray, x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
+    """The ``rows`` whose current bounds meet the box (closed): the candidates worth an exact test."""
+    g = queries.bodies.geometry
+    return rows[(g.minx[rows] <= x1) & (g.maxx[rows] >= x0) & (g.miny[rows] <= y1) & (g.maxy[rows] >= y0)]
+
+
+def candidate_rows(queries: SpatialQueries, x0: float, y0: float, x1: float, y1: float, mask: int,
+                   skip: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+    """Rows with a hitbox in ``mask`` (sensors never block), minus those ``skip`` (rows -> keep
+    mask) removes, whose bounds meet the box ``(x0, y0, x1, y1)``."""
+    store = queries.bodies.store
+    rows = queries._candidate_rows(x0, y0, x1, y1)
+    rows = rows[((store.layer[rows] & mask) != 0) & ~store.sensor[rows]]
+    if skip is not None and rows.size:
+        rows = rows[skip(rows)]
+    return _in_box(queries, rows, x0, y0, x1, y1)
+
+
 def cast_rows(
     queries: SpatialQueries, shape: Shape, x: float, y: float, rotation: float, mx: float, my: float,
     accept: Callable[[int, float, float, float], bool] | None = None, *, mask: int = 0xFFFFFFFF,
-    skip: Callable[[np.ndarray], np.ndarray] | None = None,
+    skip: Callable[[np.ndarray], np.ndarray] | None = None, rows: np.ndarray | None = None,
 ) -> tuple[int, float, float, float] | None:
     """The first hit of ``shape`` (hitbox origin at ``(x, y)``, turned by ``rotation``) moving by
     ``(mx, my)``: ``(row, fraction, nx, ny)`` with the surface normal facing the shape, or None.
 
-    Candidates are rows with a hitbox in ``mask`` (sensors never block), minus those ``skip``
-    (rows -> keep mask) removes; ``accept(row, fraction, nx, ny)`` may refuse a hit (a one-way
-    platform hit from below), and the next earliest counts instead."""
-    bodies = queries.bodies
-    store = bodies.store
+    Candidates are the rows :func:`candidate_rows` gives for the swept box (or those of ``rows``,
+    already filtered by mask and ``skip``, whose bounds meet it); ``accept(row, fraction, nx, ny)``
+    may refuse a hit (a one-way platform hit from below), and the next earliest counts instead."""
+    store = queries.bodies.store
     x0, y0, x1, y1 = shape_bounds(shape, x, y, rotation)
     pad = 1e-9 * (abs(x) + abs(y) + shape.bounding_radius + abs(mx) + abs(my))
-    rows = queries._candidate_rows(min(x0, x0 + mx) - pad, min(y0, y0 + my) - pad,
-                                   max(x1, x1 + mx) + pad, max(y1, y1 + my) + pad)
-    rows = rows[((store.layer[rows] & mask) != 0) & ~store.sensor[rows]]
-    if skip is not None and rows.size:
-        rows = rows[skip(rows)]
+    box = (min(x0, x0 + mx) - pad, min(y0, y0 + my) - pad, max(x1, x1 + mx) + pad, max(y1, y1 + my) + pad)
+    if rows is None:
+        rows = candidate_rows(queries, *box, mask, skip)
+    else:
+        rows = _in_box(queries, rows, *box)
     if rows.size == 0:
         return None
-    geom = bodies.geometry
+    geom = queries.bodies.geometry
     found = []
     for r in rows.tolist():
         other = store.hitboxes[r].shape
@@ -140,18 +157,14 @@ def cast_rows(
 
 def overlapping_rows(queries: SpatialQueries, shape: Shape, x: float, y: float, rotation: float,
                      mask: int, skip: Callable[[np.ndarray], np.ndarray] | None = None,
-                     ) -> list[tuple[int, float, float, float]]:
-    """Rows (in ``mask``, not sensors, not ``skip``-ped) whose hitboxes ``shape`` overlaps at
-    ``(x, y)``: ``(row, nx, ny, depth)``, the normal pointing from the row's hitbox toward the
-    shape (the way out)."""
-    bodies = queries.bodies
-    store = bodies.store
-    x0, y0, x1, y1 = shape_bounds(shape, x, y, rotation)
-    rows = queries._candidate_rows(x0, y0, x1, y1)
-    rows = rows[((store.layer[rows] & mask) != 0) & ~store.sensor[rows]]
-    if skip is not None and rows.size:
-        rows = rows[skip(rows)]
-    geom = bodies.geometry
+                     rows: np.ndarray | None = None) -> list[tuple[int, float, float, float]]:
+    """Rows (in ``mask``, not sensors, not ``skip``-ped; or those of ``rows``) whose hitboxes
+    ``shape`` overlaps at ``(x, y)``: ``(row, nx, ny, depth)``, the normal pointing from the row's
+    hitbox toward the shape (the way out)."""
+    store = queries.bodies.store
+    box = shape_bounds(shape, x, y, rotation)
+    rows = candidate_rows(queries, *box, mask, skip) if rows is None else _in_box(queries, rows, *box)
+    geom = queries.bodies.geometry
     out = []
     for r in rows.tolist():
         c = collide(store.hitboxes[r].shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),

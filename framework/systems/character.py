@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import esper
 import numpy as np
 
-from ..casting import cast_rows, overlapping_rows, shape_bounds
+from ..casting import candidate_rows, cast_rows, overlapping_rows, shape_bounds
 from ..character import CharacterController
 from ..collision import collide
 from ..components import Velocity
@@ -43,6 +43,8 @@ class _Move:
     floor_cos: float
     dropping: set[int]
     ignore: set[int] = field(default_factory=set)
+    box: tuple[float, float, float, float] | None = None  # where ``rows`` holds every candidate
+    rows: np.ndarray | None = None  # candidate rows in ``box``: mask, sensors, itself, dropped out
     floor: tuple[int, float, float] | None = None  # (row, nx, ny)
     wall: tuple[int, float, float] | None = None
     wall_stopped: bool = False  # a wall took motion away (not only touched at the end of the move)
@@ -129,12 +131,13 @@ class CharacterStage(Stage):
         if was_on_floor and floor_row is not None and moved and floor_row < frame.start_x.size:
             carried = (float(store.x[floor_row] - frame.start_x[floor_row]),
                        float(store.y[floor_row] - frame.start_y[floor_row]))
-            if carried != (0.0, 0.0):
-                mv.ignore.add(floor_row)
-                self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
-                mv.ignore.discard(floor_row)
-                mv.floor = mv.wall = None
-                mv.ceiling = mv.wall_stopped = False
+        self._gather(mv, ctrl, carried, vx, vy, dt, size)
+        if carried != (0.0, 0.0):
+            mv.ignore.add(floor_row)
+            self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
+            mv.ignore.discard(floor_row)
+            mv.floor = mv.wall = None
+            mv.ceiling = mv.wall_stopped = False
         # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
         if not self._depenetrate(mv, start_bottom, frame, moved):
             ctrl.crushed = True
@@ -226,6 +229,32 @@ class CharacterStage(Stage):
         rows = rows[np.abs(geom.maxy[rows] - y0) <= eps]
         return {int(e) for e in store.entity[rows]}
 
+    def _gather(self, mv: _Move, ctrl: CharacterController, carried: tuple[float, float], vx: float, vy: float,
+                dt: float, size: float) -> None:
+        """The candidates of every cast this step, from one look-up: the hitboxes near enough to be
+        met by the farthest this body can go (a cast reaching further looks up again)."""
+        gx, gy = self.pipeline.active_gravity()
+        own = (abs(vx) + abs(vy) + (abs(gx) + abs(gy)) * abs(ctrl.gravity_scale) * dt) * dt
+        carry = abs(carried[0]) + abs(carried[1])
+        snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
+        reach = (2.0 * carry + own * (1.0 + math.tan(math.radians(ctrl.max_floor_angle))) + 2.0 * ctrl.step_height
+                 + snap + 0.5 * size + 8.0 * mv.skin)
+        x0, y0, x1, y1 = _bounds(mv)
+        mv.box = (x0 - reach, y0 - reach, x1 + reach, y1 + reach)
+        mv.rows = candidate_rows(self.queries, *mv.box, mv.mask, self._skip(mv))
+
+    def _near(self, mv: _Move, box: tuple[float, float, float, float]) -> np.ndarray | None:
+        """The gathered candidates (minus those ignored for now), if ``box`` lies in the gathered
+        region; None: look up afresh."""
+        b = mv.box
+        if mv.rows is None or b is None or not (b[0] <= box[0] and b[1] <= box[1] and box[2] <= b[2]
+                                                and box[3] <= b[3]):
+            return None
+        rows = mv.rows
+        if mv.ignore and rows.size:
+            rows = rows[~np.isin(rows, np.fromiter(mv.ignore, dtype=np.int64))]
+        return rows
+
     def _skip(self, mv: _Move):
         store = self.bodies.store
         drop = np.array(sorted(mv.dropping), dtype=np.int64)
@@ -254,8 +283,11 @@ class CharacterStage(Stage):
                                (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))) is None
             return True
 
+        x0, y0, x1, y1 = _bounds(mv)
+        pad = 1e-6 * (abs(x0) + abs(y0) + abs(mx) + abs(my) + x1 - x0 + y1 - y0)
+        box = (min(x0, x0 + mx) - pad, min(y0, y0 + my) - pad, max(x1, x1 + mx) + pad, max(y1, y1 + my) + pad)
         return cast_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mx, my, accept, mask=mv.mask,
-                         skip=self._skip(mv))
+                         skip=self._skip(mv), rows=self._near(mv, box))
 
     def _advance(self, mv: _Move, mx: float, my: float, f: float, nx: float, ny: float) -> None:
         """Move by ``f`` of ``(mx, my)`` (up to a contact of normal ``n``), then back along the way
@@ -348,7 +380,8 @@ class CharacterStage(Stage):
         store = self.bodies.store
         free = True
         for _ in range(4):
-            found = overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask, self._skip(mv))
+            found = overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask, self._skip(mv),
+                                     self._near(mv, _bounds(mv)))
             found = [o for o in found if self._holds(mv, o, start_bottom, frame, moved)]
             if not found:
                 return free
@@ -366,7 +399,7 @@ class CharacterStage(Stage):
             if ny >= mv.floor_cos:
                 mv.floor = (r, nx, ny)
         return free and not overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask,
-                                             self._skip(mv))
+                                             self._skip(mv), self._near(mv, _bounds(mv)))
 
     def _holds(self, mv: _Move, overlap: tuple[int, float, float, float], start_bottom: float,
                frame: StepFrame, moved: bool) -> bool:
