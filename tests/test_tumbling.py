@@ -222,3 +222,23 @@ def test_scene_contact_points_are_the_two_corners_a_box_rests_on():
         # stopped, not turned: to the velocity solver's tolerance, 1e-8 of the speeds (g dt here)
         assert (v.x, v.y, v.angular) == pytest.approx((0.0, 0.0, 0.0), abs=1e-8 * G * DT)
         assert s.resolved[0].size == 1  # one pair applied
+
+
+@pytest.mark.parametrize("x0, rot", [(0.3, 0.1), (1.0, 0.0)])
+def test_a_box_resting_on_a_static_circle_is_measured_again_and_does_not_sink(x0, rot):
+    """A turning box against an immovable circle: its contact is measured again between rounds
+    from the narrow phase's point (a circle has no outline to clip), so the box settles on the
+    big circle (stable: radius 10 > its half height) without sinking into it."""
+    from framework.collision import collide
+
+    s = Scene(gravity=(0.0, -10.0))
+    s.spawn(Transform(0.0, 0.0), Hitbox(Circle(10.0), body="static"))
+    b = s.spawn(Transform(x0, 11.0, rot), Velocity(), Hitbox(Polygon.box(1.0, 1.0), friction=0.8))
+    t = s.get(b, Transform)
+    for k in range(600):
+        s.step(1 / 60)
+        c = collide(Polygon.box(1.0, 1.0), t, Circle(10.0), (0.0, 0.0))
+        if k > 100:
+            assert c is None or c.depth <= 1e-6
+    assert math.hypot(t.x, t.y) == pytest.approx(10.5, abs=1e-3)  # resting on top, tilted to the radius
+    s.close()

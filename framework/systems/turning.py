@@ -43,13 +43,15 @@ def manifold_points(store: BodyStore, geom, ra: np.ndarray, rb: np.ndarray, nx: 
     the step's geometry, keeping the points less than ``gap`` times the smaller body's size
     apart: ``(count, px, py, sep)``."""
     margin = gap * np.minimum(store.bound[ra], store.bound[rb])
-    caps = np.flatnonzero((store.kind[ra] == KIND_CAPSULE) | (store.kind[rb] == KIND_CAPSULE))
+    round_ = ((store.kind[ra] == KIND_CAPSULE) | (store.kind[rb] == KIND_CAPSULE) | (store.kind[ra] == KIND_CIRCLE)
+              | (store.kind[rb] == KIND_CIRCLE))
+    caps = np.flatnonzero(round_)
     if caps.size == 0:
         return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh,
                               geom.poly_slot, geom.world_poly, geom.count)
-    # A pair with a capsule has no outline to clip: its one point is the narrow phase's, where
-    # they overlap (none where they do not).
-    rest = np.flatnonzero((store.kind[ra] != KIND_CAPSULE) & (store.kind[rb] != KIND_CAPSULE))
+    # A pair with a circle or a capsule has no outline to clip: its one point is the narrow
+    # phase's, where they overlap (none where they do not).
+    rest = np.flatnonzero(~round_)
     n_pts, px, py, sep = (np.zeros(ra.size, dtype=np.int64), np.zeros((ra.size, 2)), np.zeros((ra.size, 2)),
                           np.zeros((ra.size, 2)))
     if rest.size:
