@@ -12,6 +12,8 @@ import math
 import random
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from framework import AABB, Circle, Hitbox, InvalidValue, Polygon, Scene, Transform, Velocity, collide
 from framework.character import CharacterController
@@ -449,3 +451,45 @@ def test_a_capsule_character_walks_over_the_hill():
         # Resting on the surface: a short cast down meets it at once.
         hit = s.shape_cast(cap, (t.x, t.y), (t.x, t.y - 1.0), ignore=[e])
         assert hit is not None and hit.fraction <= 1e-9
+
+
+terrain_kinds = st.sampled_from([None, None, None, "solid", "solid", "slope_up", "slope_down", "slope_up_low",
+                                 "slope_up_high", "slope_down_high", "slope_down_low", "step"])
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.lists(terrain_kinds, min_size=10, max_size=10), min_size=3, max_size=3),
+       st.lists(st.tuples(st.sampled_from([-256.0, -128.0, 0.0, 128.0, 256.0]), st.booleans()), min_size=5,
+                max_size=5),
+       st.sampled_from([AABB(W, H), Circle(12.0), "capsule"]))
+def test_random_terrain_and_input_never_leave_a_character_inside_the_ground(cells, inputs, shape):
+    """Random tile terrain (framework.tiles) walled in on a floor, random running and jumping: the
+    character is never inside a piece of terrain and never leaves the walls."""
+    from framework.shapes import Capsule
+    from framework.tiles import terrain_pieces
+
+    if shape == "capsule":
+        shape = Capsule(10.0, 8.0)
+    rows = [[None] * 12 for _ in range(6)] + [[("solid" if c in (0, 11) else k) for c, k in
+                                               enumerate([None, *row, None])] for row in cells] + [["solid"] * 12]
+    for row in rows[:6]:
+        row[0] = row[11] = "solid"
+    pieces = terrain_pieces(rows, T)
+    s = Scene(gravity=(0.0, G))
+    try:
+        for pc in pieces:
+            s.spawn(Transform(pc.x, pc.y), Hitbox(pc.shape, body="static"))
+        e = s.spawn(Transform(T * 5.5, T * 9.5), Velocity(), Hitbox(shape, body="kinematic"),
+                    CharacterController(step_height=8.0))
+        t, v, c = s.get(e, Transform), s.get(e, Velocity), s.get(e, CharacterController)
+        for vx, jump in inputs:
+            for k in range(24):
+                v.x = vx
+                if jump and k == 0 and c.on_floor:
+                    v.y = 500.0
+                s.step(DT)
+                assert T < t.x < 11 * T and 0.0 < t.y < 12 * T
+                for pc in pieces:
+                    assert collide(shape, (t.x, t.y), pc.shape, (pc.x, pc.y)) is None
+    finally:
+        s.close()

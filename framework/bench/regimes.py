@@ -17,6 +17,8 @@ bodies. Scenes (``dt = 1/60`` s, gravity (0, -10), unless said):
 - **platformer-1**: ours is the platformer's :class:`Game` playing its first level with the
   scripted demo input; the peers get the same level's bodies (read from our game scene at spawn, in
   tile units), their enemies patrolling and the platform moving back and forth (:func:`platformer`).
+  Our player and walkers are kinematic bodies moved by the character controller (shape casts
+  against the level); the peers have no controller and get them as dynamic bodies.
 
 Every engine's bodies are of mass 1 and cannot rotate (our AABBs never turn): pymunk
 ``Body(1, inf)``, Box2D ``fixed_rotation=True`` with density 1 / area; friction and restitution 0.
@@ -55,6 +57,7 @@ from typing import Any
 import numpy as np
 
 from .. import AABB, Circle, Hitbox, Polygon, Shape, Transform, Velocity
+from ..character import CharacterController
 from ..collision.batch import collide_many
 from ..collision.broad_phase import brute_force_pairs
 from .perf import DT as PERF_DT
@@ -321,8 +324,11 @@ def platformer() -> Regime | None:
                         ("platform", (*(c * s for c in (*plat.start, *plat.end)), plat.speed * s)) if plat
                         else (None, ()))
         ox, oy = hb.offset
+        # Our player and walkers are kinematic bodies our character controller moves; the peers have
+        # no controller, so they get them as dynamic bodies (as the game's were before it had one).
+        body = "dynamic" if scene.try_get(e, CharacterController) is not None else hb.body.value
         pieces.append(Piece(_scaled(hb.shape, s), (t.x + ox) * s, (t.y + oy) * s,
-                            v.x * s if v else 0.0, v.y * s if v else 0.0, hb.body.value, hb.sensor,
+                            v.x * s if v else 0.0, v.y * s if v else 0.0, body, hb.sensor,
                             judged=not (hb.sensor or hb.one_way), role=role, params=params))
         ents.append(e)
     return Regime("platformer-1", "platformer", pieces, gravity=tuple(g * s for g in scene.gravity),
