@@ -9,6 +9,7 @@ about 1e-11 here), so "feet on the surface" means a gap in [0, 1e-9].
 from __future__ import annotations
 
 import math
+import os
 import random
 
 import pytest
@@ -457,7 +458,7 @@ terrain_kinds = st.sampled_from([None, None, None, "solid", "solid", "slope_up",
                                  "slope_up_high", "slope_down_high", "slope_down_low", "step"])
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=int(os.environ.get("CHARACTER_EXAMPLES", "40")), deadline=None)
 @given(st.lists(st.lists(terrain_kinds, min_size=10, max_size=10), min_size=3, max_size=3),
        st.lists(st.tuples(st.sampled_from([-256.0, -128.0, 0.0, 128.0, 256.0]), st.booleans()), min_size=5,
                 max_size=5),
