@@ -199,6 +199,13 @@ class Hitbox:
             self._store.hitbox_changed(self._entity)
         object.__setattr__(self, "_" + name, value)
 
+    def __getstate__(self) -> dict[str, Any]:  # pickling (snapshots): every slot, as it is
+        return {name: object.__getattribute__(self, name) for name in Hitbox.__slots__}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
+
     @property
     def effective_mass(self) -> float:
         """The mass given, else ``density`` times the shape's area, else 1."""

@@ -30,6 +30,9 @@ from .frame import StepFrame, add_counters
 from .input import Input
 from .queries import ALL_LAYERS, SceneHit, ShapeHit, SpatialQueries
 from .shapes import Shape
+from .snapshot import Snapshot
+from .snapshot import restore as restore_snapshot
+from .snapshot import take as take_snapshot
 from .systems import pipeline_stages
 from .systems.geometry import Geometry
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
@@ -469,6 +472,21 @@ class Scene:
         """Entities whose hitbox contains the point (closed: a point on the boundary counts)."""
         self._activate()
         return self._queries.query_point(x, y, mask)
+
+    # --- snapshots ---------------------------------------------------------------------------
+
+    def snapshot(self) -> Snapshot:
+        """The scene's state now, between steps: entities and components, the store, contacts and
+        events, sleeping, the solver's warm start, the step counter and clock, the resources. A
+        restored scene steps bit-identically to this one; the snapshot pickles (see
+        :mod:`framework.snapshot`)."""
+        return take_snapshot(self)
+
+    def restore(self, snapshot: Snapshot) -> None:
+        """Put the scene back in the state of ``snapshot`` (taken from this scene or one built the
+        same way). A snapshot from a scene of another shape (other systems or handlers) or another
+        version is an ``InvalidValue``, and the scene is unchanged."""
+        restore_snapshot(self, snapshot)
 
     # --- lifetime ----------------------------------------------------------------------------
 
