@@ -43,6 +43,9 @@ __all__ = ["DEFAULT_EFFECTS", "EFFECTS", "SLEEP_SPEED", "SLEEP_STEPS", "STAGES",
            "ShapeHit", "resolve_effects"]
 
 _scene_ids = itertools.count(1)
+# Called with each new scene (the test plugin, framework.testing.plugin, follows the scenes a test
+# makes, to picture them when it fails).
+SCENE_CREATED: list[Callable[[Scene], None]] = []
 
 System = Callable[["Scene", float], Any]
 
@@ -105,6 +108,8 @@ class Scene:
         self._stages = {stage.name: stage for stage in pipeline_stages(self._pipeline)}
         for stage in self._stages.values():
             esper.add_processor(stage, stage.priority)
+        for hook in SCENE_CREATED:
+            hook(self)
 
     # --- settings and what the last step computed ----------------------------------------------
 

@@ -1,0 +1,112 @@
+"""Golden runs: record a scene's trace (every step's positions, rotations, velocities and
+collision events) to a file once, and compare later runs with it bit for bit.
+
+::
+
+    check_golden(scene, "tests/golden/coin_pickup.json", steps=120, keys=script)
+
+The first run (or any run with ``update=True``, the environment variable
+``FRAMEWORK_UPDATE_GOLDEN=1`` or pytest's ``--update-golden``) writes the file; every later run
+compares and fails at the first step that differs, saying which entity, which field, the golden
+value and the new one (``atol`` allows a tolerance). The failure carries a snapshot of the scene
+one step before the difference (:attr:`GoldenMismatch.snapshot`, see :mod:`framework.snapshot`)
+to restore and inspect. A file written by another version of the trace format or of the
+framework is an error that says so (rerun with update to accept the new behaviour).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+from ..validation import InvalidValue
+from .running import DT, Keys, _hold, _steps
+
+__all__ = ["GOLDEN_FORMAT", "GoldenMismatch", "check_golden", "trace_step"]
+
+GOLDEN_FORMAT = 1
+FIELDS = ("x", "y", "rot", "vx", "vy", "w")
+
+
+class GoldenMismatch(AssertionError):
+    """A run that differs from its golden file; ``step``: the first step that differs,
+    ``snapshot``: the scene one step before it."""
+
+    def __init__(self, message: str, step: int, snapshot: Any) -> None:
+        super().__init__(message)
+        self.step, self.snapshot = step, snapshot
+
+
+def trace_step(scene: Any) -> dict[str, Any]:
+    """One step of a trace: the frame, each entity's position fields, the step's events."""
+    store = scene.bodies.store
+    bodies = {str(int(store.entity[r])): [float(store.cols[f][r]) for f in FIELDS] for r in range(store.n)}
+    return {"frame": scene.frame, "bodies": bodies, "events": [[e.kind, e.a, e.b] for e in scene.events]}
+
+
+def _update_wanted(update: bool | None) -> bool:
+    if update is not None:
+        return bool(update)
+    return os.environ.get("FRAMEWORK_UPDATE_GOLDEN", "") not in ("", "0")
+
+
+def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None, dt: float = DT,
+                 update: bool | None = None, atol: float = 0.0) -> None:
+    """Run ``scene`` ``steps`` steps (holding ``keys``, at ``dt``) and compare each step with the
+    golden file at ``path``, or write it (see the module docstring)."""
+    from .. import __version__
+
+    n = _steps(steps, None, dt, "check_golden")
+    if not (isinstance(atol, (int, float)) and atol >= 0 and math.isfinite(atol)):
+        raise InvalidValue(f"atol must be a finite number >= 0, got {atol!r}")
+    path = Path(path)
+    if _update_wanted(update):
+        trace = []
+        for k in range(n):
+            _hold(scene, keys, k)
+            scene.step(dt)
+            trace.append(trace_step(scene))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps({"format": GOLDEN_FORMAT, "framework": __version__, "dt": dt, "steps": n,
+                                    "trace": trace}, indent=None, separators=(",", ":")))
+        return
+    if not path.exists():
+        raise AssertionError(f"no golden file {path}: run once with update=True, FRAMEWORK_UPDATE_GOLDEN=1 or "
+                             "pytest --update-golden to record it")
+    try:
+        golden = json.loads(path.read_text())
+        fmt, version, trace = golden["format"], golden["framework"], golden["trace"]
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InvalidValue(f"{path}: not a golden trace ({exc})") from None
+    if fmt != GOLDEN_FORMAT or version != __version__:
+        raise InvalidValue(f"{path}: a golden trace from another version (trace format {fmt}, framework {version!r}; "
+                           f"this is format {GOLDEN_FORMAT}, framework {__version__!r}); rerun with update to "
+                           "record it again")
+    if golden.get("dt") != dt or golden.get("steps") != n:
+        raise InvalidValue(f"{path}: recorded with dt={golden.get('dt')!r} over {golden.get('steps')!r} steps; "
+                           f"this run asks dt={dt!r} over {n} steps")
+    for k in range(n):
+        before = scene.snapshot()
+        _hold(scene, keys, k)
+        scene.step(dt)
+        problem = _difference(trace[k], trace_step(scene), atol)
+        if problem:
+            raise GoldenMismatch(f"{path}: step {k + 1} of {n} (frame {scene.frame}) differs from the golden run: "
+                                 f"{problem}", k + 1, before)
+
+
+def _difference(want: dict[str, Any], got: dict[str, Any], atol: float) -> str | None:
+    wb, gb = want["bodies"], got["bodies"]
+    if set(wb) != set(gb):
+        gone, new = sorted(set(wb) - set(gb), key=int), sorted(set(gb) - set(wb), key=int)
+        return f"entities differ: missing now {gone}, new now {new}"
+    for e in sorted(wb, key=int):
+        for name, a, b in zip(FIELDS, wb[e], gb[e]):
+            if not (a == b or abs(a - b) <= atol):
+                return f"entity {e} {name}: golden {a!r}, now {b!r} (differs by {b - a:.3g})"
+    if want["events"] != got["events"]:
+        return f"events: golden {want['events']}, now {got['events']}"
+    return None
