@@ -5,9 +5,10 @@ collision events) to a file once, and compare later runs with it bit for bit.
 
     check_golden(scene, "tests/golden/coin_pickup.json", steps=120, keys=script)
 
-The first run (or any run with ``update=True``, the environment variable
-``FRAMEWORK_UPDATE_GOLDEN=1`` or pytest's ``--update-golden``) writes the file; every later run
-compares and fails at the first step that differs, saying which entity, which field, the golden
+A run with ``update=True`` (or the environment variable ``FRAMEWORK_UPDATE_GOLDEN=1``, or
+pytest's ``--update-golden``) writes the file; without, a missing file fails saying how to record
+it (a golden file nobody checked in must not pass silently), and every run compares and fails at
+the first step that differs, saying which entity, which field, the golden
 value and the new one (``atol`` allows a tolerance). The failure carries a snapshot of the scene
 one step before the difference (:attr:`GoldenMismatch.snapshot`, see :mod:`framework.snapshot`)
 to restore and inspect. A file written by another version of the trace format or of the
