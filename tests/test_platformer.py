@@ -22,6 +22,7 @@ from examples.platformer.components import Coin, Enemy, MovingPlatform, Player, 
 from examples.platformer.demo import Autoplay, level1, level2
 from examples.platformer.levels import to_tmj
 from framework import Hitbox, Transform, Velocity
+from framework.testing import run
 
 ROOT = Path(__file__).resolve().parents[1]
 T = 32.0
@@ -37,33 +38,12 @@ def make(text: str) -> Game:
     return Game([parse_text(text, "test.txt")])
 
 
-def steps(g: Game, n: int, keys=()) -> None:
-    for _ in range(n):
-        g.step(set(keys))
-
-
 def feet(g: Game) -> float:
     return g.player_transform.y - HALF_H
 
 
 def vel(g: Game) -> Velocity:
     return g.scene.get(g.player, Velocity)
-
-
-@pytest.fixture(autouse=True)
-def _close_scenes():
-    games: list[Game] = []
-    orig = Game.__init__
-
-    def track(self, *a, **k):
-        orig(self, *a, **k)
-        games.append(self)
-
-    Game.__init__ = track
-    yield
-    Game.__init__ = orig
-    for g in games:
-        g.close()
 
 
 # --- the demo and the command line ---------------------------------------------------------------
@@ -143,7 +123,7 @@ def test_lands_and_stands_still_for_thousands_of_frames():
 #..........#
 ############
 """)
-    steps(g, 40)
+    run(g.scene, 40, keys=set())
     y0 = g.player_transform.y
     assert feet(g) == pytest.approx(T, abs=1e-9)  # on top of the floor row (y 0..32)
     for _ in range(2000):
@@ -155,7 +135,7 @@ def test_lands_and_stands_still_for_thousands_of_frames():
 
 def test_runs_across_tile_seams_at_constant_speed():
     g = make("#" + "." * 60 + "#\n#P" + "." * 58 + "G#\n" + "#" * 62)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     xs, ys = [], []
     for _ in range(200):
         g.step({"right"})
@@ -181,7 +161,7 @@ def test_cannot_run_through_a_thin_wall(direction):
     side = -1 if direction == "right" else 1
     if direction == "left":
         g.player_transform.x = 12.5 * T
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     for _ in range(240):  # keeps pushing at full speed
         g.step({direction})
         assert (g.player_transform.x - wall_x) * side > 0.5 * T
@@ -209,7 +189,7 @@ def test_cannot_jump_through_a_one_tile_ceiling():
 #..P..G#
 ########
 """)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     ceiling = 3 * T
     for _ in range(60):
         g.step({"space"})
@@ -246,9 +226,9 @@ def _apex(g: Game, hold: int) -> float:
 def test_variable_jump_height():
     level = "#" + "." * 8 + "#\n"
     g = make(level * 8 + "#...P...G#\n" + "#" * 10)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     full = _apex(g, 60)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     tap = _apex(g, 3)
     # A full jump rises v^2 / 2g (about 3.5 tiles; semi-implicit Euler lands a step's fall short).
     assert full == pytest.approx(JUMP * JUMP / (2 * G), abs=JUMP * DT)
@@ -269,7 +249,7 @@ LEDGE_LEVEL = """
 
 
 def _run_off_the_ledge(g: Game) -> None:
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     while g.player_state.grounded:
         g.step({"right"})
 
@@ -277,15 +257,15 @@ def _run_off_the_ledge(g: Game) -> None:
 def test_coyote_time():
     g = make(LEDGE_LEVEL)
     _run_off_the_ledge(g)
-    steps(g, 4, {"right"})  # 5 frames in the air: still within coyote time (0.1 s)
+    run(g.scene, 4, keys={"right"})  # 5 frames in the air: still within coyote time (0.1 s)
     g.step({"right", "space"})
     assert vel(g).y > 0.5 * JUMP
     g = make(LEDGE_LEVEL)
     _run_off_the_ledge(g)
-    steps(g, 12, {"right"})  # too late
+    run(g.scene, 12, keys={"right"})  # too late
     g.step({"right", "space"})
     assert vel(g).y < 0
-    steps(g, 60)
+    run(g.scene, 60, keys=set())
     assert g.player_state.grounded and feet(g) == pytest.approx(T, abs=1e-9)  # landed, no jump
 
 
@@ -293,15 +273,15 @@ def _jump_pressed_before_landing(early: int) -> float:
     """A full jump from the ledge, then the same jump with jump tapped ``early`` steps before it
     lands; the highest vertical velocity in the few steps after the landing."""
     g = make(LEDGE_LEVEL)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     g.step({"space"})
     n = 1
     while not g.player_state.grounded:
         g.step(set())
         n += 1
-    steps(g, 5)
+    run(g.scene, 5, keys=set())
     g.step({"space"})
-    steps(g, n - 1 - early)
+    run(g.scene, n - 1 - early, keys=set())
     g.step({"space"})  # tapped: pressed and released
     best = -math.inf
     for _ in range(early + 4):
@@ -333,13 +313,13 @@ ONE_WAY_LEVEL = """
 def test_one_way_platform_jump_up_through_land_stay_drop_down():
     g = make(ONE_WAY_LEVEL)
     top = 4 * T  # the slab is the top quarter of row 4 of 8: 3 tiles above the floor
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     rise = []
     for _ in range(40):
         g.step({"space"})
         rise.append(feet(g))
     assert max(rise) > top  # went up through it from below
-    steps(g, 30)
+    run(g.scene, 30, keys=set())
     assert feet(g) == pytest.approx(top, abs=1e-9) and g.player_state.grounded  # and landed on it
     y = g.player_transform.y
     for _ in range(500):
@@ -347,27 +327,27 @@ def test_one_way_platform_jump_up_through_land_stay_drop_down():
         assert abs(g.player_transform.y - y) <= 1e-9
     g.step({"space"})  # a plain jump from it is a jump, not a drop
     assert vel(g).y > 0
-    steps(g, 60)
+    run(g.scene, 60, keys=set())
     assert feet(g) == pytest.approx(top, abs=1e-9)
     g.step({"down"})
     g.step({"down", "space"})  # down + jump: drop through
-    steps(g, 40, {"down"})
+    run(g.scene, 40, keys={"down"})
     assert feet(g) == pytest.approx(T, abs=1e-9) and g.player_state.grounded
     hb = g.scene.get(g.player, Hitbox)
     assert hb.mask & 2  # the one-way layer is back in the mask
-    steps(g, 10)
-    steps(g, 60, {"space"})  # and it is solid from above again after the drop
+    run(g.scene, 10, keys=set())
+    run(g.scene, 60, keys={"space"})  # and it is solid from above again after the drop
     assert feet(g) == pytest.approx(top, abs=1e-9)
 
 
 def test_walks_off_a_one_way_platform_edge_and_lands_on_the_floor():
     g = make(ONE_WAY_LEVEL)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     g.step({"space"})
-    steps(g, 60)
+    run(g.scene, 60, keys=set())
     for _ in range(60):
         g.step({"right"})
-    steps(g, 30)
+    run(g.scene, 30, keys=set())
     assert feet(g) == pytest.approx(T, abs=1e-9)
 
 
@@ -382,7 +362,7 @@ def test_rides_the_moving_platform(path):
         text = "#..............#\n#.......P......#\n#.......MMM....#\n" + "#.......~......#\n" * 3
     g = make(text + "#.............G#\n################")
     (pe, plat), = g.scene.query(MovingPlatform)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     pt = g.scene.get(pe, Transform)
     offsets = set()
     xs = set()
@@ -399,13 +379,13 @@ def test_can_walk_and_jump_on_a_moving_platform():
     g = make("#..............#\n#.......P......#\n#.......MMM~~~~#\n" + "#..............#\n" * 3
              + "#.............G#\n################")
     (pe, _), = g.scene.query(MovingPlatform)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     pt = g.scene.get(pe, Transform)
     dx0 = g.player_transform.x - pt.x
-    steps(g, 8, {"right"})
+    run(g.scene, 8, keys={"right"})
     assert g.player_transform.x - pt.x > dx0 + 0.5 * T  # walks relative to it
     g.step({"space"})
-    steps(g, 70)
+    run(g.scene, 70, keys=set())
     assert g.player_state.ground == pe  # and lands on it again
 
 
@@ -420,7 +400,7 @@ def test_coins_are_collected_exactly_once():
 ##################
 """)
     assert g.state.coin_total_in_level == 7
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     for _ in range(120):
         g.step({"right"})
     assert g.state.coins == 7 and g.state.coins_in_level == 7
@@ -456,7 +436,7 @@ def test_touching_an_enemy_from_the_side_kills_and_respawns_at_the_checkpoint():
 #.P...K.........E.G#
 ####################
 """)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     checkpoint = (6.5 * T, T)
     for _ in range(300):
         g.step({"right"})
@@ -474,7 +454,7 @@ def test_spikes_and_falling_out_kill():
 #.P..^^....#
 #######...G#
 """)
-    steps(g, 10)
+    run(g.scene, 10, keys=set())
     for _ in range(60):
         g.step({"right"})
         if g.state.deaths:
@@ -482,7 +462,7 @@ def test_spikes_and_falling_out_kill():
     assert g.state.deaths == 1
     assert g.player_transform.x == pytest.approx(2.5 * T)  # no checkpoint: back to the start
     g.player_transform.x = 8.5 * T  # over the hole
-    steps(g, 90)
+    run(g.scene, 90, keys=set())
     assert g.state.deaths == 2 and feet(g) == pytest.approx(T, abs=1e-9)
 
 
@@ -537,10 +517,10 @@ def test_goal_then_next_level_and_restart():
         g.step(set())
     assert g.state.level_index == 1 and g.player != first and not g.scene.exists(first)
     assert g.player_transform.x == pytest.approx(4.5 * T)
-    steps(g, 40, {"left"})
+    run(g.scene, 40, keys={"left"})
     assert g.state.coins == 1 and g.state.coins_in_level == 1
     g.step({"r"})  # restart: the level as it was, its coins back
-    steps(g, 3)
+    run(g.scene, 3, keys=set())
     assert g.state.level_index == 1 and g.state.coins_in_level == 0 and len(g.scene.query(Coin)) == 1
     assert g.player_transform.x == pytest.approx(4.5 * T) and g.state.coins == 1
 
@@ -661,7 +641,7 @@ def test_missing_level_file(tmp_path):
 
 def test_player_state_resets_on_death():
     g = make("#.........#\n#.P..^...G#\n###########")
-    steps(g, 5)
+    run(g.scene, 5, keys=set())
     g.scene.get(g.player, Player).drop_timer = 0.1
     for _ in range(60):
         g.step({"right"})
@@ -679,7 +659,7 @@ def test_an_enemy_that_falls_out_of_the_level_is_removed():
 #######...#
 """)
     g.scene.get(g.scene.query(Enemy)[0][0], Enemy).direction = 1
-    steps(g, 90)
+    run(g.scene, 90, keys=set())
     assert not g.scene.query(Enemy) and g.state.deaths == 0
 
 
@@ -700,11 +680,11 @@ def test_a_crate_moves_while_the_player_pushes_it_and_stops_when_it_stops():
 """)
     crate = _prop(g, "crate")
     x0 = g.scene.get(crate, Transform).x
-    steps(g, 60, {"right"})
+    run(g.scene, 60, keys={"right"})
     pushed = g.scene.get(crate, Transform).x
     assert pushed > x0 + 3 * T  # pushed along, several tiles in a second
     assert g.scene.get(crate, Velocity).x > 0.5 * RUN
-    steps(g, 60)  # let go: friction (0.6 of g) stops it within a fraction of a second
+    run(g.scene, 60, keys=set())  # let go: friction (0.6 of g) stops it within a fraction of a second
     v = g.scene.get(crate, Velocity).x
     stop = g.scene.get(crate, Transform).x
     assert v == 0.0
@@ -720,10 +700,10 @@ def test_a_barrel_pushed_along_rolls_on_and_off_a_ledge():
 ##########.............
 """)
     barrel = _prop(g, "barrel")
-    steps(g, 20, {"right"})
+    run(g.scene, 20, keys={"right"})
     v = g.scene.get(barrel, Velocity)
     assert v.x > 0.0 and v.angular == pytest.approx(-v.x / (TU.barrel_radius * T), rel=1e-6)  # rolling
-    steps(g, 120)  # let go: a rolling barrel keeps rolling (no rolling resistance) ...
+    run(g.scene, 120, keys=set())  # let go: a rolling barrel keeps rolling (no rolling resistance) ...
     t = g.scene.get(barrel, Transform)
     assert t.x > 10 * T and t.y < T  # ... off the ledge at x = 10 tiles, falling
 

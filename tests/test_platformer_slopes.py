@@ -5,7 +5,6 @@ from __future__ import annotations
 import random
 
 import numpy as np
-import pytest
 
 from examples.platformer import Game, builtin_levels, parse_text
 from examples.platformer.components import Enemy, LevelPiece, Tuning
@@ -18,22 +17,6 @@ TU = Tuning()
 HALF_H = TU.player_size[1] * T / 2
 RUN = TU.run_speed * T
 DT = 1.0 / 60.0
-
-
-@pytest.fixture(autouse=True)
-def _close_scenes():
-    games: list[Game] = []
-    orig = Game.__init__
-
-    def track(self, *a, **k):
-        orig(self, *a, **k)
-        games.append(self)
-
-    Game.__init__ = track
-    yield
-    Game.__init__ = orig
-    for g in games:
-        g.close()
 
 
 def feet(g: Game) -> float:
