@@ -30,10 +30,12 @@ from typing import Any
 from .input import Input
 from .validation import InvalidValue
 
-__all__ = ["FORMAT", "VERSION", "Replay"]
+__all__ = ["FORMAT", "MAX_BYTES", "MAX_FRAMES", "VERSION", "Replay"]
 
 FORMAT = "framework-replay"
 VERSION = 1
+MAX_BYTES = 256 * 1024 * 1024  # a replay file's size, by default (Replay.load(max_bytes=...))
+MAX_FRAMES = 10_000_000        # frames a replay may declare (46 hours at 60 Hz), by default
 
 
 def _keys(keys: object, where: str) -> frozenset[str]:
@@ -135,10 +137,15 @@ class Replay:
         os.replace(tmp, path)  # never a half-written replay under the real name
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Replay:
+    def load(cls, path: str | os.PathLike[str], *, max_bytes: int = MAX_BYTES, max_frames: int = MAX_FRAMES) -> Replay:
         """Read a replay written by :meth:`save`; ``ValueError`` naming the file (and line) if it
-        is not one. A missing file raises ``FileNotFoundError``."""
+        is not one, whatever it holds (a file over ``max_bytes``, or declaring more than
+        ``max_frames`` frames, is refused before it is read). A missing file raises
+        ``FileNotFoundError``."""
         name = os.fspath(path)
+        size = os.stat(name).st_size
+        if size > max_bytes:
+            raise InvalidValue(f"{name}: the file is {size} bytes, more than the limit of {max_bytes} (max_bytes)")
         try:
             with open(name, encoding="utf-8") as f:
                 text = f.read()
@@ -155,6 +162,8 @@ class Replay:
                 return json.loads(lines[i], parse_constant=_no_constant)
             except ValueError as exc:
                 raise InvalidValue(f"{name}: line {i + 1}: not JSON ({exc})") from None
+            except RecursionError:
+                raise InvalidValue(f"{name}: line {i + 1}: nested too deeply to be part of a replay") from None
 
         header = parse(0)
         if not isinstance(header, dict) or header.get("format") != FORMAT:
@@ -170,6 +179,8 @@ class Replay:
         count = header.get("frames")
         if isinstance(count, bool) or not isinstance(count, int) or count < 0:
             raise InvalidValue(f"{where}: frames must be an int >= 0, got {count!r}")
+        if count > max_frames:
+            raise InvalidValue(f"{where}: {count} frames, more than the limit of {max_frames} (max_frames)")
         if count != len(lines) - 1:
             raise InvalidValue(f"{name}: the header promises {count} frames but the file has {len(lines) - 1} "
                                "(truncated or edited?)")

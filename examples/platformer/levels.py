@@ -42,7 +42,6 @@ file's name and says what is wrong.
 from __future__ import annotations
 
 import base64
-import gzip
 import json
 import math
 import zlib
@@ -54,8 +53,8 @@ from typing import Any
 from framework import tiles as terrain
 
 __all__ = [
-    "LEVEL_DIR", "Level", "LevelError", "LevelObject", "builtin_levels", "load_level", "parse_text",
-    "parse_tmj", "to_tmj", "dump_tmj",
+    "DEFAULT_LIMITS", "LEVEL_DIR", "Level", "LevelError", "LevelLimits", "LevelObject", "builtin_levels",
+    "load_level", "parse_text", "parse_tmj", "to_tmj", "dump_tmj",
 ]
 
 LEVEL_DIR = Path(__file__).with_name("levels")
@@ -78,6 +77,21 @@ _FLIP_V_OR_D = 0x60000000  # flipped vertically, or diagonally (a rotation by 90
 
 class LevelError(ValueError):
     """A level file that cannot be loaded; the message names the file and the problem."""
+
+
+@dataclass(frozen=True)
+class LevelLimits:
+    """What a level file may declare, checked before anything is allocated for it (a file from a
+    stranger can declare a 100,000 x 100,000 map in a few bytes). Raise them for a bigger game:
+    ``load_level(path, limits=LevelLimits(max_tiles=20_000_000))``."""
+
+    max_bytes: int = 16 * 1024 * 1024   # the file's size
+    max_tiles: int = 4_000_000          # width x height (2,000 x 2,000)
+    max_objects: int = 100_000
+    max_layers: int = 1_000
+
+
+DEFAULT_LIMITS = LevelLimits()
 
 
 @dataclass(frozen=True)
@@ -174,10 +188,17 @@ def _is_number(v: object) -> bool:
 
 def parse_text(
     text: str, source: str = "<text>", *, tile: float = DEFAULT_TILE, name: str | None = None,
+    limits: LevelLimits = DEFAULT_LIMITS,
 ) -> Level:
     """A :class:`Level` from a text map (see the module docstring for the characters)."""
     def fail(msg: str) -> None:
         raise LevelError(f"{source}: {msg}")
+
+    if not isinstance(text, str):
+        fail(f"a text map must be text, got {type(text).__name__}")
+    if len(text) > limits.max_bytes:
+        fail(f"the map is {len(text)} characters long, more than the limit of {limits.max_bytes} "
+             "(LevelLimits.max_bytes)")
 
     lines = [ln.rstrip("\r\n").rstrip() for ln in text.splitlines()]
     lines = [ln for ln in lines if not ln.lstrip().startswith(";")]
@@ -188,6 +209,9 @@ def parse_text(
     if not lines:
         fail("the map is empty")
     width = max(len(ln) for ln in lines)
+    if width * len(lines) > limits.max_tiles:
+        fail(f"the map is {width} x {len(lines)} tiles, more than the limit of {limits.max_tiles} "
+             "(LevelLimits.max_tiles)")
     grid = [ln.ljust(width, ".") for ln in lines]
     height = len(grid)
     tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
@@ -262,8 +286,10 @@ def _text_platforms(grid: list[str], tile: float, fail) -> list[LevelObject]:
 # --- Tiled maps ------------------------------------------------------------------------------------
 
 
-def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None) -> Level:
-    """A :class:`Level` from a decoded Tiled JSON map."""
+def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
+              limits: LevelLimits = DEFAULT_LIMITS) -> Level:
+    """A :class:`Level` from a decoded Tiled JSON map. What it declares is checked against
+    ``limits`` and against what it holds before anything is allocated for it."""
     def fail(msg: str) -> None:
         raise LevelError(f"{source}: {msg}")
 
@@ -286,11 +312,20 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None) -> L
         fail(f"tiles must be square, got tilewidth {tw} and tileheight {th}")
     if not isinstance(data["layers"], list):
         fail("'layers' must be a list")
+    if width * height > limits.max_tiles:
+        fail(f"the map declares {width} x {height} = {width * height} tiles, more than the limit of "
+             f"{limits.max_tiles} (LevelLimits.max_tiles)")
+    layers = _flat_layers(data["layers"], fail, limits)
+    for layer in layers:  # what each tile layer holds must match the size declared, before any grid exists
+        held = layer.get("data")
+        if layer.get("type") == "tilelayer" and isinstance(held, list) and len(held) != width * height:
+            fail(f"layer {str(layer.get('name', ''))!r} has {len(held)} tiles, expected width x height = "
+                 f"{width} x {height} = {width * height}")
     gid_kinds = _tileset_kinds(data.get("tilesets", []), fail)
     tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
     objects: list[LevelObject] = []
     map_h = float(height * th)
-    for layer in _flat_layers(data["layers"], fail):
+    for layer in layers:
         lname = str(layer.get("name", ""))
         ltype = layer.get("type")
         where = f"layer {lname!r}"
@@ -322,6 +357,8 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None) -> L
             objs = layer.get("objects", [])
             if not isinstance(objs, list):
                 fail(f"{where}: 'objects' must be a list")
+            if len(objects) + len(objs) > limits.max_objects:
+                fail(f"{where}: more than {limits.max_objects} objects (LevelLimits.max_objects)")
             for obj in objs:
                 objects.append(_tmj_object(obj, map_h, fail, where))
         elif ltype in ("imagelayer",):
@@ -332,15 +369,26 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None) -> L
     return Level(str(title), source, float(tw), width, height, tiles, objects).validate()
 
 
-def _flat_layers(layers: list, fail) -> list[dict]:
-    out = []
-    for layer in layers:
+def _flat_layers(layers: list, fail, limits: LevelLimits) -> list[dict]:
+    """The layers, groups opened (without recursion: a hostile file may nest them deeply)."""
+    out: list[dict] = []
+    todo = [iter(layers)]
+    while todo:
+        layer = next(todo[-1], None)
+        if layer is None:
+            todo.pop()
+            continue
         if not isinstance(layer, dict):
             fail(f"a layer must be a JSON object, got {layer!r:.60}")
         if layer.get("type") == "group":
-            out.extend(_flat_layers(layer.get("layers", []), fail))
+            inner = layer.get("layers", [])
+            if not isinstance(inner, list):
+                fail(f"group layer {str(layer.get('name', ''))!r}: 'layers' must be a list")
+            todo.append(iter(inner))
         else:
             out.append(layer)
+        if len(out) + len(todo) > limits.max_layers:
+            fail(f"more than {limits.max_layers} layers (LevelLimits.max_layers)")
     return out
 
 
@@ -353,8 +401,8 @@ def _props(thing: dict, fail, where: str) -> dict[str, Any]:
         fail(f"{where}: 'properties' must be a list")
     out = {}
     for p in raw:
-        if not isinstance(p, dict) or "name" not in p or "value" not in p:
-            fail(f"{where}: a property needs 'name' and 'value', got {p!r:.80}")
+        if not isinstance(p, dict) or not isinstance(p.get("name"), str) or "value" not in p:
+            fail(f"{where}: a property needs a 'name' (text) and a 'value', got {p!r:.80}")
         out[p["name"]] = p["value"]
     return out
 
@@ -369,16 +417,28 @@ def _tileset_kinds(tilesets: Any, fail) -> dict[int, str]:
         if "source" in ts:
             fail(f"external tileset {ts['source']!r} is not supported: embed the tileset in the map")
         first = ts["firstgid"]
-        for tile in ts.get("tiles", []):
+        if isinstance(first, bool) or not isinstance(first, int) or first < 1:
+            fail(f"tileset {ts.get('name')!r}: 'firstgid' must be a positive integer, got {first!r}")
+        tiles = ts.get("tiles", [])
+        if not isinstance(tiles, list):
+            fail(f"tileset {ts.get('name')!r}: 'tiles' must be a list")
+        for tile in tiles:
+            if not isinstance(tile, dict):
+                fail(f"tileset {ts.get('name')!r}: a tile must be a JSON object, got {tile!r:.60}")
             kind = _props(tile, fail, f"tileset {ts.get('name')!r}").get(
                 "kind", tile.get("type") or tile.get("class"))
+            if not isinstance(kind, str | None):
+                fail(f"tileset {ts.get('name')!r}: tile {tile.get('id')!r} has a kind that is not text: {kind!r:.60}")
             if kind in DECORATION:
                 continue
             if kind is not None:
                 if kind not in TILE_KINDS:
                     fail(f"tileset {ts.get('name')!r}: tile {tile.get('id')} has unknown kind {kind!r} "
                          f"(known: {', '.join(TILE_KINDS)})")
-                kinds[first + int(tile["id"])] = kind
+                tid = tile.get("id")
+                if isinstance(tid, bool) or not isinstance(tid, int) or tid < 0:
+                    fail(f"tileset {ts.get('name')!r}: a tile's 'id' must be an integer >= 0, got {tid!r:.60}")
+                kinds[first + tid] = kind
     return kinds
 
 
@@ -389,13 +449,18 @@ def _layer_data(layer: dict, width: int, height: int, fail, where: str) -> list[
     if data is None:
         fail(f"{where} has no 'data' (chunks of infinite maps are not supported)")
     if layer.get("encoding") == "base64":
+        want = 4 * width * height  # bytes of the gids the map declares: never inflate more than that
+        if not isinstance(data, str):
+            fail(f"{where}: base64 tile data must be text, got {type(data).__name__}")
         try:
-            raw = base64.b64decode(data)
+            raw = base64.b64decode(data, validate=True)
             comp = layer.get("compression", "")
-            if comp == "zlib":
-                raw = zlib.decompress(raw)
-            elif comp == "gzip":
-                raw = gzip.decompress(raw)
+            if comp in ("zlib", "gzip"):
+                inflate = zlib.decompressobj(zlib.MAX_WBITS | (16 if comp == "gzip" else 0))
+                raw = inflate.decompress(raw, want + 1)
+                if len(raw) > want:
+                    fail(f"{where}: the compressed tile data holds more than the {want} bytes the map's "
+                         f"{width} x {height} tiles need")
             elif comp:
                 fail(f"{where}: unsupported compression {comp!r} (use none, zlib or gzip)")
         except (ValueError, zlib.error, OSError) as exc:
@@ -441,10 +506,15 @@ def _tmj_object(obj: Any, map_h: float, fail, where: str) -> LevelObject:
 # --- loading and writing ---------------------------------------------------------------------------
 
 
-def load_level(path: str | Path) -> Level:
-    """Load a ``.tmj`` (or ``.json``) Tiled map or a ``.txt`` text map; :class:`LevelError` if bad."""
+def load_level(path: str | Path, *, limits: LevelLimits = DEFAULT_LIMITS) -> Level:
+    """Load a ``.tmj`` (or ``.json``) Tiled map or a ``.txt`` text map; :class:`LevelError` if bad
+    (whatever the file holds: see :class:`LevelLimits` for what a file may declare)."""
     p = Path(path)
     try:
+        size = p.stat().st_size
+        if size > limits.max_bytes:
+            raise LevelError(f"{p}: the file is {size} bytes, more than the limit of {limits.max_bytes} "
+                             "(LevelLimits.max_bytes)")
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise LevelError(f"{p}: no such level file") from None
@@ -456,9 +526,11 @@ def load_level(path: str | Path) -> Level:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
             raise LevelError(f"{p}: not valid JSON ({exc})") from None
-        return parse_tmj(data, str(p))
+        except RecursionError:
+            raise LevelError(f"{p}: the JSON is nested too deeply to be a level") from None
+        return parse_tmj(data, str(p), limits=limits)
     if suffix == ".txt":
-        return parse_text(text, str(p))
+        return parse_text(text, str(p), limits=limits)
     raise LevelError(f"{p}: unknown level format {suffix!r} (use .tmj or .txt)")
 
 

@@ -30,6 +30,7 @@ __all__ = ["GOLDEN_FORMAT", "GoldenMismatch", "check_golden", "trace_step"]
 
 GOLDEN_FORMAT = 1
 FIELDS = ("x", "y", "rot", "vx", "vy", "w")
+MAX_BYTES = 512 * 1024 * 1024  # a golden file's size
 
 
 class GoldenMismatch(AssertionError):
@@ -77,11 +78,16 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
     if not path.exists():
         raise AssertionError(f"no golden file {path}: run once with update=True, FRAMEWORK_UPDATE_GOLDEN=1 or "
                              "pytest --update-golden to record it")
+    size = path.stat().st_size
+    if size > MAX_BYTES:
+        raise InvalidValue(f"{path}: the file is {size} bytes, more than the limit of {MAX_BYTES} for a golden trace")
     try:
-        golden = json.loads(path.read_text())
+        golden = json.loads(path.read_text(encoding="utf-8"))
         fmt, version, trace = golden["format"], golden["framework"], golden["trace"]
-    except (ValueError, KeyError, TypeError) as exc:
-        raise InvalidValue(f"{path}: not a golden trace ({exc})") from None
+    except (ValueError, KeyError, TypeError) as exc:  # UnicodeDecodeError is a ValueError
+        raise InvalidValue(f"{path}: not a golden trace ({type(exc).__name__}: {exc})") from None
+    except RecursionError:
+        raise InvalidValue(f"{path}: not a golden trace (nested too deeply)") from None
     if fmt != GOLDEN_FORMAT or version != __version__:
         raise InvalidValue(f"{path}: a golden trace from another version (trace format {fmt}, framework {version!r}; "
                            f"this is format {GOLDEN_FORMAT}, framework {__version__!r}); rerun with update to "
@@ -89,6 +95,8 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
     if golden.get("dt") != dt or golden.get("steps") != n:
         raise InvalidValue(f"{path}: recorded with dt={golden.get('dt')!r} over {golden.get('steps')!r} steps; "
                            f"this run asks dt={dt!r} over {n} steps")
+    if not isinstance(trace, list) or len(trace) != n or not all(_step_ok(t) for t in trace):
+        raise InvalidValue(f"{path}: not a golden trace (the trace must be {n} steps of bodies and events)")
     for k in range(n):
         before = scene.snapshot()
         _hold(scene, keys, k)
@@ -97,6 +105,16 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
         if problem:
             raise GoldenMismatch(f"{path}: step {k + 1} of {n} (frame {scene.frame}) differs from the golden run: "
                                  f"{problem}", k + 1, before)
+
+
+def _step_ok(step: Any) -> bool:
+    """Whether one step of a trace read from a file has the shape :func:`trace_step` writes."""
+    if not isinstance(step, dict) or not isinstance(step.get("bodies"), dict) or not isinstance(step.get("events"),
+                                                                                                  list):
+        return False
+    return all(isinstance(k, str) and k.lstrip("-").isdigit() and isinstance(v, list) and len(v) == len(FIELDS)
+               and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
+               for k, v in step["bodies"].items())
 
 
 def _difference(want: dict[str, Any], got: dict[str, Any], atol: float) -> str | None:
