@@ -130,10 +130,9 @@ def _dumps(value: Any, refs: dict[int, str]) -> bytes:
     return buf.getvalue()
 
 
-def take(scene: Scene) -> Snapshot:
-    """The state of ``scene`` now (between steps); see :meth:`framework.scene.Scene.snapshot`."""
-    from . import __version__
-
+def collect_state(scene: Scene) -> tuple[dict[str, Any], dict[int, str]]:
+    """The scene's state (see the module docstring) and the references to its own objects and
+    resources (``id(object) -> name``) that a saved copy writes by name."""
     scene._activate()
     if scene._stepping:
         raise InvalidValue("snapshot() was called from inside a step (a system or a collision handler)")
@@ -152,24 +151,37 @@ def take(scene: Scene) -> Snapshot:
         "scene": {k: getattr(scene, k) for k in _SCENE_FIELDS},
         "pending": list(scene._pending_despawn),
     }
+    return state, refs
+
+
+def resource_parts(scene: Scene) -> list[tuple[str, Any, type, bool, Any]]:
+    """Each resource as ``(name, key, type, in place, payload)``: its attributes where it has
+    them (restored into the very object the game holds), else its value."""
+    out = []
+    for key, value in scene.resources.items():
+        in_place = hasattr(value, "__dict__")
+        out.append((_name(key), key, type(value), in_place, dict(value.__dict__) if in_place else value))
+    return out
+
+
+def take(scene: Scene) -> Snapshot:
+    """The state of ``scene`` now (between steps); see :meth:`framework.scene.Scene.snapshot`."""
+    from . import __version__
+
+    state, refs = collect_state(scene)
     try:
         data = _dumps(state, refs)
     except Exception as exc:
-        _name_unpicklable(entities, refs)
+        _name_unpicklable(state["esper"]["entities"], refs)
         raise InvalidValue(f"the scene's state cannot be saved: {exc}") from exc
-    # Resources: each one's attributes (so a restore can put them back into the very objects the
-    # game holds), or its value where it has none; one that cannot be pickled is left out.
     headers, payloads, skipped = [], {}, []
-    for key, value in scene.resources.items():
-        name = _name(key)
-        in_place = hasattr(value, "__dict__")
-        payload = dict(value.__dict__) if in_place else value
+    for name, key, cls, in_place, payload in resource_parts(scene):
         try:
-            _dumps((key, type(value), payload), refs)
+            _dumps((key, cls, payload), refs)
         except Exception:
-            skipped.append(name)
+            skipped.append(name)  # one that cannot be pickled is left out
             continue
-        headers.append((name, key, type(value), in_place))
+        headers.append((name, key, cls, in_place))
         payloads[name] = payload
     blob = pickle.dumps((data, _dumps(headers, {}), _dumps(payloads, refs)), protocol=pickle.HIGHEST_PROTOCOL)
     return Snapshot(SNAPSHOT_VERSION, __version__, scene_shape(scene), scene.frame, blob, tuple(sorted(skipped)))
@@ -186,6 +198,31 @@ def _name_unpicklable(entities: dict[int, dict[type, Any]], refs: dict[int, str]
                                    f"({exc}); components must be picklable") from exc
 
 
+def check_shape(scene: Scene, shape: Any, what: str = "snapshot") -> None:
+    """``InvalidValue`` unless ``shape`` is the scene's (see :func:`scene_shape`)."""
+    now = scene_shape(scene)
+    if shape != now:
+        raise InvalidValue(f"the {what} is from a scene of another shape (other systems, processors, collision "
+                           f"handlers or substeps): {_shape_difference(shape, now)}")
+
+
+def resource_targets(scene: Scene, headers: list[tuple[str, Any, type, bool]],
+                     objects: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
+    """Where each saved resource goes: ``name -> (key, the object its attributes go into, or
+    None to replace the value)``; registers every resource object in ``objects`` by reference name."""
+    current = {_name(key): value for key, value in scene.resources.items()}
+    for key, value in scene.resources.items():
+        objects[f"resource:{_name(key)}"] = value
+    targets = {}
+    for name, key, cls, in_place in headers:
+        obj = current.get(name)
+        if in_place and (obj is None or type(obj) is not cls or not hasattr(obj, "__dict__")):
+            obj = cls.__new__(cls)  # a resource the scene lacks (or of another type): a new one
+        objects[f"resource:{name}"] = obj if in_place else objects.get(f"resource:{name}")
+        targets[name] = (key, obj if in_place else None)
+    return targets
+
+
 def restore(scene: Scene, snapshot: Snapshot) -> None:
     """Put ``scene`` back in the state ``snapshot`` saved; see :meth:`framework.scene.Scene.restore`."""
     from . import __version__
@@ -198,29 +235,22 @@ def restore(scene: Scene, snapshot: Snapshot) -> None:
     if snapshot.version != SNAPSHOT_VERSION or snapshot.framework != __version__:
         raise InvalidValue(f"the snapshot is from another version (snapshot format {snapshot.version}, framework "
                            f"{snapshot.framework!r}; this is format {SNAPSHOT_VERSION}, framework {__version__!r})")
-    shape = scene_shape(scene)
-    if snapshot.shape != shape:
-        raise InvalidValue("the snapshot is from a scene of another shape (other systems, processors, collision "
-                           f"handlers or substeps): {_shape_difference(snapshot.shape, shape)}")
+    check_shape(scene, snapshot.shape)
     objects = _own_objects(scene)
     try:
         data, header_blob, payload_blob = pickle.loads(snapshot.data)
-        headers = pickle.loads(header_blob)
-        current = {_name(key): value for key, value in scene.resources.items()}
-        for key, value in scene.resources.items():
-            objects[f"resource:{_name(key)}"] = value
-        targets = {}  # name -> (key, the object its attributes go into, or None to replace the value)
-        for name, key, cls, in_place in headers:
-            obj = current.get(name)
-            if in_place and (obj is None or type(obj) is not cls or not hasattr(obj, "__dict__")):
-                obj = cls.__new__(cls)  # a resource the scene lacks (or of another type): a new one
-            objects[f"resource:{name}"] = obj if in_place else objects.get(f"resource:{name}")
-            targets[name] = (key, obj if in_place else None)
+        targets = resource_targets(scene, pickle.loads(header_blob), objects)
         state = _Unpickler(io.BytesIO(data), objects).load()
         payloads = _Unpickler(io.BytesIO(payload_blob), objects).load()
     except Exception as exc:
         raise InvalidValue(f"the snapshot cannot be read: {exc}") from exc
-    # Nothing has changed yet; from here on everything is replaced.
+    apply_state(scene, state, targets, payloads)
+
+
+def apply_state(scene: Scene, state: dict[str, Any], targets: dict[str, tuple[Any, Any]],
+                payloads: dict[str, Any]) -> None:
+    """Replace the scene's state by ``state`` and its resources by ``payloads`` (everything was
+    read and checked before: from here on nothing can fail halfway)."""
     world = state["esper"]
     esper._entities.clear()
     esper._entities.update(world["entities"])
