@@ -1,0 +1,362 @@
+"""Files from strangers: every loader, fed mutations of valid files, raises only its documented
+error, within a memory bound (a resource limit on the process while it loads) and a time bound.
+
+A short run is part of the normal test command (``FUZZ_EXAMPLES`` per loader, default 40). A long
+run on request: ``FUZZ_EXAMPLES=2000 FUZZ_REPORT=docs/data/fuzz.json pytest tests/test_fuzz.py``
+writes how many inputs each loader was given and how each ended. Every crash a run finds stays
+below as a regression test with its input (``test_found_...``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import random
+import resource
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from examples.platformer.levels import LevelError, builtin_levels, load_level, parse_text
+from framework import InvalidValue
+from framework.replay import Replay
+
+EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "40"))
+REPORT = os.environ.get("FUZZ_REPORT")
+MEMORY = 1024 * 1024 * 1024  # bytes a load may add to the process's address space
+SECONDS = 10.0                # the longest a load may take
+TALLY: dict[str, Counter] = {}
+
+
+@contextlib.contextmanager
+def bounded():
+    """Cap the address space while a loader runs: an allocation beyond the bound fails there."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    with open("/proc/self/statm") as f:
+        used = int(f.read().split()[0]) * resource.getpagesize()
+    limit = used + MEMORY
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
+
+def attempt(loader: str, load, allowed: tuple[type[BaseException], ...]) -> None:
+    """Run ``load()`` under the bounds; it may succeed or raise one of ``allowed``, nothing else."""
+    t0 = time.perf_counter()
+    outcome = "loaded"
+    with bounded():
+        try:
+            load()
+        except allowed as exc:
+            outcome = type(exc).__name__
+    took = time.perf_counter() - t0
+    TALLY.setdefault(loader, Counter())[outcome] += 1
+    assert took < SECONDS, f"{loader}: a load took {took:.1f} s"
+
+
+def _write_report() -> None:
+    if REPORT:
+        Path(REPORT).write_text(json.dumps({k: dict(v) | {"inputs": sum(v.values())} for k, v in TALLY.items()},
+                                           indent=1, sort_keys=True))
+
+
+# --- mutations ---------------------------------------------------------------------------------------
+
+JUNK = [b"-1", b"1e308", b"-1e308", b"NaN", b"Infinity", b"99999999999999999999", b"100000", b"0", b"null",
+        b"true", b'"x"', b"[]", b"{}", b"[" * 5000, b"{\"a\":" * 3000, b"\xff\xfe", b"\x00", b"\"\\ud800\""]
+
+
+@st.composite
+def mutated(draw, data: bytes) -> bytes:
+    """A valid file's bytes, damaged: truncated, bytes flipped, a token replaced by a huge,
+    negative or non-finite number or another type, a key duplicated, deep nesting, re-encoded."""
+    rng = random.Random(draw(st.integers(0, 2**32)))
+    how = draw(st.sampled_from(["truncate", "flip", "token", "duplicate", "nest", "encoding", "splice"]))
+    if how == "truncate":
+        return data[: rng.randrange(len(data) + 1)]
+    if how == "flip":
+        out = bytearray(data)
+        for _ in range(rng.randint(1, 16)):
+            out[rng.randrange(len(out))] = rng.randrange(256)
+        return bytes(out)
+    if how == "token":  # replace a number or a literal with junk
+        spots = [i for i in range(len(data)) if data[i:i + 1].isdigit() or data[i:i + 1] in (b"t", b"f", b"\"")]
+        if not spots:
+            return data
+        i = rng.choice(spots)
+        j = i + 1
+        while j < len(data) and data[j:j + 1] not in (b",", b"}", b"]", b"\n"):
+            j += 1
+        return data[:i] + rng.choice(JUNK) + data[j:]
+    if how == "duplicate":  # a key given twice, the second time with junk
+        keys = [i for i in range(len(data) - 1) if data[i:i + 1] == b"{"]
+        if not keys:
+            return data
+        i = rng.choice(keys) + 1
+        key = rng.choice([b"width", b"height", b"layers", b"data", b"format", b"frames", b"trace", b"tilesets"])
+        return data[:i] + b'"' + key + b'": ' + rng.choice(JUNK) + b", " + data[i:]
+    if how == "nest":
+        depth = rng.choice([10, 1000, 100_000])
+        return b"[" * depth + data + b"]" * rng.randint(0, depth)
+    if how == "encoding":
+        text = data.decode("utf-8", "replace") + "\u00e9\u4e2d"
+        return text.encode(rng.choice(["utf-16", "latin-1", "utf-32"]), "replace")
+    i, j = sorted(rng.randrange(len(data) + 1) for _ in range(2))
+    return data[:i] + data[j:] + data[i:j]  # a piece moved
+
+
+FUZZ = settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
+
+
+# --- the loaders ---------------------------------------------------------------------------------------
+
+TMJ = builtin_levels()[2].read_bytes()
+TEXT = b"""
+#..............#
+#..C.....-----.#
+#.P..E../##\\..G#
+################
+"""
+
+
+@FUZZ
+@given(st.data())
+def test_tiled_maps(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("tmj") / "map.tmj"
+    path.write_bytes(data.draw(mutated(TMJ)))
+    attempt("Tiled map (.tmj)", lambda: load_level(path), (LevelError,))
+    _write_report()
+
+
+@FUZZ
+@given(st.data())
+def test_text_levels(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("txt") / "map.txt"
+    path.write_bytes(data.draw(mutated(TEXT)))
+    attempt("text level (.txt)", lambda: load_level(path), (LevelError,))
+    _write_report()
+
+
+def _replay_bytes() -> bytes:
+    import tempfile
+
+    r = Replay([{"right"}, {"right", "space"}, set(), {"left"}] * 5, seed=3, meta={"level": "x"})
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "r.jsonl"
+        r.save(p)
+        return p.read_bytes()
+
+
+REPLAY = _replay_bytes()
+
+
+@FUZZ
+@given(st.data())
+def test_replays(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("replay") / "r.jsonl"
+    path.write_bytes(data.draw(mutated(REPLAY)))
+    attempt("replay", lambda: Replay.load(path), (InvalidValue,))
+    _write_report()
+
+
+def _golden_scene():
+    from framework import Circle, Hitbox, Transform, Velocity
+    from framework.testing import text_scene
+
+    def ball(scene, x, y, tile):
+        return scene.spawn(Transform(x, y), Velocity(2.0, 0.0), Hitbox(Circle(0.4)))
+
+    return text_scene("#....#\n#.O..#\n######", {"O": ball}).scene
+
+
+def _golden_bytes() -> bytes:
+    import tempfile
+
+    from framework.testing import check_golden
+
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "g.json"
+        check_golden(_golden_scene(), p, 20, update=True)
+        return p.read_bytes()
+
+
+GOLDEN = _golden_bytes()
+
+
+@FUZZ
+@given(st.data())
+def test_golden_traces(tmp_path_factory, data):
+    from framework.testing import GoldenMismatch, check_golden
+
+    path = tmp_path_factory.mktemp("golden") / "g.json"
+    path.write_bytes(data.draw(mutated(GOLDEN)))
+    scene = _golden_scene()
+    try:
+        attempt("golden trace", lambda: check_golden(scene, path, 20, update=False), (InvalidValue, GoldenMismatch))
+    finally:
+        scene.close()
+    _write_report()
+
+
+def _snapshot_scene():
+    from test_snapshot import build
+
+    return build(5, bodies=4)
+
+
+def _snapshot_bytes() -> bytes:
+    import tempfile
+
+    from framework.snapshot_file import save_snapshot
+
+    s = _snapshot_scene()
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "s.npz"
+        save_snapshot(s, p)
+        return p.read_bytes()
+
+
+SNAPSHOT = _snapshot_bytes()
+
+
+@st.composite
+def mutated_snapshot(draw) -> bytes:
+    """Either the file's bytes damaged, or its description's JSON damaged inside a valid zip."""
+    if draw(st.booleans()):
+        return draw(mutated(SNAPSHOT))
+    import io
+
+    with np.load(io.BytesIO(SNAPSHOT), allow_pickle=False) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    arrays["__meta__"] = np.frombuffer(draw(mutated(arrays["__meta__"].tobytes())), dtype=np.uint8)
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+@FUZZ
+@given(mutated_snapshot())
+def test_snapshot_files(tmp_path_factory, blob):
+    from test_snapshot import state_hash
+
+    from framework.snapshot_file import load_snapshot
+
+    path = tmp_path_factory.mktemp("snap") / "s.npz"
+    path.write_bytes(blob)
+    scene = _snapshot_scene()
+    before = state_hash(scene)
+    try:
+        outcome = []
+
+        def load():
+            load_snapshot(scene, path)
+            outcome.append("loaded")
+
+        attempt("snapshot file (.npz)", load, (InvalidValue,))
+        if not outcome:
+            assert state_hash(scene) == before  # refused: the scene is as it was
+    finally:
+        scene.close()
+    _write_report()
+
+
+# --- found by fuzzing, kept ------------------------------------------------------------------------
+
+
+def test_found_a_map_declaring_a_huge_size_with_one_cell(tmp_path):
+    """Issue 25's first finding: 100,000 x 100,000 declared, one data cell (allocated for the
+    declared size: MemoryError after 5 s under a 4 GB limit)."""
+    path = tmp_path / "huge.tmj"
+    path.write_text(json.dumps({"width": 100_000, "height": 100_000, "tilewidth": 32, "tileheight": 32,
+                                "layers": [{"type": "tilelayer", "name": "solid", "data": [1]}]}))
+    with bounded(), pytest.raises(LevelError, match="more than the limit of 4000000"):
+        load_level(path)
+
+
+def test_found_a_replay_of_deeply_nested_brackets(tmp_path):
+    """Issue 25's second finding: 100,000 nested brackets (a RecursionError from the decoder)."""
+    path = tmp_path / "deep.jsonl"
+    path.write_text("[" * 100_000 + "]" * 100_000 + "\n")
+    with pytest.raises(InvalidValue, match="nested too deeply"):
+        Replay.load(path)
+
+
+def test_found_a_zlib_bomb_in_tile_data(tmp_path):
+    """Compressed tile data that inflates far beyond what the map declares is refused while it
+    inflates, not after."""
+    import base64
+    import zlib
+
+    bomb = base64.b64encode(zlib.compress(b"\x00" * (256 * 1024 * 1024), 9)).decode()
+    path = tmp_path / "bomb.tmj"
+    path.write_text(json.dumps({"width": 4, "height": 4, "tilewidth": 32, "tileheight": 32, "layers": [
+        {"type": "tilelayer", "name": "solid", "encoding": "base64", "compression": "zlib", "data": bomb}]}))
+    with bounded(), pytest.raises(LevelError, match="holds more than the 64 bytes"):
+        load_level(path)
+
+
+def test_found_deeply_nested_group_layers(tmp_path):
+    inner = '{"type": "tilelayer", "name": "solid", "data": [0, 0, 0, 0]}'
+    layers = '{"type": "group", "layers": [' * 5000 + inner + "]}" * 5000
+    path = tmp_path / "groups.tmj"
+    path.write_text('{"width": 2, "height": 2, "tilewidth": 8, "tileheight": 8, "layers": [' + layers + "]}")
+    with pytest.raises(LevelError, match="nested too deeply|more than 1000 layers"):
+        load_level(path)
+
+
+@pytest.mark.parametrize("tilesets", [
+    [{"firstgid": 1, "tiles": [{"type": "solid"}]}],              # a typed tile without an id
+    [{"firstgid": 1, "tiles": [{"id": "x", "type": "solid"}]}],   # an id that is not a number
+    [{"firstgid": 1, "tiles": "solid"}],                          # tiles that are not a list
+    [{"firstgid": "1", "tiles": []}],                             # firstgid as text
+    [{"firstgid": 1, "tiles": [{"id": 0, "properties": [{"name": ["k"], "value": 1}]}]}],  # a list as a name
+])
+def test_found_malformed_tilesets(tmp_path, tilesets):
+    path = tmp_path / "ts.tmj"
+    path.write_text(json.dumps({"width": 2, "height": 1, "tilewidth": 8, "tileheight": 8, "tilesets": tilesets,
+                                "layers": [{"type": "tilelayer", "name": "t", "data": [1, 0]}]}))
+    with pytest.raises(LevelError):
+        load_level(path)
+
+
+def test_found_base64_tile_data_that_is_not_text(tmp_path):
+    path = tmp_path / "b64.tmj"
+    path.write_text(json.dumps({"width": 1, "height": 1, "tilewidth": 8, "tileheight": 8, "layers": [
+        {"type": "tilelayer", "name": "solid", "encoding": "base64", "data": [1]}]}))
+    with pytest.raises(LevelError, match="base64 tile data must be text"):
+        load_level(path)
+
+
+def test_text_levels_that_are_too_big_are_refused():
+    with pytest.raises(LevelError, match="more than the limit"):
+        parse_text("#" * 3000 + "\n" + ("#\n" * 2000) + "P", "big.txt")
+
+
+def test_found_a_snapshot_file_with_an_unknown_compression_method(tmp_path):
+    """Found by the long run: a flipped byte in a zip header's compression method made zipfile
+    raise NotImplementedError."""
+    from test_snapshot import state_hash
+
+    from framework.snapshot_file import load_snapshot
+
+    data = bytearray(SNAPSHOT)
+    for sig, at in ((b"PK\x03\x04", 8), (b"PK\x01\x02", 10)):
+        i = data.find(sig)
+        data[i + at:i + at + 2] = (99).to_bytes(2, "little")
+    path = tmp_path / "s.npz"
+    path.write_bytes(bytes(data))
+    scene = _snapshot_scene()
+    before = state_hash(scene)
+    with pytest.raises(InvalidValue, match="not a snapshot file"):
+        load_snapshot(scene, path)
+    assert state_hash(scene) == before
