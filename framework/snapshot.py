@@ -20,7 +20,8 @@ component that cannot be pickled is an error naming the entity and the component
 objects are new after a restore: fetch them again (``scene.get``).
 
 Snapshots use :mod:`pickle`: fine between the processes of one program; never restore one from
-a file a stranger gave you (unpickling runs code).
+a file a stranger gave you (unpickling runs code). For that, :mod:`framework.snapshot_file` writes
+and reads the same state without pickle.
 """
 
 from __future__ import annotations
