@@ -287,7 +287,7 @@ class CharacterStage(Stage):
         pad = 1e-6 * (abs(x0) + abs(y0) + abs(mx) + abs(my) + x1 - x0 + y1 - y0)
         box = (min(x0, x0 + mx) - pad, min(y0, y0 + my) - pad, max(x1, x1 + mx) + pad, max(y1, y1 + my) + pad)
         return cast_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mx, my, accept, mask=mv.mask,
-                         skip=self._skip(mv), rows=self._near(mv, box))
+                         skip=self._skip(mv), rows=self._near(mv, box), exact=False)
 
     def _advance(self, mv: _Move, mx: float, my: float, f: float, nx: float, ny: float) -> None:
         """Move by ``f`` of ``(mx, my)`` (up to a contact of normal ``n``), then back along the way
@@ -381,7 +381,7 @@ class CharacterStage(Stage):
         free = True
         for _ in range(4):
             found = overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask, self._skip(mv),
-                                     self._near(mv, _bounds(mv)))
+                                     self._near(mv, _bounds(mv)), apart=0.5 * mv.skin)
             found = [o for o in found if self._holds(mv, o, start_bottom, frame, moved)]
             if not found:
                 return free
@@ -399,7 +399,7 @@ class CharacterStage(Stage):
             if ny >= mv.floor_cos:
                 mv.floor = (r, nx, ny)
         return free and not overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask,
-                                             self._skip(mv), self._near(mv, _bounds(mv)))
+                                             self._skip(mv), self._near(mv, _bounds(mv)), apart=0.5 * mv.skin)
 
     def _holds(self, mv: _Move, overlap: tuple[int, float, float, float], start_bottom: float,
                frame: StepFrame, moved: bool) -> bool:
