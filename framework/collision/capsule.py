@@ -38,6 +38,7 @@ from numba import njit
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from .exact import BAND, TINY, Offset, float_approx, ratio_approx, rounded_exact
+from .ray import closest_on_segment
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
 __all__ = ["capsule_first", "capsule_many", "capsule_pair", "core_points", "half_segments", "segment"]
@@ -152,19 +153,8 @@ def _pick(cd, cx, cy, m, size):
     return shortest, cx[w], cy[w]
 
 
-@njit(cache=True)
-def _on_segment(px, py, s0x, s0y, s1x, s1y):
-    """The point of the segment s0 s1 closest to p."""
-    ex, ey = s1x - s0x, s1y - s0y
-    e2 = ex * ex + ey * ey
-    if e2 == 0.0:
-        return s0x, s0y
-    t = ((px - s0x) * ex + (py - s0y) * ey) / e2
-    if t <= 0.0:
-        return s0x, s0y
-    if t >= 1.0:
-        return s1x, s1y
-    return s0x + t * ex, s0y + t * ey
+# The point of a segment closest to a point: ray.py's function, compiled for the kernels here.
+_on_segment = njit(cache=True)(closest_on_segment)
 
 
 @njit(cache=True)
