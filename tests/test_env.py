@@ -155,3 +155,41 @@ def test_rgb_array_renders_headless():
     frame = e.render()
     assert frame.shape == (270, 480, 3) and frame.dtype == np.uint8 and frame.std() > 0
     e.close()
+
+
+def _reference_rays(env, player):
+    """The observation's rays, the slow way: one scene.raycast_all per ray (the oracle)."""
+    from examples.platformer.components import ENEMY, HAZARD, ONE_WAY, PICKUP, SOLID
+    from framework import Transform
+
+    scene = env.game.scene
+    t = scene.get(player, Transform)
+    out = np.ones((3, env.rays))
+    for i, direction in enumerate(env._directions):
+        for hit in scene.raycast_all((t.x, t.y), direction, env._range, mask=SOLID | ONE_WAY | ENEMY | HAZARD | PICKUP):
+            if hit.entity == player:
+                continue
+            channel = env._channel(hit.entity)
+            if channel is not None and out[channel, i] == 1.0:
+                out[channel, i] = hit.distance / env._range
+                if channel == 0:
+                    break
+    return out
+
+
+@pytest.mark.parametrize("level", [0, 1, 2])
+def test_the_vectorised_rays_agree_with_one_raycast_per_ray(level):
+    e = PlatformerEnv(level)
+    e.reset()
+    rng = np.random.default_rng(level)
+    for k in range(120):
+        e.step(int(rng.choice([2, 5, 3, 0, 1])))
+        if k % 10 == 0:
+            player = e.game.state.player
+            from framework import Transform
+
+            t = e.game.scene.get(player, Transform)
+            got = e._rays(t.x, t.y, player)
+            want = _reference_rays(e, player)
+            assert np.allclose(got, want, atol=1e-9), (got, want)
+    e.close()

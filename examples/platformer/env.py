@@ -42,6 +42,7 @@ import numpy as np
 from gymnasium import spaces
 
 from framework import Hitbox, Transform, Velocity
+from framework.collision.kinds import KIND_AABB
 from framework.validation import InvalidValue
 
 from .components import ENEMY, HAZARD, ONE_WAY, PICKUP, SOLID, Coin, Goal, Tuning
@@ -85,6 +86,10 @@ class PlatformerEnv(gym.Env):
         self.rays = rays
         angles = np.arange(rays) * (2.0 * math.pi / rays)
         self._directions = [(math.cos(a), math.sin(a)) for a in angles.tolist()]
+        # Exact zeros along the axes (cos(pi / 2) is 6e-17), so the slab test sees them as such.
+        self._dir_x = np.array([0.0 if abs(c) < 1e-12 else c for c, _ in self._directions])
+        self._dir_y = np.array([0.0 if abs(s) < 1e-12 else s for _, s in self._directions])
+        self._channels: dict[int, int] = {}
         self.game = Game([self.level], view=(WIDTH, HEIGHT))
         self.tuning: Tuning = self.game.tuning
         self._range = float(ray_range) * self.level.tile
@@ -102,6 +107,7 @@ class PlatformerEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
         super().reset(seed=seed)
         self.game.scene.restore(self._start)
+        self._channels.clear()
         self._frames = 0
         self._best_x = self._player_x()
         return self._observe(), self._info()
@@ -171,22 +177,70 @@ class PlatformerEnv(gym.Env):
         fall = self.tuning.fall_speed * tile
         obs[:PLAYER_VALUES] = (2.0 * t.x / width - 1.0, 2.0 * t.y / height - 1.0, v.x / fall, v.y / fall,
                                1.0 if p.grounded else -1.0, float(p.facing))
-        n = self.rays
-        for i, direction in enumerate(self._directions):
-            hits = scene.raycast_all((t.x, t.y), direction, self._range, mask=SOLID | ONE_WAY | ENEMY | HAZARD | PICKUP)
-            seen = [1.0, 1.0, 1.0]
-            for hit in hits:
-                if hit.entity == player:
-                    continue
-                channel = self._channel(hit.entity)
-                if channel is not None and seen[channel] == 1.0:
-                    seen[channel] = hit.distance / self._range
-                    if channel == 0:
-                        break  # nothing behind a wall is seen
-            obs[PLAYER_VALUES + i] = seen[0]
-            obs[PLAYER_VALUES + n + i] = seen[1]
-            obs[PLAYER_VALUES + 2 * n + i] = seen[2]
+        obs[PLAYER_VALUES:] = self._rays(t.x, t.y, player).reshape(-1)
         return np.clip(obs, -1.0, 1.0)
+
+    def _rays(self, ox: float, oy: float, player: int) -> np.ndarray:
+        """``(3, rays)``: per channel (solid, danger, pickup) and ray, the distance over the range
+        to the nearest such thing the ray meets before any solid one (1: none). Boxes (most of a
+        level) are met by one vectorised slab test for every ray at once; other shapes by
+        :func:`framework.collision.raycast`."""
+        from framework.collision import raycast
+
+        scene, reach = self.game.scene, self._range
+        bodies = scene.bodies  # the read-only surface (docs/rendering.md): the store and its geometry
+        store, geom = bodies.store, bodies.ensure_geometry()
+        n = store.n
+        near = ((geom.minx[:n] < ox + reach) & (geom.maxx[:n] > ox - reach) & (geom.miny[:n] < oy + reach)
+                & (geom.maxy[:n] > oy - reach) & (store.kind[:n] >= 0)
+                & ((store.layer[:n] & (SOLID | ONE_WAY | ENEMY | HAZARD | PICKUP)) != 0)
+                & (store.entity[:n] != player))
+        rows = np.flatnonzero(near)
+        channels = np.array([self._channel_of(int(e)) for e in store.entity[rows].tolist()], dtype=np.int64)
+        keep = channels >= 0
+        rows, channels = rows[keep], channels[keep]
+        dist = np.full((3, self.rays), np.inf)
+        box = store.kind[rows] == KIND_AABB
+        for r, channel in zip(rows[~box].tolist(), channels[~box].tolist()):
+            hb = store.hitboxes[r]
+            pose = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
+            for i, d in enumerate(self._directions):
+                hit = raycast(hb.shape, pose, (ox, oy), d, reach)
+                if hit is not None and hit.distance < dist[channel, i]:
+                    dist[channel, i] = hit.distance
+        br = rows[box]
+        boxes = np.stack([geom.hx[br], geom.hy[br], store.hw[br], store.hh[br], channels[box]], axis=1) if br.size \
+            else []
+        if len(boxes):
+            b = boxes
+            dx, dy = self._dir_x[:, None], self._dir_y[:, None]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tx1, tx2 = (b[:, 0] - b[:, 2] - ox) / dx, (b[:, 0] + b[:, 2] - ox) / dx
+                ty1, ty2 = (b[:, 1] - b[:, 3] - oy) / dy, (b[:, 1] + b[:, 3] - oy) / dy
+            # A ray along an axis: inside the slab is all of time, outside it none.
+            inx = (np.abs(ox - b[:, 0]) < b[:, 2])[None, :]
+            iny = (np.abs(oy - b[:, 1]) < b[:, 3])[None, :]
+            lox = np.where(dx == 0.0, np.where(inx, -np.inf, np.inf), np.minimum(tx1, tx2))
+            hix = np.where(dx == 0.0, np.where(inx, np.inf, -np.inf), np.maximum(tx1, tx2))
+            loy = np.where(dy == 0.0, np.where(iny, -np.inf, np.inf), np.minimum(ty1, ty2))
+            hiy = np.where(dy == 0.0, np.where(iny, np.inf, -np.inf), np.maximum(ty1, ty2))
+            enter, leave = np.maximum(lox, loy), np.minimum(hix, hiy)
+            hit = (enter < leave) & (leave > 0.0) & (enter <= reach)
+            d = np.where(hit, np.maximum(enter, 0.0), np.inf)
+            for channel in range(3):
+                mine = b[:, 4] == channel
+                if mine.any():
+                    dist[channel] = np.minimum(dist[channel], d[:, mine].min(axis=1))
+        dist[1:] = np.where(dist[1:] < dist[0], dist[1:], np.inf)  # nothing behind a wall is seen
+        return np.where(np.isfinite(dist), dist / reach, 1.0)
+
+    def _channel_of(self, entity: int) -> int:
+        """:meth:`_channel`, remembered per entity for the episode (-1: none)."""
+        channel = self._channels.get(entity)
+        if channel is None:
+            found = self._channel(entity)
+            channel = self._channels[entity] = -1 if found is None else found
+        return channel
 
     def _channel(self, entity: int) -> int | None:
         """0 solid, 1 danger, 2 pickup (None: something else, e.g. a checkpoint)."""
