@@ -171,16 +171,16 @@ def cast_rows(
         return None
     geom = queries.bodies.geometry
     found = []
-    box = not exact and isinstance(shape, AABB)
-    hw, hh = (shape.width * 0.5, shape.height * 0.5) if box else (0.0, 0.0)  # type: ignore[attr-defined]
+    slabs = not exact and isinstance(shape, AABB)
+    hw, hh = (shape.width * 0.5, shape.height * 0.5) if isinstance(shape, AABB) else (0.0, 0.0)
     for r in rows.tolist():
-        other = store.hitboxes[r].shape
-        if box and isinstance(other, AABB):
+        other = store.hitboxes[r].shape  # type: ignore[union-attr]  # (candidates have hitboxes)
+        if slabs and isinstance(other, AABB):
             quick = _box_sweep(x, y, hw, hh, float(geom.hx[r]), float(geom.hy[r]), other.width * 0.5,
                                other.height * 0.5, mx, my)
             if quick is None:
                 continue
-            if quick is not False:
+            if isinstance(quick, tuple):
                 found.append((quick[0], int(store.entity[r]), r, quick[1], quick[2]))
                 continue
         pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
@@ -214,7 +214,7 @@ def overlapping_rows(queries: SpatialQueries, shape: Shape, x: float, y: float, 
         # Bounds apart by more than rounding: no overlap, no exact test needed.
         if geom.minx[r] >= x1 + tol or geom.maxx[r] <= x0 - tol or geom.miny[r] >= y1 + tol or geom.maxy[r] <= y0 - tol:
             continue
-        other = store.hitboxes[r].shape
+        other = store.hitboxes[r].shape  # type: ignore[union-attr]  # (candidates have hitboxes)
         if box_shape and isinstance(other, AABB) and not (
                 abs(float(geom.hx[r]) - x) < (shape.width + other.width) * 0.5  # type: ignore[attr-defined]
                 and abs(float(geom.hy[r]) - y) < (shape.height + other.height) * 0.5):  # type: ignore[attr-defined]

@@ -115,12 +115,12 @@ class SpatialQueries:
         pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
         entity = int(store.entity[r])
         if fraction == 0.0:
-            contact = collide(shape, (x0, y0, rot), store.hitboxes[r].shape, pose_b)
+            contact = collide(shape, (x0, y0, rot), store.hitboxes[r].shape, pose_b)  # type: ignore[union-attr]
             if contact is not None:
                 return ShapeHit(entity, 0.0, contact.point, Vec2(nx, ny))
         at = (x0 + mx * fraction, y0 + my * fraction, rot)
-        return ShapeHit(entity, fraction, touch_point(shape, at, store.hitboxes[r].shape, pose_b, -nx, -ny),
-                        Vec2(nx, ny))
+        other = store.hitboxes[r].shape  # type: ignore[union-attr]  # (a row hit has a hitbox)
+        return ShapeHit(entity, fraction, touch_point(shape, at, other, pose_b, -nx, -ny), Vec2(nx, ny))
 
     def _world_extent(self, ox: float, oy: float) -> float:
         g = self.bodies.ensure_geometry()
@@ -147,6 +147,7 @@ class SpatialQueries:
     def _contains(self, r: int, px: float, py: float) -> bool:
         store, geom = self.bodies.store, self.bodies.geometry
         hb = store.hitboxes[r]
+        assert hb is not None  # (candidates have hitboxes)
         dx, dy = px - float(geom.hx[r]), py - float(geom.hy[r])
         shape = hb.shape
         if isinstance(shape, Circle):

@@ -34,6 +34,7 @@ from .snapshot import Snapshot
 from .snapshot import restore as restore_snapshot
 from .snapshot import take as take_snapshot
 from .systems import pipeline_stages
+from .systems.character import CharacterStage
 from .systems.geometry import Geometry
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
 from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister
@@ -242,7 +243,7 @@ class Scene:
             self._remove(entity)
 
     def _remove(self, entity: int) -> None:
-        comps = esper.components_for_entity(entity)
+        comps: tuple[Any, ...] = esper.components_for_entity(entity)
         self.handlers.remember(entity, {type(c) for c in comps})
         store = self.bodies.store
         if entity in store.row_of:
@@ -289,7 +290,7 @@ class Scene:
         if not esper.has_component(entity, component_type):
             name = getattr(component_type, "__name__", repr(component_type))
             raise InvalidValue(f"entity {entity} has no {name} component")
-        comp = esper.remove_component(entity, component_type)
+        comp: Any = esper.remove_component(entity, component_type)
         store = self.bodies.store
         if component_type is Velocity and entity in store.row_of:
             store.unbind(entity, comp)  # before the row forgets its values
@@ -386,8 +387,9 @@ class Scene:
         dt = positive("dt", dt)
         store = self.bodies.store
         store.check()
-        if self._stages["character"].wanted():
-            self._stages["character"].check()
+        characters = self._stages["character"]
+        if isinstance(characters, CharacterStage) and characters.wanted():
+            characters.check()
         self._totals = None
         n = self.substeps
         if n == 1:

@@ -78,7 +78,7 @@ def scene_shape(scene: Scene) -> tuple[Any, ...]:
     from .systems.stage import Stage, SystemProcessor
 
     scene._activate()
-    procs = []
+    procs: list[tuple[Any, ...]] = []
     for p in esper._processors:
         if isinstance(p, Stage):
             procs.append(("stage", p.name, p.priority))
@@ -218,7 +218,7 @@ def resource_targets(scene: Scene, headers: list[tuple[str, Any, type, bool]],
     for name, key, cls, in_place in headers:
         obj = current.get(name)
         if in_place and (obj is None or type(obj) is not cls or not hasattr(obj, "__dict__")):
-            obj = cls.__new__(cls)  # a resource the scene lacks (or of another type): a new one
+            obj = cls.__new__(cls)  # type: ignore[call-overload]  # a resource the scene lacks: a new one
         objects[f"resource:{name}"] = obj if in_place else objects.get(f"resource:{name}")
         targets[name] = (key, obj if in_place else None)
     return targets

@@ -237,7 +237,7 @@ class _Decoder:
             return out
         if tag == "O":
             cls = self.cls(rest[0])
-            obj = cls.__new__(cls)
+            obj = cls.__new__(cls)  # type: ignore[call-overload]  # (no __init__ of the file's choosing)
             self.made[n] = obj
             for k, x in rest[1]:
                 if not isinstance(k, str) or not k.isidentifier():
@@ -284,7 +284,7 @@ def save_snapshot(scene: Any, path: str | Path, *, allow: Iterable[type] = ()) -
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "wb") as f:
-        np.savez(f, **arrays)
+        np.savez(f, **arrays)  # type: ignore[arg-type]  # (numpy's stub reads **kwds as allow_pickle)
     tmp.replace(path)
     return tuple(sorted(skipped))
 

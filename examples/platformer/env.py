@@ -168,7 +168,7 @@ class PlatformerEnv(gym.Env):
     def _observe(self) -> np.ndarray:
         game, scene = self.game, self.game.scene
         state, tile = game.state, self.level.tile
-        obs = np.ones(self.observation_space.shape, dtype=np.float32)
+        obs = np.ones(PLAYER_VALUES + 3 * self.rays, dtype=np.float32)
         player = state.player
         if player is None:
             return obs
@@ -202,17 +202,15 @@ class PlatformerEnv(gym.Env):
         dist = np.full((3, self.rays), np.inf)
         box = store.kind[rows] == KIND_AABB
         for r, channel in zip(rows[~box].tolist(), channels[~box].tolist()):
-            hb = store.hitboxes[r]
+            shape = store.hitboxes[r].shape  # type: ignore[union-attr]  # (rows with kind >= 0 have one)
             pose = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
-            for i, d in enumerate(self._directions):
-                hit = raycast(hb.shape, pose, (ox, oy), d, reach)
-                if hit is not None and hit.distance < dist[channel, i]:
-                    dist[channel, i] = hit.distance
+            for i, direction in enumerate(self._directions):
+                ray = raycast(shape, pose, (ox, oy), direction, reach)
+                if ray is not None and ray.distance < dist[channel, i]:
+                    dist[channel, i] = ray.distance
         br = rows[box]
-        boxes = np.stack([geom.hx[br], geom.hy[br], store.hw[br], store.hh[br], channels[box]], axis=1) if br.size \
-            else []
-        if len(boxes):
-            b = boxes
+        if br.size:
+            b = np.stack([geom.hx[br], geom.hy[br], store.hw[br], store.hh[br], channels[box]], axis=1)
             dx, dy = self._dir_x[:, None], self._dir_y[:, None]
             with np.errstate(divide="ignore", invalid="ignore"):
                 tx1, tx2 = (b[:, 0] - b[:, 2] - ox) / dx, (b[:, 0] + b[:, 2] - ox) / dx

@@ -103,6 +103,7 @@ class CharacterStage(Stage):
         store = self.bodies.store
         geom = self.bodies.ensure_geometry()
         hb = store.hitboxes[row]
+        assert hb is not None  # (run() moves only rows with a hitbox)
         shape = hb.shape
         dt = frame.dt
         ox, oy = float(geom.hx[row] - store.x[row]), float(geom.hy[row] - store.y[row])
@@ -132,7 +133,7 @@ class CharacterStage(Stage):
             carried = (float(store.x[floor_row] - frame.start_x[floor_row]),
                        float(store.y[floor_row] - frame.start_y[floor_row]))
         self._gather(mv, ctrl, carried, vx, vy, dt, size)
-        if carried != (0.0, 0.0):
+        if carried != (0.0, 0.0) and floor_row is not None:
             mv.ignore.add(floor_row)
             self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
             mv.ignore.discard(floor_row)
@@ -182,7 +183,7 @@ class CharacterStage(Stage):
             ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
         ctrl.on_wall = mv.wall is not None
         ctrl.wall_normal = (mv.wall[1], mv.wall[2]) if mv.wall is not None else (0.0, 0.0)
-        if mv.wall_stopped and vx * mv.wall[1] < 0.0 and store.body[mv.wall[0]] != DYNAMIC:
+        if mv.wall is not None and mv.wall_stopped and vx * mv.wall[1] < 0.0 and store.body[mv.wall[0]] != DYNAMIC:
             vx = 0.0
         ctrl.on_ceiling = mv.ceiling
         if mv.ceiling and vy > 0.0:
@@ -279,7 +280,7 @@ class CharacterStage(Stage):
                 return False
             if f == 0.0:  # touching, or already inside it (then it does not hold the body)
                 geom = self.bodies.geometry
-                return collide(mv.shape, (mv.x, mv.y, mv.rot), store.hitboxes[r].shape,
+                return collide(mv.shape, (mv.x, mv.y, mv.rot), store.hitboxes[r].shape,  # type: ignore[union-attr]
                                (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))) is None
             return True
 

@@ -92,7 +92,8 @@ class EventLog:
 
 def _types(entity: int) -> frozenset[type]:
     try:
-        return frozenset(type(c) for c in esper.components_for_entity(entity))
+        comps: tuple[Any, ...] = esper.components_for_entity(entity)
+        return frozenset(type(c) for c in comps)
     except KeyError:
         return frozenset()
 
