@@ -260,7 +260,7 @@ def test_passes(scene):
 
 def test_the_plugin_pictures_a_failing_tests_scene(pytester):
     pytester.makepyfile(test_game=GAME_TEST)
-    result = pytester.runpytest("-p", "no:cacheprovider", "--framework-pictures", "pics")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider", "--framework-pictures", "pics")
     result.assert_outcomes(passed=1, failed=1)
     out = result.stdout.str()
     assert "framework picture" in out
@@ -275,7 +275,8 @@ def test_the_plugin_pictures_a_failing_tests_scene(pytester):
 
 def test_the_plugin_can_be_told_not_to_picture(pytester):
     pytester.makepyfile(test_game=GAME_TEST)
-    result = pytester.runpytest("-p", "no:cacheprovider", "--no-framework-pictures", "--framework-pictures", "pics")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider", "--no-framework-pictures",
+                                           "--framework-pictures", "pics")
     result.assert_outcomes(passed=1, failed=1)
     assert "framework picture" not in result.stdout.str() and not (pytester.path / "pics").exists()
 
