@@ -84,6 +84,10 @@ def test_the_wheel_has_one_top_level_package_and_no_examples(wheel, names):
         assert z.read(top_level).decode().split() == ["framework"]
 
 
+def test_the_wheel_marks_the_package_as_typed(names):
+    assert "framework/py.typed" in names  # PEP 561: users' type checkers read the package's hints
+
+
 def test_every_module_of_the_framework_is_in_the_wheel(names):
     # pyproject.toml lists the packages by hand: a new subpackage of framework/ must be added there.
     missing = [str(p) for p in _files(ROOT / "framework") if f"framework/{p.as_posix()}" not in names]
