@@ -6,6 +6,7 @@ import argparse
 import os
 import sys
 from pathlib import Path
+from typing import Any
 
 from .report import DATA_DIR, REPO, command_line, replace_generated, to_json, write_csv, write_json
 
@@ -63,34 +64,40 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     progress = not args.no_progress
+    report: dict[str, Any]
+    mod: Any  # the benchmark's module: its markdown() and text_report() write the report
     if args.benchmark == "perf":
-        from . import perf as mod
+        from . import perf
 
-        cfg = mod.QUICK if args.quick else mod.FULL
+        mod = perf
+        cfg: dict[str, Any] = perf.QUICK if args.quick else perf.FULL
         sizes = args.sizes or cfg["sizes"]
         tile_bodies = args.tile_bodies or (1_000 if args.sizes is None else min(sizes))
         rounds = {n: args.rounds for n in (*sizes, tile_bodies)} if args.rounds else cfg["rounds"]
         small = [n for n in (*sizes, tile_bodies) if n <= cfg["check_up_to"]]
-        report = mod.run_perf(sizes=sizes, rounds=rounds, tiles=mod.TILES if args.tiles is None else args.tiles,
+        report = perf.run_perf(sizes=sizes, rounds=rounds, tiles=perf.TILES if args.tiles is None else args.tiles,
                               tile_bodies=tile_bodies, brute_sizes=cfg["brute_sizes"] if args.sizes is None else
                               (min(sizes),), check_up_to=max(small, default=min(sizes)), progress=progress,
                               quick=args.quick)
     elif args.benchmark == "accuracy":
-        from . import accuracy as mod
+        from . import accuracy
 
-        report = mod.run_accuracy(progress=progress, quick=args.quick, scenarios=args.scenarios)
+        mod = accuracy
+        report = accuracy.run_accuracy(progress=progress, quick=args.quick, scenarios=args.scenarios)
     else:
-        from . import regimes as mod
+        from . import regimes
 
-        for given, known in ((args.scenes, mod.SCENES), (args.crowds, mod.CROWDS)):
+        mod = regimes
+        for given, known in ((args.scenes, regimes.SCENES), (args.crowds, regimes.CROWDS)):
             if set(given or ()) - set(known):
                 parser.error(f"unknown {sorted(set(given) - set(known))}; known: {', '.join(known)}")
-        cfg: dict = {}
+        cfg = {}
         if args.rounds:
             cfg.update(rounds=((10**12, args.rounds),), platformer_rounds=args.rounds)
         if args.crowd_steps:
             cfg.update(crowd_steps=args.crowd_steps)
-        report = mod.run_regimes(cfg, scenes=args.scenes, crowds=args.crowds, progress=progress, quick=args.quick)
+        report = regimes.run_regimes(cfg, scenes=args.scenes, crowds=args.crowds, progress=progress,
+                                     quick=args.quick)
     command = command_line(argv)
     report["command"] = command
     stem = args.benchmark + ("-quick" if args.quick else "")
