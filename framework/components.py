@@ -17,6 +17,7 @@ from enum import Enum
 from typing import TYPE_CHECKING, Any
 
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
+from .sprites import Animation, Frame
 from .validation import InvalidValue, finite, vector2
 
 if TYPE_CHECKING:
@@ -310,15 +311,28 @@ def check_component(comp: object) -> None:
 
 
 class Visual:
-    """How the render system draws an entity: a filled shape matching its hitbox in ``color``
-    (RGB or RGBA, 0-255), or an ``image`` (a file path) centred on the entity; higher ``z`` draws
-    on top. Entities without a Visual are not drawn (the debug overlay still outlines hitboxes)."""
+    """How the render system draws an entity; entities without a Visual are not drawn (the debug
+    overlay still outlines hitboxes).
 
-    __slots__ = ("color", "z", "image", "visible")
+    What it shows, the first given of: ``animation`` (an :class:`~framework.sprites.Animation`,
+    its frame chosen by the scene's clock), ``frame`` (a :class:`~framework.sprites.Frame`: part
+    of an image, e.g. of a :class:`~framework.sprites.SpriteSheet`), ``image`` (a file path: the
+    whole image); else the entity's hitbox filled in ``color``. Images are centred on the entity,
+    one pixel per world unit, tinted by ``color`` (white: none) and mirrored left-right with
+    ``flip_x``. ``color`` is RGB or RGBA (0-255); higher ``z`` draws on top; ``visible=False``
+    hides it. Every field may change at any time.
+
+    ``started``: the scene time the animation started at (``None``: when the entity is spawned,
+    or the Visual added). :meth:`play` switches animations; :meth:`frame_at` says which frame
+    shows at a scene time, the one the renderer draws."""
+
+    __slots__ = ("color", "z", "image", "visible", "frame", "animation", "flip_x", "started", "_store", "_entity")
+    _TRACKED = frozenset(("color", "z", "image", "visible", "frame", "animation", "flip_x", "started"))
 
     def __init__(
         self, color: tuple[int, ...] = (255, 255, 255), z: int = 0, image: str | None = None,
-        visible: bool = True,
+        visible: bool = True, *, frame: Frame | None = None, animation: Animation | None = None,
+        flip_x: bool = False, started: float | None = None,
     ) -> None:
         if not isinstance(color, tuple) or len(color) not in (3, 4) or not all(
             isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in color
@@ -328,10 +342,63 @@ class Visual:
             raise InvalidValue(f"Visual z must be an int, got {z!r}")
         if image is not None and not isinstance(image, str):
             raise InvalidValue(f"Visual image must be a file path or None, got {image!r}")
-        self.color = color if len(color) == 4 else (*color, 255)
-        self.z = z
-        self.image = image
-        self.visible = bool(visible)
+        if frame is not None and not isinstance(frame, Frame):
+            raise InvalidValue(f"Visual frame must be a Frame (framework.sprites) or None, got {frame!r}")
+        if animation is not None and not isinstance(animation, Animation):
+            raise InvalidValue(f"Visual animation must be an Animation (framework.sprites) or None, got {animation!r}")
+        if started is not None:
+            started = finite("Visual started", started)
+        set_ = object.__setattr__
+        set_(self, "_store", None)
+        set_(self, "_entity", -1)
+        set_(self, "color", color if len(color) == 4 else (*color, 255))
+        set_(self, "z", z)
+        set_(self, "image", image)
+        set_(self, "visible", bool(visible))
+        set_(self, "frame", frame)
+        set_(self, "animation", animation)
+        set_(self, "flip_x", bool(flip_x))
+        set_(self, "started", started)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        object.__setattr__(self, name, value)
+        if name in Visual._TRACKED and self._store is not None:
+            self._store.visual_changed(self._entity)  # the renderer looks at this entity again
+
+    def play(self, animation: Animation, at: float, *, restart: bool = False) -> None:
+        """Show ``animation`` from scene time ``at`` (a game system passes ``scene.time``). Playing
+        the animation already shown changes nothing unless ``restart``."""
+        if not isinstance(animation, Animation):
+            raise InvalidValue(f"Visual.play takes an Animation, got {animation!r}")
+        at = finite("Visual.play at", at)
+        if restart or animation != self.animation:
+            self.animation = animation
+            self.started = at
+
+    def frame_at(self, time: float) -> Frame | None:
+        """The frame shown at scene time ``time`` (``None`` for a filled hitbox)."""
+        if self.animation is not None:
+            return self.animation.frame_at(time - (self.started or 0.0))
+        if self.frame is not None:
+            return self.frame
+        return None if self.image is None else Frame.whole(self.image)
+
+    def _bind(self, store: BodyStore | None, entity: int, time: float) -> None:
+        """Tie to the scene's ``store`` (edits then tell the renderer) and start a pending animation."""
+        object.__setattr__(self, "_store", store)
+        object.__setattr__(self, "_entity", entity)
+        if self.animation is not None and self.started is None:
+            object.__setattr__(self, "started", float(time))
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {name: getattr(self, name) for name in self.__slots__}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
 
     def __repr__(self) -> str:
-        return f"Visual(color={self.color!r}, z={self.z!r}, image={self.image!r}, visible={self.visible!r})"
+        shown = (f"animation={self.animation!r}, " if self.animation is not None else
+                 f"frame={self.frame!r}, " if self.frame is not None else "")
+        return (f"Visual(color={self.color!r}, z={self.z!r}, image={self.image!r}, visible={self.visible!r}, "
+                f"{shown}flip_x={self.flip_x!r})")

@@ -22,7 +22,7 @@ import numpy as np
 
 from .bodies import Bodies
 from .character import CharacterController
-from .components import Hitbox, Transform, Velocity
+from .components import Hitbox, Transform, Velocity, Visual
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
@@ -228,6 +228,8 @@ class Scene:
         for comp in components:
             if isinstance(comp, CharacterController):
                 comp.bind(entity)
+            elif isinstance(comp, Visual):
+                comp._bind(self.bodies.store if t is not None else None, entity, self.time)
         return entity
 
     def despawn(self, entity: int) -> None:
@@ -273,6 +275,11 @@ class Scene:
         esper.add_component(entity, component)
         if isinstance(component, CharacterController):
             component.bind(entity)
+        if isinstance(component, Visual):
+            if isinstance(old, Visual):
+                store.unbind(entity, old)
+            component._bind(store if entity in store.row_of else None, entity, self.time)
+            store.visual_changed(entity)
         if isinstance(component, Velocity):
             if old is not None:
                 store.unbind(entity, old)  # the replaced Velocity no longer writes to the row
@@ -297,6 +304,9 @@ class Scene:
             store.set_velocity(entity, None)
         elif component_type is Hitbox and entity in store.row_of:
             store.set_hitbox(entity, None)
+        elif component_type is Visual:
+            store.unbind(entity, comp)
+            store.visual_changed(entity)
         return comp
 
     def get(self, entity: int, component_type: type) -> Any:

@@ -20,7 +20,7 @@ import numpy as np
 
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
-from .components import Body, Hitbox, Transform, Velocity, check_hitbox_field, check_mass_and_density
+from .components import Body, Hitbox, Transform, Velocity, Visual, check_hitbox_field, check_mass_and_density
 from .shapes import AABB, Capsule, Circle
 from .validation import InvalidValue
 
@@ -40,6 +40,7 @@ _FLOATS = (
 _INTS = {
     "kind": np.int8, "body": np.int8, "layer": np.int64, "mask": np.int64, "entity": np.int64,
     "still": np.int32,  # consecutive steps the body has been at rest (sleeping)
+    "look": np.int64,  # stamp of the row's last change a renderer must look at (Visual, hitbox shape, new row)
 }
 _BOOLS = ("has_vel", "sensor", "ccd", "one_way", "asleep")
 _FIELD_NAMES = {
@@ -90,6 +91,7 @@ class BodyStore:
         self.wakes = 0  # bumped whenever a sleeping row wakes
         self.writes = 0  # bumped by every write from game code (component views)
         self.motion = 0  # bumped by every move the pipeline makes (move_by_velocity, place)
+        self.looks = 0  # the last stamp given to a row's ``look`` column
         self._lookup = np.full(1, -1, dtype=np.int64)  # entity id -> row (rows_of)
         self._lookup_version = -1
 
@@ -255,6 +257,8 @@ class BodyStore:
         self.hitboxes.append(None)
         self.shapes.append(None)
         self._set_hitbox_row(row, hitbox)
+        self.looks += 1
+        c["look"][row] = self.looks
         if hitbox is not None and hitbox._body is Body.STATIC:
             self.static_dirty = True
         for comp in (transform, velocity, hitbox):
@@ -293,8 +297,17 @@ class BodyStore:
         if isinstance(comp, (Transform, Velocity)) and comp._store is self:
             comp._own = [self.read(entity, col) for col in comp._columns]
             comp._store = None
-        elif isinstance(comp, Hitbox) and comp._store is self:
+        elif isinstance(comp, (Hitbox, Visual)) and comp._store is self:
             object.__setattr__(comp, "_store", None)
+
+    def visual_changed(self, entity: int) -> None:
+        """Stamp ``entity``'s row (if it has one) as changed for renderers: its Visual was edited,
+        added or removed. A renderer compares each row's ``look`` with the stamp it last drew, so it
+        visits only what changed, never every entity every frame."""
+        row = self.row_of.get(entity)
+        if row is not None:
+            self.looks += 1
+            self.cols["look"][row] = self.looks
 
     def set_velocity(self, entity: int, velocity: Velocity | None) -> None:
         """Give the row ``velocity``'s values (or none); unbind the old Velocity first."""
@@ -329,7 +342,11 @@ class BodyStore:
     def _set_hitbox_row(self, row: int, hb: Hitbox | None) -> None:
         c = self.cols
         self.hitboxes[row] = hb
-        self.shapes[row] = None if hb is None else hb._shape
+        shape = None if hb is None else hb._shape
+        if shape is not self.shapes[row]:  # a filled hitbox is drawn from its shape: renderers look again
+            self.looks += 1
+            c["look"][row] = self.looks
+        self.shapes[row] = shape
         if hb is None:
             c["kind"][row] = KIND_NONE
             c["body"][row] = DYNAMIC
