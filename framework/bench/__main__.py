@@ -1,4 +1,4 @@
-"""Command line: ``python -m framework.bench {perf,accuracy,regimes} [--quick] [--json] [--plot PATH] [--docs]``."""
+"""Command line: ``python -m framework.bench {perf,accuracy,regimes,render} [--quick] [--json] [--plot PATH] [--docs]``."""
 
 from __future__ import annotations
 
@@ -13,8 +13,9 @@ from .report import DATA_DIR, REPO, command_line, replace_generated, to_json, wr
 __all__ = ["main"]
 
 DOCS = {"perf": REPO / "docs" / "performance.md", "accuracy": REPO / "docs" / "accuracy.md",
-        "regimes": REPO / "docs" / "performance.md"}
-QUICK_HELP = {"perf": "perf < 2 min", "accuracy": "accuracy < 1 min", "regimes": "regimes ~2 min"}
+        "regimes": REPO / "docs" / "performance.md", "render": REPO / "docs" / "rendering.md"}
+QUICK_HELP = {"perf": "perf < 2 min", "accuracy": "accuracy < 1 min", "regimes": "regimes ~2 min",
+              "render": "render ~2 min"}
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -22,7 +23,8 @@ def _parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="benchmark", required=True)
     for name, help_ in (("perf", "cost of a step: ours vs pymunk vs the broad-phase floor"),
                         ("accuracy", "accuracy knobs against exact answers"),
-                        ("regimes", "piles, stacks, scattered boxes, the platformer, crowds: ours vs pymunk vs Box2D")):
+                        ("regimes", "piles, stacks, scattered boxes, the platformer, crowds: ours vs pymunk vs Box2D"),
+                        ("render", "moving sprites: ours vs a naive pyglet loop, a numpy floor and arcade")):
         s = sub.add_parser(name, help=help_)
         s.add_argument("--quick", action="store_true", help=f"fewer sizes and rounds ({QUICK_HELP[name]})")
         s.add_argument("--json", action="store_true", help="print the report as JSON (an object with a 'rows' list)")
@@ -39,6 +41,10 @@ def _parser() -> argparse.ArgumentParser:
             s.add_argument("--rounds", type=int, metavar="R", help="timed rounds per size (default: by size)")
             s.add_argument("--tiles", type=int, metavar="T", help="static tiles of the level (default 100,000)")
             s.add_argument("--tile-bodies", type=int, metavar="N", help="moving boxes over the level (default 1,000)")
+        elif name == "render":
+            s.add_argument("--sizes", type=_ints, metavar="N,N,...", help="sprite counts (default 1k,10k,50k)")
+            s.add_argument("--kinds", type=_names, metavar="A,B,...", help="only these kinds (default: all)")
+            s.add_argument("--no-arcade", action="store_true", help="leave arcade out even if it is installed")
         elif name == "accuracy":
             s.add_argument("--scenarios", type=_names, metavar="A,B,...", help="only these scenarios (default: all)")
         else:
@@ -79,6 +85,15 @@ def main(argv: list[str] | None = None) -> int:
                               tile_bodies=tile_bodies, brute_sizes=cfg["brute_sizes"] if args.sizes is None else
                               (min(sizes),), check_up_to=max(small, default=min(sizes)), progress=progress,
                               quick=args.quick)
+    elif args.benchmark == "render":
+        from . import render
+
+        mod = render
+        cfg = render.QUICK if args.quick else render.FULL
+        if set(args.kinds or ()) - set(render.KINDS):
+            parser.error(f"unknown {sorted(set(args.kinds) - set(render.KINDS))}; known: {', '.join(render.KINDS)}")
+        report = render.run_render(sizes=args.sizes or cfg["sizes"], kinds=args.kinds or render.KINDS,
+                                   quick=args.quick, progress=progress, arcade=not args.no_arcade)
     elif args.benchmark == "accuracy":
         from . import accuracy
 
@@ -109,10 +124,11 @@ def main(argv: list[str] | None = None) -> int:
             write_csv(out / (stem.replace(args.benchmark, args.benchmark + "-crowds", 1) + ".csv"), report["crowds"])
     plot_rel = None
     if args.plot:
-        from .plots import plot_accuracy, plot_perf, plot_regimes
+        from .plots import plot_accuracy, plot_perf, plot_regimes, plot_render
 
         plot = Path(args.plot)
-        drawn = {"perf": plot_perf, "accuracy": plot_accuracy, "regimes": plot_regimes}[args.benchmark](report, plot)
+        plotters = {"perf": plot_perf, "accuracy": plot_accuracy, "regimes": plot_regimes, "render": plot_render}
+        drawn = plotters[args.benchmark](report, plot)
         if drawn:
             plot_rel = os.path.relpath(plot.resolve(), DOCS[args.benchmark].parent)
     if args.docs:

@@ -181,3 +181,33 @@ def plot_regimes(report: dict[str, Any], path: Path) -> bool:
     fig.suptitle(f"python -m framework.bench regimes, {report['machine']['date']}", fontsize=9)
     _save(fig, plt, path)
     return True
+
+
+def plot_render(report: dict[str, Any], path: Path) -> bool:
+    """Log-log ms per frame against the number of sprites, one panel per kind: ours, the numpy
+    floor, a naive pyglet loop and arcade."""
+    plt = _pyplot()
+    if plt is None:
+        stderr_note(f"matplotlib is not installed: no plot written to {path} (pip install 'framework[bench]')")
+        return False
+    rows = report["rows"]
+    kinds = list(dict.fromkeys(r["kind"] for r in rows))
+    fig, axes = plt.subplots(1, len(kinds), figsize=(3.6 * len(kinds), 3.8), squeeze=False)
+    for ax, kind in zip(axes[0], kinds):
+        mine = sorted((r for r in rows if r["kind"] == kind), key=lambda r: r["n"])
+        n = [r["n"] for r in mine]
+        for key, style, label in (("ours_ms", "o-", "ours"), ("floor_ms", "^--", "floor (numpy, one vertex list)"),
+                                  ("naive_ms", "s:", "naive pyglet"), ("arcade_ms", "x-.", "arcade SpriteList")):
+            pts = [(x, r[key]) for x, r in zip(n, mine) if r.get(key)]
+            if pts:
+                ax.loglog(*zip(*pts), style, label=label)
+        ax.set_title(kind)
+        ax.set_xlabel("moving sprites")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].set_ylabel("ms per frame (median)")
+    axes[0][0].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True

@@ -74,6 +74,12 @@ class OffscreenTarget:
     def capture(self, width: int, height: int, background: tuple[int, ...], draw: Callable[[], None]) -> np.ndarray:
         """Clear the target to ``background`` (r, g, b), call ``draw()`` into it and return its
         pixels (see :func:`read_pixels`)."""
+        return self.draw(width, height, background, draw, read=True)
+
+    def draw(self, width: int, height: int, background: tuple[int, ...], draw: Callable[[], None],
+             read: bool = False) -> Any:
+        """Clear the target to ``background``, call ``draw()`` into it; its pixels when ``read``
+        (the render benchmark draws without reading back)."""
         if self._framebuffer is None or self._size != (width, height):
             self.delete()
             self._texture = pyglet.image.Texture.create(width, height, internalformat=gl.GL_RGBA8)
@@ -90,7 +96,7 @@ class OffscreenTarget:
             gl.glClearColor(r, g, b, 1.0)
             gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
             draw()
-            return read_pixels(width, height)
+            return read_pixels(width, height) if read else None
         finally:
             framebuffer.unbind()
 
