@@ -1,4 +1,4 @@
-"""Command line: ``python -m framework.bench {perf,accuracy,regimes,render} [--quick] [--json] [--plot PATH] [--docs]``."""
+"""Command line: ``python -m framework.bench {perf,accuracy,regimes,render} [--quick] [--json] [--plot P] [--docs]``."""
 
 from __future__ import annotations
 
