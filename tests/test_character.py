@@ -196,12 +196,12 @@ V_LEVEL = floor_row(8) + floor_row(3, 48.0) + floor_row(3, 48.0, start=5) + [
 """Ground at 64 on both sides of a V: a 45-degree slope down from x = 96 to 128, up to 160."""
 
 
-@pytest.mark.parametrize("x, rest", [(128.0, 44.0), (125.0, 47.0), (134.0, 50.0)])
-def test_stands_in_a_v(x, rest):
+@pytest.mark.parametrize("drop_x, rest", [(128.0, 44.0), (125.0, 47.0), (134.0, 50.0)])
+def test_stands_in_a_v(drop_x, rest):
     """Dropped into a V of two 45-degree slopes, it stays where it lands: centred, its corners on
     both slopes; off centre, on the slope its lower corner meets (it does not slide down)."""
     s = scene_with(V_LEVEL)
-    e = character(s, x, 120.0)
+    e = character(s, drop_x, 120.0)
     for _ in range(200):
         s.step(DT)
     c = s.get(e, CharacterController)
@@ -211,7 +211,7 @@ def test_stands_in_a_v(x, rest):
         s.step(DT)
         assert (t.x, t.y) == (x, y)
     assert c.on_floor
-    assert x == pytest.approx(x, abs=0.0) and feet(s, e) == pytest.approx(rest, abs=3 * SKIN)
+    assert x == drop_x and feet(s, e) == pytest.approx(rest, abs=3 * SKIN)  # straight down, no slide
 
 
 def test_walks_through_a_v():
@@ -245,15 +245,22 @@ def test_jumping_into_a_wall_never_sticks():
     e = character(s, 140.0, 32.0)
     settle(s, e)
     s.get(e, Velocity).y = 512.0
-    vys = []
+    c = s.get(e, CharacterController)
+    vys, walls = [], []
     for _ in range(30):
         s.get(e, Velocity).x = 128.0
         s.step(DT)
         vys.append(s.get(e, Velocity).y)
-        assert s.get(e, Transform).x + W / 2 <= 160.0
+        right = s.get(e, Transform).x + W / 2
+        assert right <= 160.0
+        walls.append((right == 160.0, c.on_wall, c.wall_normal))
     # Gravity acts every step while pressed against the wall: the jump rises and falls freely.
     assert all(b - a == pytest.approx(G * DT) for a, b in zip(vys, vys[1:]) if a > -400.0 and b != 0.0)
-    assert s.get(e, CharacterController).on_wall is not None
+    # It reaches the wall exactly (touching it: not yet on it); from the next step on, pushing into it,
+    # it is on the wall (normal to the left) every step, still in the air.
+    first = next(i for i, (at, _on, _n) in enumerate(walls) if at)
+    assert first < 10 and all(w == (True, True, (-1.0, 0.0)) for w in walls[first + 1:])
+    assert not c.on_floor
 
 
 def platform_scene(vx: float, vy: float, one_way: bool = False) -> tuple[Scene, int, int]:
