@@ -163,6 +163,51 @@ def enemy() -> np.ndarray:
     return img
 
 
+def player_sheet() -> np.ndarray:
+    """7 frames of 24 x 28 in a row, facing right (the renderer mirrors them for left): idle (2:
+    standing, then breathing in a pixel), run (4: the feet apart and together, bobbing), jump (1:
+    feet tucked)."""
+    base = player(1)
+    frames = [base, np.roll(base, -1, axis=0)]
+    for k in range(4):
+        f = np.roll(base, -1 if k % 2 else 0, axis=0).copy()
+        f[24:, :] = 0
+        foot = (60, 130, 210, 255)
+        apart = k in (0, 2)
+        for x0 in ((2, 16) if apart else (6, 12)):
+            f[24:28, x0:x0 + 6] = foot
+        frames.append(f)
+    jump = base.copy()
+    jump[22:, :] = 0
+    jump[22:25, 4:20] = (60, 130, 210, 255)
+    frames.append(jump)
+    return np.concatenate(frames, axis=1)
+
+
+def enemy_sheet() -> np.ndarray:
+    """2 frames of 24 x 22 (walking: the feet step), facing left as :func:`enemy`."""
+    a = enemy()
+    b = a.copy()
+    b[18:22] = 0
+    b[18:22, 4:12, :3] = b[18:22, 12:20, :3] = (70, 30, 60)
+    b[18:22, 4:12, 3] = b[18:22, 12:20, 3] = 255
+    return np.concatenate([a, b], axis=1)
+
+
+def coin_sheet() -> np.ndarray:
+    """4 frames of 16 x 16: a gold coin turning (full, narrower, edge-on, narrower)."""
+    frames = []
+    for rx in (7.5, 5.0, 1.5, 5.0):
+        img = np.zeros((16, 16, 4), dtype=np.uint8)
+        disc = _ellipse_mask(16, 16, 7.5, 7.5, 7.5, rx)
+        img[disc] = (255, 212, 64, 255)
+        _outline(img, (200, 150, 30))
+        if rx > 2:
+            img[4:12, 7:9, :3] = np.where(disc[4:12, 7:9, None], (255, 240, 150), img[4:12, 7:9, :3])
+        frames.append(img)
+    return np.concatenate(frames, axis=1)
+
+
 def flag(width: int, color: tuple[int, int, int]) -> np.ndarray:
     """``width`` x 32: a pole with a flag (the goal: 32 wide; a checkpoint: 16)."""
     img = np.zeros((32, width, 4), dtype=np.uint8)
@@ -211,6 +256,9 @@ def main() -> None:
     write_png(IMAGES / "player_right.png", player(1))
     write_png(IMAGES / "player_left.png", player(-1))
     write_png(IMAGES / "enemy.png", enemy())
+    write_png(IMAGES / "player_sheet.png", player_sheet())
+    write_png(IMAGES / "enemy_sheet.png", enemy_sheet())
+    write_png(IMAGES / "coin_sheet.png", coin_sheet())
     write_png(IMAGES / "goal.png", flag(32, (90, 224, 120)))
     write_png(IMAGES / "checkpoint.png", flag(16, (150, 150, 150)))
     write_png(IMAGES / "checkpoint_on.png", flag(16, (120, 230, 255)))

@@ -23,6 +23,7 @@ from framework.input import Input
 from framework.tiles import SLOPES, STEP, terrain_pieces
 
 from . import systems
+from .animations import SHEETS, animations
 from .components import (
     ALL,
     ENEMY,
@@ -58,7 +59,7 @@ PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
 ART_TILE = 32.0  # the tile images (see art.py) are drawn for 32-unit tiles; other sizes get colours
 IMAGES = {name: Path(__file__).with_name("images") / f"{name}.png" for name in (
     "ground", "ground_top", "plank", "player_right", "player_left", "enemy", "goal", "checkpoint",
-    "checkpoint_on", *SLOPES, STEP)}
+    "checkpoint_on", *SLOPES, STEP, *SHEETS)}
 
 
 class Game:
@@ -126,6 +127,9 @@ class Game:
         def look(image: str, color: str, z: int) -> Visual:
             return Visual(image=str(IMAGES[image]), z=z) if art else Visual(COLORS[color], z=z)
 
+        def moving(animation: str, color: str, z: int) -> Visual:
+            return Visual(animation=animations()[animation], z=z) if art else Visual(COLORS[color], z=z)
+
         # Terrain (solid cells and slopes): framework.tiles merges slope runs into convex pieces,
         # so nothing catches on a seam; a solid cell on its own stays one box per cell.
         for pc in terrain_pieces(level.tiles, t):
@@ -158,7 +162,7 @@ class Game:
             if obj.kind == "coin":
                 piece("coin", Transform(obj.x, obj.y), Hitbox(
                     Circle(tu.coin_radius * t), body="static", sensor=True, layer=PICKUP, mask=PLAYER),
-                    Coin(), Visual(COLORS["coin"], z=2))
+                    Coin(), moving("coin", "coin", 2))
             elif obj.kind in ("goal", "checkpoint"):
                 w, h = (obj.width, obj.height) if obj.width > 0 and obj.height > 0 else (t, t)
                 bottom = obj.bottom if obj.height > 0 else obj.y
@@ -190,14 +194,14 @@ class Game:
                 piece("enemy", Transform(obj.x, obj.bottom + h * 0.5), Velocity(), Hitbox(
                     AABB(w, h), body="kinematic", layer=ENEMY, mask=SOLID | ONE_WAY | PLAYER | ENEMY | HAZARD),
                     CharacterController(step_height=tu.step_height * t, solid_mask=SOLID | ONE_WAY | ENEMY),
-                    Enemy(speed, int(obj.props.get("direction", -1))), look("enemy", "enemy", 3))
+                    Enemy(speed, int(obj.props.get("direction", -1))), moving("walk", "enemy", 3))
         st.coin_total_in_level = len(level.of_kind("coin"))
         w, h = tu.player_size[0] * t, tu.player_size[1] * t
         st.player = piece("player", Transform(start.x, start.bottom + h * 0.5), Velocity(),
                           Hitbox(AABB(w, h), body="kinematic", layer=PLAYER, mask=PLAYER_MASK),
                           CharacterController(step_height=tu.step_height * t, solid_mask=SOLID | ONE_WAY,
                                               push_mass=tu.push_mass),
-                          Player(), look("player_right", "player", 4))
+                          Player(), moving("idle", "player", 4))
         systems.follow_camera(scene, 0.0)
 
     @staticmethod

@@ -7,7 +7,7 @@ Where each runs in a step (see :func:`install`)::
     character         (framework: the player and the walkers move and slide with their
                        CharacterController: slopes, steps, riding platforms, one-way platforms)
     ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide)
-    after response    sense_player -> sense_enemies -> fall_out -> face -> follow_camera
+    after response    sense_player -> sense_enemies -> fall_out -> animate -> follow_camera
     end of step       collision handlers: coins, spikes, enemies, checkpoints, the goal
 
 The game's own movement code is input -> the velocity wanted: the framework's character
@@ -28,6 +28,7 @@ from framework.components import Visual
 from framework.events import CollisionEvent
 from framework.input import Input
 
+from .animations import animations
 from .components import (
     ONE_WAY,
     SOLID,
@@ -217,14 +218,24 @@ def fall_out(scene: Scene, dt: float) -> None:
             scene.despawn(e)
 
 
-def face(scene: Scene, dt: float) -> None:
-    """The player's picture looks the way it last ran (levels drawn with images only)."""
+def animate(scene: Scene, dt: float) -> None:
+    """The player's animation follows its state (jumping or falling, running, standing) and looks
+    the way it last ran; walkers look the way they walk (levels drawn with images only). Playing
+    the animation already shown, or setting the flip it has, changes nothing."""
     if not _state(scene).art:
         return
-    for _e, (p, vis) in scene.query(Player, Visual):
-        want = "player_right.png" if p.facing > 0 else "player_left.png"
-        if vis.image is not None and not vis.image.endswith(want):
-            vis.image = vis.image.replace("player_left.png" if p.facing > 0 else "player_right.png", want)
+    anims = animations()
+    for e, (p, vis) in scene.query(Player, Visual):
+        if vis.animation is None:
+            continue
+        v = scene.try_get(e, Velocity)
+        running = v is not None and abs(v.x) > 1.0
+        vis.play(anims["run" if running else "idle"] if p.grounded else anims["jump"], scene.time)
+        if vis.flip_x != (p.facing < 0):
+            vis.flip_x = p.facing < 0
+    for _e, (en, vis) in scene.query(Enemy, Visual):
+        if vis.animation is not None and vis.flip_x != (en.direction > 0):
+            vis.flip_x = en.direction > 0
 
 
 def follow_camera(scene: Scene, dt: float) -> None:
@@ -336,7 +347,7 @@ def install(scene: Scene) -> None:
 
     for system in (level_flow, move_platforms, control_player, walk_enemies):
         scene.add_system(system, before="movement")
-    for system in (sense_player, sense_enemies, fall_out, face, follow_camera):
+    for system in (sense_player, sense_enemies, fall_out, animate, follow_camera):
         scene.add_system(system, after="response")
     scene.on_collision(P, Coin, on_coin)
     scene.on_collision(P, Hazard, on_hazard, kinds=("started", "ongoing"))
