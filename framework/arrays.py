@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["distinct"]
 
+_T = TypeVar("_T", bound=np.generic)
 
-def distinct(values: np.ndarray) -> np.ndarray:
+
+def distinct(values: NDArray[_T]) -> NDArray[_T]:
     """The sorted distinct values of an integer array: ``np.unique(values)`` by one sort.
 
     numpy 2's ``np.unique`` takes a hash-table path for integers that costs about seven times a

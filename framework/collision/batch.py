@@ -37,9 +37,11 @@ Inputs must be finite (the systems check components); kernels never return NaN o
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue
@@ -74,7 +76,7 @@ def _template(shape: object) -> tuple[tuple[tuple[float, float], ...], bool]:
     raise InvalidValue(f"outlines needs AABB or Polygon shapes, got {shape!r}")
 
 
-def outlines(shapes: Sequence[AABB | Polygon], rotations: object) -> tuple[np.ndarray, np.ndarray]:
+def outlines(shapes: Sequence[AABB | Polygon], rotations: object) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Outlines of boxes and polygons, rotated, relative to their hitbox origins.
 
     Returns ``(verts, counts)``: ``verts [N, K, 2]`` float64, counter-clockwise, ``K`` the largest
@@ -149,21 +151,24 @@ def collide_many(
     ra = np.array([s.bounding_radius for s in sa])
     rb = np.array([s.bounding_radius for s in sb])
 
-    def run(mask: np.ndarray, kernel) -> None:
+    def run(mask: NDArray[np.bool_], kernel: Callable[[NDArray[np.intp]], ContactArrays]) -> None:
         rows = np.flatnonzero(mask)
         if rows.size:
             res = kernel(rows)
             for dst, src in zip(out, res, strict=True):
                 dst[rows] = src
 
-    def radius(shapes: list[Shape], rows: np.ndarray) -> np.ndarray:
-        return np.array([shapes[i].radius for i in rows])  # type: ignore[attr-defined]
+    def radius(shapes: list[Shape], rows: NDArray[np.intp]) -> NDArray[np.float64]:
+        return np.array([shapes[i].radius for i in rows])
 
-    def half(shapes: list[Shape], rows: np.ndarray, attr: str) -> np.ndarray:
+    def half(shapes: list[Shape], rows: NDArray[np.intp], attr: str) -> NDArray[np.float64]:
         return np.array([getattr(shapes[i], attr) * 0.5 for i in rows])
 
-    def shape_outlines(shapes: list[Shape], rot: np.ndarray, rows: np.ndarray):
-        return outlines([shapes[i] for i in rows], rot[rows])  # type: ignore[misc]
+    def shape_outlines(
+        shapes: list[Shape], rot: NDArray[np.float64], rows: NDArray[np.intp],
+    ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+        # (the pair table sends only boxes and polygons here)
+        return outlines(cast("list[AABB | Polygon]", [shapes[i] for i in rows]), rot[rows])
 
     run(family == CIRCLES, lambda r: circle_circle(
         pa[r, 0], pa[r, 1], radius(sa, r), pb[r, 0], pb[r, 1], radius(sb, r)))
@@ -183,9 +188,10 @@ def collide_many(
         swap = flip[caps].copy()
         for j, i in enumerate(caps.tolist()):
             if not swap[j] and isinstance(sb[i], Capsule):
+                # (not flipped: A is a capsule too; the poses are rows of three)
                 swap[j] = not capsule_first(sa[i], tuple(pa[i]), sb[i], tuple(pb[i]))  # type: ignore[arg-type]
         res = _capsule_rows(
-            [sb[i] if w else sa[i] for i, w in zip(caps.tolist(), swap.tolist(), strict=True)],
+            cast("list[Capsule]", [sb[i] if w else sa[i] for i, w in zip(caps.tolist(), swap.tolist(), strict=True)]),
             np.where(swap[:, None], pb[caps], pa[caps]),
             [sa[i] if w else sb[i] for i, w in zip(caps.tolist(), swap.tolist(), strict=True)],
             np.where(swap[:, None], pa[caps], pb[caps]), swap)
@@ -197,7 +203,9 @@ def collide_many(
     return out
 
 
-def core_rows(shapes: Sequence[Shape], rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def core_rows(
+    shapes: Sequence[Shape], rotations: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
     """The cores of shapes for :func:`capsule_many`, rotated, about their hitbox origins:
     ``(verts [N, K, 2], counts [N], radii [N])`` (a circle: its centre; a capsule: its ends ``-u``,
     ``+u``; a box or polygon: its outline, radius 0)."""
@@ -205,7 +213,8 @@ def core_rows(shapes: Sequence[Shape], rotations: np.ndarray) -> tuple[np.ndarra
     rot = np.broadcast_to(np.asarray(rotations, dtype=F64), (n,))
     outl = [i for i, s in enumerate(shapes) if isinstance(s, (AABB, Polygon))]
     caps = [i for i, s in enumerate(shapes) if isinstance(s, Capsule)]
-    verts_o, count_o = outlines([shapes[i] for i in outl], rot[outl]) if outl else (np.zeros((0, 2, 2)), None)
+    verts_o, count_o = (outlines(cast("list[AABB | Polygon]", [shapes[i] for i in outl]), rot[outl]) if outl
+                        else (np.zeros((0, 2, 2)), None))
     k = max(2, verts_o.shape[1])
     verts = np.zeros((n, k, 2))
     counts = np.ones(n, dtype=np.int64)
@@ -213,8 +222,9 @@ def core_rows(shapes: Sequence[Shape], rotations: np.ndarray) -> tuple[np.ndarra
     if outl:
         verts[outl, : verts_o.shape[1]] = verts_o
         verts[outl, verts_o.shape[1]:] = verts_o[:, -1:]
-        counts[outl] = count_o
+        counts[outl] = count_o  # type: ignore[assignment]  # (not None: there are outlines)
     if caps:
+        # (the rows `caps` hold capsules)
         ux, uy = half_segments([shapes[i].half_length for i in caps], rot[caps])  # type: ignore[attr-defined]
         verts[caps, 0, 0], verts[caps, 0, 1] = -ux, -uy
         verts[caps, 1:, 0], verts[caps, 1:, 1] = ux[:, None], uy[:, None]
@@ -225,11 +235,11 @@ def core_rows(shapes: Sequence[Shape], rotations: np.ndarray) -> tuple[np.ndarra
     return verts, counts, radii
 
 
-def _capsule_rows(caps: list[Shape], pc: np.ndarray, others: list[Shape], po: np.ndarray,
-                  flip: np.ndarray) -> ContactArrays:
+def _capsule_rows(caps: list[Capsule], pc: NDArray[np.float64], others: list[Shape], po: NDArray[np.float64],
+                  flip: NDArray[np.bool_]) -> ContactArrays:
     """:func:`capsule_many` of capsules ``caps`` at poses ``pc [P, 3]`` against ``others`` at ``po``."""
-    ux, uy = half_segments([c.half_length for c in caps], pc[:, 2])  # type: ignore[attr-defined]
+    ux, uy = half_segments([c.half_length for c in caps], pc[:, 2])
     verts, counts, radii = core_rows(others, po[:, 2])
-    return capsule_many(pc[:, 0], pc[:, 1], ux, uy, np.array([c.radius for c in caps]),  # type: ignore[attr-defined]
+    return capsule_many(pc[:, 0], pc[:, 1], ux, uy, np.array([c.radius for c in caps]),
                         np.array([c.bounding_radius for c in caps]), po[:, 0], po[:, 1], verts, counts, radii,
                         np.array([o.bounding_radius for o in others]), flip)

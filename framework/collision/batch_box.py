@@ -20,6 +20,7 @@ where the scalar code takes its depths from exact overlaps, so does this kernel 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .batch_common import F64, ContactArrays, columns, finish, frame, sum_leading
 from .batch_point import overlap_point
@@ -30,7 +31,7 @@ from .tiebreak import DEPTH_TOL
 __all__ = ["aabb_aabb", "aabb_aabb_fast"]
 
 
-def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _two_sum(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(s, e)``: ``s = fl(a + b)`` and ``s + e == a + b`` exactly (Knuth; no overflow)."""
     s = a + b
     bb = s - a
@@ -42,13 +43,13 @@ def _reach(o, q, ha, hb):
     return (*_two_sum(q, -o), *_two_sum(ha, hb))
 
 
-def _dd_overlap(dh, dl, rh, rl) -> np.ndarray:
+def _dd_overlap(dh, dl, rh, rl) -> NDArray[np.float64]:
     """``(rh + rl) - |dh + dl|`` (reach less distance), to about double-double accuracy."""
     sgn = np.where(dh < 0.0, -1.0, 1.0)
     return (rh - np.abs(dh)) + (rl - sgn * dl)
 
 
-def _less(dh, dl, rh, rl) -> np.ndarray:
+def _less(dh, dl, rh, rl) -> NDArray[np.bool_]:
     """``|dh + dl| < rh + rl`` exactly (``dh``, ``rh`` the rounded leading parts, ``rh >= 0``)."""
     adh = np.abs(dh)
     return (adh < rh) | ((adh == rh) & (np.sign(dh) * dl < rl))
@@ -110,7 +111,7 @@ def aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh) -> ContactArrays:
     return finish(hit, nx, ny, depth, px, py, k, ax, ay)
 
 
-def _crossing(t: np.ndarray, u: np.ndarray, gone: np.ndarray) -> np.ndarray:
+def _crossing(t: NDArray[np.float64], u: NDArray[np.float64], gone: NDArray[np.bool_]) -> NDArray[np.float64]:
     """1.0 where two edges cross (``t`` and ``u`` in [0, 1]; a vanished edge never crosses)."""
     return ((t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0) & ~gone).astype(F64)
 

@@ -82,7 +82,8 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, fallback: bo
     p = vx.shape[1]
     ax, ay, bx, by, r = columns_of(p, ax, ay, bx, by, br)
     if p == 0:
-        return finish(np.zeros(0, dtype=bool), *([np.zeros(0)] * 5), np.zeros(0, dtype=int), ax, ay)
+        z = np.zeros(0)
+        return finish(np.zeros(0, dtype=bool), z, z, z, z, z, np.zeros(0, dtype=int), ax, ay)
     f = np.where(np.broadcast_to(np.asarray(flip, dtype=bool), (p,)), -1.0, 1.0)  # per row
     # The polygon's frame, whichever shape of the pair it is.
     cx, cy, k = frame(ax, ay, bx, by, np.maximum(extent(vx, vy), r))

@@ -20,9 +20,10 @@ shape in its own local coordinates and B's offset kept apart: a projection is
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..validation import InvalidValue
 from .exact import TINY
@@ -31,9 +32,10 @@ from .tiebreak import DEPTH_TOL, DIR_TOL
 __all__ = ["ContactArrays", "sum_leading"]
 
 F64 = np.float64
+_T = TypeVar("_T", bound=np.generic)
 
 
-def sum_leading(values: np.ndarray) -> np.ndarray:
+def sum_leading(values: NDArray[_T]) -> NDArray[_T]:
     """The sum over every axis but the last (the pairs, ``[..., P]``), in one fixed order (first
     index first), so a pair's sum does not depend on how many pairs share the batch. (numpy sums
     a 1-D run pairwise: a batch of one pair would add its terms in another order than a batch of
@@ -54,12 +56,12 @@ class ContactArrays(NamedTuple):
     exactly as :func:`framework.collision.collide` gives them. Elsewhere every value is 0.
     """
 
-    hit: np.ndarray
-    nx: np.ndarray
-    ny: np.ndarray
-    depth: np.ndarray
-    px: np.ndarray
-    py: np.ndarray
+    hit: NDArray[np.bool_]
+    nx: NDArray[np.float64]
+    ny: NDArray[np.float64]
+    depth: NDArray[np.float64]
+    px: NDArray[np.float64]
+    py: NDArray[np.float64]
 
 
 def no_contacts(n: int) -> ContactArrays:
@@ -67,7 +69,7 @@ def no_contacts(n: int) -> ContactArrays:
     return ContactArrays(np.zeros(n, dtype=bool), z, z.copy(), z.copy(), z.copy(), z.copy())
 
 
-def columns(*values: object) -> list[np.ndarray]:
+def columns(*values: object) -> list[NDArray[np.float64]]:
     """The inputs as float64 1-D arrays of one common length (scalars broadcast)."""
     arrs = np.broadcast_arrays(*(np.atleast_1d(np.asarray(v, dtype=F64)) for v in values))
     if arrs[0].ndim != 1:
@@ -75,7 +77,7 @@ def columns(*values: object) -> list[np.ndarray]:
     return [np.ascontiguousarray(a) for a in arrs]
 
 
-def columns_of(n: int, *values: object) -> list[np.ndarray]:
+def columns_of(n: int, *values: object) -> list[NDArray[np.float64]]:
     """The inputs as float64 arrays of shape ``(n,)`` (scalars broadcast)."""
     out = []
     for v in values:
@@ -89,7 +91,10 @@ def columns_of(n: int, *values: object) -> list[np.ndarray]:
     return out
 
 
-def frame(ox: np.ndarray, oy: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach: np.ndarray):
+def frame(
+    ox: NDArray[np.float64], oy: NDArray[np.float64], qx: NDArray[np.float64], qy: NDArray[np.float64],
+    reach: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int32]]:
     """The scaled local frame of the scalar code: ``(dx, dy, k)`` with the offset of q from o
     scaled by ``2**-k`` so that it and ``reach`` (the larger bounding radius) are about 1.
 
@@ -102,7 +107,11 @@ def frame(ox: np.ndarray, oy: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach:
     return np.ldexp(hx, 1 - k), np.ldexp(hy, 1 - k), k
 
 
-def finish(hit: np.ndarray, nx, ny, depth, px, py, k, ox, oy) -> ContactArrays:
+def finish(
+    hit: NDArray[np.bool_], nx: NDArray[np.float64], ny: NDArray[np.float64], depth: NDArray[np.float64],
+    px: NDArray[np.float64], py: NDArray[np.float64], k: NDArray[np.integer], ox: NDArray[np.float64],
+    oy: NDArray[np.float64],
+) -> ContactArrays:
     """Contacts of the ``hit`` rows (compressed, in the scaled local frame of origin (ox, oy),
     all ``[H]``) unscaled, moved to the world and spread back to all rows (zeros elsewhere)."""
     n = hit.shape[0]
@@ -129,7 +138,9 @@ def finish(hit: np.ndarray, nx, ny, depth, px, py, k, ox, oy) -> ContactArrays:
 # the few slots is then a reduction over axis 0, which numpy vectorises along the P pairs (a
 # reduction over a short last axis costs some 30 times more).
 
-def outline_rows(verts: object, count: object, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def outline_rows(
+    verts: object, count: object, name: str,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]:
     """``(vx [K, P], vy [K, P], count [P])`` of an outline batch ``[P, K, 2]``; the padding is
     rewritten to repeat each outline's last vertex, whatever the caller put there."""
     v = np.asarray(verts, dtype=F64)
@@ -152,7 +163,7 @@ def outline_rows(verts: object, count: object, name: str) -> tuple[np.ndarray, n
     return vx, vy, c
 
 
-def edges(v: np.ndarray) -> np.ndarray:
+def edges(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """One coordinate of the edge vectors of padded outlines ``[K, P]`` (module docstring)."""
     e = np.empty_like(v)
     np.subtract(v[1:], v[:-1], out=e[:-1])
@@ -160,18 +171,18 @@ def edges(v: np.ndarray) -> np.ndarray:
     return e
 
 
-def edge_mask(ex: np.ndarray, ey: np.ndarray) -> np.ndarray:
+def edge_mask(ex: NDArray[np.float64], ey: NDArray[np.float64]) -> NDArray[np.bool_]:
     """The edges that give an axis; padding edges (and, as in the scalar code, an edge scaled
     away to nothing) have length exactly zero."""
     return (ex != 0.0) | (ey != 0.0)
 
 
-def vertex_mask(count: np.ndarray, k: int) -> np.ndarray:
+def vertex_mask(count: NDArray[np.intp], k: int) -> NDArray[np.bool_]:
     """``[K, P]``: the real (not padding) vertex slots."""
     return np.arange(k)[:, None] < count
 
 
-def norm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def norm(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
     """``|(x, y)|`` for values of order 1 (a scaled frame): the root of the squares, which is
     several times faster than ``np.hypot``, with ``hypot`` where the squares would underflow."""
     n = np.sqrt(x * x + y * y)
@@ -181,7 +192,7 @@ def norm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return n
 
 
-def extent(vx: np.ndarray, vy: np.ndarray) -> np.ndarray:
+def extent(vx: NDArray[np.float64], vy: NDArray[np.float64]) -> NDArray[np.float64]:
     """Per outline ``[K, P]``, a length within a factor 2 of its bounding radius (for scaling)."""
     return np.maximum(np.abs(vx).max(axis=0), np.abs(vy).max(axis=0))
 
@@ -192,32 +203,34 @@ def extent(vx: np.ndarray, vy: np.ndarray) -> np.ndarray:
 BIG = 1e300
 
 
-def first(mask: np.ndarray) -> np.ndarray:
+def first(mask: NDArray[np.bool_]) -> NDArray[np.intp]:
     """Per column of ``mask [C, P]``, the first row that is True (0 where none is): ``argmax``
     returns the first of equal maxima (ten times faster than a loop over the rows on the few dozen
     pairs a re-measure holds)."""
     return np.argmax(mask, axis=0)
 
 
-def first_min(v: np.ndarray) -> np.ndarray:
+def first_min(v: NDArray[np.float64]) -> NDArray[np.intp]:
     """Per column of ``v [C, P]``, the first row holding the column's minimum (as ``argmin``)."""
     return first(v == v.min(axis=0))
 
 
-def cols(v: np.ndarray, rows: np.ndarray) -> np.ndarray:
+def cols(v: NDArray[_T], rows: NDArray[np.intp]) -> NDArray[_T]:
     """The pairs ``rows`` (integer indices) of a slot-major array ``[C, P]``, C-contiguous (plain
     ``v[:, mask]`` can come out column-major, which makes every later axis-0 reduction slow)."""
     return np.take(v, rows, axis=1)
 
 
-def take(v: np.ndarray, i: np.ndarray) -> np.ndarray:
+def take(v: NDArray[_T], i: NDArray[np.intp]) -> NDArray[_T]:
     """``v[i[p], p]`` for every column p."""
     return v[i, np.arange(v.shape[1])]
 
 
 # --- the tie-break rule on arrays ------------------------------------------------------------
 
-def pick(depth: np.ndarray, nx: np.ndarray, ny: np.ndarray, size: np.ndarray):
+def pick(
+    depth: NDArray[np.float64], nx: NDArray[np.float64], ny: NDArray[np.float64], size: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Per column, the winning ``(depth, nx, ny)`` among candidates ``[C, P]`` (``depth`` >= BIG
     for absent ones), by the steps of :func:`framework.collision.tiebreak.pick`."""
     best = depth.min(axis=0)

@@ -18,6 +18,7 @@ AABB's outline) are, to the scalar code, two AABBs: they go to the exact box ker
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..validation import InvalidValue
 from .batch_box import aabb_aabb, aabb_aabb_fast
@@ -52,7 +53,7 @@ def _frame(avx, avy, bvx, bvy, ax, ay, bx, by):
     return avx, avy, bvx, bvy, dx, dy, k, size
 
 
-def _centred_boxes(vx: np.ndarray, vy: np.ndarray, count: np.ndarray) -> np.ndarray:
+def _centred_boxes(vx: NDArray[np.float64], vy: NDArray[np.float64], count: NDArray[np.intp]) -> NDArray[np.bool_]:
     """The outlines that are ``(±hw, ±hh)`` exactly, as an AABB's (``Polygon.box`` unturned)."""
     if vx.shape[0] < 4:
         return np.zeros(count.shape, dtype=bool)
@@ -78,7 +79,9 @@ def _rows(ax, ay, averts, acount, bx, by, bverts, bcount):
     return avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, boxes, rest, box_args
 
 
-def _extent(ux: np.ndarray, uy: np.ndarray, vx: np.ndarray, vy: np.ndarray):
+def _extent(
+    ux: NDArray[np.float64], uy: NDArray[np.float64], vx: NDArray[np.float64], vy: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Min and max of every vertex ``[K, P]`` projected on every axis ``[C, P]``: ``[C, P]``."""
     # A loop over the few vertices keeps the temporaries small (3x faster than [C, K, P]).
     lo = ux * vx[0]
@@ -154,9 +157,11 @@ def polygon_polygon(ax, ay, averts, acount, bx, by, bverts, bcount, size=None, e
     for dst, src in zip(out, res, strict=True):
         dst[boxes] = src
     if rest.size:
+        r_avx, r_avy, r_acount, r_bvx, r_bvy, r_bcount = (
+            cols(v, rest) if v.ndim == 2 else v[rest] for v in (avx, avy, acount, bvx, bvy, bcount))
         res = _polygon_polygon(
-            *(cols(v, rest) if v.ndim == 2 else v[rest] for v in (avx, avy, acount, bvx, bvy, bcount)),
-            *(v[rest] for v in (ax, ay, bx, by)), None if size is None else size[rest], exact, points,
+            r_avx, r_avy, r_acount, r_bvx, r_bvy, r_bcount, ax[rest], ay[rest], bx[rest], by[rest],
+            None if size is None else size[rest], exact, points,
         )
         for dst, src in zip(out, res, strict=True):
             dst[rest] = src
@@ -192,7 +197,7 @@ def _polygon_polygon(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, size, e
         np.divide(over, ln, out=d)
         np.maximum(d, TINY, out=d)
         d += absent
-    depth, nx, ny = pick(*(a.reshape(2 * c, n) for a in (cdepth, cnx, cny)), sz)
+    depth, nx, ny = pick(cdepth.reshape(2 * c, n), cnx.reshape(2 * c, n), cny.reshape(2 * c, n), sz)
     # The point is found with B at its offset.
     if points:
         bvx, bvy = bvx + dx, bvy + dy

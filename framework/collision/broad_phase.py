@@ -25,19 +25,21 @@ How (the invariants and their proofs are in :mod:`framework.collision.grid`):
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..arrays import distinct
 from ..validation import InvalidValue, finite, positive
 from . import grid
-from .grid import CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
+from .grid import Bounds, CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
 
 __all__ = ["SpatialHash", "brute_force_pairs"]
 
 _I64 = np.int64
 _EMPTY_I = np.zeros(0, dtype=_I64)
-_EMPTY_BOUNDS = (np.zeros(0),) * 4
+_EMPTY_BOUNDS: Bounds = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
 # At most this many moving bodies are paired directly, every two of them (see SpatialHash.pairs).
 SMALL = 48
 
@@ -46,23 +48,26 @@ class _FewBodies:
     """The moving bodies of a :meth:`SpatialHash.pairs` call that paired them directly: what the
     queries read of them (their bounds; none is large)."""
 
-    def __init__(self, bounds: tuple) -> None:
+    def __init__(self, bounds: Bounds) -> None:
         self.bounds = bounds
         self.n = bounds[0].shape[0]
         self.large = _EMPTY_I
 
 
-_UPPER: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+_UPPER: dict[int, tuple[NDArray[np.int64], NDArray[np.int64]]] = {}
 
 
-def _upper_pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+def _upper_pairs(n: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """``(i, j)``, every ``i < j < n`` (cached per ``n``)."""
     if n not in _UPPER:
-        _UPPER[n] = tuple(v.astype(_I64) for v in np.triu_indices(n, 1))
+        i, j = np.triu_indices(n, 1)
+        _UPPER[n] = (i.astype(_I64), j.astype(_I64))
     return _UPPER[n]
 
 
-def brute_force_pairs(minx, miny, maxx, maxy, static=None) -> tuple[np.ndarray, np.ndarray]:
+def brute_force_pairs(
+    minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, static: ArrayLike | None = None,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Reference answer by testing all N^2 pairs (numpy, in row blocks): ``(i, j)``, ``i < j``.
 
     Index pairs of strictly overlapping bounds, excluding static-static pairs, lexicographically
@@ -78,7 +83,7 @@ def brute_force_pairs(minx, miny, maxx, maxy, static=None) -> tuple[np.ndarray, 
     return i[keep], j[keep]
 
 
-def _as_ids(ids, n: int) -> np.ndarray:
+def _as_ids(ids: ArrayLike, n: int) -> NDArray[np.int64]:
     a = np.asarray(ids).reshape(-1)
     if a.shape[0] != n:
         raise InvalidValue(f"ids must have {n} entries (one per body), got {a.shape[0]}")
@@ -89,7 +94,9 @@ def _as_ids(ids, n: int) -> np.ndarray:
     return a.astype(_I64, copy=False)
 
 
-def _sorted_id_pairs(ia: np.ndarray, ib: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _sorted_id_pairs(
+    ia: NDArray[np.int64], ib: NDArray[np.int64],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """``(lo, hi)`` of id pairs, ``lo < hi``, sorted lexicographically."""
     lo = np.minimum(ia, ib)
     hi = np.maximum(ia, ib)
@@ -123,7 +130,7 @@ class SpatialHash:
         self._static = CellIndex(_EMPTY_BOUNDS, 1.0)
         self._static_ids = _EMPTY_I
         self._static_extent: tuple[float, float, float, float] | None = None
-        self._moving = StripSweep(_EMPTY_BOUNDS, 1.0)
+        self._moving: StripSweep | _FewBodies = StripSweep(_EMPTY_BOUNDS, 1.0)
         self._moving_ids = _EMPTY_I
         self._moving_cells: CellIndex | None = None
         self._queries = 0
@@ -142,19 +149,19 @@ class SpatialHash:
             raise InvalidValue("set_cell_size must come before the first set_static or pairs call")
         self._cell = positive("cell_size", cell_size)
 
-    def _choose_cell(self, bounds: tuple) -> float:
+    def _choose_cell(self, bounds: Bounds) -> float:
         if self._cell is None:
             self._cell = grid.auto_cell_size(*bounds)
         return self._cell if self._cell is not None else 1.0
 
     # --- building ---------------------------------------------------------------------------------
 
-    def set_static(self, minx, miny, maxx, maxy, ids) -> None:
+    def set_static(self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike) -> None:
         """Enter the static bodies (replacing any earlier ones). Call again only when they change."""
         b = as_bounds(minx, miny, maxx, maxy)
-        ids = _as_ids(ids, b[0].shape[0])
+        sids = _as_ids(ids, b[0].shape[0])
         self._static = CellIndex(b, self._choose_cell(b))
-        self._static_ids = ids.copy()
+        self._static_ids = sids.copy()
         # The box around every static (None if some static is not finite, or there is none).
         with np.errstate(over="ignore"):  # a huge sum only makes the extent unknown
             fin = np.isfinite(b[0] + b[1] + b[2] + b[3])
@@ -162,7 +169,10 @@ class SpatialHash:
                                float(b[3].max())) if fin.size and fin.all() else None
         self.rehashed_last = b[0].shape[0]
 
-    def pairs(self, minx, miny, maxx, maxy, ids, *, moving_pairs: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    def pairs(
+        self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike, *,
+        moving_pairs: bool = True,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """All moving-moving and moving-static pairs of strictly overlapping bounds.
 
         The arguments are this step's moving bodies. Returns ``(id_a, id_b)`` int64 arrays with
@@ -171,20 +181,22 @@ class SpatialHash:
         second hash holding the sleeping ones).
         """
         b = as_bounds(minx, miny, maxx, maxy)
-        ids = _as_ids(ids, b[0].shape[0])
+        mids = _as_ids(ids, b[0].shape[0])
         n = b[0].shape[0]
         cell = self._choose_cell(b)
         # Up to SMALL bodies are paired directly, every two of them (cheaper than sorting them into
         # strips), the statics through the bodies near one: the same pairs as the strips give.
         few = n <= SMALL
-        mov = self._moving = _FewBodies(tuple(v.copy() for v in b)) if few else StripSweep(b, cell)
+        mov = self._moving = (_FewBodies((b[0].copy(), b[1].copy(), b[2].copy(), b[3].copy())) if few
+                              else StripSweep(b, cell))
         self._moving_cells = None
         self._queries = 0
-        self._moving_ids = ids = ids.copy()
+        self._moving_ids = ids = mids.copy()
         self.rehashed_last = n
 
-        out_a, out_b = [], []
-        if few:
+        out_a: list[NDArray[np.int64]] = []
+        out_b: list[NDArray[np.int64]] = []
+        if isinstance(mov, _FewBodies):  # (n <= SMALL)
             if moving_pairs and n > 1:
                 i, j = _upper_pairs(n)
                 ok = strict_overlap(*(v[i] for v in b), *(v[j] for v in b))
@@ -212,19 +224,22 @@ class SpatialHash:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
 
-    def static_pairs(self, minx, miny, maxx, maxy, ids) -> tuple[np.ndarray, np.ndarray]:
+    def static_pairs(
+        self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """The pairs of the given bodies with the static ones, like ``pairs(..., moving_pairs=False)``
         but leaving the last :meth:`pairs` call's moving bodies (and queries on them) as they were."""
         b = as_bounds(minx, miny, maxx, maxy)
-        ids = _as_ids(ids, b[0].shape[0])
-        out_a: list[np.ndarray] = []
-        out_b: list[np.ndarray] = []
-        self._near_static_pairs(b, ids, out_a, out_b)
+        out_a: list[NDArray[np.int64]] = []
+        out_b: list[NDArray[np.int64]] = []
+        self._near_static_pairs(b, _as_ids(ids, b[0].shape[0]), out_a, out_b)
         if not out_a:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
 
-    def _near_static_pairs(self, b: tuple, ids: np.ndarray, out_a: list, out_b: list) -> None:
+    def _near_static_pairs(
+        self, b: Bounds, ids: NDArray[np.int64], out_a: list[NDArray[np.int64]], out_b: list[NDArray[np.int64]],
+    ) -> None:
         """Append the pairs of the bodies ``b`` (ids ``ids``) with the statics: only the bodies near
         a static are swept against them."""
         if b[0].shape[0] == 0 or self._static.n == 0:
@@ -244,12 +259,12 @@ class SpatialHash:
             return False
         return not (maxx > ext[0] and minx < ext[2] and maxy > ext[1] and miny < ext[3])
 
-    def near_statics(self, minx, miny, maxx, maxy) -> np.ndarray:
+    def near_statics(self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike) -> NDArray[np.bool_]:
         """Mask of the boxes that may strictly overlap a static body (a cheap superset test)."""
         b = as_bounds(minx, miny, maxx, maxy)
         return self._near_statics(b)
 
-    def _near_statics(self, b: tuple) -> np.ndarray:
+    def _near_statics(self, b: Bounds) -> NDArray[np.bool_]:
         """Mask of the boxes that may meet a static body: one shares a cell they need (no false
         negatives: strictly overlapping bounds always share a cell), a large static overlaps them,
         or they span many cells or are not finite (not looked at closely). Boxes outside the box
@@ -285,7 +300,10 @@ class SpatialHash:
         keep[cand[near]] = True
         return keep
 
-    def _cross_static(self, mov: StripSweep, b: tuple, ids: np.ndarray, out_a: list, out_b: list) -> None:
+    def _cross_static(
+        self, mov: StripSweep, b: Bounds, ids: NDArray[np.int64], out_a: list[NDArray[np.int64]],
+        out_b: list[NDArray[np.int64]],
+    ) -> None:
         """Append the pairs of the swept bodies ``mov`` (bounds ``b``, ids ``ids``) with the statics."""
         stat, sids = self._static, self._static_ids
         if mov.entries and stat.entries:
@@ -319,14 +337,14 @@ class SpatialHash:
             self._moving_cells = CellIndex(self._moving.bounds, self._cell or 1.0, copy=False)
         return self._moving_cells
 
-    def _sets(self):
+    def _sets(self) -> tuple[tuple[CellIndex | None, Bounds, NDArray[np.int64]], ...]:
         """``(index or None, bounds, ids)`` of the static and the moving bodies."""
         return (
             (self._static, self._static.bounds, self._static_ids),
             (self._moving_index(), self._moving.bounds, self._moving_ids),
         )
 
-    def query_box(self, minx, miny, maxx, maxy) -> np.ndarray:
+    def query_box(self, minx: float, miny: float, maxx: float, maxy: float) -> NDArray[np.int64]:
         """Sorted ids of the static bodies and of the last :meth:`pairs` call's moving bodies whose
         bounds strictly overlap the box ``[minx, maxx] x [miny, maxy]`` (touching does not count)."""
         x0, y0 = finite("minx", minx), finite("miny", miny)
@@ -347,10 +365,10 @@ class SpatialHash:
                 found.append(ids[c[ok]])
         return distinct(np.concatenate(found)) if found else _EMPTY_I
 
-    def _box_candidates(self, index: CellIndex, box) -> np.ndarray | None:
+    def _box_candidates(self, index: CellIndex, box: tuple[float, float, float, float]) -> NDArray[np.int64] | None:
         """Sorted numbers of the bodies in the cells under the box and of the large bodies; ``None``
         when the box covers more cells than the index has entries (then test every body)."""
-        cell = self._cell
+        cell = cast(float, self._cell)  # (bodies were entered in the index: a cell size was chosen)
         cx0, cx1 = (int(v) for v in grid.cell_index(np.array([box[0], box[2]]), cell))
         cy0, cy1 = (int(v) for v in grid.cell_index(np.array([box[1], box[3]]), cell))
         gx0, gx1 = max(cx0, index.x0), min(cx1, index.x0 + index.wx - 1)
@@ -362,12 +380,13 @@ class SpatialHash:
         cx = np.tile(np.arange(gx0, gx0 + nx, dtype=_I64), ny)
         return distinct(np.concatenate([index.large, index.bodies_in_cells(cx, cy)]))
 
-    def cells_in_use(self) -> np.ndarray:
+    def cells_in_use(self) -> NDArray[np.int64]:
         """``(M, 2)`` int64 (column, row) of the cells holding a static body or a moving body of the
         last :meth:`pairs` call, sorted; cell ``(c, r)`` spans ``[c, c+1] x [r, r+1]`` times
         :attr:`cell_size`. Large bodies (see the module notes) occupy no cell."""
         cols, rows = [], []
-        for index in (self._static, self._moving_index(for_query=False)):
+        # (not for a query, the moving bodies' index is always built)
+        for index in (self._static, cast(CellIndex, self._moving_index(for_query=False))):
             c, r = index.used_cells()
             cols.append(c)
             rows.append(r)

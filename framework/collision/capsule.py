@@ -32,14 +32,19 @@ give the same bits.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike, NDArray
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from .exact import BAND, TINY, Offset, float_approx, ratio_approx, rounded_exact
 from .ray import closest_on_segment
 from .tiebreak import DEPTH_TOL, DIR_TOL
+
+if TYPE_CHECKING:
+    from .batch_common import ContactArrays
 
 __all__ = ["capsule_first", "capsule_many", "capsule_pair", "core_points", "half_segments", "segment"]
 
@@ -60,7 +65,7 @@ def segment(shape: Capsule, rotation: float, k: int = 0) -> tuple[float, float]:
     return -(s * h), c * h
 
 
-def half_segments(half_length, rotation) -> tuple[np.ndarray, np.ndarray]:
+def half_segments(half_length: ArrayLike, rotation: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """:func:`segment` of many capsules (unscaled), ``[N]`` each: ``math.cos`` and ``math.sin`` as
     the scalar code (numpy's may differ in the last bit), ``(0, h)`` at rotation 0."""
     hl = np.asarray(half_length, dtype=np.float64)
@@ -399,7 +404,7 @@ def capsule_pair(sa: Capsule, rot_a: float, sb: Shape, rot_b: float, dx: float, 
 # --- many pairs (the batch kernel) ------------------------------------------------------------------
 
 def capsule_many(ax, ay, aux, auy, ar, abound, bx, by, bverts, bcount, br, bbound, flip=False,
-                 exact: bool = True):
+                 exact: bool = True) -> ContactArrays:
     """Capsules A (hitbox origins (ax, ay), half segments (aux, auy) already rotated, radii ``ar``,
     bounding radii ``abound``, all ``[P]``) against cores B: origins (bx, by), core points about
     them ``bverts [P, K, 2]`` with ``bcount`` of them (1: a circle's centre; 2: a capsule's ends,

@@ -27,8 +27,9 @@ Numerics, in three layers:
 from __future__ import annotations
 
 import math
+from typing import cast
 
-from ..shapes import Capsule, Circle, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue
 from .capsule import capsule_first, capsule_pair
 from .exact import (
@@ -123,10 +124,12 @@ def _pair(
         res = circle_circle(math.ldexp(sa.radius, -k), math.ldexp(sb.radius, -k), dx, dy, off)
     elif family == POLYGON_CIRCLE:
         assert isinstance(sb, Circle)
-        res = polygon_circle(local_outline(sa, rot_a, k), dx, dy, math.ldexp(sb.radius, -k), off, size,
-                             flip)
+        # (the pair rule puts the box or polygon first)
+        res = polygon_circle(local_outline(cast("AABB | Polygon", sa), rot_a, k), dx, dy, math.ldexp(sb.radius, -k),
+                             off, size, flip)
     else:  # BOXES or POLYGONS: boxes are polygons here
-        res = polygon_polygon(local_outline(sa, rot_a, k), local_outline(sb, rot_b, k), dx, dy, off, size)
+        res = polygon_polygon(local_outline(cast("AABB | Polygon", sa), rot_a, k),
+                              local_outline(cast("AABB | Polygon", sb), rot_b, k), dx, dy, off, size)
     return None if res is None else (res, k)
 
 

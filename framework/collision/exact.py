@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 __all__ = [
     "BAND", "TINY", "Offset", "PolygonCircleExact", "circle_circle_exact", "exact_ints", "float_approx",
@@ -90,7 +90,8 @@ class PolygonCircleExact(NamedTuple):
     contact is made of, each standing for ``n * 2**u`` with the unit ``u`` given (``e`` below)."""
 
     case: str  # "inside" (or on the boundary), "face" (nearest a face) or "vertex" (nearest a vertex)
-    index: int  # "face": the edge from vertex ``index`` to the next; "vertex": the vertex
+    # (The field shadows tuple.index, which nothing calls on this record: mypy flags the override.)
+    index: int  # type: ignore[assignment]  # "face": the edge from vertex ``index`` to the next; "vertex": the vertex
     seps: list[int]  # per edge: the centre's distance outside its line, times the edge's length (2e)
     num: int  # "face": r^2 |edge|^2 - seps[index]^2 (4e); "vertex": r^2 - |centre - vertex|^2 (2e)
     edge2: int  # "face": |edge|^2 (2e)
@@ -199,7 +200,7 @@ def _point_segment_excess(px: int, py: int, s0: tuple[int, int], s1: tuple[int, 
 
 def rounded_exact(
     pa: Pts, lb: Pts, offset: Offset, ra: float, rb: float
-) -> tuple[str] | tuple[str, int, int, int, int] | None:
+) -> tuple[Literal["meet"]] | tuple[Literal["apart"], int, int, int, int] | None:
     """A segment (``pa``: its two ends, about the origin) rounded by ``ra`` against B's core
     (``lb`` about B's own origin, at the offset: one point, a segment's two ends, or a convex CCW
     outline) rounded by ``rb``, on exact integers: ``None`` if they do not overlap (the cores are

@@ -36,12 +36,16 @@ among small ones costs O(N), not a huge number of cells.
 
 from __future__ import annotations
 
+from typing import TypeAlias
+
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
 from ..validation import InvalidValue
 
 __all__ = [
+    "Bounds",
     "CELL_LIMIT",
     "LARGE_CELLS",
     "CellIndex",
@@ -63,6 +67,9 @@ CELL_LIMIT = 1 << 29
 #: A body covering more cells than this is compared with every other body directly instead.
 LARGE_CELLS = 64
 
+#: The bounds of N bodies: ``(minx, miny, maxx, maxy)``, four float64 arrays ``[N]``.
+Bounds: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
 _I64 = np.int64
 _EMPTY_I = np.zeros(0, dtype=_I64)
 # Upper bound on the elements of one dense block in overlap_pairs.
@@ -72,7 +79,7 @@ _BLOCK = 1 << 21
 # --- small helpers --------------------------------------------------------------------------------
 
 
-def as_bounds(minx, miny, maxx, maxy) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def as_bounds(minx: object, miny: object, maxx: object, maxy: object) -> Bounds:
     """The four bounds as 1-D float64 arrays of one length; inverted bounds raise InvalidValue.
 
     NaN passes through (a body with a NaN bound overlaps nothing, as in the brute-force test).
@@ -92,12 +99,13 @@ def as_bounds(minx, miny, maxx, maxy) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return lo_x, lo_y, hi_x, hi_y
 
 
-def subset(bounds: tuple, idx: np.ndarray) -> tuple:
+def subset(bounds: Bounds, idx: NDArray[np.integer]) -> Bounds:
     """The bounds of the bodies ``idx``."""
-    return tuple(v[idx] for v in bounds)
+    minx, miny, maxx, maxy = bounds
+    return minx[idx], miny[idx], maxx[idx], maxy[idx]
 
 
-def cell_index(v: np.ndarray, cell: float, clip: bool = True) -> np.ndarray:
+def cell_index(v: NDArray[np.float64], cell: float, clip: bool = True) -> NDArray[np.int64]:
     """``floor(v / cell)`` clipped to +-CELL_LIMIT, as int64 (``v`` finite or +-inf, not NaN).
 
     ``clip=False`` skips the clipping when the caller knows every ``|v| / cell`` is below the limit.
@@ -105,14 +113,16 @@ def cell_index(v: np.ndarray, cell: float, clip: bool = True) -> np.ndarray:
     return _floor_cells(v / cell, clip)
 
 
-def _floor_cells(q: np.ndarray, clip: bool) -> np.ndarray:
+def _floor_cells(q: NDArray[np.float64], clip: bool) -> NDArray[np.int64]:
     np.floor(q, out=q)
     if clip:
         np.clip(q, -CELL_LIMIT, CELL_LIMIT, out=q)
     return q.astype(_I64)
 
 
-def cell_range(lo: np.ndarray, hi: np.ndarray, cell: float, clip: bool = True):
+def cell_range(
+    lo: NDArray[np.float64], hi: NDArray[np.float64], cell: float, clip: bool = True,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """First and last cell index that interval ``[lo, hi]`` needs, for strict overlaps.
 
     The last is ``cell_index(p)`` for a ``p`` between the float just below ``hi`` and ``hi``, so a
@@ -166,7 +176,9 @@ def strict_overlap(ax0, ay0, ax1, ay1, bx0, by0, bx1, by1):
     return (ax1 > bx0) & (bx1 > ax0) & (ay1 > by0) & (by1 > ay0)
 
 
-def expand_runs(counts: np.ndarray, starts: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def expand_runs(
+    counts: NDArray[np.integer], starts: NDArray[np.integer] | None = None,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """``(owner, value)``: for each ``k``, ``counts[k]`` entries with owner ``k`` and values
     ``starts[k], starts[k] + 1, ...`` (``0, 1, ...`` when ``starts`` is None)."""
     total = int(counts.sum())
@@ -177,7 +189,7 @@ def expand_runs(counts: np.ndarray, starts: np.ndarray | None = None) -> tuple[n
     return owner, value
 
 
-def overlap_pairs(a: tuple, b: tuple, upper: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def overlap_pairs(a: Bounds, b: Bounds, upper: bool = False) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """All ``(i, j)`` with bounds ``a[i]`` strictly overlapping ``b[j]``, in dense blocks (O(|a| |b|)).
 
     ``a`` and ``b`` are ``(minx, miny, maxx, maxy)`` tuples of arrays. With ``upper`` (``a`` is
@@ -203,11 +215,11 @@ class _Ranges:
     """Cell ranges of a set of bodies; ``small`` are the numbers of the bodies entered in cells,
     ``lo_x, hi_x``: the least minx and greatest maxx of the small bodies."""
 
-    def __init__(self, bounds: tuple, cell: float) -> None:
+    def __init__(self, bounds: Bounds, cell: float) -> None:
         with np.errstate(over="ignore"):  # huge coordinates over a tiny cell: clipped below
             self._compute(bounds, cell)
 
-    def _compute(self, bounds: tuple, cell: float) -> None:
+    def _compute(self, bounds: Bounds, cell: float) -> None:
         minx, miny, maxx, maxy = bounds
         n = minx.shape[0]
         if n == 0:
@@ -241,7 +253,7 @@ class _Ranges:
             self.hi_x = float(maxx[self.small].max()) if k else 0.0
 
 
-def _offsets(span: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _offsets(span: NDArray[np.integer]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """``(i, d)`` for every ``i`` and ``0 <= d < span[i]``, grouped by ``d`` when spans are short
     (each group keeps the order of ``i``)."""
     top = int(span.max()) if span.shape[0] else 0
@@ -270,8 +282,9 @@ class CellIndex:
       ``ukey``, ``bound``: the distinct keys, and where the code ranges of each one's run start.
     """
 
-    def __init__(self, bounds: tuple, cell: float, copy: bool = True) -> None:
-        self.bounds = tuple(np.array(v) for v in bounds) if copy else bounds
+    def __init__(self, bounds: Bounds, cell: float, copy: bool = True) -> None:
+        self.bounds: Bounds = (
+            (np.array(bounds[0]), np.array(bounds[1]), np.array(bounds[2]), np.array(bounds[3])) if copy else bounds)
         self.n = self.bounds[0].shape[0]
         self.cell = cell
         r = _Ranges(self.bounds, cell)
@@ -339,7 +352,9 @@ class CellIndex:
     _LO = np.array([2, 2, 1, 0], dtype=_I64)
     _HI = np.array([3, 4, 3, 4], dtype=_I64)
 
-    def lookup(self, cx: np.ndarray, cy: np.ndarray, f: np.ndarray | None = None):
+    def lookup(
+        self, cx: NDArray[np.int64], cy: NDArray[np.int64], f: NDArray[np.int64] | None = None,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """``(lo, hi)``: the entries of cell ``(cx[k], cy[k])`` are ``lo[k]:hi[k]`` (empty if none);
         with query flags ``f``, only those an entry with flags ``f[k]`` is paired with in that cell
         (``f | flags == 0b11``). Fastest when the cells come in row-major order."""
@@ -361,7 +376,7 @@ class CellIndex:
             lo, hi = self.bound[u, self._LO[f]], self.bound[u, self._HI[f]]
         return lo, np.where(hit, hi, lo)
 
-    def bodies_in_cells(self, cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
+    def bodies_in_cells(self, cx: NDArray[np.int64], cy: NDArray[np.int64]) -> NDArray[np.int64]:
         """Numbers of the bodies entered in any of the given cells (with repeats)."""
         if self.entries == 0 or cx.shape[0] == 0:
             return _EMPTY_I
@@ -369,7 +384,7 @@ class CellIndex:
         _, pos = expand_runs(hi - lo, lo)
         return self.body[pos]
 
-    def used_cells(self) -> tuple[np.ndarray, np.ndarray]:
+    def used_cells(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """(column, row) of the cells holding something."""
         if self.entries == 0:
             return _EMPTY_I, _EMPTY_I
@@ -395,14 +410,14 @@ class StripSweep:
     the body's bounds ``ex0, ey0, ex1, ey1``, the sweep key ``skey`` and its limit ``slim``.
     """
 
-    def __init__(self, bounds: tuple, cell: float) -> None:
+    def __init__(self, bounds: Bounds, cell: float) -> None:
         minx, miny, maxx, maxy = bounds  # not kept: the caller may reuse its arrays
         self.n = minx.shape[0]
         self.cell = cell
         r = self._ranges = _Ranges(bounds, cell)
         self.large = r.large
         self._large_bounds = subset(bounds, r.large)
-        self._bounds = None
+        self._bounds: Bounds | None = None
         sb = r.small
         k = sb.shape[0]
         if k == 0:
@@ -434,11 +449,11 @@ class StripSweep:
         self.skey = np.append(skey, np.iinfo(_I64).max)
 
     @property
-    def bounds(self) -> tuple:
+    def bounds(self) -> Bounds:
         """The bodies' (minx, miny, maxx, maxy), rebuilt on demand from the entries (each small body
         once, from its first row) and the large bodies."""
         if self._bounds is None:
-            out = tuple(np.empty(self.n) for _ in range(4))
+            out = (np.empty(self.n), np.empty(self.n), np.empty(self.n), np.empty(self.n))
             once = np.flatnonzero(self.first)
             entry = (self.ex0, self.ey0, self.ex1, self.ey1)
             for v, e, lg in zip(out, entry, self._large_bounds, strict=True):
@@ -447,7 +462,7 @@ class StripSweep:
             self._bounds = out
         return self._bounds
 
-    def quantise(self, x: np.ndarray) -> np.ndarray:
+    def quantise(self, x: NDArray[np.float64]) -> NDArray[np.int64]:
         """The monotone quantiser ``q`` of the sort order (see the class notes)."""
         lo, scale, top = self._q
         if scale == 0.0:  # one x for all, or a span that overflows: no order within rows at all
@@ -460,14 +475,14 @@ class StripSweep:
     def entries(self) -> int:
         return self.row.shape[0]
 
-    def self_pairs(self) -> tuple[np.ndarray, np.ndarray]:
+    def self_pairs(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """``(a, b)`` body numbers of the strictly overlapping pairs of small bodies, each once."""
         if self.entries < 2:
             return _EMPTY_I, _EMPTY_I
         pa, pb = sweep_pairs(self.skey, self.slim, self.ex0, self.ey0, self.ex1, self.ey1, self.first)
         return self.body[pa], self.body[pb]
 
-    def cross_pairs(self, stat: CellIndex) -> tuple[np.ndarray, np.ndarray]:
+    def cross_pairs(self, stat: CellIndex) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """``(m, s)``: small moving body ``m`` strictly overlapping small static body ``s``."""
         if self.entries == 0 or stat.entries == 0:
             return _EMPTY_I, _EMPTY_I

@@ -14,6 +14,7 @@ Circles touch at one point: collide's. Points are in the overlap region (the con
 from __future__ import annotations
 
 import math
+from typing import cast
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from .collide import collide
@@ -37,8 +38,9 @@ def manifold(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: o
     single = Manifold(c.normal, (ManifoldPoint(c.point, c.depth),))
     if isinstance(shape_a, (Circle, Capsule)) or isinstance(shape_b, (Circle, Capsule)):
         return single  # (a round shape touches at one point)
-    pa = _world(shape_a, *pose("transform_a", transform_a))
-    pb = _world(shape_b, *pose("transform_b", transform_b))
+    # (collide accepted them and neither is round: boxes or polygons)
+    pa = _world(cast("AABB | Polygon", shape_a), *pose("transform_a", transform_a))
+    pb = _world(cast("AABB | Polygon", shape_b), *pose("transform_b", transform_b))
     nx, ny = c.normal
     ia, along_a = _facing(pa, nx, ny)
     ib, along_b = _facing(pb, -nx, -ny)

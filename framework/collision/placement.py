@@ -7,6 +7,8 @@ scene at x = 1e9 gives the answers of the same scene at the origin, to float64 r
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import cast
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue, finite
@@ -24,19 +26,19 @@ def pose(name: str, transform: object) -> tuple[float, float, float]:
     """``(x, y, rotation)`` of a Transform (or an ``(x, y[, rotation])`` sequence), checked finite."""
     if hasattr(transform, "x") and hasattr(transform, "y"):
         return (
-            finite(f"{name}.x", transform.x),  # type: ignore[union-attr]
-            finite(f"{name}.y", transform.y),  # type: ignore[union-attr]
+            finite(f"{name}.x", transform.x),
+            finite(f"{name}.y", transform.y),
             finite(f"{name}.rotation", getattr(transform, "rotation", 0.0)),
         )
     try:
-        n = len(transform)  # type: ignore[arg-type]
+        n = len(transform)  # type: ignore[arg-type]  # (any object: one without a length raises TypeError)
     except TypeError:
         n = -1
     if n not in (2, 3) or isinstance(transform, (str, bytes)):
         raise InvalidValue(f"{name} must be a Transform or an (x, y[, rotation]) tuple, got {transform!r}")
-    seq = transform  # type: ignore[assignment]
-    rot = seq[2] if n == 3 else 0.0  # type: ignore[index]
-    return (finite(f"{name}[0]", seq[0]), finite(f"{name}[1]", seq[1]),  # type: ignore[index]
+    seq = cast("Sequence[object]", transform)  # (a length of 2 or 3, not a string: a sequence)
+    rot = seq[2] if n == 3 else 0.0
+    return (finite(f"{name}[0]", seq[0]), finite(f"{name}[1]", seq[1]),
             finite(f"{name}[2]", rot))
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from numbers import Real
+from typing import cast
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue, vector2
@@ -74,7 +75,8 @@ def raycast(
     elif isinstance(shape, Capsule):
         res = _ray_capsule(mx, my, shape, rot, k, ux, uy)
     else:
-        res = _ray_polygon(scaled_outline(shape, 0.0, 0.0, rot, k), mx, my, ux, uy, ulen)
+        # (not a circle or a capsule: check_shape let only a box or a polygon through)
+        res = _ray_polygon(scaled_outline(cast("AABB | Polygon", shape), 0.0, 0.0, rot, k), mx, my, ux, uy, ulen)
     if res is None:
         return None
     tau, normal = res

@@ -25,8 +25,9 @@ bit (except at fraction 0, where the normal is ``collide``'s).
 from __future__ import annotations
 
 import math
+from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import vector2
 from .capsule import capsule_first, core_points
 from .collide import collide
@@ -116,7 +117,9 @@ def _sweep_pair(
     rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
     if rule.family == CAPSULES:
         # The capsule first (of two, the one placed first), as collide does; then turned round.
-        flip = rule.flip or (isinstance(shape_b, Capsule) and not capsule_first(shape_a, pose_a, shape_b, pose_b))
+        # (of a capsule pair the rule does not flip, A is a capsule)
+        flip = rule.flip or (isinstance(shape_b, Capsule)
+                             and not capsule_first(cast(Capsule, shape_a), pose_a, shape_b, pose_b))
         if flip:
             return _turned_round(_capsule_pair(shape_b, br, shape_a, ar, -dx, -dy, -vx, -vy, k))
         return _capsule_pair(shape_a, ar, shape_b, br, dx, dy, vx, vy, k)
@@ -126,13 +129,13 @@ def _sweep_pair(
                               vx, vy)
     if rule.family == POLYGON_CIRCLE and not rule.flip:
         assert isinstance(shape_b, Circle)
-        return _polygon_circle(scaled_outline(shape_a, 0.0, 0.0, ar, k), dx, dy,
+        return _polygon_circle(scaled_outline(_outlined(shape_a), 0.0, 0.0, ar, k), dx, dy,
                                math.ldexp(shape_b.radius, -k), vx, vy)
     if rule.family == POLYGON_CIRCLE:
         # A circle against B: in B's frame (as when B comes first, so that both orders do the same
         # arithmetic), cast A's centre at -delta, moving by -v; then turn the normals round.
         assert isinstance(shape_a, Circle)
-        res = _polygon_circle(scaled_outline(shape_b, 0.0, 0.0, br, k), -dx, -dy,
+        res = _polygon_circle(scaled_outline(_outlined(shape_b), 0.0, 0.0, br, k), -dx, -dy,
                               math.ldexp(shape_a.radius, -k), -vx, -vy)
         return _turned_round(res)
     # BOXES or POLYGONS: the swept SAT.
@@ -140,11 +143,11 @@ def _sweep_pair(
         # Work in the frame of whichever shape sorts first, so that swapping A and B repeats the
         # very same arithmetic: the same fraction and the exactly negated normal. (Two circles'
         # numbers only change sign when swapped; a circle and a polygon work in the polygon's frame.)
-        res = _polygon_polygon(scaled_outline(shape_b, 0.0, 0.0, br, k),
-                               scaled_outline(shape_a, -dx, -dy, ar, k), -vx, -vy)
+        res = _polygon_polygon(scaled_outline(_outlined(shape_b), 0.0, 0.0, br, k),
+                               scaled_outline(_outlined(shape_a), -dx, -dy, ar, k), -vx, -vy)
         return _turned_round(res)
-    return _polygon_polygon(scaled_outline(shape_a, 0.0, 0.0, ar, k),
-                            scaled_outline(shape_b, dx, dy, br, k), vx, vy)
+    return _polygon_polygon(scaled_outline(_outlined(shape_a), 0.0, 0.0, ar, k),
+                            scaled_outline(_outlined(shape_b), dx, dy, br, k), vx, vy)
 
 
 def _turned_round(res: _Sweep | None) -> _Sweep | None:
@@ -154,9 +157,14 @@ def _turned_round(res: _Sweep | None) -> _Sweep | None:
     return res[0], res[1], [(t, -nx, -ny) for t, nx, ny in res[2]]
 
 
-def _order_key(shape: Shape, x: float, y: float, rotation: float) -> tuple:
+def _outlined(shape: Shape) -> AABB | Polygon:
+    """``shape`` as the box or polygon that the pair rule says it is here (no check made)."""
+    return cast("AABB | Polygon", shape)
+
+
+def _order_key(shape: Shape, x: float, y: float, rotation: float) -> tuple[object, ...]:
     """A total order on placed boxes and polygons (equal keys: the same outline at the same place)."""
-    params = (shape.width, shape.height) if isinstance(shape, AABB) else shape.points  # type: ignore[union-attr]
+    params = (shape.width, shape.height) if isinstance(shape, AABB) else cast(Polygon, shape).points
     return (x, y, rotation, kind_of(shape), params)
 
 
