@@ -36,7 +36,8 @@ class _Columns:
     def __init__(self, *values: object) -> None:
         self._store: BodyStore | None = None
         self._entity = -1
-        self._own = [finite(f"{type(self).__name__} {name}", v) for name, v in zip(self._fields, values)]
+        # (a value written later is kept as written and checked at the next step: any object)
+        self._own: list[object] = [finite(f"{type(self).__name__} {name}", v) for name, v in zip(self._fields, values)]
 
     def _get(self, i: int) -> Any:
         store = self._store
@@ -61,7 +62,7 @@ class _Columns:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return self._values() == other._values()  # type: ignore[attr-defined]
+        return self._values() == other._values()
 
     __hash__ = None  # type: ignore[assignment]  # mutable
 
@@ -81,9 +82,14 @@ class Transform(_Columns):
     def __init__(self, x: float = 0.0, y: float = 0.0, rotation: float = 0.0) -> None:
         super().__init__(x, y, rotation)
 
-    x = _field(0, "World x of the entity's origin.")
-    y = _field(1, "World y of the entity's origin (y up).")
-    rotation = _field(2, "Rotation in radians, counter-clockwise.")
+    if TYPE_CHECKING:  # the properties below, as type checkers see them
+        x: float
+        y: float
+        rotation: float
+    else:
+        x = _field(0, "World x of the entity's origin.")
+        y = _field(1, "World y of the entity's origin (y up).")
+        rotation = _field(2, "Rotation in radians, counter-clockwise.")
 
 
 class Velocity(_Columns):
@@ -98,9 +104,14 @@ class Velocity(_Columns):
     def __init__(self, x: float = 0.0, y: float = 0.0, angular: float = 0.0) -> None:
         super().__init__(x, y, angular)
 
-    x = _field(0, "Velocity along x, world units per second.")
-    y = _field(1, "Velocity along y, world units per second.")
-    angular = _field(2, "Angular velocity, radians per second (counter-clockwise).")
+    if TYPE_CHECKING:  # the properties below, as type checkers see them
+        x: float
+        y: float
+        angular: float
+    else:
+        x = _field(0, "Velocity along x, world units per second.")
+        y = _field(1, "Velocity along y, world units per second.")
+        angular = _field(2, "Angular velocity, radians per second (counter-clockwise).")
 
 
 class Body(Enum):
@@ -156,6 +167,44 @@ class Hitbox:
     """
 
     __slots__ = ("_store", "_entity") + tuple("_" + f for f in _HITBOX_FIELDS)
+
+    if TYPE_CHECKING:
+        # The fields as type checkers see them (__getattr__ and __setattr__ serve them at run time;
+        # a field set to a bad value is kept as written and reported by the scene's next step).
+        shape: Shape
+        offset: tuple[float, float]
+        layer: int
+        mask: int
+        sensor: bool
+
+        @property
+        def body(self) -> Body: ...
+        @body.setter
+        def body(self, value: Body | str) -> None: ...
+
+        mass: float
+        restitution: float
+        ccd: bool
+        one_way: bool
+        friction: float | None
+        inertia: float | None
+        density: float | None
+        # the slots behind them
+        _store: BodyStore | None
+        _entity: int
+        _shape: Shape
+        _offset: tuple[float, float]
+        _layer: int
+        _mask: int
+        _sensor: bool
+        _body: Body
+        _mass: float
+        _restitution: float
+        _ccd: bool
+        _one_way: bool
+        _friction: float | None
+        _inertia: float | None
+        _density: float | None
 
     def __init__(
         self,
@@ -256,7 +305,7 @@ def check_hitbox_field(name: str, value: object) -> Any:
     if name == "mass":
         if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
             raise InvalidValue(f"Hitbox mass must be a number > 0, got {value!r}")
-        m = float(value)  # type: ignore[arg-type]
+        m = float(value)
         if not (m > 0.0):  # inf allowed: immovable
             raise InvalidValue(f"Hitbox mass must be > 0 (math.inf for immovable), got {value!r}")
         return m
@@ -270,7 +319,7 @@ def check_hitbox_field(name: str, value: object) -> Any:
             return None
         if isinstance(value, bool) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
             raise InvalidValue(f"Hitbox inertia must be a number > 0 (or None), got {value!r}")
-        i = float(value)  # type: ignore[arg-type]
+        i = float(value)
         if not (i > 0.0):  # inf allowed: never turns
             raise InvalidValue(f"Hitbox inertia must be > 0 (math.inf: never turns; None: from the shape), "
                                f"got {value!r}")
@@ -310,6 +359,15 @@ def check_component(comp: object) -> None:
             object.__setattr__(comp, "_" + name, value)
 
 
+def _rgba(color: Any) -> tuple[int, int, int, int]:
+    """A Visual's colour as RGBA (alpha 255 when RGB is given); anything else is an InvalidValue."""
+    if not isinstance(color, tuple) or len(color) not in (3, 4) or not all(
+        isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in color
+    ):
+        raise InvalidValue(f"Visual color must be an (r, g, b[, a]) tuple of ints 0-255, got {color!r}")
+    return (color[0], color[1], color[2], color[3] if len(color) == 4 else 255)
+
+
 class Visual:
     """How the render system draws an entity; entities without a Visual are not drawn (the debug
     overlay still outlines hitboxes).
@@ -334,10 +392,7 @@ class Visual:
         visible: bool = True, *, frame: Frame | None = None, animation: Animation | None = None,
         flip_x: bool = False, started: float | None = None,
     ) -> None:
-        if not isinstance(color, tuple) or len(color) not in (3, 4) or not all(
-            isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in color
-        ):
-            raise InvalidValue(f"Visual color must be an (r, g, b[, a]) tuple of ints 0-255, got {color!r}")
+        color = _rgba(color)
         if isinstance(z, bool) or not isinstance(z, int):
             raise InvalidValue(f"Visual z must be an int, got {z!r}")
         if image is not None and not isinstance(image, str):
@@ -351,7 +406,7 @@ class Visual:
         set_ = object.__setattr__
         set_(self, "_store", None)
         set_(self, "_entity", -1)
-        set_(self, "color", color if len(color) == 4 else (*color, 255))
+        set_(self, "color", color)
         set_(self, "z", z)
         set_(self, "image", image)
         set_(self, "visible", bool(visible))
@@ -361,6 +416,8 @@ class Visual:
         set_(self, "started", started)
 
     def __setattr__(self, name: str, value: Any) -> None:
+        if name == "color":
+            value = _rgba(value)
         object.__setattr__(self, name, value)
         if name in Visual._TRACKED and self._store is not None:
             self._store.visual_changed(self._entity)  # the renderer looks at this entity again
