@@ -13,7 +13,7 @@ from .report import DATA_DIR, REPO, command_line, replace_generated, to_json, wr
 __all__ = ["main"]
 
 DOCS = {"perf": REPO / "docs" / "performance.md", "accuracy": REPO / "docs" / "accuracy.md",
-        "regimes": REPO / "docs" / "performance.md", "render": REPO / "docs" / "rendering.md"}
+        "regimes": REPO / "docs" / "performance.md", "render": REPO / "docs" / "performance.md"}
 QUICK_HELP = {"perf": "perf < 2 min", "accuracy": "accuracy < 1 min", "regimes": "regimes ~2 min",
               "render": "render ~2 min"}
 
