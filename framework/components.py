@@ -14,7 +14,7 @@ a scene, a component keeps its own values.
 from __future__ import annotations
 
 from enum import Enum
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .sprites import Animation, Frame
@@ -67,7 +67,15 @@ class _Columns:
     __hash__ = None  # type: ignore[assignment]  # mutable
 
 
-def _field(i: int, doc: str) -> property:
+if TYPE_CHECKING:
+    class _FloatField(Protocol):
+        """What a :func:`_field` property is to a type checker: a float to read and to write."""
+
+        def __get__(self, obj: Any, owner: type | None = None, /) -> float: ...
+        def __set__(self, obj: Any, value: float, /) -> None: ...
+
+
+def _field(i: int, doc: str) -> _FloatField:
     return property(lambda self: self._get(i), lambda self, v: self._set(i, v), doc=doc)
 
 
@@ -82,14 +90,9 @@ class Transform(_Columns):
     def __init__(self, x: float = 0.0, y: float = 0.0, rotation: float = 0.0) -> None:
         super().__init__(x, y, rotation)
 
-    if TYPE_CHECKING:  # the properties below, as type checkers see them
-        x: float
-        y: float
-        rotation: float
-    else:
-        x = _field(0, "World x of the entity's origin.")
-        y = _field(1, "World y of the entity's origin (y up).")
-        rotation = _field(2, "Rotation in radians, counter-clockwise.")
+    x = _field(0, "World x of the entity's origin.")
+    y = _field(1, "World y of the entity's origin (y up).")
+    rotation = _field(2, "Rotation in radians, counter-clockwise.")
 
 
 class Velocity(_Columns):
@@ -104,14 +107,9 @@ class Velocity(_Columns):
     def __init__(self, x: float = 0.0, y: float = 0.0, angular: float = 0.0) -> None:
         super().__init__(x, y, angular)
 
-    if TYPE_CHECKING:  # the properties below, as type checkers see them
-        x: float
-        y: float
-        angular: float
-    else:
-        x = _field(0, "Velocity along x, world units per second.")
-        y = _field(1, "Velocity along y, world units per second.")
-        angular = _field(2, "Angular velocity, radians per second (counter-clockwise).")
+    x = _field(0, "Velocity along x, world units per second.")
+    y = _field(1, "Velocity along y, world units per second.")
+    angular = _field(2, "Angular velocity, radians per second (counter-clockwise).")
 
 
 class Body(Enum):
