@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import math
 from numbers import Real
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
@@ -49,7 +50,7 @@ _FIELD_NAMES = {
 }
 
 
-def as_selector(rows: np.ndarray) -> slice | np.ndarray:
+def as_selector(rows: NDArray[np.intp]) -> slice | NDArray[np.intp]:
     """Sorted distinct ``rows`` as a slice when they are one contiguous run, else as they are."""
     if rows.size and int(rows[-1]) - int(rows[0]) + 1 == rows.size:
         return slice(int(rows[0]), int(rows[-1]) + 1)
@@ -59,10 +60,40 @@ def as_selector(rows: np.ndarray) -> slice | np.ndarray:
 class BodyStore:
     """Columns of every entity that has a Transform (and optionally Velocity and Hitbox)."""
 
+    if TYPE_CHECKING:  # the live rows of the columns (``cols[name][:n]``), as __getattr__ serves them
+        x: NDArray[np.float64]
+        y: NDArray[np.float64]
+        rot: NDArray[np.float64]
+        vx: NDArray[np.float64]
+        vy: NDArray[np.float64]
+        w: NDArray[np.float64]
+        ox: NDArray[np.float64]
+        oy: NDArray[np.float64]
+        hw: NDArray[np.float64]
+        hh: NDArray[np.float64]
+        radius: NDArray[np.float64]
+        bound: NDArray[np.float64]
+        inv_mass: NDArray[np.float64]
+        restitution: NDArray[np.float64]
+        friction: NDArray[np.float64]
+        inv_inertia: NDArray[np.float64]
+        kind: NDArray[np.int8]
+        body: NDArray[np.int8]
+        layer: NDArray[np.int64]
+        mask: NDArray[np.int64]
+        entity: NDArray[np.int64]
+        still: NDArray[np.int32]
+        has_vel: NDArray[np.bool_]
+        sensor: NDArray[np.bool_]
+        ccd: NDArray[np.bool_]
+        one_way: NDArray[np.bool_]
+        asleep: NDArray[np.bool_]
+
     def __init__(self, capacity: int = 64) -> None:
         self.n = 0
         self.cap = capacity
-        self.cols: dict[str, np.ndarray] = {}
+        # (columns of several dtypes: float64, int8 / int32 / int64 and bool; see the declarations above)
+        self.cols: dict[str, NDArray[Any]] = {}
         for name in _FLOATS:
             self.cols[name] = np.zeros(capacity)
         for name, dt in _INTS.items():
@@ -82,6 +113,8 @@ class BodyStore:
         self.sleep_dirty = False  # a body fell asleep or woke: re-hash the sleepers
         self.written: set[int] = set()  # entities game code wrote to since the last check
         self._active_key: tuple[int, int, int] | None = None
+        self._active: tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]
+        self._active_sel: tuple[slice | NDArray[np.intp], ...]
         self._layers_key = -1
         self._kinds_key = -1
         self._kinds: frozenset[int] = frozenset()
@@ -117,7 +150,7 @@ class BodyStore:
         if value:
             self.sleep_epoch += 1
 
-    def active(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def active(self) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]:
         """``(movers, awake_bodies, nonstatic)`` rows, cached until rows, kinds or sleep change:
         movers have a Velocity and are neither static nor asleep; awake bodies have a hitbox and
         are neither static nor asleep. Per-step work walks these, never the static level."""
@@ -159,13 +192,13 @@ class BodyStore:
             self._kinds_key = self.version
         return self._kinds
 
-    def active_sel(self) -> tuple[slice | np.ndarray, ...]:
+    def active_sel(self) -> tuple[slice | NDArray[np.intp], ...]:
         """:meth:`active` as selectors: a slice where the rows are one contiguous run (the usual
         case: movers spawned together), so the per-step column reads are views, not gathers."""
         self.active()
         return self._active_sel
 
-    def rows_of(self, entities: np.ndarray) -> np.ndarray:
+    def rows_of(self, entities: NDArray[np.integer] | list[int]) -> NDArray[np.int64]:
         """Rows of ``entities`` (-1 for an id without a row), through a table rebuilt after each
         structural change: the one entity -> row lookup of the pipeline, the queries and the renderer."""
         if self._lookup_version != self.version:  # (every spawn and despawn bumps the version)
@@ -173,10 +206,10 @@ class BodyStore:
             lut = np.full(size, -1, dtype=np.int64)
             lut[self.entity] = np.arange(self.n)
             self._lookup, self._lookup_version = lut, self.version
-        entities = np.asarray(entities, dtype=np.int64)
-        out = np.full(entities.size, -1, dtype=np.int64)
-        ok = entities < self._lookup.size
-        out[ok] = self._lookup[entities[ok]]
+        ents = np.asarray(entities, dtype=np.int64)
+        out = np.full(ents.size, -1, dtype=np.int64)
+        ok = ents < self._lookup.size
+        out[ok] = self._lookup[ents[ok]]
         return out
 
     def has_friction(self) -> bool:
@@ -186,7 +219,7 @@ class BodyStore:
             self._friction_seen = (self.version, bool((self.friction > 0.0).any()))
         return self._friction_seen[1]
 
-    def pair_friction(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    def pair_friction(self, ra: NDArray[np.integer], rb: NDArray[np.integer]) -> NDArray[np.float64]:
         """The friction coefficient of each pair ``(ra, rb)``: ``sqrt(f_a * f_b)`` where both
         hitboxes give one, the one given where one does, 0 where neither does."""
         fa, fb = self.friction[ra], self.friction[rb]
@@ -194,7 +227,7 @@ class BodyStore:
         both = np.sqrt(np.maximum(fa, 0.0) * np.maximum(fb, 0.0))
         return np.where(given_a & given_b, both, np.where(given_a, fa, np.where(given_b, fb, 0.0)))
 
-    def movable(self, rows: np.ndarray) -> np.ndarray:
+    def movable(self, rows: NDArray[np.integer]) -> NDArray[np.bool_]:
         """Mask of ``rows`` the response may move: a finite mass (``inv_mass > 0``), and awake."""
         return (self.inv_mass[rows] > 0.0) & ~self.asleep[rows]
 
@@ -202,7 +235,7 @@ class BodyStore:
     # Each bumps ``motion``, so whatever is derived from positions (hitbox bounds) knows it is stale
     # without the mover having to say so.
 
-    def move_by_velocity(self, rows: np.ndarray, sel: slice | np.ndarray, dt: float) -> None:
+    def move_by_velocity(self, rows: NDArray[np.intp], sel: slice | NDArray[np.intp], dt: float) -> None:
         """``x += vx dt``, ``y += vy dt`` and ``rot += w dt`` over ``rows`` (``sel``: the same rows,
         as a slice where they are one run, so the column reads are views, not gathers)."""
         c = self.cols
@@ -214,7 +247,9 @@ class BodyStore:
             c["rot"][rows[spinning]] += w[spinning] * dt
         self.motion += 1
 
-    def place(self, rows: np.ndarray | int, x: np.ndarray | float, y: np.ndarray | float) -> None:
+    def place(
+        self, rows: NDArray[np.integer] | int, x: NDArray[np.float64] | float, y: NDArray[np.float64] | float,
+    ) -> None:
         """Put ``rows`` at ``(x, y)``."""
         self.cols["x"][rows] = x
         self.cols["y"][rows] = y
@@ -222,7 +257,7 @@ class BodyStore:
 
     # --- columns ---------------------------------------------------------------------------
 
-    def __getattr__(self, name: str) -> np.ndarray:
+    def __getattr__(self, name: str) -> NDArray[Any]:  # (a column of any of the dtypes above)
         cols = self.__dict__.get("cols")
         if cols is not None and name in cols:
             return cols[name][: self.__dict__["n"]]
@@ -391,7 +426,7 @@ class BodyStore:
             return bad
         return float(self.cols[col][self.row_of[entity]])
 
-    def wake(self, rows: np.ndarray | int) -> None:
+    def wake(self, rows: NDArray[np.integer] | int) -> None:
         """Wake sleeping rows (game code moved them, or something touched them)."""
         asleep = self.cols["asleep"]
         rows = np.atleast_1d(rows)
@@ -474,7 +509,7 @@ class BodyStore:
         changed = self.dirty_hitboxes
         for e in changed:
             row = self.row_of[e]
-            hb = self.hitboxes[row]
+            hb = cast(Hitbox, self.hitboxes[row])  # (the row of an edited hitbox holds it)
             try:
                 for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction", "inertia",
                              "density"):
