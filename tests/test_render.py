@@ -456,6 +456,22 @@ def test_overlay_marks_the_points_a_turning_box_rests_on(render, turns):
         assert (np.abs(xs - 80) <= 4).any() and (np.abs(xs - 120) <= 4).any(), sorted(set(xs.tolist()))
 
 
+def test_overlay_draws_each_moving_body_s_velocity(render):
+    """A line from the body's position to where its velocity takes it in VELOCITY_SECONDS; none for
+    a body at rest."""
+    from framework.render.overlay import VELOCITY_SECONDS
+
+    colors = render.OVERLAY_COLORS
+    with Scene(cell_size=256.0) as s:
+        s.spawn(Transform(40.0, 40.0), Velocity(80.0, 0.0), Hitbox(AABB(4.0, 4.0), sensor=True))
+        s.spawn(Transform(40.0, 80.0), Velocity(0.0, 0.0), Hitbox(AABB(4.0, 4.0), sensor=True))
+        img = render.screenshot(s, width=128, height=96, background=BG, debug=True)
+        reach = int(80.0 * VELOCITY_SECONDS)  # 20 px
+        lit = np.argwhere(np.all(img[..., :3] == colors["velocity"][:3], axis=-1))
+        assert sorted(set((96 - 1 - lit[:, 0]).tolist())) == [40]  # one row, y = 40
+        assert sorted(lit[:, 1].tolist()) == list(range(40, 40 + reach))  # from x = 40, 20 px long
+
+
 def test_scene_effect_debug_overlay_turns_the_overlay_on(render):
     with Scene(effects=["movement", "detection", "debug_overlay"]) as s:
         r = render.Renderer(width=32, height=32)

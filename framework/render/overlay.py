@@ -9,6 +9,8 @@
 - the friction in use at them (``scene.step_frame.support``): a line along the contact, the way
   friction pushes B, as long as a normal where friction is at its limit (the bodies slide) and
   shorter in proportion where it holds them (static friction);
+- each moving body's velocity: a line from its position to where it would be
+  :data:`VELOCITY_SECONDS` later;
 - the swept paths of continuous-detection bodies (``scene.step_frame.swept_paths``);
 - the spatial hash's cells in use, by the static bodies and the last step's moving ones
   (``scene.bodies.hash.cells_in_use()``);
@@ -49,6 +51,7 @@ OVERLAY_COLORS: dict[str, tuple[int, int, int, int]] = {
     "friction": (255, 110, 200, 255),
     "point": (255, 140, 0, 255),
     "swept": (255, 0, 255, 255),
+    "velocity": (150, 110, 255, 255),
     "cell": (50, 50, 100, 255),
     "ray": (255, 255, 255, 255),
     "ray_rest": (110, 110, 110, 255),
@@ -59,6 +62,7 @@ OVERLAY_COLORS: dict[str, tuple[int, int, int, int]] = {
 CIRCLE_SEGMENTS = 24
 CROSS_PX = 4.0    # half size of a contact cross, in screen pixels
 NORMAL_PX = 16.0  # length of a drawn normal, in screen pixels
+VELOCITY_SECONDS = 0.25  # a velocity is drawn as the way its body would go in this time
 
 _VERTEX = """#version 150 core
 in vec2 position;
@@ -160,6 +164,20 @@ def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segme
         seg_colors = np.broadcast_to(colors[capsules][:, None, :], segs.shape[:2] + (4,))
         out.append((segs.reshape(-1, 4), seg_colors.reshape(-1, 4)))
     return out
+
+
+def _velocity_segments(store: Any, rows: np.ndarray) -> list[Segments]:
+    """For each of ``rows`` with a non-zero Velocity: its entity's position to where the velocity
+    takes it in :data:`VELOCITY_SECONDS`."""
+    if rows.size == 0:
+        return []
+    vx, vy = store.vx[rows], store.vy[rows]
+    moving = store.has_vel[rows] & ((vx != 0.0) | (vy != 0.0))
+    if not moving.any():
+        return []
+    x, y = store.x[rows][moving], store.y[rows][moving]
+    ends = np.stack([x, y, x + vx[moving] * VELOCITY_SECONDS, y + vy[moving] * VELOCITY_SECONDS], axis=1)
+    return [_segments(ends, OVERLAY_COLORS["velocity"])]
 
 
 def _cell_segments(static_hash: Any, box: tuple[float, float, float, float]) -> list[Segments]:
@@ -312,6 +330,7 @@ class DebugOverlay:
         parts: list[Segments] = []
         parts += _cell_segments(bodies.hash, renderer.camera.view_box())
         parts += _outline_segments(store, geometry, rows[store.kind[rows] >= 0])
+        parts += _velocity_segments(store, rows)
         parts += _swept_path_segments(frame.swept_paths)
         parts += _ray_segments(frame.ray_log, NORMAL_PX / zoom)
         parts += _contact_segments(frame.contacts, CROSS_PX / zoom, NORMAL_PX / zoom)
