@@ -13,6 +13,7 @@ a scene, a component keeps its own values.
 
 from __future__ import annotations
 
+import os
 from enum import Enum
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -366,6 +367,17 @@ def _rgba(color: Any) -> tuple[int, int, int, int]:
     return (color[0], color[1], color[2], color[3] if len(color) == 4 else 255)
 
 
+def _check_image(image: Any) -> None:
+    """A Visual's image: None or the path of an existing file (a missing one is named at once, not
+    when a frame is drawn)."""
+    if image is None:
+        return
+    if not isinstance(image, str):
+        raise InvalidValue(f"Visual image must be a file path or None, got {image!r}")
+    if not os.path.isfile(image):
+        raise InvalidValue(f"Visual image {image!r}: no such file")
+
+
 class Visual:
     """How the render system draws an entity; entities without a Visual are not drawn (the debug
     overlay still outlines hitboxes).
@@ -393,8 +405,7 @@ class Visual:
         color = _rgba(color)
         if isinstance(z, bool) or not isinstance(z, int):
             raise InvalidValue(f"Visual z must be an int, got {z!r}")
-        if image is not None and not isinstance(image, str):
-            raise InvalidValue(f"Visual image must be a file path or None, got {image!r}")
+        _check_image(image)
         if frame is not None and not isinstance(frame, Frame):
             raise InvalidValue(f"Visual frame must be a Frame (framework.sprites) or None, got {frame!r}")
         if animation is not None and not isinstance(animation, Animation):
@@ -416,6 +427,8 @@ class Visual:
     def __setattr__(self, name: str, value: Any) -> None:
         if name == "color":
             value = _rgba(value)
+        elif name == "image":
+            _check_image(value)
         object.__setattr__(self, name, value)
         if name in Visual._TRACKED and self._store is not None:
             self._store.visual_changed(self._entity)  # the renderer looks at this entity again

@@ -243,10 +243,18 @@ def test_a_visual_removed_or_changed_mid_animation(render, sheet):
         renderer.close()
 
 
-def test_a_missing_image_names_the_entity_and_the_file_and_the_scene_steps_on(render, tmp_path):
+def test_a_missing_or_broken_image_is_named_and_the_scene_stays_as_it_was(render, tmp_path):
+    with pytest.raises(InvalidValue, match=r"Visual image .*gone\.png.*no such file"):
+        Visual(image=str(tmp_path / "gone.png"))
+    broken = tmp_path / "broken.png"
+    broken.write_bytes(b"\x89PNG\r\n\x1a\n not really")
     with Scene() as s:
-        e = s.spawn(Transform(8.0, 4.0), Velocity(1.0, 0.0), Visual(image=str(tmp_path / "gone.png")))
-        with pytest.raises(ValueError, match=rf"entity {e}: Visual image .*gone\.png.* could not be loaded"):
+        e = s.spawn(Transform(8.0, 4.0), Velocity(1.0, 0.0), Visual((1, 2, 3)))
+        with pytest.raises(InvalidValue, match="gone.png"):
+            s.get(e, Visual).image = str(tmp_path / "gone.png")
+        assert s.get(e, Visual).image is None
+        s.get(e, Visual).image = str(broken)  # it exists: what is in it shows when it is drawn
+        with pytest.raises(ValueError, match=rf"entity {e}: Visual image .*broken\.png.* could not be loaded"):
             shot(render, s)
         x = s.get(e, Transform).x
         s.step(1.0)  # no renderer attached: the simulation is not touched by the failed picture
