@@ -26,17 +26,6 @@ from framework.input import Input
 RED, GREEN, BLUE, BG = (255, 0, 0), (0, 255, 0), (0, 0, 255), (0, 0, 40)
 
 
-@pytest.fixture(scope="module")
-def render():
-    try:
-        import framework.render as render
-
-        render.offscreen_window()
-    except Exception as exc:  # no GL library, no EGL device: not a failure of the code under test
-        pytest.skip(f"no OpenGL context available here ({type(exc).__name__}: {exc})")
-    return render
-
-
 @pytest.fixture
 def scene():
     s = Scene()

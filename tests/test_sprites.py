@@ -20,17 +20,6 @@ BG = (0, 0, 40)
 COLORS = [(255, 0, 0), (0, 255, 0), (0, 0, 255), (255, 255, 0)]
 
 
-@pytest.fixture(scope="module")
-def render():
-    try:
-        import framework.render as render
-
-        render.offscreen_window()
-    except Exception as exc:  # no GL library, no EGL device: not a failure of the code under test
-        pytest.skip(f"no OpenGL context available here ({type(exc).__name__}: {exc})")
-    return render
-
-
 def write(path, rgba: np.ndarray) -> str:
     from framework.render.offscreen import write_png
 

@@ -127,7 +127,24 @@ class Ours:
 # --- a naive pyglet loop and the floor ---------------------------------------------------------------
 
 
-class Naive:
+class _OneBatch:
+    """A peer drawing one pyglet batch into the offscreen target, in the hidden window's context."""
+
+    window: Any
+    batch: Any
+
+    def show(self, target: Any) -> None:
+        from pyglet import gl
+
+        target.draw(WIDTH, HEIGHT, (0, 0, 0), self._draw)
+        gl.glFinish()
+
+    def _draw(self) -> None:
+        self.window.projection = _projection()
+        self.batch.draw()
+
+
+class Naive(_OneBatch):
     """One pyglet shape or sprite per body, positions moved with numpy and set one by one."""
 
     def __init__(self, kind: str, n: int, directory: Path) -> None:
@@ -165,7 +182,6 @@ class Naive:
         self.time = 0.0
 
     def frame(self, target: Any) -> None:
-        from pyglet import gl
 
         self.x += self.vx * DT
         self.y += self.vy * DT
@@ -193,12 +209,7 @@ class Naive:
             else:
                 for o, x, y, r in zip(self.objs, self.x.tolist(), self.y.tolist(), deg):
                     o.update(x=x, y=y, rotation=r)
-        target.draw(WIDTH, HEIGHT, (0, 0, 0), self._draw)
-        gl.glFinish()
-
-    def _draw(self) -> None:
-        self.window.projection = _projection()
-        self.batch.draw()
+        self.show(target)
 
     def close(self) -> None:
         for o in self.objs:
@@ -219,7 +230,7 @@ void main() { final_colors = vertex_colors; }
 """
 
 
-class Floor:
+class Floor(_OneBatch):
     """N quads (two triangles each) whose positions are written from numpy into one vertex list."""
 
     def __init__(self, kind: str, n: int, directory: Path) -> None:
@@ -239,19 +250,13 @@ class Floor:
         self.n = n
 
     def frame(self, target: Any) -> None:
-        from pyglet import gl
 
         self.x += self.vx * DT
         self.y += self.vy * DT
         centres = np.stack([self.x, self.y], axis=1).astype(np.float32)
         pos = (centres[:, None, :] + self.corners[None, :, :]).reshape(-1)
         self.vlist.position[:] = pos
-        target.draw(WIDTH, HEIGHT, (0, 0, 0), self._draw)
-        gl.glFinish()
-
-    def _draw(self) -> None:
-        self.window.projection = _projection()
-        self.batch.draw()
+        self.show(target)
 
     def close(self) -> None:
         self.vlist.delete()
