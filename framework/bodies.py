@@ -10,6 +10,7 @@ positions change, so no mover has to remember to invalidate anything.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .collision.broad_phase import SpatialHash
 from .collision.grid import auto_cell_size
@@ -31,7 +32,7 @@ class Bodies:
         self.n_static = 0
         self._geometry_stamp: tuple[int, ...] | None = None
 
-    def rows_of(self, entities: np.ndarray) -> np.ndarray:
+    def rows_of(self, entities: NDArray[np.integer] | list[int]) -> NDArray[np.int64]:
         """Rows of ``entities`` (-1 for ids without one)."""
         return self.store.rows_of(entities)
 
@@ -61,7 +62,7 @@ class Bodies:
         store.static_dirty = False
         return int(rows.size)
 
-    def _choose_cell_size(self, static_rows: np.ndarray) -> None:
+    def _choose_cell_size(self, static_rows: NDArray[np.intp]) -> None:
         """The automatic cell: about twice the median extent of the moving bodies or of the static
         ones, whichever is larger, so small tiles do not make every mover span dozens of cells
         and small movers do not cut large tiles into many."""
@@ -77,7 +78,7 @@ class Bodies:
             self.hash.set_cell_size(max(sizes))
             self.sleep_hash.set_cell_size(max(sizes))
 
-    def static_rows_in_box(self, minx: float, miny: float, maxx: float, maxy: float) -> np.ndarray:
+    def static_rows_in_box(self, minx: float, miny: float, maxx: float, maxy: float) -> NDArray[np.int64]:
         """Rows of the static bodies whose hashed cells meet the box (candidates, not overlaps)."""
         rows = self.rows_of(self.hash.query_box(minx, miny, maxx, maxy))
         rows = rows[rows >= 0]

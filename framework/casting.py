@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .collision import collide, time_of_impact
 from .collision.results import Vec2
@@ -52,6 +53,7 @@ def shape_bounds(shape: Shape, x: float, y: float, rotation: float) -> tuple[flo
         ys = [y + px * s + py * c for px, py in shape.points]
         return min(xs), min(ys), max(xs), max(ys)
     if shape.kind == "capsule":  # its segment's ends, grown by the radius
+        # (kind "capsule": a Capsule, without importing it here)
         h, r = shape.length * 0.5, shape.radius  # type: ignore[attr-defined]
         ex, ey = abs(h * math.sin(rotation)), abs(h * math.cos(rotation))
         return x - ex - r, y - ey - r, x + ex + r, y + ey + r
@@ -71,6 +73,7 @@ def _support(shape: Shape, x: float, y: float, rotation: float, nx: float, ny: f
         pts = [(x + px * c - py * s, y + px * s + py * c) for px, py in shape.points]
     else:  # a rounded segment (a capsule): its segment's ends pushed out by the radius
         c, s = math.cos(rotation), math.sin(rotation)
+        # (the shapes left are capsules)
         h = shape.length * 0.5  # type: ignore[attr-defined]
         r = shape.radius  # type: ignore[attr-defined]
         pts = [(x + h * s + nx * r, y - h * c + ny * r), (x - h * s + nx * r, y + h * c + ny * r)]
@@ -101,14 +104,16 @@ def touch_point(shape_a: Shape, pose_a: tuple[float, float, float], shape_b: Sha
     return Vec2(d * nx + mid * tx + 0.0, d * ny + mid * ty + 0.0)
 
 
-def _in_box(queries: SpatialQueries, rows: np.ndarray, x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
+def _in_box(
+    queries: SpatialQueries, rows: NDArray[np.intp], x0: float, y0: float, x1: float, y1: float,
+) -> NDArray[np.intp]:
     """The ``rows`` whose current bounds meet the box (closed): the candidates worth an exact test."""
     g = queries.bodies.geometry
     return rows[(g.minx[rows] <= x1) & (g.maxx[rows] >= x0) & (g.miny[rows] <= y1) & (g.maxy[rows] >= y0)]
 
 
 def candidate_rows(queries: SpatialQueries, x0: float, y0: float, x1: float, y1: float, mask: int,
-                   skip: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+                   skip: Callable[[NDArray[np.intp]], NDArray[np.bool_]] | None = None) -> NDArray[np.intp]:
     """Rows with a hitbox in ``mask`` (sensors never block), minus those ``skip`` (rows -> keep
     mask) removes, whose bounds meet the box ``(x0, y0, x1, y1)``."""
     store = queries.bodies.store
@@ -149,7 +154,8 @@ def _box_sweep(ax: float, ay: float, ahw: float, ahh: float, bx: float, by: floa
 def cast_rows(
     queries: SpatialQueries, shape: Shape, x: float, y: float, rotation: float, mx: float, my: float,
     accept: Callable[[int, float, float, float], bool] | None = None, *, mask: int = 0xFFFFFFFF,
-    skip: Callable[[np.ndarray], np.ndarray] | None = None, rows: np.ndarray | None = None, exact: bool = True,
+    skip: Callable[[NDArray[np.intp]], NDArray[np.bool_]] | None = None, rows: NDArray[np.intp] | None = None,
+    exact: bool = True,
 ) -> tuple[int, float, float, float] | None:
     """The first hit of ``shape`` (hitbox origin at ``(x, y)``, turned by ``rotation``) moving by
     ``(mx, my)``: ``(row, fraction, nx, ny)`` with the surface normal facing the shape, or None.
@@ -174,7 +180,7 @@ def cast_rows(
     slabs = not exact and isinstance(shape, AABB)
     hw, hh = (shape.width * 0.5, shape.height * 0.5) if isinstance(shape, AABB) else (0.0, 0.0)
     for r in rows.tolist():
-        other = store.hitboxes[r].shape  # type: ignore[union-attr]  # (candidates have hitboxes)
+        other = store.hitboxes[r].shape  # (candidates have hitboxes)
         if slabs and isinstance(other, AABB):
             quick = _box_sweep(x, y, hw, hh, float(geom.hx[r]), float(geom.hy[r]), other.width * 0.5,
                                other.height * 0.5, mx, my)
@@ -195,8 +201,8 @@ def cast_rows(
 
 
 def overlapping_rows(queries: SpatialQueries, shape: Shape, x: float, y: float, rotation: float,
-                     mask: int, skip: Callable[[np.ndarray], np.ndarray] | None = None,
-                     rows: np.ndarray | None = None, apart: float | None = None,
+                     mask: int, skip: Callable[[NDArray[np.intp]], NDArray[np.bool_]] | None = None,
+                     rows: NDArray[np.intp] | None = None, apart: float | None = None,
                      ) -> list[tuple[int, float, float, float]]:
     """Rows (in ``mask``, not sensors, not ``skip``-ped; or those of ``rows``) whose hitboxes
     ``shape`` overlaps at ``(x, y)``: ``(row, nx, ny, depth)``, the normal pointing from the row's
@@ -214,7 +220,8 @@ def overlapping_rows(queries: SpatialQueries, shape: Shape, x: float, y: float, 
         # Bounds apart by more than rounding: no overlap, no exact test needed.
         if geom.minx[r] >= x1 + tol or geom.maxx[r] <= x0 - tol or geom.miny[r] >= y1 + tol or geom.maxy[r] <= y0 - tol:
             continue
-        other = store.hitboxes[r].shape  # type: ignore[union-attr]  # (candidates have hitboxes)
+        other = store.hitboxes[r].shape  # (candidates have hitboxes)
+        # (box_shape: the shape is an AABB too)
         if box_shape and isinstance(other, AABB) and not (
                 abs(float(geom.hx[r]) - x) < (shape.width + other.width) * 0.5  # type: ignore[attr-defined]
                 and abs(float(geom.hy[r]) - y) < (shape.height + other.height) * 0.5):  # type: ignore[attr-defined]

@@ -17,6 +17,7 @@ from typing import Any, Literal, NamedTuple
 
 import esper
 import numpy as np
+from numpy.typing import NDArray
 
 from .collision.results import Vec2
 from .validation import InvalidValue
@@ -49,13 +50,13 @@ class CollisionEvent(NamedTuple):
 class StepContacts(NamedTuple):
     """This step's overlapping pairs as arrays (entity ids, a < b), sorted by (a, b)."""
 
-    a: np.ndarray
-    b: np.ndarray
-    nx: np.ndarray
-    ny: np.ndarray
-    depth: np.ndarray
-    px: np.ndarray
-    py: np.ndarray
+    a: NDArray[np.int64]
+    b: NDArray[np.int64]
+    nx: NDArray[np.float64]
+    ny: NDArray[np.float64]
+    depth: NDArray[np.float64]
+    px: NDArray[np.float64]
+    py: NDArray[np.float64]
 
     @classmethod
     def empty(cls) -> StepContacts:
@@ -63,21 +64,24 @@ class StepContacts(NamedTuple):
         i = np.zeros(0, dtype=np.int64)
         return cls(i, i, z, z, z, z, z)
 
-    def take(self, idx: np.ndarray) -> StepContacts:
-        return StepContacts(*(arr[idx] for arr in self))
+    def take(self, idx: NDArray[np.integer]) -> StepContacts:
+        return StepContacts(self.a[idx], self.b[idx], self.nx[idx], self.ny[idx], self.depth[idx], self.px[idx],
+                            self.py[idx])
 
 
-def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def pair_keys(a: NDArray[np.integer], b: NDArray[np.integer]) -> NDArray[np.int64]:
     """One int64 per pair of entity ids (each below 2**32), ordered as ``(a, b)`` is."""
     return (a.astype(np.int64) << 32) | b.astype(np.int64)
 
 
-def pair_parts(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def pair_parts(keys: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """The ``(a, b)`` of :func:`pair_keys`."""
     return keys >> 32, keys & 0xFFFFFFFF
 
 
-def sorted_find(keys: np.ndarray, table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def sorted_find(
+    keys: NDArray[np.int64], table: NDArray[np.int64],
+) -> tuple[NDArray[np.intp], NDArray[np.bool_]]:
     """Where each of ``keys`` is in the sorted ``table`` (one binary search per key), and whether
     it is there at all (where not, the position is meaningless)."""
     if table.size == 0:
@@ -86,12 +90,12 @@ def sorted_find(keys: np.ndarray, table: np.ndarray) -> tuple[np.ndarray, np.nda
     return pos, table[pos] == keys
 
 
-def sorted_member(keys: np.ndarray, table: np.ndarray) -> np.ndarray:
+def sorted_member(keys: NDArray[np.int64], table: NDArray[np.int64]) -> NDArray[np.bool_]:
     """``np.isin(keys, table)`` for a sorted ``table``."""
     return sorted_find(keys, table)[1]
 
 
-def sorted_members(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def sorted_members(a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """``(np.isin(a, b), np.isin(b, a))`` for two sorted arrays of distinct keys, by one merge.
 
     A stable sort of the two runs one after the other is a linear merge (timsort finds the runs),
@@ -116,7 +120,7 @@ class PairTracker:
         self.active = StepContacts.empty()
         self.keys = np.zeros(0, dtype=np.int64)
 
-    def update(self, now: StepContacts) -> tuple[np.ndarray, np.ndarray, StepContacts]:
+    def update(self, now: StepContacts) -> tuple[NDArray[np.bool_], NDArray[np.bool_], StepContacts]:
         """Record this step's pairs; return (started mask over ``now``, ongoing mask, ended pairs)."""
         keys = pair_keys(now.a, now.b)
         was, kept = sorted_members(keys, self.keys)
@@ -127,7 +131,7 @@ class PairTracker:
 
 
 def to_events(
-    contacts: StepContacts, started: np.ndarray, ongoing: np.ndarray, ended: StepContacts
+    contacts: StepContacts, started: NDArray[np.bool_], ongoing: NDArray[np.bool_], ended: StepContacts
 ) -> list[CollisionEvent]:
     """Event records, sorted by pair (a, b), then ended before started before ongoing."""
     out: list[tuple[int, int, int, CollisionEvent]] = []
@@ -163,7 +167,7 @@ class CollisionHandlers:
     are remembered by their component types until the dispatch, so their ``ended`` events still
     reach the handlers of those types."""
 
-    def __init__(self, rows_of: Callable[[np.ndarray], np.ndarray]) -> None:
+    def __init__(self, rows_of: Callable[[NDArray[np.int64]], NDArray[np.int64]]) -> None:
         self._rows_of = rows_of
         self._handlers: list[tuple[type, type, Handler, frozenset[str]]] = []
         self._ghosts: dict[int, set[type]] = {}
@@ -184,7 +188,7 @@ class CollisionHandlers:
         """``entity`` is being despawned: keep its component types for this step's dispatch."""
         self._ghosts[entity] = types
 
-    def wanted(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    def wanted(self, ra: NDArray[np.int64], rb: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Mask of the pairs (rows) that some handler's two component types could match."""
         need = np.zeros(ra.size, dtype=bool)
         for ta, tb, _handler, _kinds in self._handlers:
@@ -192,7 +196,7 @@ class CollisionHandlers:
             need |= (has_a[ra] & has_b[rb]) | (has_a[rb] & has_b[ra])
         return need
 
-    def _has_type(self, component_type: type, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    def _has_type(self, component_type: type, ra: NDArray[np.int64], rb: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Per row: whether the entity has a ``component_type`` component (current esper world)."""
         size = int(max(ra.max(), rb.max())) + 1 if ra.size else 0
         mask = np.zeros(size, dtype=bool)

@@ -13,19 +13,30 @@ contact_rows, started, ended`` -> response -> ``resolved, support`` -> sleeping 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeAlias
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .events import CollisionEvent, StepContacts, to_events
 
-__all__ = ["NO_POINTS", "NO_RESOLVED", "NO_SUPPORT", "StepFrame", "add_counters", "new_counters"]
+__all__ = ["NO_POINTS", "NO_RESOLVED", "NO_SUPPORT", "Points", "Resolved", "StepFrame", "Support", "add_counters",
+           "new_counters"]
 
-_INTS = np.zeros(0, dtype=np.int64)
-_FLOATS = np.zeros(0)
-NO_RESOLVED = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS)
-NO_SUPPORT = (*NO_RESOLVED, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
-NO_POINTS = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
+_I: TypeAlias = NDArray[np.int64]
+_F: TypeAlias = NDArray[np.float64]
+#: The contacts the response applied: entities a, b, normal x, y, push.
+Resolved: TypeAlias = tuple[_I, _I, _F, _F, _F]
+#: The pairs acted on, kept for the next step: a, b, nx, ny, push, impulse, gap, tangent push and impulse.
+Support: TypeAlias = tuple[_I, _I, _F, _F, _F, _F, _F, _F, _F]
+#: Contact points acted on: pair key, slot, push, impulse, tangent push and impulse, x, y.
+Points: TypeAlias = tuple[_I, _I, _F, _F, _F, _F, _F, _F]
+
+_INTS: _I = np.zeros(0, dtype=np.int64)
+_FLOATS: _F = np.zeros(0)
+NO_RESOLVED: Resolved = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS)
+NO_SUPPORT: Support = (*NO_RESOLVED, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
+NO_POINTS: Points = (_INTS, _INTS, _FLOATS, _FLOATS, _FLOATS, _FLOATS, _FLOATS, _FLOATS)
 
 
 def new_counters() -> dict[str, Any]:
@@ -46,7 +57,7 @@ def add_counters(total: dict[str, Any], step: dict[str, Any]) -> None:
             total[key] = total.get(key, 0) + value
 
 
-def _pairs() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _pairs() -> tuple[_I, _I, _I, _I]:
     return (_INTS, _INTS, _INTS, _INTS)
 
 
@@ -60,28 +71,28 @@ class StepFrame:
     counters: dict[str, Any] = field(default_factory=new_counters)
     stage_ms: dict[str, float] = field(default_factory=dict)
     # movement: where every row started the step (rows spawned during it: none), the swept bodies
-    start_x: np.ndarray = field(default_factory=lambda: _FLOATS)
-    start_y: np.ndarray = field(default_factory=lambda: _FLOATS)
-    ccd_rows: np.ndarray = field(default_factory=lambda: _INTS)
-    ccd_start: tuple[np.ndarray, np.ndarray] = (_FLOATS, _FLOATS)
+    start_x: _F = field(default_factory=lambda: _FLOATS)
+    start_y: _F = field(default_factory=lambda: _FLOATS)
+    ccd_rows: NDArray[np.integer] = field(default_factory=lambda: _INTS)
+    ccd_start: tuple[_F, _F] = (_FLOATS, _FLOATS)
     # continuous detection: each swept body's path ((x0, y0), (x1, y1)), for the overlay
     swept_paths: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)
     # broad phase: candidate pairs (entities a < b, their rows) and how many bodies sleep
-    pairs: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = field(default_factory=_pairs)
+    pairs: tuple[_I, _I, _I, _I] = field(default_factory=_pairs)
     n_asleep: int = 0
     # narrow phase: the overlapping pairs, their rows, which started, which ended
     contacts: StepContacts = field(default_factory=StepContacts.empty)
-    contact_rows: tuple[np.ndarray, np.ndarray] = (_INTS, _INTS)
-    started: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    contact_rows: tuple[_I, _I] = (_INTS, _INTS)
+    started: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     ended: StepContacts = field(default_factory=StepContacts.empty)
     # response: the contacts applied (a, b, nx, ny, pushed) and the pairs acted on, kept for the next
     # step with their push, impulse, the gap they ended with and their friction's tangential push
     # and impulse (a, b, nx, ny, push, impulse, gap, tangent push, tangent impulse)
-    resolved: tuple[np.ndarray, ...] = NO_RESOLVED
-    support: tuple[np.ndarray, ...] = NO_SUPPORT
+    resolved: Resolved = NO_RESOLVED
+    support: Support = NO_SUPPORT
     # where bodies turn (see framework.systems.turning): each contact point acted on, by pair and
     # slot (pair key, slot, push, impulse, tangent push, tangent impulse, x, y), sorted by pair
-    points: tuple[np.ndarray, ...] = NO_POINTS
+    points: Points = NO_POINTS
     # queries during the step: (origin, end, first hit or None), for the overlay
     ray_log: list[tuple[tuple[float, float], tuple[float, float], Any]] = field(default_factory=list)
     _events: list[CollisionEvent] | None = None

@@ -12,6 +12,7 @@ from collections.abc import Iterable
 from typing import Any, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .casting import ShapeHit, cast_rows, touch_point
 from .collision import batch, collide
@@ -45,7 +46,7 @@ class SpatialQueries:
         self.pipeline = pipeline
         self.bodies = pipeline.bodies
 
-    def _candidate_rows(self, minx: float, miny: float, maxx: float, maxy: float) -> np.ndarray:
+    def _candidate_rows(self, minx: float, miny: float, maxx: float, maxy: float) -> NDArray[np.intp]:
         """Rows whose current bounds strictly meet the box: statics via the hash, moving bodies by
         one vectorised test over their current bounds."""
         bodies = self.bodies
@@ -58,8 +59,9 @@ class SpatialQueries:
         hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)
         return np.concatenate([st, mv[hit]])
 
-    def _mask_ok(self, rows: np.ndarray, mask: int) -> np.ndarray:
-        return rows[(self.bodies.store.layer[rows] & mask) != 0]
+    def _mask_ok(self, rows: NDArray[np.intp], mask: int) -> NDArray[np.intp]:
+        keep: NDArray[np.bool_] = (self.bodies.store.layer[rows] & mask) != 0  # (numpy types `!=` as Any)
+        return rows[keep]
 
     def raycast_all(self, origin: tuple[float, float], direction: tuple[float, float],
                     max_distance: float = math.inf, mask: int = ALL_LAYERS) -> list[SceneHit]:
@@ -104,7 +106,7 @@ class SpatialQueries:
             raise InvalidValue(f"the motion from {start!r} to {end!r} is too long for floats")
         store = self.bodies.store
 
-        def skip(rows: np.ndarray) -> np.ndarray:
+        def skip(rows: NDArray[np.intp]) -> NDArray[np.bool_]:
             return ~np.isin(store.entity[rows], skip_entities)
 
         hit = cast_rows(self, shape, x0, y0, rot, mx, my, mask=mask, skip=skip if skip_entities.size else None)
@@ -115,6 +117,7 @@ class SpatialQueries:
         pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
         entity = int(store.entity[r])
         if fraction == 0.0:
+            # (a row hit has a hitbox)
             contact = collide(shape, (x0, y0, rot), store.hitboxes[r].shape, pose_b)  # type: ignore[union-attr]
             if contact is not None:
                 return ShapeHit(entity, 0.0, contact.point, Vec2(nx, ny))
@@ -165,7 +168,8 @@ class SpatialQueries:
                 return False
         return True
 
-    def _overlapping(self, shape: Any, center: tuple[float, float], mask: int, box: tuple) -> list[int]:
+    def _overlapping(self, shape: Any, center: tuple[float, float], mask: int,
+                     box: tuple[float, float, float, float]) -> list[int]:
         rows = self._mask_ok(self._candidate_rows(*box), mask)
         store, geom = self.bodies.store, self.bodies.geometry
         check_shape("shape", shape)

@@ -15,13 +15,15 @@ import itertools
 import math
 from collections.abc import Callable, Iterable
 from numbers import Integral
-from typing import Any
+from typing import Any, cast
 
 import esper
 import numpy as np
+from numpy.typing import NDArray
 
 from .bodies import Bodies
 from .character import CharacterController
+from .collision.broad_phase import SpatialHash
 from .components import Hitbox, Transform, Velocity, Visual
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import check_added_component, spawn_components
@@ -33,9 +35,11 @@ from .shapes import Shape
 from .snapshot import Snapshot
 from .snapshot import restore as restore_snapshot
 from .snapshot import take as take_snapshot
+from .store import BodyStore
 from .systems import pipeline_stages
 from .systems.character import CharacterStage
 from .systems.geometry import Geometry
+from .systems.narrow_phase import NarrowPhase
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
 from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister
 from .validation import InvalidValue, positive, vector2
@@ -168,16 +172,21 @@ class Scene:
         return self._pipeline.frame.contacts
 
     @property
-    def resolved(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def resolved(
+        self,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """The contacts the response actually applied this step, as arrays ``(a, b, nx, ny,
         pushed)`` (entity ids a < b, the normal from a to b it pushed along, the total push-out),
         sorted by pair. A contact the response discarded (the sliver of a tile under a body
         pushed into a wall, once the wall's push freed it) is not here: a game asking "am I
         standing on something?" should look here, not at every contact."""
-        return self._pipeline.frame.resolved  # type: ignore[return-value]
+        return self._pipeline.frame.resolved
 
     @property
-    def contact_points(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def contact_points(
+        self,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+               NDArray[np.float64]]:
         """Where boxes and polygons turn (the ``rotation`` effect): the points the response pushed
         at this step, as arrays ``(a, b, x, y, push, impulse)`` (entity ids a < b; each point's
         push-out and normal impulse), sorted by pair; two where a face rests on a face (see
@@ -197,12 +206,25 @@ class Scene:
         return self._pipeline.frame.swept_paths
 
     # Read-only views of the pipeline's data, for tools, tests and the renderer.
-    store = property(lambda self: self.bodies.store, doc="The columnar store (see framework.store).")
-    geometry: Geometry = property(lambda self: self.bodies.geometry,  # type: ignore[assignment]
-                                  doc="Hitbox origins and bounds (current after ensure_geometry).")
-    hash = property(lambda self: self.bodies.hash, doc="The spatial hash of the static bodies.")
-    tracker: PairTracker = property(lambda self: self._stages["narrow_phase"].tracker,  # type: ignore[assignment]
-                                    doc="The narrow phase's pair tracker.")
+    @property
+    def store(self) -> BodyStore:
+        """The columnar store (see framework.store)."""
+        return self.bodies.store
+
+    @property
+    def geometry(self) -> Geometry:
+        """Hitbox origins and bounds (current after ensure_geometry)."""
+        return self.bodies.geometry
+
+    @property
+    def hash(self) -> SpatialHash:
+        """The spatial hash of the static bodies."""
+        return self.bodies.hash
+
+    @property
+    def tracker(self) -> PairTracker:
+        """The narrow phase's pair tracker."""
+        return cast(NarrowPhase, self._stages["narrow_phase"]).tracker
 
     def ensure_geometry(self) -> None:
         """Bring ``scene.geometry`` (hitbox origins and bounds) up to date, if anything moved."""

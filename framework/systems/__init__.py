@@ -18,7 +18,8 @@ __all__ = ["BroadPhase", "CharacterStage", "ContinuousDetection", "Movement", "N
            "Response",
            "STAGES", "Sleeping", "Stage", "pipeline_stages"]
 
-_ORDER = (Movement, CharacterStage, ContinuousDetection, BroadPhase, NarrowPhase, Response, Sleeping, Render)
+_ORDER: tuple[type[Stage], ...] = (
+    Movement, CharacterStage, ContinuousDetection, BroadPhase, NarrowPhase, Response, Sleeping, Render)
 
 
 def pipeline_stages(pipeline: Pipeline) -> list[Stage]:
