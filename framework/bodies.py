@@ -32,7 +32,7 @@ class Bodies:
         self.n_static = 0
         self._geometry_stamp: tuple[int, ...] | None = None
 
-    def rows_of(self, entities: NDArray[np.integer] | list[int]) -> NDArray[np.int64]:
+    def rows_of(self, entities: NDArray[np.int64] | list[int]) -> NDArray[np.int64]:
         """Rows of ``entities`` (-1 for ids without one)."""
         return self.store.rows_of(entities)
 

@@ -64,12 +64,12 @@ class StepContacts(NamedTuple):
         i = np.zeros(0, dtype=np.int64)
         return cls(i, i, z, z, z, z, z)
 
-    def take(self, idx: NDArray[np.integer]) -> StepContacts:
+    def take(self, idx: NDArray[np.intp]) -> StepContacts:
         return StepContacts(self.a[idx], self.b[idx], self.nx[idx], self.ny[idx], self.depth[idx], self.px[idx],
                             self.py[idx])
 
 
-def pair_keys(a: NDArray[np.integer], b: NDArray[np.integer]) -> NDArray[np.int64]:
+def pair_keys(a: NDArray[np.int64], b: NDArray[np.int64]) -> NDArray[np.int64]:
     """One int64 per pair of entity ids (each below 2**32), ordered as ``(a, b)`` is."""
     return (a.astype(np.int64) << 32) | b.astype(np.int64)
 

@@ -73,7 +73,7 @@ class StepFrame:
     # movement: where every row started the step (rows spawned during it: none), the swept bodies
     start_x: _F = field(default_factory=lambda: _FLOATS)
     start_y: _F = field(default_factory=lambda: _FLOATS)
-    ccd_rows: NDArray[np.integer] = field(default_factory=lambda: _INTS)
+    ccd_rows: NDArray[np.intp] = field(default_factory=lambda: _INTS)
     ccd_start: tuple[_F, _F] = (_FLOATS, _FLOATS)
     # continuous detection: each swept body's path ((x0, y0), (x1, y1)), for the overlay
     swept_paths: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)

@@ -198,7 +198,7 @@ class BodyStore:
         self.active()
         return self._active_sel
 
-    def rows_of(self, entities: NDArray[np.integer] | list[int]) -> NDArray[np.int64]:
+    def rows_of(self, entities: NDArray[np.intp] | list[int]) -> NDArray[np.int64]:
         """Rows of ``entities`` (-1 for an id without a row), through a table rebuilt after each
         structural change: the one entity -> row lookup of the pipeline, the queries and the renderer."""
         if self._lookup_version != self.version:  # (every spawn and despawn bumps the version)
@@ -219,7 +219,7 @@ class BodyStore:
             self._friction_seen = (self.version, bool((self.friction > 0.0).any()))
         return self._friction_seen[1]
 
-    def pair_friction(self, ra: NDArray[np.integer], rb: NDArray[np.integer]) -> NDArray[np.float64]:
+    def pair_friction(self, ra: NDArray[np.intp], rb: NDArray[np.intp]) -> NDArray[np.float64]:
         """The friction coefficient of each pair ``(ra, rb)``: ``sqrt(f_a * f_b)`` where both
         hitboxes give one, the one given where one does, 0 where neither does."""
         fa, fb = self.friction[ra], self.friction[rb]
@@ -227,7 +227,7 @@ class BodyStore:
         both = np.sqrt(np.maximum(fa, 0.0) * np.maximum(fb, 0.0))
         return np.where(given_a & given_b, both, np.where(given_a, fa, np.where(given_b, fb, 0.0)))
 
-    def movable(self, rows: NDArray[np.integer]) -> NDArray[np.bool_]:
+    def movable(self, rows: NDArray[np.intp]) -> NDArray[np.bool_]:
         """Mask of ``rows`` the response may move: a finite mass (``inv_mass > 0``), and awake."""
         return (self.inv_mass[rows] > 0.0) & ~self.asleep[rows]
 
@@ -248,7 +248,7 @@ class BodyStore:
         self.motion += 1
 
     def place(
-        self, rows: NDArray[np.integer] | int, x: NDArray[np.float64] | float, y: NDArray[np.float64] | float,
+        self, rows: NDArray[np.intp] | int, x: NDArray[np.float64] | float, y: NDArray[np.float64] | float,
     ) -> None:
         """Put ``rows`` at ``(x, y)``."""
         self.cols["x"][rows] = x
@@ -426,7 +426,7 @@ class BodyStore:
             return bad
         return float(self.cols[col][self.row_of[entity]])
 
-    def wake(self, rows: NDArray[np.integer] | int) -> None:
+    def wake(self, rows: NDArray[np.intp] | int) -> None:
         """Wake sleeping rows (game code moved them, or something touched them)."""
         asleep = self.cols["asleep"]
         rows = np.atleast_1d(rows)

@@ -109,7 +109,7 @@ def frame(
 
 def finish(
     hit: NDArray[np.bool_], nx: NDArray[np.float64], ny: NDArray[np.float64], depth: NDArray[np.float64],
-    px: NDArray[np.float64], py: NDArray[np.float64], k: NDArray[np.integer], ox: NDArray[np.float64],
+    px: NDArray[np.float64], py: NDArray[np.float64], k: NDArray[np.int32], ox: NDArray[np.float64],
     oy: NDArray[np.float64],
 ) -> ContactArrays:
     """Contacts of the ``hit`` rows (compressed, in the scaled local frame of origin (ox, oy),

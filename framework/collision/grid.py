@@ -99,7 +99,7 @@ def as_bounds(minx: object, miny: object, maxx: object, maxy: object) -> Bounds:
     return lo_x, lo_y, hi_x, hi_y
 
 
-def subset(bounds: Bounds, idx: NDArray[np.integer]) -> Bounds:
+def subset(bounds: Bounds, idx: NDArray[np.intp]) -> Bounds:
     """The bounds of the bodies ``idx``."""
     minx, miny, maxx, maxy = bounds
     return minx[idx], miny[idx], maxx[idx], maxy[idx]
@@ -177,7 +177,7 @@ def strict_overlap(ax0, ay0, ax1, ay1, bx0, by0, bx1, by1):
 
 
 def expand_runs(
-    counts: NDArray[np.integer], starts: NDArray[np.integer] | None = None,
+    counts: NDArray[np.int64], starts: NDArray[np.int64] | None = None,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """``(owner, value)``: for each ``k``, ``counts[k]`` entries with owner ``k`` and values
     ``starts[k], starts[k] + 1, ...`` (``0, 1, ...`` when ``starts`` is None)."""
@@ -253,7 +253,7 @@ class _Ranges:
             self.hi_x = float(maxx[self.small].max()) if k else 0.0
 
 
-def _offsets(span: NDArray[np.integer]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _offsets(span: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """``(i, d)`` for every ``i`` and ``0 <= d < span[i]``, grouped by ``d`` when spans are short
     (each group keeps the order of ``i``)."""
     top = int(span.max()) if span.shape[0] else 0
