@@ -268,12 +268,19 @@ def _polygon_circle(poly: Pts, cx: float, cy: float, r: float, vx: float, vy: fl
                 hx, hy = hx - x0, hy - y0
             elif "end" in tags and "face" not in tags:
                 hx, hy = hx - x1, hy - y1
-            else:  # through the pushed-out face ("inner" only if overlapping at the start)
+            else:  # through the pushed-out face, or the pushed-in one
                 hx = hy = 0.0
             # Through an end of the rectangle the entry is next to a vertex (whose disc is entered
-            # no later): the normal points from that vertex.
+            # no later): the normal points from that vertex. Through the pushed-in side (first only
+            # when overlapping at the start, or when the polygon is flat to within rounding, as the
+            # cores' hull of two nearly parallel capsules is) it is that side's outward normal, -n.
             hl = math.hypot(hx, hy)
-            cands.append((a, hx / hl, hy / hl) if hl > 0.0 else (a, nx / ln, ny / ln))
+            if hl > 0.0:
+                cands.append((a, hx / hl, hy / hl))
+            elif "inner" in tags and "face" not in tags:
+                cands.append((a, -nx / ln, -ny / ln))
+            else:
+                cands.append((a, nx / ln, ny / ln))
         # Open disc around vertex p0.
         iv = disc_interval(qx, qy, r, vx, vy)
         if iv is not None:
