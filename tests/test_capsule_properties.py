@@ -10,13 +10,13 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, Point
 from shapely.geometry import Polygon as SPolygon
 
 from framework import AABB, Capsule, Circle, Polygon
-from framework.collision import collide, time_of_impact
+from framework.collision import collide, raycast, time_of_impact
 from framework.collision.batch import collide_many
 
 FAST = settings(max_examples=150, deadline=None, derandomize=True,
@@ -200,3 +200,91 @@ def test_time_of_impact_is_the_first_overlap(cap, pa, other, pb, motion):
         assert before is None or before.depth < 1e-9
     swapped = time_of_impact(other, pb, (0, 0), cap, pa, (mx, my))
     assert swapped is not None and swapped.fraction == f
+
+
+# --- raycasts against shapely --------------------------------------------------------------------
+
+QUAD_SEGS = 64
+# shapely's buffer puts its vertices on the circle: its arcs are chords, inside the true capsule by
+# at most r (1 - cos(theta / 2)), theta = (pi / 2) / QUAD_SEGS. The polygon buffered by
+# r / cos(theta / 2) has its edges tangent to the circle of radius r: it holds the true capsule.
+OUTWARD = 1.0 / math.cos(math.pi / (4 * QUAD_SEGS))
+ray_origins = st.tuples(st.integers(-48, 48).map(lambda i: i / 8), st.integers(-48, 48).map(lambda i: i / 8))
+ray_aims = st.one_of(st.none(), st.tuples(eighths, eighths))
+
+
+def _core(cap, pose):
+    """The ends of the capsule's core segment in the world."""
+    x, y, r = pose
+    c, s, h = math.cos(r), math.sin(r), cap.half_length
+    return (x + s * h, y - c * h), (x - s * h, y + c * h)
+
+
+def _from_core(cap, pose, p):
+    """How far ``p`` is from the capsule's core segment, and the nearest point of it."""
+    (ax, ay), (bx, by) = _core(cap, pose)
+    ex, ey = bx - ax, by - ay
+    e2 = ex * ex + ey * ey
+    t = 0.0 if e2 == 0.0 else min(1.0, max(0.0, ((p[0] - ax) * ex + (p[1] - ay) * ey) / e2))
+    cx, cy = ax + t * ex, ay + t * ey
+    return math.hypot(p[0] - cx, p[1] - cy), (cx, cy)
+
+
+@settings(max_examples=400, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(capsules, poses, ray_origins, st.tuples(eighths, eighths), ray_aims, st.one_of(st.just(math.inf),
+                                                                                       st.floats(0, 20)))
+def test_raycast_agrees_with_shapely(cap, pose, origin, direction, aim, max_distance):
+    """Hit or miss and the distance, checked against shapely's buffered segment: the capsule lies
+    between the buffer of r (inside it, its arcs being chords) and that of r / cos(theta / 2)
+    (around it). A ray that misses the outer polygon misses; one through the inner polygon's
+    interior hits, between its distances to the two. Rays starting in the band between them, or
+    only grazing the inner one, are left out."""
+    if aim is not None:  # most rays aimed near the capsule, so that most of them hit
+        direction = (pose[0] + aim[0] - origin[0], pose[1] + aim[1] - origin[1])
+    assume(direction != (0.0, 0.0))
+    (a, b), r = _core(cap, pose), cap.radius
+    inner = LineString([a, b]).buffer(r, quad_segs=QUAD_SEGS)
+    outer = LineString([a, b]).buffer(r * OUTWARD * (1 + 1e-9) + 1e-12, quad_segs=QUAD_SEGS)
+    dl = math.hypot(*direction)
+    ux, uy = direction[0] / dl, direction[1] / dl
+    line = LineString([origin, (origin[0] + 100.0 * ux, origin[1] + 100.0 * uy)])
+    o = Point(origin)
+    hit = raycast(cap, pose, origin, direction, max_distance)
+    if inner.buffer(-1e-9).contains(o):  # inside: a hit where it starts, facing back along the ray
+        event("inside")
+        assert hit is not None and hit.distance == 0.0 and hit.point == origin
+        assert hit.normal == pytest.approx((-ux, -uy), abs=1e-12)
+        return
+    if outer.contains(o) or outer.exterior.distance(o) <= 1e-9:
+        event("origin in the band: left out")
+        return  # in the band where the polygons and the capsule may differ
+    if outer.distance(line) > 1e-9:
+        event("miss")
+        assert hit is None  # clear of the capsule's outside bound
+        return
+    # (through the interior: a ray along a straight side meets the polygon's boundary only, which
+    # shapely counts as meeting it, and the contract as a graze, a miss)
+    through = line.intersection(inner.buffer(-1e-7, quad_segs=QUAD_SEGS))
+    if through.length <= 1e-6:
+        event("graze of the band: left out")
+        return  # a graze: the polygons cannot tell
+    near, far = o.distance(line.intersection(outer)), o.distance(through)
+    assert near <= far
+    if max_distance < near * (1 - 1e-9):
+        event("short of it")
+        assert hit is None
+        return
+    if max_distance > far * (1 + 1e-9):
+        assert hit is not None
+    if hit is None:
+        return
+    event("hit")
+    assert near - 1e-9 <= hit.distance <= far + 1e-9
+    # The entry point lies on the capsule (radius r from its core) along the ray; the normal is the
+    # outward one there, facing the ray.
+    assert hit.point == pytest.approx((origin[0] + hit.distance * ux, origin[1] + hit.distance * uy), abs=1e-9)
+    d, (cx, cy) = _from_core(cap, pose, hit.point)
+    assert d == pytest.approx(r, rel=1e-9, abs=1e-9)
+    assert hit.normal == pytest.approx(((hit.point[0] - cx) / d, (hit.point[1] - cy) / d), abs=1e-9)
+    assert hit.normal.x * ux + hit.normal.y * uy < 0.0

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from framework import AABB, Circle, Hitbox, InvalidValue, Polygon, Scene, Transform, Velocity, collide
+from framework import AABB, Capsule, Circle, Hitbox, InvalidValue, Polygon, Scene, Transform, Velocity, collide
 from framework.collision import time_of_impact
 
 
@@ -110,7 +110,8 @@ def test_bad_input_is_a_clear_error(scene, kw, match):
         scene.shape_cast(args["shape"], args["start"], args["end"], rotation=rotation)
 
 
-shapes = st.sampled_from([AABB(8.0, 4.0), Circle(3.0), Polygon([(-4, -2), (4, -2), (0, 5)]), Polygon.box(6.0, 2.0)])
+shapes = st.sampled_from([AABB(8.0, 4.0), Circle(3.0), Polygon([(-4, -2), (4, -2), (0, 5)]), Polygon.box(6.0, 2.0),
+                          Capsule(2.0, 6.0), Capsule(3.0, 0.5)])
 coord = st.integers(-64, 64).map(lambda v: v / 4.0)
 
 
