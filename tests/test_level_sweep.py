@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import sys
 
@@ -19,9 +20,9 @@ def test_tasks_play_the_scripted_agent_once_and_the_random_one_per_seed():
 
 
 def test_in_process_sweep_writes_a_summary(tmp_path, capsys):
-    out = tmp_path / "s.json"
+    out, png = tmp_path / "s.json", tmp_path / "s.png"
     assert sweep.main(["--workers", "0", "--episodes", "2", "--levels", "2", "--out", str(out),
-                       "--plot", str(tmp_path / "s.png"), "--no-progress"]) == 0
+                       "--plot", str(png), "--no-progress"]) == 0
     summary = json.loads(out.read_text())
     rows = {(r["name"], r["agent"]): r for r in summary["rows"]}
     assert rows["Hills", "scripted"]["completion_rate"] == 1.0  # the demo finishes its level
@@ -30,6 +31,12 @@ def test_in_process_sweep_writes_a_summary(tmp_path, capsys):
     assert summary["frames_per_second"] > 0
     printed = capsys.readouterr().out
     assert "Hills" in printed and "summary:" in printed
+    if importlib.util.find_spec("matplotlib") is None:  # (the plot needs it; the summary does not)
+        assert "no plot: matplotlib is not installed" in printed and not png.exists()
+    else:  # a 6 x 3.2 inch chart at 100 dpi
+        data = png.read_bytes()
+        assert f"plot: {png}" in printed and data[:8] == b"\x89PNG\r\n\x1a\n"
+        assert (int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")) == (600, 320)
 
 
 def test_the_random_agent_is_deterministic_per_seed():
