@@ -40,6 +40,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from numpy.typing import NDArray
 
 from framework import Hitbox, Transform, Velocity
 from framework.collision.kinds import KIND_AABB
@@ -68,7 +69,7 @@ class PlatformerEnv(gym.Env):
     ``ray_range`` (tiles): the observation's fan of ray casts. ``render_mode``: None,
     ``"rgb_array"`` or ``"human"``."""
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 15}
+    metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 15}
 
     def __init__(self, level: int | str | Path | Level = 0, *, frame_skip: int = 4, max_frames: int = 3600,
                  rays: int = 16, ray_range: float = 8.0, render_mode: str | None = None) -> None:
@@ -104,7 +105,9 @@ class PlatformerEnv(gym.Env):
 
     # --- the Gymnasium API --------------------------------------------------------------------------
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None,
+    ) -> tuple[NDArray[np.float32], dict[str, Any]]:
         super().reset(seed=seed)
         self.game.scene.restore(self._start)
         self._channels.clear()
@@ -112,7 +115,7 @@ class PlatformerEnv(gym.Env):
         self._best_x = self._player_x()
         return self._observe(), self._info()
 
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
+    def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict[str, Any]]:
         if not self.action_space.contains(action):
             raise InvalidValue(f"action {action!r} is not in the action space {self.action_space} "
                                f"({', '.join(f'{i} {n}' for i, n in enumerate(ACTION_NAMES))})")
@@ -138,7 +141,7 @@ class PlatformerEnv(gym.Env):
             self.render()
         return self._observe(), float(reward), terminated, truncated, self._info()
 
-    def render(self) -> np.ndarray | None:
+    def render(self) -> NDArray[np.uint8] | None:
         if self.render_mode == "rgb_array":
             from framework.render import Camera, screenshot
 
@@ -165,7 +168,7 @@ class PlatformerEnv(gym.Env):
         player = self.game.state.player
         return self.game.scene.get(player, Transform).x if player is not None else 0.0
 
-    def _observe(self) -> np.ndarray:
+    def _observe(self) -> NDArray[np.float32]:
         game, scene = self.game, self.game.scene
         state, tile = game.state, self.level.tile
         obs = np.ones(PLAYER_VALUES + 3 * self.rays, dtype=np.float32)
@@ -180,7 +183,7 @@ class PlatformerEnv(gym.Env):
         obs[PLAYER_VALUES:] = self._rays(t.x, t.y, player).reshape(-1)
         return np.clip(obs, -1.0, 1.0)
 
-    def _rays(self, ox: float, oy: float, player: int) -> np.ndarray:
+    def _rays(self, ox: float, oy: float, player: int) -> NDArray[np.float64]:
         """``(3, rays)``: per channel (solid, danger, pickup) and ray, the distance over the range
         to the nearest such thing the ray meets before any solid one (1: none). Boxes (most of a
         level) are met by one vectorised slab test for every ray at once; other shapes by
@@ -202,7 +205,7 @@ class PlatformerEnv(gym.Env):
         dist = np.full((3, self.rays), np.inf)
         box = store.kind[rows] == KIND_AABB
         for r, channel in zip(rows[~box].tolist(), channels[~box].tolist()):
-            shape = store.hitboxes[r].shape  # type: ignore[union-attr]  # (rows with kind >= 0 have one)
+            shape = store.hitboxes[r].shape  # (rows with kind >= 0 have one)
             pose = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
             for i, direction in enumerate(self._directions):
                 ray = raycast(shape, pose, (ox, oy), direction, reach)
@@ -263,6 +266,7 @@ class PlatformerEnv(gym.Env):
 
     def _show(self) -> None:
         import pyglet
+        from pyglet import gl
 
         from framework.render import Camera, Renderer
 
@@ -274,6 +278,7 @@ class PlatformerEnv(gym.Env):
         self._renderer.draw(self.game.scene)
         self._window.switch_to()
         self._window.dispatch_events()
+        gl.glClearColor(*(c / 255.0 for c in BACKGROUND), 1.0)  # (as the window runner does; else black)
         self._window.clear()
         self._renderer.render()
         self._window.flip()
