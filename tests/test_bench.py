@@ -429,3 +429,25 @@ def test_progress_bar_writes_to_its_stream_only_when_enabled():
     with Progress(3, "t", stream=quiet, enabled=False) as bar:
         bar.advance()
     assert quiet.getvalue() == ""
+
+
+# --- the render benchmark -----------------------------------------------------------------------------
+
+
+def test_render_cli_of_a_tiny_configuration(render, capsys, tmp_path):
+    """Every kind at a tiny size, through the command line: a row per (kind, size) with all three
+    in-process contenders timed, ratios that are what they say, goals stated; JSON and CSV written."""
+    from framework.bench import render as rb
+
+    code = main(["render", "--quick", "--json", "--sizes", "30,60", "--no-arcade", "--no-progress",
+                 "--out", str(tmp_path)])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [(r["kind"], r["n"]) for r in data["rows"]] == [(k, n) for k in rb.KINDS for n in (30, 60)]
+    for r in data["rows"]:
+        assert r["ours_ms"] > 0 and r["floor_ms"] > 0 and r["naive_ms"] > 0 and r["arcade_ms"] is None
+        assert r["vs_floor"] == pytest.approx(r["ours_ms"] / r["floor_ms"])
+        assert r["drawn"] == r["n"]  # every sprite in view, drawn
+    assert {g["goal"].split(":")[0] for g in data["goals"]} >= {"boxes", "animated"}
+    assert (tmp_path / "render-quick.csv").read_text().startswith("kind,n,drawn,ours_ms")
+    assert "| kind" in rb.markdown(data, "python -m framework.bench render", "images/render.png")

@@ -368,7 +368,7 @@ def run_render(*, sizes: tuple[int, ...] = FULL["sizes"], kinds: tuple[str, ...]
         directory = Path(tmp)
         for kind in kinds:
             for n in sizes:
-                frames = cfg["frames"].get(n, max(8, 400_000 // max(n, 1)))
+                frames = cfg["frames"].get(n, min(60, max(8, 400_000 // max(n, 1))))
                 if progress:
                     print(f"render: {kind} x {n} ...", file=sys.stderr, flush=True)
                 ours = Ours(kind, n, directory)
