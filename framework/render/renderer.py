@@ -111,7 +111,7 @@ class Renderer:
         # Per entity id (grown by _grow_entities):
         self._slot_of = np.full(0, -1, dtype=np.int64)  # its slot, -1 for none
         self._look = np.full(0, -1, dtype=np.int64)  # the store's look stamp when it was last visited
-        self._drawable = np.zeros(0, dtype=bool)  # its Visual has something to draw (when last visited)
+        self._drawable = np.zeros(0, dtype=bool)  # its Visual is visible and has something to draw
         self._sprite_reach = np.zeros(0)  # how far a sprite reaches beyond its entity's bounds
         # Per slot (grown by _grow_slots); the Python lists are touched on structural changes only:
         self._s_entity = np.full(0, -1, dtype=np.int64)
@@ -283,7 +283,7 @@ class Renderer:
             frame = None if visual is None else self._still_frame(entity, visual)
             sprite = visual is not None and (visual.animation is not None or frame is not None)
             drawable = visual is not None and (sprite or shape is not None)
-            self._drawable[entity] = drawable
+            self._drawable[entity] = drawable and visual.visible  # a hidden Visual gets no new drawable
             if sprite:
                 self._note_sprite_reach(entity, visual, frame)
             else:
