@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 
 import pytest
 from hypothesis import given, settings
@@ -293,3 +294,58 @@ def test_it_was_closed():
     assert made[0].closed
 """)
     pytester.runpytest("-p", "no:cacheprovider").assert_outcomes(passed=2)
+
+
+def test_without_gl_the_report_says_why_there_is_no_picture(pytester, monkeypatch):
+    import framework.testing.pictures
+
+    def no_gl(scene, path, *args, **kwargs):  # what rendering does where no OpenGL context can be made
+        raise RuntimeError("no EGL device (made up by this test)")
+
+    monkeypatch.setattr(framework.testing.pictures, "picture", no_gl)
+    pytester.makepyfile(test_game=GAME_TEST)
+    result = pytester.runpytest("-p", "no:cacheprovider", "--framework-pictures", "pics")
+    result.assert_outcomes(passed=1, failed=1)
+    out = result.stdout.str()
+    assert "framework picture" in out
+    assert "no picture of scene 1 (step 60): RuntimeError: no EGL device (made up by this test)" in out
+    assert "with hitboxes, contacts and velocities" not in out and not (pytester.path / "pics").exists()
+
+
+GOLDEN_TEST = """
+from framework import Circle, Hitbox, Transform, Velocity
+from framework.testing import check_golden, text_scene
+
+def spawn_ball(scene, x, y, tile):
+    return scene.spawn(Transform(x, y), Velocity(SPEED, 0.0), Hitbox(Circle(0.4), restitution=0.5))
+
+def test_roll(golden_dir):
+    level = text_scene("#......#\\n#.O....#\\n########", {"O": spawn_ball})
+    check_golden(level.scene, golden_dir / "roll.json", steps=90)
+"""
+
+
+def test_the_update_golden_option_records_and_golden_dir_is_next_to_the_test(pytester, monkeypatch):
+    monkeypatch.delenv("FRAMEWORK_UPDATE_GOLDEN", raising=False)
+
+    def pytest_run(*args):  # in this process: no pictures (their GL objects would outlive the inner session)
+        return pytester.runpytest("-p", "no:cacheprovider", "--no-framework-pictures", "tests", *args)
+
+    pytester.mkdir("tests")
+    test_file = pytester.path / "tests" / "test_ball.py"
+    test_file.write_text("SPEED = 3.0\n" + GOLDEN_TEST)
+    golden = pytester.path / "tests" / "golden" / "roll.json"
+    first = pytest_run()
+    first.assert_outcomes(failed=1)  # nothing recorded yet: a failure saying how to record it
+    assert f"no golden file {golden}" in first.stdout.str() and "pytest --update-golden" in first.stdout.str()
+    assert not golden.parent.exists()
+    pytest_run("--update-golden").assert_outcomes(passed=1)
+    assert golden.exists() and json.loads(golden.read_text())["steps"] == 90
+    assert "FRAMEWORK_UPDATE_GOLDEN" not in os.environ  # the option lasts for its session only
+    pytest_run().assert_outcomes(passed=1)  # compares: the same run passes
+    test_file.write_text("SPEED = 3.25\n" + GOLDEN_TEST)
+    changed = pytest_run()
+    changed.assert_outcomes(failed=1)
+    assert "step 1 of 90 (frame 1) differs from the golden run" in changed.stdout.str()
+    pytest_run("--update-golden").assert_outcomes(passed=1)
+    pytest_run().assert_outcomes(passed=1)  # the new behaviour, accepted

@@ -9,8 +9,8 @@
 - :mod:`.golden`: golden runs (:func:`check_golden`);
 - :mod:`.strategies`: hypothesis strategies for shapes, transforms and small scenes (import it
   yourself: it needs hypothesis);
-- :mod:`.plugin`: the pytest plugin (a ``scene`` fixture, pictures of failing tests' scenes),
-  active wherever the framework is installed.
+- :mod:`.plugin`: the pytest plugin (a ``scene`` fixture, a ``golden_dir`` fixture, pictures of
+  failing tests' scenes, ``--update-golden``), active wherever the framework is installed.
 
 See docs/testing.md.
 """

@@ -7,7 +7,10 @@ the package is installed, no conftest needed).
   (default ``.framework-failures/``), and the picture's path is printed in the failure report;
   ``--no-framework-pictures`` turns it off; where no OpenGL is available the report says why there
   is no picture. Scenes a test made are closed after it.
-- ``--update-golden``: golden runs (:mod:`framework.testing.golden`) record instead of comparing.
+- a ``golden_dir`` fixture: the folder ``golden/`` next to the test's file (a :class:`~pathlib.Path`,
+  not created until a golden run records into it), where a test keeps its golden files;
+- ``--update-golden``: golden runs (:mod:`framework.testing.golden`) record instead of comparing
+  (for the session: it sets ``FRAMEWORK_UPDATE_GOLDEN``, put back as it was at the end).
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from typing import Any
 import pytest
 
 SECTION = "framework picture"
+UPDATE_GOLDEN = "FRAMEWORK_UPDATE_GOLDEN"
 
 
 def pytest_addoption(parser: Any) -> None:
@@ -33,7 +37,18 @@ def pytest_addoption(parser: Any) -> None:
 
 def pytest_configure(config: Any) -> None:
     if config.getoption("update_golden", default=False):
-        os.environ["FRAMEWORK_UPDATE_GOLDEN"] = "1"
+        config._framework_update_golden_was = os.environ.get(UPDATE_GOLDEN)
+        os.environ[UPDATE_GOLDEN] = "1"
+
+
+def pytest_unconfigure(config: Any) -> None:
+    if not hasattr(config, "_framework_update_golden_was"):
+        return
+    was = config._framework_update_golden_was
+    if was is None:
+        os.environ.pop(UPDATE_GOLDEN, None)
+    else:
+        os.environ[UPDATE_GOLDEN] = was
 
 
 @pytest.fixture
@@ -44,6 +59,14 @@ def scene() -> Iterator[Any]:
     s = Scene()
     yield s
     s.close()
+
+
+@pytest.fixture
+def golden_dir(request: Any) -> Path:
+    """The folder ``golden/`` next to the test's file, for its golden files (check them in):
+    ``check_golden(scene, golden_dir / "jump.json", steps=120)``. Not created here: a run that
+    records (``--update-golden``) creates it."""
+    return Path(request.path).parent / "golden"
 
 
 class _Made:
