@@ -2,14 +2,21 @@
 
 from __future__ import annotations
 
-from typing import TypeVar
+from typing import TypeAlias, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["distinct"]
+__all__ = ["BoolArray", "F64Array", "I64Array", "IntpArray", "distinct"]
 
 _T = TypeVar("_T", bound=np.generic)
+
+# Shorthands for the stages' annotations (numpy.typing): a column of floats, of row numbers (what
+# ``np.flatnonzero`` and ``argsort`` give), of int64 (entity ids, pair keys, the store's rows) and a mask.
+F64Array: TypeAlias = NDArray[np.float64]
+IntpArray: TypeAlias = NDArray[np.intp]
+I64Array: TypeAlias = NDArray[np.int64]
+BoolArray: TypeAlias = NDArray[np.bool_]
 
 
 def distinct(values: NDArray[_T]) -> NDArray[_T]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import BoolArray, IntpArray
 from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from .narrow_phase import filter_layers
@@ -55,7 +56,7 @@ class BroadPhase(Stage):
         counters["candidate_pairs"] = int(keep.sum())
         return True
 
-    def _someone_reads(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    def _someone_reads(self, ra: IntpArray, rb: IntpArray) -> BoolArray:
         """Without the events effect, only pairs the response or a handler reads are tested."""
         store = self.bodies.store
         need = np.zeros(ra.size, dtype=bool)

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ..arrays import F64Array, IntpArray
 from ..collision.sweep import time_of_impact
 from ..frame import StepFrame
 from ..store import STATIC, BodyStore
@@ -47,7 +48,7 @@ class ContinuousDetection(Stage):
 
 
 def sweep_ccd_bodies(
-    store: BodyStore, geom: Geometry, rows: np.ndarray, start_x: np.ndarray, start_y: np.ndarray,
+    store: BodyStore, geom: Geometry, rows: IntpArray, start_x: F64Array, start_y: F64Array,
     static_candidates, counts: dict[str, int],
 ) -> int:
     """Sweep ``rows`` (which moved from ``start_x, start_y``); return how many were stopped early."""

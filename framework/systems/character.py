@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import esper
 import numpy as np
 
+from ..arrays import BoolArray, IntpArray
 from ..casting import candidate_rows, cast_rows, overlapping_rows, shape_bounds
 from ..character import CharacterController
 from ..collision import collide
@@ -44,7 +45,7 @@ class _Move:
     dropping: set[int]
     ignore: set[int] = field(default_factory=set)
     box: tuple[float, float, float, float] | None = None  # where ``rows`` holds every candidate
-    rows: np.ndarray | None = None  # candidate rows in ``box``: mask, sensors, itself, dropped out
+    rows: IntpArray | None = None  # candidate rows in ``box``: mask, sensors, itself, dropped out
     floor: tuple[int, float, float] | None = None  # (row, nx, ny)
     wall: tuple[int, float, float] | None = None
     wall_stopped: bool = False  # a wall took motion away (not only touched at the end of the move)
@@ -244,7 +245,7 @@ class CharacterStage(Stage):
         mv.box = (x0 - reach, y0 - reach, x1 + reach, y1 + reach)
         mv.rows = candidate_rows(self.queries, *mv.box, mv.mask, self._skip(mv))
 
-    def _near(self, mv: _Move, box: tuple[float, float, float, float]) -> np.ndarray | None:
+    def _near(self, mv: _Move, box: tuple[float, float, float, float]) -> IntpArray | None:
         """The gathered candidates (minus those ignored for now), if ``box`` lies in the gathered
         region; None: look up afresh."""
         b = mv.box
@@ -261,7 +262,7 @@ class CharacterStage(Stage):
         drop = np.array(sorted(mv.dropping), dtype=np.int64)
         ignore = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64)
 
-        def skip(rows: np.ndarray) -> np.ndarray:
+        def skip(rows: IntpArray) -> BoolArray:
             keep = ~np.isin(rows, ignore)
             if drop.size:
                 keep &= ~np.isin(store.entity[rows], drop)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import F64Array, IntpArray
 from ..collision.kinds import KIND_CIRCLE
 from ..frame import StepFrame
 from ..store import STATIC, BodyStore
@@ -34,17 +35,17 @@ __all__ = ["NO_FRICTION_POSITIONS", "NO_FRICTION_VELOCITIES", "Friction"]
 
 _NONE = np.zeros(0)
 # the loops' friction arguments in a solve without friction
-NO_FRICTION_POSITIONS = (_NONE,) * 12
-NO_FRICTION_VELOCITIES = (_NONE,) * 9
+NO_FRICTION_POSITIONS: tuple[F64Array, ...] = (_NONE,) * 12
+NO_FRICTION_VELOCITIES: tuple[F64Array, ...] = (_NONE,) * 9
 
 
 class Friction:
     """The friction columns of one solve's contacts ``(ra, rb)`` (local bodies ``a``, ``b``, shares
     of inverse mass ``wa``, ``wb``; sleepers count as immovable)."""
 
-    def __init__(self, store: BodyStore, ra: np.ndarray, rb: np.ndarray, wa: np.ndarray, wb: np.ndarray,
-                 mu: np.ndarray, rotation: bool, arms: tuple[np.ndarray, np.ndarray] | None = None,
-                 inertia: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+    def __init__(self, store: BodyStore, ra: IntpArray, rb: IntpArray, wa: F64Array, wb: F64Array, mu: F64Array,
+                 rotation: bool, arms: tuple[F64Array, F64Array] | None = None,
+                 inertia: tuple[F64Array, F64Array] | None = None) -> None:
         self.mu = mu
         self.wa, self.wb = wa, wb
         if arms is None:
@@ -66,17 +67,17 @@ class Friction:
         self.turns = bool(ia.any() or ib.any())
 
     @classmethod
-    def of(cls, store: BodyStore, ra: np.ndarray, rb: np.ndarray, wa: np.ndarray, wb: np.ndarray,
-           rotation: bool, arms: tuple[np.ndarray, np.ndarray] | None = None,
-           inertia: tuple[np.ndarray, np.ndarray] | None = None) -> Friction | None:
+    def of(cls, store: BodyStore, ra: IntpArray, rb: IntpArray, wa: F64Array, wb: F64Array,
+           rotation: bool, arms: tuple[F64Array, F64Array] | None = None,
+           inertia: tuple[F64Array, F64Array] | None = None) -> Friction | None:
         """The columns, or None when no pair has friction. ``arms``, ``inertia``: each contact's
         lever arms along it and its bodies' inverse inertias, for contacts at points (default:
         circles' radii; the store's inertias with ``rotation``)."""
         mu = store.pair_friction(ra, rb)
         return cls(store, ra, rb, wa, wb, mu, rotation, arms, inertia) if mu.any() else None
 
-    def limits(self, share_a: np.ndarray, share_b: np.ndarray,
-               turning: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    def limits(self, share_a: F64Array, share_b: F64Array,
+               turning: tuple[F64Array, F64Array] | None = None) -> F64Array:
         """Per contact, the largest tangential push (impulse) per unit of normal push (impulse),
         in the loops' units, for normal pushes shared by ``share_a, share_b``: ``mu`` times the
         tangential effective inverse mass over the normal one. Where shock propagation keeps a
@@ -88,7 +89,7 @@ class Friction:
         k_normal = np.where(lower_a, wb, np.where(lower_b, wa, wa + wb))
         return self.mu * (self.k / k_normal)
 
-    def start(self, frame: StepFrame, store: BodyStore, rows: np.ndarray, x: np.ndarray, y: np.ndarray,
+    def start(self, frame: StepFrame, store: BodyStore, rows: IntpArray, x: F64Array, y: F64Array,
               before: Friction | None = None) -> None:
         """Per body (``rows``, standing at ``x, y`` when the solve began): its motion this step
         before the solve, and its turn by the solve so far (the bodies ``before`` knew keep theirs;
@@ -106,29 +107,30 @@ class Friction:
             k = before.dturn.size
             self.rot0[:k], self.dturn[:k] = before.rot0, before.dturn
 
-    def clip(self, value: np.ndarray, normal: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    def clip(self, value: F64Array, normal: F64Array, limits: F64Array) -> F64Array:
         """Tangential values (last step's, as a warm start) within the limits of the normal ones."""
         bound = limits * normal
         return np.clip(value, -bound, bound)
 
-    def spread(self, a: np.ndarray, b: np.ndarray, nx: np.ndarray, ny: np.ndarray, value: np.ndarray,
-               n_bodies: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def spread(self, a: IntpArray, b: IntpArray, nx: F64Array, ny: F64Array, value: F64Array,
+               n_bodies: int) -> tuple[F64Array, F64Array, F64Array]:
         """Per body, the ``(x, y, turn)`` changes the tangential ``value`` of every contact makes
         (a warm start)."""
         ox, oy = warm_start(a, b, -ny, nx, self.tshare_a, self.tshare_b, value, n_bodies)
         turn = np.bincount(b, self.turn_b * value, n_bodies) - np.bincount(a, self.turn_a * value, n_bodies)
-        return ox, oy, turn
+        # (bincount with weights gives float64; numpy's stub says an integer array whatever the weights)
+        return ox, oy, turn  # type: ignore[return-value]
 
-    def positions_args(self, limits: np.ndarray, tpush: np.ndarray) -> tuple[np.ndarray, ...]:
+    def positions_args(self, limits: F64Array, tpush: F64Array) -> tuple[F64Array, ...]:
         """:func:`solve_positions`' friction arguments."""
         return (limits, self.tshare_a, self.tshare_b, self.turn_a, self.turn_b, self.arm_a, self.arm_b, tpush,
                 self.mx, self.my, self.mturn, self.dturn)
 
-    def velocities_args(self, limits: np.ndarray, timpulse: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
+    def velocities_args(self, limits: F64Array, timpulse: F64Array, w: F64Array) -> tuple[F64Array, ...]:
         """:func:`solve_velocities`' friction arguments."""
         return (limits, self.tshare_a, self.tshare_b, self.turn_a, self.turn_b, self.arm_a, self.arm_b, timpulse, w)
 
-    def place_turns(self, store: BodyStore, rows: np.ndarray) -> None:
+    def place_turns(self, store: BodyStore, rows: IntpArray) -> None:
         """Turn the bodies the position solve turned."""
         turned = np.flatnonzero(self.dturn != 0.0)
         if turned.size:

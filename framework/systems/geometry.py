@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import F64Array, I64Array, IntpArray
 from ..shapes import Capsule, Polygon
 from ..store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, BodyStore
 
@@ -17,7 +18,7 @@ __all__ = ["Geometry", "widen_down", "widen_up"]
 _TINY = 5e-324  # the smallest subnormal: the step away from 0
 
 
-def _ulp_step(v: np.ndarray) -> np.ndarray:
+def _ulp_step(v: F64Array) -> F64Array:
     """``|v| * 2**-52`` (between one and two ulps of ``v``), at least the smallest subnormal (which
     moves 0 and subnormals). (Not the sum of the two: below about 1e-292 the product is itself
     subnormal, and rounded up it plus the smallest subnormal made three ulps.)"""
@@ -27,7 +28,7 @@ def _ulp_step(v: np.ndarray) -> np.ndarray:
     return step
 
 
-def widen_down(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+def widen_down(v: F64Array, out: F64Array | None = None) -> F64Array:
     """``v`` lowered by one or two ulps (at least to ``np.nextafter(v, -inf)``), by arithmetic:
     several times faster than ``nextafter``. The rounded difference ``v - step`` lies one or two
     ulps below ``v``; -inf stays -inf (and a lower bound is never +inf: it is at most the
@@ -35,7 +36,7 @@ def widen_down(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     return np.subtract(v, _ulp_step(v), out=out)
 
 
-def widen_up(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+def widen_up(v: F64Array, out: F64Array | None = None) -> F64Array:
     """``v`` raised by one or two ulps (see :func:`widen_down`)."""
     return np.add(v, _ulp_step(v), out=out)
 
@@ -86,7 +87,7 @@ class Geometry:
         else:
             self._compute(store, store.active()[2], full=False, sel=store.active_sel()[2])
 
-    def update_rows(self, store: BodyStore, rows: np.ndarray) -> None:
+    def update_rows(self, store: BodyStore, rows: IntpArray) -> None:
         """Origins and bounds of ``rows`` only (bodies the response just moved); a full
         :meth:`update` if the structure changed since the last one."""
         if self.version != store.version or (store.version, store.static_epoch, store.n) != getattr(
@@ -95,7 +96,7 @@ class Geometry:
         else:
             self._compute(store, rows, full=False)
 
-    def _compute(self, store: BodyStore, rows: np.ndarray, full: bool, sel: slice | np.ndarray | None = None) -> None:
+    def _compute(self, store: BodyStore, rows: IntpArray, full: bool, sel: slice | IntpArray | None = None) -> None:
         """Origins and bounds of ``rows`` (``sel``: the same rows as a slice, if they are one run)."""
         n = store.n
         if sel is None:
@@ -170,7 +171,7 @@ class Geometry:
                     lo[sel] = widen_down(lo[sel])
                     hi[sel] = widen_up(hi[sel])
 
-    def outlines(self, store: BodyStore, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def outlines(self, store: BodyStore, rows: IntpArray) -> tuple[F64Array, I64Array]:
         """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows."""
         K = self.K
         out = np.empty((rows.size, K, 2))

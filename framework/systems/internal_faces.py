@@ -20,15 +20,16 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+from numpy.typing import NDArray
 
-from ..arrays import distinct
+from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision.broad_phase import SpatialHash
 from ..store import KIND_AABB, STATIC, BodyStore
 from .geometry import Geometry
 
 __all__ = ["InternalFaces"]
 
-RowsOf = Callable[[np.ndarray], np.ndarray]  # entity ids -> store rows
+RowsOf = Callable[[I64Array], I64Array]  # entity ids -> store rows
 
 # Face bits, by the direction a body leaves the box through them.
 LEFT, RIGHT, DOWN, UP = 1, 2, 4, 8
@@ -43,7 +44,7 @@ class InternalFaces:
         self._mask = np.zeros(0, dtype=np.uint8)
 
     def masks(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
-              rows: np.ndarray) -> np.ndarray:
+              rows: IntpArray) -> NDArray[np.uint8]:
         """Face bits of the static AABB ``rows`` (0 for rows of other kinds)."""
         key = (store.version, store.static_epoch, store.n)
         if key != self._key:
@@ -55,12 +56,12 @@ class InternalFaces:
         return self._mask[rows]
 
     @staticmethod
-    def _eligible(store: BodyStore, rows: np.ndarray) -> np.ndarray:
+    def _eligible(store: BodyStore, rows: IntpArray) -> BoolArray:
         return (store.kind[rows] == KIND_AABB) & (store.body[rows] == STATIC) & ~store.one_way[rows] \
             & ~store.sensor[rows]
 
     def _compute(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
-                 rows: np.ndarray) -> np.ndarray:
+                 rows: IntpArray) -> NDArray[np.uint8]:
         out = np.zeros(rows.size, dtype=np.uint8)
         ok = self._eligible(store, rows)
         if not ok.any():
@@ -93,9 +94,9 @@ class InternalFaces:
         out[ok] = acc
         return out
 
-    def redirect(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf, ra: np.ndarray,
-                 rb: np.ndarray, nx: np.ndarray, ny: np.ndarray, depth: np.ndarray, hit: np.ndarray,
-                 rank: np.ndarray) -> int:
+    def redirect(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf, ra: IntpArray,
+                 rb: IntpArray, nx: F64Array, ny: F64Array, depth: F64Array, hit: BoolArray,
+                 rank: F64Array) -> int:
         """Re-aim (in place) the contacts whose push-out leaves a static box through an internal face:
         along the box's open face the body is least deep behind; or, if the body's middle lies
         beyond that face, drop them (``hit`` False: the covering box's own contact resolves the
@@ -161,7 +162,7 @@ class InternalFaces:
         return int(cand.size + beyond.sum())
 
 
-def _extent(store: BodyStore, geom: Geometry, rows: np.ndarray) -> tuple[np.ndarray, ...]:
+def _extent(store: BodyStore, geom: Geometry, rows: IntpArray) -> tuple[F64Array, F64Array, F64Array, F64Array]:
     """``(minx, maxx, miny, maxy)`` of the rows' hitboxes where their origins are now."""
     hx, hy = geom.hx[rows], geom.hy[rows]
     ex, ey = store.hw[rows].copy(), store.hh[rows].copy()

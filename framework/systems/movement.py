@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import IntpArray
 from ..frame import StepFrame
 from ..store import DYNAMIC, STATIC, BodyStore
 from .stage import Stage
@@ -17,14 +18,14 @@ from .stage import Stage
 __all__ = ["Movement", "integrate", "integrate_rows"]
 
 
-def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> np.ndarray:
+def integrate(store: BodyStore, dt: float, gravity: tuple[float, float]) -> IntpArray:
     """Advance every moving row by ``dt``; return the rows integrated."""
     rows = store.active()[0]
     _advance(store, rows, store.active_sel()[0], dt, gravity)  # a slice where the movers are one run
     return rows
 
 
-def integrate_rows(store: BodyStore, rows: np.ndarray, dt: float, gravity: tuple[float, float]) -> None:
+def integrate_rows(store: BodyStore, rows: IntpArray, dt: float, gravity: tuple[float, float]) -> None:
     """:func:`integrate` for some rows only (bodies woken after the movement stage, catching up on
     the step they slept through); rows without a Velocity, and static rows, stay put."""
     c = store.cols
@@ -32,7 +33,7 @@ def integrate_rows(store: BodyStore, rows: np.ndarray, dt: float, gravity: tuple
     _advance(store, rows, rows, dt, gravity)
 
 
-def _advance(store: BodyStore, rows: np.ndarray, sel: slice | np.ndarray, dt: float,
+def _advance(store: BodyStore, rows: IntpArray, sel: slice | IntpArray, dt: float,
              gravity: tuple[float, float]) -> None:
     """Semi-implicit Euler on ``rows`` (``sel``: the same rows, as a slice where they are one run)."""
     if rows.size == 0:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arrays import distinct
+from ..arrays import BoolArray, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.kinds import (
     BOXES,
@@ -38,7 +38,7 @@ _PAIR_FAMILY = np.array([rule.family for rule in PAIRS.values()], dtype=np.int64
 _PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
 
 
-def filter_layers(store: BodyStore, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+def filter_layers(store: BodyStore, ra: IntpArray, rb: IntpArray) -> BoolArray:
     """Mask of the pairs whose layers and masks let them meet."""
     if store.layers_all_meet():
         return np.ones(ra.size, dtype=bool)
@@ -47,7 +47,7 @@ def filter_layers(store: BodyStore, ra: np.ndarray, rb: np.ndarray) -> np.ndarra
 
 
 def pair_contacts(
-    store: BodyStore, geom: Geometry, ra: np.ndarray, rb: np.ndarray, counts: dict[str, int] | None = None,
+    store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray, counts: dict[str, int] | None = None,
     *, remeasure: bool = False,
 ) -> batch.ContactArrays:
     """Contacts of B (rows ``rb``) against A (rows ``ra``), in input order.
@@ -110,7 +110,7 @@ def pair_contacts(
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
 
 
-def _capsule_pairs(store: BodyStore, geom: Geometry, a: np.ndarray, b: np.ndarray, code: np.ndarray,
+def _capsule_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, code: IntpArray,
                    remeasure: bool) -> batch.ContactArrays:
     """:func:`~framework.collision.capsule.capsule_many` of pairs with a capsule: the capsule
     first (the pair rule's flip; of two capsules, the one placed first, as ``collide``), the other
@@ -188,7 +188,9 @@ class NarrowPhase(Stage):
         frame.counters["events"] = int(h.size + frame.ended.a.size)
         return True
 
-    def _keep_sleepers(self, frame: StepFrame, contacts: StepContacts, rows: tuple[np.ndarray, np.ndarray]):
+    def _keep_sleepers(
+        self, frame: StepFrame, contacts: StepContacts, rows: tuple[I64Array, I64Array],
+    ) -> tuple[StepContacts, tuple[I64Array, I64Array]]:
         """Add last step's contacts between idle bodies (asleep or static); wake sleepers touched by
         an awake solid body, and bring them up to date."""
         store = self.bodies.store
@@ -212,8 +214,10 @@ class NarrowPhase(Stage):
             contacts, rows = self._catch_up_woken(woken, frame.dt, contacts, rows)
         return contacts, rows
 
-    def _catch_up_woken(self, woken: np.ndarray, dt: float, contacts: StepContacts,
-                        rows: tuple[np.ndarray, np.ndarray]):
+    def _catch_up_woken(
+        self, woken: I64Array, dt: float, contacts: StepContacts,
+        rows: tuple[I64Array, I64Array],
+    ) -> tuple[StepContacts, tuple[I64Array, I64Array]]:
         """Bodies woken by a touch in this narrow phase slept through the movement stage: move them
         now as it would have (a body resting on the floor sinks into it by gravity's step, as an
         awake one does, and the response pushes it out), then measure their contacts again: those
@@ -235,4 +239,4 @@ class NarrowPhase(Stage):
             col[stale] = new
         keep = np.ones(contacts.a.size, dtype=bool)
         keep[stale[~r.hit]] = False
-        return StepContacts(*(c[keep] for c in cols)), (rows[0][keep], rows[1][keep])
+        return StepContacts._make(c[keep] for c in cols), (rows[0][keep], rows[1][keep])

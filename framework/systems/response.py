@@ -16,13 +16,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import BoolArray, F64Array, I64Array, IntpArray
 from ..collision import batch
 from ..events import pair_keys, sorted_find, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..store import STATIC
+from .geometry import Geometry
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
-from .solve import KEEP_GAP, Contacts, Solve
+from .solve import KEEP_GAP, Contacts, Pairs, Solve
 from .stage import Stage
 from .turning import manifold_points
 
@@ -92,7 +94,7 @@ class Response(Stage):
             cat([tpush0, stpush[old]]), cat([timpulse0, stimp[old]]), cat([c.px, np.zeros(old.size)]),
             cat([c.py, np.zeros(old.size)]))
 
-    def _solid(self, frame: StepFrame, cs: Contacts) -> np.ndarray:
+    def _solid(self, frame: StepFrame, cs: Contacts) -> BoolArray:
         """Mask of the contacts the response acts on."""
         store = self.bodies.store
         ra, rb = cs.ra, cs.rb
@@ -105,7 +107,7 @@ class Response(Stage):
             solid &= ~one_way | self._lands_on_one_way(frame, cs)
         return solid
 
-    def _facing(self, ra, rb, nx, ny, margin) -> np.ndarray:
+    def _facing(self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, margin: F64Array) -> BoolArray:
         """Mask of the kept pairs whose bodies still face each other across their contact: their
         bounds meet when grown by ``margin`` along the normal only (a box whose support slid away
         sideways is no longer held by it, however small the gap along the normal)."""
@@ -114,7 +116,7 @@ class Response(Stage):
         return ((geom.minx[ra] - gx < geom.maxx[rb]) & (geom.minx[rb] - gx < geom.maxx[ra])
                 & (geom.miny[ra] - gy < geom.maxy[rb]) & (geom.miny[rb] - gy < geom.maxy[ra]))
 
-    def _support_gaps(self, frame: StepFrame, ra, rb, nx, ny) -> np.ndarray:
+    def _support_gaps(self, frame: StepFrame, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array) -> F64Array:
         """How far the step's movement took last step's pairs apart along their normal, as a depth
         (<= 0; the caller subtracts the gap they ended last step with): a pair that fell together
         stays where it was (and is pushed apart again if a push below makes them overlap), one
@@ -126,7 +128,7 @@ class Response(Stage):
                + ((store.y[rb] - sy[rb]) - (store.y[ra] - sy[ra])) * ny)
         return np.minimum(-gap, 0.0)
 
-    def _lands_on_one_way(self, frame: StepFrame, cs: Contacts) -> np.ndarray:
+    def _lands_on_one_way(self, frame: StepFrame, cs: Contacts) -> BoolArray:
         """Mask of contacts a one-way platform takes: the other body comes from above (the
         normal within 45 degrees of the platform's up) and sank in only by this step's motion."""
         store = self.bodies.store
@@ -149,7 +151,7 @@ class Response(Stage):
         came_down = cs.depth <= np.maximum(sank, 0.0) + tol
         return from_above & (came_down | ~cs.alive0)
 
-    def candidate_pairs(self, frame: StepFrame, cs: Contacts) -> tuple[np.ndarray, ...]:
+    def candidate_pairs(self, frame: StepFrame, cs: Contacts) -> Pairs:
         """The broad phase's pairs that are not contacts of the solve (touching or near when the
         narrow phase measured them), where both bodies take part in the response and neither is a
         one-way platform: ``(rows a, rows b, entities a, entities b)``. Pushes may make them
@@ -162,7 +164,7 @@ class Response(Stage):
         keep = ~sorted_member(pair_keys(ea, eb), known) & (ra < store.n) & (rb < store.n)
         return self.solid_pairs(ra[keep], rb[keep], ea[keep], eb[keep])
 
-    def solid_pairs(self, ra, rb, ea, eb) -> tuple[np.ndarray, ...]:
+    def solid_pairs(self, ra: IntpArray, rb: IntpArray, ea: I64Array, eb: I64Array) -> Pairs:
         """The pairs among ``(ra, rb, ea, eb)`` the response may act on: hitboxes whose layers
         meet, neither a sensor nor a one-way platform, at least one body movable."""
         store = self.bodies.store
@@ -171,7 +173,7 @@ class Response(Stage):
         ok = self._takes_part(ra, rb) & ~(store.one_way[ra] | store.one_way[rb]) & filter_layers(store, ra, rb)
         return ra[ok], rb[ok], ea[ok], eb[ok]
 
-    def _takes_part(self, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    def _takes_part(self, ra: IntpArray, rb: IntpArray) -> BoolArray:
         """Mask of the pairs the response may act on by their bodies alone: both still have a
         hitbox (a system may have removed one), neither is a sensor, and at least one is movable
         (sleeping bodies keep still)."""
@@ -181,7 +183,9 @@ class Response(Stage):
 
     # --- geometry the solve asks for ---------------------------------------------------------
 
-    def redirect(self, ra, rb, nx, ny, depth, hit) -> None:
+    def redirect(
+        self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, depth: F64Array, hit: BoolArray,
+    ) -> None:
         """Re-aim (in place) pushes that would leave a tile through a face another tile covers."""
         b = self.bodies
         if b.n_static == 0:
@@ -189,7 +193,7 @@ class Response(Stage):
         rank = depth.copy()
         self.internal_faces.redirect(b.store, b.geometry, b.hash, b.rows_of, ra, rb, nx, ny, depth, hit, rank)
 
-    def remeasure(self, ra: np.ndarray, rb: np.ndarray) -> batch.ContactArrays:
+    def remeasure(self, ra: IntpArray, rb: IntpArray) -> batch.ContactArrays:
         """The pairs ``(ra, rb)`` measured again where the bodies now are (pairs within rounding of
         touching count as apart), pushes re-aimed off internal faces. Only these rows' hitbox
         origins are brought up to date (a full update waits for the next reader)."""
@@ -198,13 +202,13 @@ class Response(Stage):
         self.redirect(ra, rb, r.nx, r.ny, r.depth, r.hit)
         return r
 
-    def remeasure_points(self, ra: np.ndarray, rb: np.ndarray, nx: np.ndarray, ny: np.ndarray,
-                         gap: float) -> tuple[np.ndarray, ...]:
+    def remeasure_points(self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array,
+                         gap: float) -> tuple[I64Array, F64Array, F64Array, F64Array]:
         """The manifold points of the box and polygon pairs ``(ra, rb)`` along the normals ``(nx,
         ny)``, where the bodies (and their turns) now are (see :func:`manifold_points`)."""
         return manifold_points(self.bodies.store, self._geometry_of(ra, rb, True), ra, rb, nx, ny, gap)
 
-    def _geometry_of(self, ra: np.ndarray, rb: np.ndarray, turned: bool):
+    def _geometry_of(self, ra: IntpArray, rb: IntpArray, turned: bool) -> Geometry:
         """The geometry, with the hitboxes of these rows where their bodies now stand (``turned``:
         and as they are now turned; a full update waits for the next reader)."""
         store, geom = self.bodies.store, self.bodies.geometry
@@ -216,7 +220,7 @@ class Response(Stage):
             geom.hx, geom.hy = store.x, store.y
         return geom
 
-    def static_candidates(self, rows: np.ndarray, margin: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, ...]:
+    def static_candidates(self, rows: IntpArray, margin: F64Array, known: I64Array) -> Pairs:
         """Pairs of the bodies ``rows`` with the static bodies their bounds, grown by ``margin`` (per
         row), meet where they stand, other than the pairs whose keys are in ``known`` (sorted):
         ``(rows a, rows b, entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the
@@ -248,7 +252,9 @@ class Response(Stage):
             self._near = _NearStatics(key, store.n)
         return self._near
 
-    def new_static_contacts(self, rows: np.ndarray, known: np.ndarray):
+    def new_static_contacts(
+        self, rows: IntpArray, known: I64Array,
+    ) -> tuple[I64Array, I64Array, IntpArray, IntpArray, batch.ContactArrays] | None:
         """Overlaps of ``rows`` (dynamic, just moved) with static bodies, other than the pairs whose
         keys are in ``known`` (sorted): ``(ents_a, ents_b, rows_a, rows_b, contacts)`` or None."""
         bodies = self.bodies
@@ -286,7 +292,7 @@ class Response(Stage):
         if not r.hit.any():
             return None
         h = np.flatnonzero(r.hit)
-        return ea[h], eb[h], ra[h], rb[h], batch.ContactArrays(*(v[h] for v in r))
+        return ea[h], eb[h], ra[h], rb[h], batch.ContactArrays._make(v[h] for v in r)
 
 
 class _NearStatics:
@@ -299,7 +305,7 @@ class _NearStatics:
         self.row = np.zeros(0, dtype=np.int64)  # per pair: the dynamic body's row
         self.ea = self.eb = np.zeros(0, dtype=np.int64)
 
-    def refresh(self, bodies, rows: np.ndarray, margin: np.ndarray) -> None:
+    def refresh(self, bodies, rows: IntpArray, margin: F64Array) -> None:
         """Look up the statics within ``margin`` of ``rows`` again."""
         store, geom, hsh = bodies.store, bodies.geometry, bodies.hash
         stale = np.zeros(store.n, dtype=bool)
@@ -316,7 +322,7 @@ class _NearStatics:
             self.row = np.concatenate([self.row, bodies.rows_of(dyn)])
             self.ea, self.eb = np.concatenate([self.ea, ea]), np.concatenate([self.eb, eb])
 
-    def pairs_of(self, n: int, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def pairs_of(self, n: int, rows: IntpArray) -> tuple[I64Array, I64Array]:
         """The kept pairs of ``rows``."""
         want = np.zeros(n, dtype=bool)
         want[rows] = True

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arrays import distinct
+from ..arrays import I64Array, IntpArray, distinct
 from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from ..store import DYNAMIC
@@ -75,7 +75,7 @@ class Sleeping(Stage):
             self._link(ta, tb)
         return True
 
-    def _touching(self, frame: StepFrame) -> tuple[np.ndarray, np.ndarray]:
+    def _touching(self, frame: StepFrame) -> tuple[I64Array, I64Array]:
         """The rows of the pairs touching this step: its contacts and the response's resting pairs
         (bodies that fell together merely touch), both still in the store."""
         store = self.bodies.store
@@ -85,7 +85,7 @@ class Sleeping(Stage):
         ok = (ra >= 0) & (rb >= 0) & (ra < store.n) & (rb < store.n)
         return ra[ok], rb[ok]
 
-    def _link(self, ra: np.ndarray, rb: np.ndarray) -> None:
+    def _link(self, ra: IntpArray, rb: IntpArray) -> None:
         """Remember which bodies now asleep touch each other (of the touching rows ``ra, rb``, the
         pairs of two dynamic sleepers)."""
         store = self.bodies.store
@@ -111,7 +111,7 @@ class Sleeping(Stage):
         keep = sleeps_a & sleeps_b
         self.links = self.links[keep]
 
-    def _whole_islands(self, ea: np.ndarray, eb: np.ndarray, ready_rows: np.ndarray) -> np.ndarray:
+    def _whole_islands(self, ea: IntpArray, eb: IntpArray, ready_rows: IntpArray) -> IntpArray:
         """The ready rows whose whole group of touching dynamic bodies (the touching rows ``ea,
         eb``) is ready (or asleep)."""
         store = self.bodies.store

@@ -33,21 +33,24 @@ exactly as before.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeAlias
 
 import numpy as np
 
-from ..arrays import distinct
+from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
 from ..events import pair_keys, pair_parts, sorted_member
-from ..frame import NO_POINTS, StepFrame
+from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
 from .turning import expand, turning_polygons
 
-__all__ = ["Contacts", "Solve", "bounce_speed"]
+__all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
+
+#: Pairs of bodies: rows a, rows b, entities a, entities b.
+Pairs: TypeAlias = tuple[IntpArray, IntpArray, I64Array, I64Array]
 
 # Solver passes at most per response iteration (Scene.response_iterations): passes stop once
 # nothing changes (a pile warm started from the last step needs one or two, a fresh one dozens);
@@ -81,8 +84,24 @@ class Contacts:
     warm start (last step's push and impulse of the pair, and its friction's tangential push and
     impulse)."""
 
+    ra: IntpArray
+    rb: IntpArray
+    ea: I64Array
+    eb: I64Array
+    nx: F64Array
+    ny: F64Array
+    depth: F64Array
+    alive0: BoolArray
+    push0: F64Array
+    impulse0: F64Array
+    tpush0: F64Array
+    timpulse0: F64Array
+    px: F64Array
+    py: F64Array
+    slot: I64Array
+
     def __init__(self, ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, px, py,
-                 slot=None, arms=None) -> None:
+                 slot=None, *, arms=None) -> None:
         self.ra, self.rb, self.ea, self.eb = ra, rb, ea, eb
         self.nx, self.ny, self.depth, self.alive0 = nx, ny, depth, alive0
         self.push0, self.impulse0, self.tpush0, self.timpulse0 = push0, impulse0, tpush0, timpulse0
@@ -92,11 +111,11 @@ class Contacts:
         self.slot = np.zeros(ra.size, dtype=np.int64) if slot is None else slot
         self.arms = arms
 
-    def columns(self) -> tuple[np.ndarray, ...]:
+    def columns(self) -> tuple[Any, ...]:  # (columns of several dtypes)
         return (self.ra, self.rb, self.ea, self.eb, self.nx, self.ny, self.depth, self.alive0, self.push0,
                 self.impulse0, self.tpush0, self.timpulse0, self.px, self.py, self.slot)
 
-    def take(self, idx: np.ndarray) -> Contacts:
+    def take(self, idx: IntpArray) -> Contacts:
         arms = None if self.arms is None else tuple(v[idx] for v in self.arms)
         return Contacts(*(v[idx] for v in self.columns()), arms=arms)
 
@@ -109,8 +128,22 @@ class Solve:
     """One step's solve over the solid contacts ``cs``, on local copies of the bodies' positions and
     velocities (written to the store when done)."""
 
+    # Set by the methods that compute them (declared here: they are read before mypy sees them set).
+    ia: F64Array
+    ib: F64Array
+    rn_a: F64Array
+    rn_b: F64Array
+    rt_a: F64Array
+    rt_b: F64Array
+    at_points: BoolArray
+    rot0: F64Array
+    dturn: F64Array
+    b_on_a: BoolArray | None
+    a_on_b: BoolArray | None
+    position_mu: F64Array | None  # (set whenever ``fpos`` is)
+
     def __init__(self, stage: Any, frame: StepFrame, cs: Contacts,
-                 points: tuple[np.ndarray, ...] = NO_POINTS) -> None:  # stage: the Response
+                 points: Points = NO_POINTS) -> None:  # stage: the Response
         self.stage, self.frame = stage, frame
         self.store = store = stage.bodies.store
         self.gravity = stage.pipeline.active_gravity()
@@ -203,7 +236,7 @@ class Solve:
             k = turned_by.size
             cs.depth[:k] += self.rn_b[:k] * self.dturn[self.b[:k]] - self.rn_a[:k] * self.dturn[self.a[:k]] - turned_by
 
-    def _rigid_shares(self, still_a: np.ndarray, still_b: np.ndarray) -> tuple[Any, ...]:
+    def _rigid_shares(self, still_a: BoolArray, still_b: BoolArray) -> tuple[Any, ...]:
         """Contacts at points: how far a unit of push (impulse) moves and turns each body, the
         bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a, turn_b))``."""
         rn_a, rn_b = self.rn_a, self.rn_b
@@ -212,7 +245,7 @@ class Solve:
         inv = 1.0 / (wa + wb + ia * rn_a * rn_a + ib * rn_b * rn_b)
         return wa * inv, wb * inv, (ia * rn_a * inv, ib * rn_b * inv)
 
-    def _angular(self) -> tuple[np.ndarray, np.ndarray] | None:
+    def _angular(self) -> tuple[F64Array, F64Array] | None:
         """Contacts at points: each body's angular part of the normal effective inverse mass."""
         if not self.rigid:
             return None
@@ -241,7 +274,7 @@ class Solve:
         self.a_on_b = a_on_b = both & (up < -0.5) & held[self.b]
         return self._lower_stays(b_on_a, a_on_b)
 
-    def _lower_stays(self, b_on_a: np.ndarray, a_on_b: np.ndarray) -> tuple[Any, ...]:
+    def _lower_stays(self, b_on_a: BoolArray, a_on_b: BoolArray) -> tuple[Any, ...]:
         """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still, and
         the turns of contacts at points (None elsewhere): ``(share_a, share_b, turns)``."""
         if self.rigid:
@@ -250,7 +283,7 @@ class Solve:
         share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
         return share_a, share_b, None
 
-    def _order(self) -> np.ndarray:
+    def _order(self) -> IntpArray:
         """Contacts from the bottom of a pile up (contacts with immovable bodies first): a push
         then travels up a stack within one pass. Without gravity, in pair order."""
         gx, gy = self.gravity
@@ -287,7 +320,7 @@ class Solve:
             fr.start(self.frame, store, self.rows, self.x0, self.y0)
             if self.rigid:  # (one turn per body: the normal pushes' and friction's)
                 fr.rot0, fr.dturn = self.rot0, self.dturn
-            self.tpush = fr.clip(cs.tpush0, self.push, self.position_mu)
+            self.tpush = fr.clip(cs.tpush0, self.push, self.position_mu)  # type: ignore[arg-type]  # (fr: set)
             if self.tpush.any():
                 tx, ty, turn = fr.spread(self.a, self.b, cs.nx, cs.ny, self.tpush, self.rows.size)
                 self.dx += tx
@@ -354,7 +387,7 @@ class Solve:
         need = float(np.max(np.ceil(np.maximum(deep, 0.0) / self.reach[mover])))
         return int(min(need + 1.0, MAX_CLEAR_ROUNDS))
 
-    def _warm_pushes(self, push0: np.ndarray) -> np.ndarray:
+    def _warm_pushes(self, push0: F64Array) -> F64Array:
         """Last step's pushes as this step's first guess: none longer than its bodies' half-thickness
         (a body wedged between others that keep still may ask for more than any push can give, and
         its pushes must not grow from step to step: the 200-body soak shot a triangle 10 units
@@ -370,12 +403,12 @@ class Solve:
             return push0 * np.minimum(scale[self.a], scale[self.b])
         return push0.copy()
 
-    def _push_cap(self) -> np.ndarray:
+    def _push_cap(self) -> F64Array:
         """Per contact, the longest push worth remembering: the smaller half-thickness of its two
         bodies (a push that long in one step is a body being pushed out of a heap, not resting)."""
         return 2.0 * np.minimum(self.span[self.a], self.span[self.b])
 
-    def _solve(self, order: np.ndarray, tolerance: float | None = None, translate: bool = False) -> bool:
+    def _solve(self, order: IntpArray, tolerance: float | None = None, translate: bool = False) -> bool:
         """One run of the position solver over the contacts ``order``; the bodies are then placed.
         Whether a push was held back.
 
@@ -404,9 +437,10 @@ class Solve:
         self._place()
         return bool(held)
 
-    def _friction_positions(self) -> tuple[np.ndarray, ...]:
+    def _friction_positions(self) -> tuple[F64Array, ...]:
         fr = self.fpos
-        return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)
+        # (position_mu is set whenever fpos is)
+        return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)  # type: ignore[arg-type]
 
     def _place(self) -> None:
         moved = np.flatnonzero((self.dx != 0.0) | (self.dy != 0.0))
@@ -420,7 +454,7 @@ class Solve:
         elif self.fpos is not None and self.fpos.turns:
             self.fpos.place_turns(self.store, self.rows)
 
-    def _shift(self, idx: np.ndarray) -> np.ndarray:
+    def _shift(self, idx: IntpArray) -> F64Array:
         """How far the solve has moved the bodies of contacts ``idx`` apart along their normals."""
         cs, a, b = self.cs, self.a[idx], self.b[idx]
         shift = (self.dx[b] - self.dx[a]) * cs.nx[idx] + (self.dy[b] - self.dy[a]) * cs.ny[idx]
@@ -428,7 +462,7 @@ class Solve:
             shift += self.rn_b[idx] * self.dturn[b] - self.rn_a[idx] * self.dturn[a]
         return shift
 
-    def _separations(self) -> np.ndarray:
+    def _separations(self) -> F64Array:
         """Every contact's separation where the bodies now stand, along its normal (linear)."""
         return self._shift(np.arange(self.cs.size)) - self.cs.depth
 
@@ -457,7 +491,7 @@ class Solve:
         # Another round only for an overlap the solver would act on (not one within its tolerance).
         return bool((r.depth[r.hit] > self.tolerance).any()) or overlapping
 
-    def _measure_points(self, check: np.ndarray) -> bool:
+    def _measure_points(self, check: IntpArray) -> bool:
         """Measure the contact points ``check`` (turning polygons against immovable bodies) again
         where the bodies now stand and are turned: a turn moves a point along an arc, which the
         solver's linear separations follow only to first order, and may turn the pair's normal
@@ -502,22 +536,22 @@ class Solve:
         self.dirty[check[over]] = True
         return bool(over.any())
 
-    def _slack(self) -> np.ndarray:
+    def _slack(self) -> F64Array:
         """Contacts at points: per contact, the overlap of a point measured again that is left to
         the next step rather than given another round (second order: what a turn's arc adds),
         ``POINT_SLACK`` times one plus the smaller body's size."""
         store, cs = self.store, self.cs
         return POINT_SLACK * (1.0 + np.minimum(store.bound[cs.ra], store.bound[cs.rb]))
 
-    def _set_candidates(self, candidates: tuple[np.ndarray, ...]) -> None:
+    def _set_candidates(self, candidates: Pairs) -> None:
         self.candidates = candidates
 
-    def _known_keys(self) -> np.ndarray:
+    def _known_keys(self) -> I64Array:
         """The sorted pair keys of the solve's contacts and its candidates."""
         ca, cb = self.candidates[2], self.candidates[3]
         return np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
 
-    def _static_candidates(self, bodies: np.ndarray) -> None:
+    def _static_candidates(self, bodies: IntpArray) -> None:
         """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
         store, rows = self.store, self.rows[bodies]
         movable = store.movable(rows)
@@ -526,7 +560,7 @@ class Solve:
         known = self._known_keys()
         near = self.stage.static_candidates(rows[movable], self.reach[bodies[movable]], known)
         if near[0].size:
-            self._set_candidates(tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, near)))
+            self._set_candidates(_joined(self.candidates, near))
 
     def _far_candidates(self) -> bool:
         """Pushes that moved a body farther than its span (a quarter of its half-thickness) since it
@@ -559,7 +593,7 @@ class Solve:
             return False
         ea, eb = ea[keep], eb[keep]
         new = self.stage.solid_pairs(bodies.rows_of(ea), bodies.rows_of(eb), ea, eb)
-        self._set_candidates(tuple(np.concatenate([c, n]) for c, n in zip(self.candidates, new)))
+        self._set_candidates(_joined(self.candidates, new))
         return bool(new[0].size)
 
     def _new_dynamic_contacts(self, immovable_only: bool = False) -> bool:
@@ -586,7 +620,7 @@ class Solve:
         keep = np.ones(ra.size, dtype=bool)
         keep[new] = False
         self._set_candidates((ra[keep], rb[keep], ea[keep], eb[keep]))
-        self._add(ra[new], rb[new], ea[new], eb[new], batch.ContactArrays(*(v[h] for v in r)))
+        self._add(ra[new], rb[new], ea[new], eb[new], batch.ContactArrays._make(v[h] for v in r))
         return True
 
     def _late_contacts(self) -> bool:
@@ -733,7 +767,7 @@ class Solve:
         rows = self.rows[movable]
         store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
         if self.rigid or (fr is not None and fr.turns):
-            store.w[rows] = spin[movable]
+            store.w[rows] = spin[movable]  # type: ignore[index]  # (spin is set for both)
 
     def _solve_velocities(self, order, target, share_a, share_b, turns, vx, vy, spin, tol, friction) -> None:
         cs, a, b = self.cs, self.a, self.b
@@ -746,7 +780,7 @@ class Solve:
             solver.solve_velocities(order, a, b, cs.nx, cs.ny, target, share_a, share_b, self.impulse, vx, vy,
                                     self.iterations, tol, dirty, *friction)
 
-    def _velocity_shares(self, vx: np.ndarray, vy: np.ndarray) -> tuple[Any, ...]:
+    def _velocity_shares(self, vx: F64Array, vy: F64Array) -> tuple[Any, ...]:
         """Shares of the velocity impulses. As for the pushes, the lower body of a supported resting
         pair keeps still (a pile's weight goes straight down to the ground within one pass; a body
         high in a pile cannot keep a falling speed that only the pushes hide), except where the
@@ -754,7 +788,7 @@ class Solve:
         immovable body moving up would hand the upper one a bounce off a moving wall and keep its
         own speed, making energy; those pairs meet as the dynamic bodies they are. With the turns of
         contacts at points, as :meth:`_shock_shares`."""
-        if self.b_on_a is None or not (self.b_on_a.any() or self.a_on_b.any()):
+        if self.b_on_a is None or self.a_on_b is None or not (self.b_on_a.any() or self.a_on_b.any()):  # (set together)
             return self.share_a, self.share_b, self.turn_shares
         cs, a, b = self.cs, self.a, self.b
         gx, gy = self.gravity
@@ -805,7 +839,7 @@ class Solve:
         if w is not None:
             w[:] = w_in + t * dw
 
-    def _bounce_targets(self, u: np.ndarray, act: np.ndarray) -> np.ndarray | None:
+    def _bounce_targets(self, u: F64Array, act: IntpArray) -> F64Array | None:
         """The speed each touching contact must part at (0: no bounce), or None if none bounces.
 
         An approach no faster than gravity gives in two steps along the normal (``2 |g.n| dt``) is
@@ -855,11 +889,11 @@ class Solve:
         push = np.minimum(self.push, self._push_cap())[rows]  # (see _warm_pushes)
         tpush = np.zeros(rows.size)
         if self.fpos is not None:
-            tpush = self.fpos.clip(self.tpush[rows], push, self.position_mu[rows])
-        values = (self.push[rows], push, self.impulse[rows], tpush, self.timpulse[rows])
+            tpush = self.fpos.clip(self.tpush[rows], push, self.position_mu[rows])  # type: ignore[index]  # (fpos: set)
+        values: tuple[F64Array, ...] = (self.push[rows], push, self.impulse[rows], tpush, self.timpulse[rows])
         applied = acted[rows]
         if self.rigid:
-            frame.points = (keys, cs.slot[rows], *values[1:], cs.px[rows], cs.py[rows])
+            frame.points = (keys, cs.slot[rows], values[1], values[2], values[3], values[4], cs.px[rows], cs.py[rows])
             first = np.flatnonzero(np.diff(keys, prepend=keys[:1] - 1))  # (each pair's first point)
             ea, eb, nx, ny = ea[first], eb[first], nx[first], ny[first]
             if first.size:
@@ -875,7 +909,13 @@ class Solve:
         frame.counters["resolved"] = int(frame.resolved[0].size)
 
 
-def _number(table: np.ndarray, rows: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:
+def _joined(a: Pairs, b: Pairs) -> Pairs:
+    """The pairs of ``a`` followed by those of ``b``, column by column."""
+    return (np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]]), np.concatenate([a[2], b[2]]),
+            np.concatenate([a[3], b[3]]))
+
+
+def _number(table: I64Array, rows: IntpArray, first: int) -> tuple[IntpArray, I64Array]:
     """Number the rows of ``rows`` that ``table`` (row -> number, -1: none) does not know yet, from
     ``first`` on in row order, entering them in the table; return ``(the new rows, every entry's
     number)``."""
@@ -884,7 +924,7 @@ def _number(table: np.ndarray, rows: np.ndarray, first: int) -> tuple[np.ndarray
     return new, table[rows]
 
 
-def bounce_speed(u: np.ndarray, g: np.ndarray, d: np.ndarray, dt: float) -> np.ndarray:
+def bounce_speed(u: F64Array, g: F64Array, d: F64Array, dt: float) -> F64Array:
     """Speed off an immovable surface that keeps the energy of an elastic bounce.
 
     Semi-implicit Euler under gravity ``g`` (its component against the push-out) conserves

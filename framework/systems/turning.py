@@ -22,23 +22,31 @@ points are ordered along the contact's tangent), in ``frame.points``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from ..arrays import BoolArray, F64Array, I64Array, IntpArray
 from ..collision.batch_manifold import pair_manifolds
 from ..collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys
+from ..frame import Points
 from ..store import BodyStore
+from .geometry import Geometry
+
+if TYPE_CHECKING:  # (solve imports this module)
+    from .solve import Contacts
 
 __all__ = ["expand", "manifold_points", "turning_polygons"]
 
 
-def turning_polygons(store: BodyStore, rows: np.ndarray) -> np.ndarray:
+def turning_polygons(store: BodyStore, rows: IntpArray) -> BoolArray:
     """Mask of ``rows`` that are boxes or polygons contacts turn."""
     return (store.kind[rows] == KIND_POLYGON) & (store.inv_inertia[rows] > 0.0)
 
 
-def manifold_points(store: BodyStore, geom, ra: np.ndarray, rb: np.ndarray, nx: np.ndarray, ny: np.ndarray,
-                    gap: float) -> tuple[np.ndarray, ...]:
+def manifold_points(store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array,
+                    gap: float) -> tuple[I64Array, F64Array, F64Array, F64Array]:
     """:func:`pair_manifolds` of the box and polygon pairs ``(ra, rb)`` along ``(nx, ny)``, from
     the step's geometry, keeping the points less than ``gap`` times the smaller body's size
     apart: ``(count, px, py, sep)``."""
@@ -66,7 +74,7 @@ def manifold_points(store: BodyStore, geom, ra: np.ndarray, rb: np.ndarray, nx: 
     return n_pts, px, py, sep
 
 
-def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: float):
+def expand(cs: Contacts, store: BodyStore, geom: Geometry, points: Points, margin: float) -> Contacts:
     """``cs`` (:class:`~framework.systems.solve.Contacts`) with every pair that has a turning
     polygon replaced by its manifold points (points within ``margin`` times the smaller body's
     size of touching), warm started from last step's ``points`` (``frame.points``), and every
@@ -118,7 +126,7 @@ def expand(cs, store: BodyStore, geom, points: tuple[np.ndarray, ...], margin: f
     return out
 
 
-def _warm_points(cs, n_points: np.ndarray, points: tuple[np.ndarray, ...]) -> None:
+def _warm_points(cs: Contacts, n_points: I64Array, points: Points) -> None:
     """Each point's warm start: last step's values of the same pair and slot, or (a pair that had
     another number of points) its pair's, shared evenly."""
     keys = pair_keys(cs.ea, cs.eb)
