@@ -6,6 +6,10 @@
   ``<!-- runnable -->`` line just above. A ```text block right after a runnable block is what it
   prints, exactly. A block calling ``framework.render.run`` gets a stand-in that checks the
   arguments against the real signature and steps the scene headless instead of opening a window.
+- A block marked ``<!-- pytest -->`` is a test file: it runs under pytest in another process (the
+  plugin as installed, as in a game's own suite), and every test in it passes; the one using the
+  ``golden_dir`` fixture goes through a golden file's life instead (fails unrecorded, records,
+  passes, fails when the behaviour changes).
 - The README's example runs and prints what its comments say; its links lead somewhere.
 - The site's navigation (mkdocs.yml) lists every page, and lists no page that is missing.
 """
@@ -23,12 +27,16 @@ from pathlib import Path
 
 import pytest
 
+pytest_plugins = ["pytester"]
+
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 DOC_FILES = sorted(p for p in DOCS.rglob("*.md") if ">>>" in p.read_text())
 # Pages on which every ```python block is a complete program (or a >>> doctest), and runs.
 EVERY_BLOCK_RUNS = {"index.md", "concepts.md", "events.md", "examples.md", "api.md"}
 RUNNABLE_MARK = "<!-- runnable -->"
+PYTEST_MARK = "<!-- pytest -->"
+_PYTEST_BLOCK = re.compile(r"<!-- pytest -->\n```python\n(?P<code>.*?)```\n", re.S)
 _BLOCK = re.compile(r"(?P<mark><!-- runnable -->\n)?```python\n(?P<code>.*?)```\n"
                     r"(?:\n(?:[^`\n][^\n]*\n)*?\n?```text\n(?P<out>.*?)```)?", re.S)
 
@@ -83,6 +91,66 @@ def test_complete_python_blocks_in_docs_run(page, number, code, expected, capsys
     out = capsys.readouterr().out
     if expected is not None:
         assert out == expected, f"docs/{page} block {number} printed:\n{out}"
+
+
+def _pytest_blocks() -> list[tuple[str, int, str]]:
+    """(page, block number among the page's test-file blocks, code) of every ``<!-- pytest -->``
+    block."""
+    return [(path.name, i, m.group("code")) for path in sorted(DOCS.glob("*.md"))
+            for i, m in enumerate(_PYTEST_BLOCK.finditer(path.read_text()), 1)]
+
+
+PYTEST_BLOCKS = _pytest_blocks()
+GOLDEN_BLOCKS = [b for b in PYTEST_BLOCKS if "golden_dir" in b[2]]
+
+
+def test_the_testing_page_samples_are_test_files():
+    on_testing = [b for b in PYTEST_BLOCKS if b[0] == "testing.md"]
+    assert len(on_testing) >= 6 and len(GOLDEN_BLOCKS) == 1
+    assert RUNNABLE_MARK not in (DOCS / "testing.md").read_text()  # they run under pytest, not as scripts
+
+
+def _pytest_in_a_process(pytester, *args):
+    """pytest in another process, in ``pytester``'s folder; its outcomes and output."""
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider", *args)
+    return result.parseoutcomes(), result.stdout.str()
+
+
+@pytest.mark.parametrize("page,number,code", [b for b in PYTEST_BLOCKS if b not in GOLDEN_BLOCKS],
+                         ids=[f"{p}#{n}" for p, n, c in PYTEST_BLOCKS if (p, n, c) not in GOLDEN_BLOCKS])
+def test_test_file_blocks_in_docs_pass_under_pytest(page, number, code, pytester):
+    tests = re.findall(r"^def (test_\w+)\(", code, flags=re.M)
+    assert tests, f"docs/{page} test file {number} has no test function"
+    pytester.makepyfile(test_sample=code)
+    outcomes, out = _pytest_in_a_process(pytester, "--no-framework-pictures")
+    assert outcomes == {"passed": len(tests)}, f"docs/{page} test file {number}:\n{out[-4000:]}"
+
+
+def test_the_golden_sample_records_once_and_then_can_fail(pytester, monkeypatch):
+    """The page's golden sample, as its text says: the first run fails for want of a golden file,
+    ``--update-golden`` records it next to the test, the same run then passes, and a change of
+    behaviour fails at the first step that differs."""
+    monkeypatch.delenv("FRAMEWORK_UPDATE_GOLDEN", raising=False)
+    ((page, number, code),) = GOLDEN_BLOCKS
+    original = "Velocity(3.0, 0.0)"
+    assert original in code, f"docs/{page} test file {number}: the test below changes the ball's {original}"
+    pytester.mkdir("tests")
+    test_file = pytester.path / "tests" / "test_ball.py"
+    test_file.write_text(code)
+    golden = pytester.path / "tests" / "golden" / "ball.json"
+    outcomes, out = _pytest_in_a_process(pytester, "--no-framework-pictures", "tests")
+    assert outcomes == {"failed": 1} and f"no golden file {golden}" in out and "--update-golden" in out, out[-4000:]
+    outcomes, out = _pytest_in_a_process(pytester, "tests", "--update-golden")
+    assert outcomes == {"passed": 1} and golden.exists(), out[-4000:]
+    outcomes, out = _pytest_in_a_process(pytester, "tests")
+    assert outcomes == {"passed": 1}, out[-4000:]
+    test_file.write_text(code.replace(original, "Velocity(3.25, 0.0)"))
+    outcomes, out = _pytest_in_a_process(pytester, "--no-framework-pictures", "tests")
+    assert outcomes == {"failed": 1}, out[-4000:]
+    said = ("step 1 of 240 (frame 1) differs from the golden run: entity 18 x: golden 2.55, now 2.5541666666666667 "
+            "(differs by 0.00417)")
+    assert f"tests/golden/ball.json: {said}" in (DOCS / page).read_text()  # what the page shows ...
+    assert f"{golden}: {said}" in out, out[-4000:]  # ... is what it says
 
 
 def test_readme_example_runs_and_prints_what_it_says(capsys):
