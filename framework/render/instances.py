@@ -9,8 +9,9 @@ float table with a row per drawable (a *slot*), a float texture the vertex shade
 ``texelFetch``. So a frame writes numpy columns into that table and uploads it once, however many
 drawables moved, turned or changed animation frame: no Python per drawable.
 
-Slot row, three RGBA float texels: ``(x, y, cos, sin)``, ``(u0, v0, u1, v1)``, ``(width, height,
-shown, 0)``.
+Slot row, three RGBA float texels: ``(x, y, cos, sin)``, ``(u0, v0, u1, v1)`` (sprites), ``(width,
+height, shown, 0)`` (a sprite's size in pixels, a disc's radius twice). A filled circle is a disc:
+two triangles whose fragments beyond the radius are discarded, exact at every zoom.
 """
 
 from __future__ import annotations
@@ -22,18 +23,24 @@ import numpy as np
 from pyglet import gl
 from pyglet.graphics import Group
 
-__all__ = ["SLOTS_PER_ROW", "SPRITE_QUAD", "InstanceTable", "LayerGroup", "program", "vertex_list"]
+__all__ = ["DISC", "DISC_QUAD", "FILL", "SLOTS_PER_ROW", "SPRITE", "SPRITE_QUAD", "InstanceTable", "LayerGroup",
+           "program", "vertex_list"]
 
 SLOTS_PER_ROW = 1024  # slots in one row of the table texture (3 texels each)
 
+# ``draw_as`` (a vertex list's mode): 0 a filled outline (``local`` its triangles about the hitbox
+# origin), 1 a sprite
+# (``local`` the corners of the unit square, scaled by the slot's size), 2 a disc (``local`` the
+# corners of the square [-1, 1]^2, scaled by the slot's radius; the fragment shader keeps what is
+# within the radius: a circle exact at every zoom, in two triangles).
 _VERTEX = """#version 150 core
 in vec2 local;
 in vec4 colors;
 in float slot;
-in float textured;
+in float draw_as;
 out vec4 vertex_colors;
 out vec2 texture_coords;
-out float vertex_textured;
+out float vertex_mode;
 uniform sampler2D instances;
 uniform WindowBlock
 {
@@ -45,27 +52,38 @@ void main()
     int s = int(slot + 0.5);
     ivec2 at = ivec2((s % 1024) * 3, s / 1024);
     vec4 pose = texelFetch(instances, at, 0);
-    vec4 uv = texelFetch(instances, at + ivec2(1, 0), 0);
     vec4 size = texelFetch(instances, at + ivec2(2, 0), 0);
-    vec2 p = textured > 0.5 ? (local - 0.5) * size.xy : local;
+    vec2 p = local;
+    texture_coords = local;
+    if (draw_as > 0.5) {
+        p = draw_as > 1.5 ? local * size.xy : (local - 0.5) * size.xy;
+        if (draw_as < 1.5) {
+            vec4 uv = texelFetch(instances, at + ivec2(1, 0), 0);
+            texture_coords = mix(uv.xy, uv.zw, local);
+        }
+    }
     vec2 world = pose.xy + vec2(pose.z * p.x - pose.w * p.y, pose.w * p.x + pose.z * p.y);
     gl_Position = size.z > 0.5 ? window.projection * window.view * vec4(world, 0.0, 1.0)
                                : vec4(2.0, 2.0, 2.0, 1.0);  // hidden: outside the clip volume
     vertex_colors = colors;
-    texture_coords = mix(uv.xy, uv.zw, local);
-    vertex_textured = textured;
+    vertex_mode = draw_as;
 }
 """
 
 _FRAGMENT = """#version 150 core
 in vec4 vertex_colors;
 in vec2 texture_coords;
-in float vertex_textured;
+in float vertex_mode;
 out vec4 final_colors;
 uniform sampler2D atlas;
 void main()
 {
-    final_colors = vertex_textured > 0.5 ? texture(atlas, texture_coords) * vertex_colors : vertex_colors;
+    if (vertex_mode > 1.5) {
+        if (dot(texture_coords, texture_coords) > 1.0) discard;
+        final_colors = vertex_colors;
+    } else {
+        final_colors = vertex_mode > 0.5 ? texture(atlas, texture_coords) * vertex_colors : vertex_colors;
+    }
 }
 """
 
@@ -177,14 +195,18 @@ class LayerGroup(Group):
         return id(self)
 
 
+FILL, SPRITE, DISC = 0, 1, 2  # a vertex list's mode (see the vertex shader)
+
+
 def vertex_list(batch: Any, group: LayerGroup, local: np.ndarray, color: tuple[int, int, int, int], slot: int,
-                textured: bool) -> Any:
-    """A drawable's vertex list: triangles ``local`` (flat x, y pairs), one colour, its slot."""
+                mode: int) -> Any:
+    """A drawable's vertex list: triangles ``local`` (flat x, y pairs), one colour, its slot, its mode."""
     n = local.size // 2
     return group.program.vertex_list(
         n, gl.GL_TRIANGLES, batch, group,
         local=("f", local.tolist()), colors=("Bn", tuple(color) * n),
-        slot=("f", (float(slot),) * n), textured=("f", (1.0 if textured else 0.0,) * n))
+        slot=("f", (float(slot),) * n), draw_as=("f", (float(mode),) * n))
 
 
 SPRITE_QUAD = np.array([0, 0, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1], dtype=np.float64)  # unit square, two triangles
+DISC_QUAD = 2.0 * SPRITE_QUAD - 1.0  # the square [-1, 1]^2, two triangles

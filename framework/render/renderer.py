@@ -42,12 +42,13 @@ from pyglet.graphics import Batch
 from pyglet.math import Mat4
 
 from ..components import Visual
+from ..shapes import Circle
 from ..sprites import Animation, Frame
 from ..store import KIND_CAPSULE, KIND_POLYGON, STATIC
 from .atlas import Atlas
 from .camera import Camera
 from .drawables import fill_triangles
-from .instances import SPRITE_QUAD, InstanceTable, LayerGroup, vertex_list
+from .instances import DISC, DISC_QUAD, FILL, SPRITE, SPRITE_QUAD, InstanceTable, LayerGroup, vertex_list
 from .offscreen import OffscreenTarget, offscreen_window, write_png
 from .overlay import DebugOverlay
 
@@ -368,8 +369,14 @@ class Renderer:
         if remake:
             if vlist is not None:
                 vlist.delete()
-            local = SPRITE_QUAD if sprite else np.asarray(fill_triangles(shape, self.camera.zoom), dtype=np.float64)
-            self._s_vlist[slot] = vertex_list(self._batch, group, local, color, slot, sprite)
+            if sprite:
+                local, mode = SPRITE_QUAD, SPRITE
+            elif isinstance(shape, Circle):
+                local, mode = DISC_QUAD, DISC
+                self._table.rows[slot, 2, :2] = shape.radius
+            else:
+                local, mode = np.asarray(fill_triangles(shape, self.camera.zoom), dtype=np.float64), FILL
+            self._s_vlist[slot] = vertex_list(self._batch, group, local, color, slot, mode)
             self._s_key[slot] = (visual.z, color)
             self._s_pose[slot] = np.nan  # placed again by the next sync
             self._made += 1
