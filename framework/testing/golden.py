@@ -13,6 +13,11 @@ value and the new one (``atol`` allows a tolerance). The failure carries a snaps
 one step before the difference (:attr:`GoldenMismatch.snapshot`, see :mod:`framework.snapshot`)
 to restore and inspect. A file written by another version of the trace format or of the
 framework is an error that says so (rerun with update to accept the new behaviour).
+
+A golden file larger than ``max_bytes`` (default :data:`MAX_BYTES`, 16 MiB: about 120 steps of
+1,000 bodies) is refused before it is read: parsing JSON costs up to about 25 bytes of memory per
+byte of file, so the default keeps a hostile or runaway file well under 1 GiB. Pass a larger
+``max_bytes`` for longer traces.
 """
 
 from __future__ import annotations
@@ -26,11 +31,11 @@ from typing import Any
 from ..validation import InvalidValue
 from .running import DT, Keys, _hold, _steps
 
-__all__ = ["GOLDEN_FORMAT", "GoldenMismatch", "check_golden", "trace_step"]
+__all__ = ["GOLDEN_FORMAT", "MAX_BYTES", "GoldenMismatch", "check_golden", "trace_step"]
 
 GOLDEN_FORMAT = 1
 FIELDS = ("x", "y", "rot", "vx", "vy", "w")
-MAX_BYTES = 512 * 1024 * 1024  # a golden file's size
+MAX_BYTES = 16 * 1024 * 1024  # a golden file's size, by default (check_golden(max_bytes=...))
 
 
 class GoldenMismatch(AssertionError):
@@ -56,14 +61,17 @@ def _update_wanted(update: bool | None) -> bool:
 
 
 def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None, dt: float = DT,
-                 update: bool | None = None, atol: float = 0.0) -> None:
+                 update: bool | None = None, atol: float = 0.0, max_bytes: int = MAX_BYTES) -> None:
     """Run ``scene`` ``steps`` steps (holding ``keys``, at ``dt``) and compare each step with the
-    golden file at ``path``, or write it (see the module docstring)."""
+    golden file at ``path``, or write it (see the module docstring); a file over ``max_bytes`` is
+    refused before it is read."""
     from .. import __version__
 
     n = _steps(steps, None, dt, "check_golden")
     if not (isinstance(atol, (int, float)) and atol >= 0 and math.isfinite(atol)):
         raise InvalidValue(f"atol must be a finite number >= 0, got {atol!r}")
+    if isinstance(max_bytes, bool) or not isinstance(max_bytes, int) or max_bytes <= 0:
+        raise InvalidValue(f"max_bytes must be an int > 0, got {max_bytes!r}")
     path = Path(path)
     if _update_wanted(update):
         trace = []
@@ -79,10 +87,11 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
         raise AssertionError(f"no golden file {path}: run once with update=True, FRAMEWORK_UPDATE_GOLDEN=1 or "
                              "pytest --update-golden to record it")
     size = path.stat().st_size
-    if size > MAX_BYTES:
-        raise InvalidValue(f"{path}: the file is {size} bytes, more than the limit of {MAX_BYTES} for a golden trace")
+    if size > max_bytes:
+        raise InvalidValue(f"{path}: the file is {size} bytes, more than the limit of {max_bytes} for a golden trace "
+                           "(max_bytes)")
     try:
-        golden = json.loads(path.read_text(encoding="utf-8"))
+        golden = json.loads(path.read_bytes().decode("utf-8"))
         fmt, version, trace = golden["format"], golden["framework"], golden["trace"]
     except (ValueError, KeyError, TypeError) as exc:  # UnicodeDecodeError is a ValueError
         raise InvalidValue(f"{path}: not a golden trace ({type(exc).__name__}: {exc})") from None
