@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 
 import pytest
@@ -19,7 +20,9 @@ from framework.testing import (
     assert_inside,
     assert_no_overlap,
     assert_on_floor,
+    bounds,
     check_golden,
+    feet,
     run,
     step_until,
     text_scene,
@@ -171,6 +174,28 @@ def test_physics_assertions_pass_and_fail_readably():
     s.get(ball, Transform).y = 1.25  # half a unit into the ground
     with pytest.raises(AssertionError, match=r"1 pair\(s\) overlap deeper than 0 at step 120; the deepest: entities "):
         assert_no_overlap(s)
+    s.close()
+
+
+def test_bounds_and_feet_measure_where_an_entity_is():
+    level = text_scene(LEVEL, {"O": spawn_ball, "C": spawn_coin})
+    s, ball = level.scene, level.first("O")
+    assert bounds(s, ball) == (2.0, 1.0, 3.0, 2.0) and feet(s, ball) == 1.0  # a circle of radius 1/2 at (2.5, 1.5)
+    box = s.spawn(Transform(6.0, 2.5, 0.5), Velocity(0.0, 1.0), Hitbox(AABB(1.0, 0.5), offset=(0.0, 0.25)))
+    s.step(1 / 64)
+    # Exact, as the shape and the pose give it: the box's bottom is y - 1/4 to the bit (its offset
+    # turns with it: by 0.5 rad the box's centre moves (-0.25 sin 0.5, 0.25 cos 0.5) off its position).
+    t = s.get(box, Transform)
+    hx, hy = t.x - 0.25 * math.sin(0.5), t.y + 0.25 * math.cos(0.5)
+    assert bounds(s, box) == (hx - 0.5, hy - 0.25, hx + 0.5, hy + 0.25) and feet(s, box) == hy - 0.25
+    s.get(ball, Transform).x = 4.25  # moved by hand: measured where it is now
+    assert bounds(s, ball)[:3] == (3.75, 1.0, 4.75)
+    point = s.spawn(Transform(2.5, 3.0))
+    assert bounds(s, point) == (2.5, 3.0, 2.5, 3.0) and feet(s, point) == 3.0
+    with pytest.raises(AssertionError, match="does not exist"):
+        s.despawn(point)
+        s.step(1 / 60)
+        feet(s, point)
     s.close()
 
 

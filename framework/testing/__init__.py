@@ -5,7 +5,7 @@
 - :mod:`.levels`: scenes from inline text maps (:func:`text_scene`);
 - :mod:`.events`: :class:`EventLog`, which collision events happened, with assertions;
 - :mod:`.asserts`: physics assertions with readable messages (at rest, no overlap, inside a
-  region, on the floor);
+  region, on the floor), and :func:`bounds` / :func:`feet` (where an entity's hitbox is);
 - :mod:`.golden`: golden runs (:func:`check_golden`);
 - :mod:`.strategies`: hypothesis strategies for shapes, transforms and small scenes (import it
   yourself: it needs hypothesis);
@@ -15,7 +15,7 @@
 See docs/testing.md.
 """
 
-from .asserts import assert_at_rest, assert_inside, assert_no_overlap, assert_on_floor, overlaps
+from .asserts import assert_at_rest, assert_inside, assert_no_overlap, assert_on_floor, bounds, feet, overlaps
 from .events import EventLog, Recorded
 from .golden import GoldenMismatch, check_golden
 from .levels import TextLevel, text_scene
@@ -23,6 +23,6 @@ from .running import DT, KeyScript, describe, run, step_until
 
 __all__ = [
     "DT", "EventLog", "GoldenMismatch", "KeyScript", "Recorded", "TextLevel", "assert_at_rest", "assert_inside",
-    "assert_no_overlap", "assert_on_floor", "check_golden", "describe", "overlaps", "run", "step_until",
-    "text_scene",
+    "assert_no_overlap", "assert_on_floor", "bounds", "check_golden", "describe", "feet", "overlaps", "run",
+    "step_until", "text_scene",
 ]

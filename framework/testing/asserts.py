@@ -2,6 +2,7 @@
 
 Each raises ``AssertionError`` naming the entity, the step and the numbers: ``entity 7 is not at
 rest at step 120: velocity (0.31, -2.5), speed 2.52 > 1e-06``, not ``assert 2.52 <= 1e-06``.
+:func:`bounds` and :func:`feet` measure where an entity is, for a test's own comparisons.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from ..collision import collide
 from ..components import Hitbox, Transform, Velocity
 from ..validation import InvalidValue
 
-__all__ = ["assert_at_rest", "assert_inside", "assert_no_overlap", "assert_on_floor", "overlaps"]
+__all__ = ["assert_at_rest", "assert_inside", "assert_no_overlap", "assert_on_floor", "bounds", "feet", "overlaps"]
 
 
 def _row(scene: Any, entity: int) -> int:
@@ -25,6 +26,27 @@ def _row(scene: Any, entity: int) -> int:
     if row is None:
         raise InvalidValue(f"entity {entity} has no Transform: it has no position to check")
     return row
+
+
+def bounds(scene: Any, entity: int) -> tuple[float, float, float, float]:
+    """``(minx, miny, maxx, maxy)`` of ``entity``'s hitbox where it is now, exactly as its shape
+    and pose give it (a box's bottom is ``y - height / 2`` to the bit; the broad phase's bounds are
+    wider by an ulp or two); its position, as a point, without a hitbox."""
+    from ..casting import shape_bounds
+
+    row = _row(scene, entity)
+    store = scene.bodies.store
+    hitbox = store.hitboxes[row]
+    if hitbox is None:
+        t = scene.get(entity, Transform)
+        return t.x, t.y, t.x, t.y
+    geom = scene.bodies.ensure_geometry()  # (its hitbox origin: the position, turned offset added)
+    return shape_bounds(hitbox.shape, float(geom.hx[row]), float(geom.hy[row]), float(store.rot[row]))
+
+
+def feet(scene: Any, entity: int) -> float:
+    """The lowest point of ``entity``'s hitbox now: where it stands (``bounds(...)[1]``)."""
+    return bounds(scene, entity)[1]
 
 
 def assert_at_rest(scene: Any, entity: int, *, speed: float = 1e-6) -> None:
@@ -76,20 +98,13 @@ def assert_no_overlap(scene: Any, *, deeper_than: float = 0.0, among: set[int] |
 def assert_inside(scene: Any, entity: int, box: tuple[float, float, float, float]) -> None:
     """``entity``'s hitbox (or its position, without one) lies inside ``box`` = (minx, miny,
     maxx, maxy)."""
-    row = _row(scene, entity)
     x0, y0, x1, y1 = box
     if not (x1 > x0 and y1 > y0):
         raise InvalidValue(f"box must be (minx, miny, maxx, maxy) with max > min, got {box!r}")
-    store = scene.bodies.store
-    if store.hitboxes[row] is not None:
-        geom = scene.bodies.ensure_geometry()
-        bounds = (float(geom.minx[row]), float(geom.miny[row]), float(geom.maxx[row]), float(geom.maxy[row]))
-    else:
-        t = scene.get(entity, Transform)
-        bounds = (t.x, t.y, t.x, t.y)
-    if not (bounds[0] >= x0 and bounds[1] >= y0 and bounds[2] <= x1 and bounds[3] <= y1):
+    b = bounds(scene, entity)
+    if not (b[0] >= x0 and b[1] >= y0 and b[2] <= x1 and b[3] <= y1):
         raise AssertionError(f"entity {entity} is not inside {box!r} at step {scene.frame}: it spans "
-                             f"({bounds[0]:.6g}, {bounds[1]:.6g}) to ({bounds[2]:.6g}, {bounds[3]:.6g})")
+                             f"({b[0]:.6g}, {b[1]:.6g}) to ({b[2]:.6g}, {b[3]:.6g})")
 
 
 def assert_on_floor(scene: Any, entity: int, *, gap: float = 1e-6) -> None:
