@@ -17,6 +17,8 @@ import json
 from framework import AABB, Hitbox, Scene, Transform, Velocity
 from framework.components import Visual
 
+__all__ = ["Square", "main", "make_scene"]
+
 WIDTH, HEIGHT = 960, 540  # world units are screen pixels (the camera's default: zoom 1)
 
 

@@ -3,9 +3,8 @@
     python -m examples.bullet_hell                          # a window: the title shows the numbers
     python -m examples.bullet_hell --headless --frames 60   # no window: a one-line JSON summary
 
-Three emitters spray spirals of bullets at a ship (arrows steer it in a window). Bullets are
-sensors whose mask sees only the ship, so no two bullets are ever paired, and the scene declares
-only the effects it uses: movement and detection. A system sums ``scene.stage_ms`` every step."""
+Three emitters spray spirals of bullets at a ship (arrows steer it). Bullets are sensors whose mask sees only the
+ship, so no two are ever paired; the scene declares only the effects it uses. A system sums ``scene.stage_ms``."""
 
 import argparse
 import json
@@ -16,6 +15,7 @@ from framework import AABB, Circle, Hitbox, Scene, Transform, Velocity
 from framework.components import Visual
 from framework.input import Input
 
+__all__ = ["Bullet", "Ship", "main", "make_scene"]
 WIDTH, HEIGHT, DT = 960, 540, 1 / 60
 SHIP, BULLET = 1, 2  # collision layers
 PER_EMITTER, SPEED, LIFETIME = 4, 160.0, 180  # bullets per emitter per step; their speed; steps they live
@@ -34,7 +34,7 @@ def make_scene() -> tuple[Scene, dict]:
     ship = scene.spawn(Transform(WIDTH / 2, 60), Velocity(), Visual((120, 200, 255), z=1), Ship(),
                        Hitbox(AABB(24, 24), body="kinematic", layer=SHIP, mask=BULLET))
     alive: deque[tuple[int, int]] = deque()  # (frame fired, bullet), oldest first
-    stats = {"hits": 0, "stage_ms": {}}
+    stats: dict = {"hits": 0, "stage_ms": {}}
 
     def fire(scene: Scene, dt: float) -> None:
         f = scene.frame

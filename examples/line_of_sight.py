@@ -14,17 +14,20 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from typing import Any
 
 from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.components import Visual
 from framework.input import Input
+
+__all__ = ["main", "make_scene"]
 
 WIDTH, HEIGHT, SPEED = 960, 540, 180.0
 WORLD, GUARD = 1, 2  # collision layers: the ray looks at WORLD only
 SEEN, HIDDEN = (240, 80, 70), (90, 210, 120)
 
 
-def make_scene() -> tuple[Scene, dict[str, int]]:
+def make_scene() -> tuple[Scene, dict[str, Any]]:
     scene = Scene()  # no gravity: seen from above
     guard = scene.spawn(Transform(120, HEIGHT / 2), Hitbox(Circle(16), body="static", layer=GUARD),
                         Visual((250, 230, 90)))
@@ -35,7 +38,7 @@ def make_scene() -> tuple[Scene, dict[str, int]]:
     scene.spawn(Transform(300, 270), Hitbox(Polygon([(-20, -40), (20, -40), (0, 40)]), body="static"),
                 Visual(grey))
     runner = scene.spawn(Transform(800, 40), Velocity(0, SPEED), Hitbox(AABB(30, 30)), Visual(HIDDEN))
-    stats = {"seen": 0, "hidden": 0, "first_seen": None}
+    stats: dict[str, Any] = {"seen": 0, "hidden": 0, "first_seen": None}
 
     def steer(scene: Scene, dt: float) -> None:  # arrows steer; without keys it patrols up and down
         keys, vel, pos = scene.resources[Input], scene.get(runner, Velocity), scene.get(runner, Transform)

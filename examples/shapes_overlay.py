@@ -21,6 +21,8 @@ from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.components import Visual
 from framework.scene import DEFAULT_EFFECTS
 
+__all__ = ["SHAPES", "main", "make_scene"]
+
 WIDTH, HEIGHT = 960, 540
 SHAPES = [Circle(14), Circle(9), Polygon.box(30, 20), Polygon([(-16, -12), (18, -10), (0, 16)]),
           Polygon([(math.cos(k * math.pi / 3) * 15, math.sin(k * math.pi / 3) * 15) for k in range(6)])]

@@ -24,6 +24,8 @@ from .demo import Autoplay, level1, play_all
 from .game import DT, Game
 from .levels import LevelError, builtin_levels
 
+__all__ = ["BACKGROUND", "camera_for", "hud", "main", "make_game", "parse_args", "run_headless", "run_window"]
+
 WIDTH, HEIGHT = 960, 540
 BACKGROUND = (24, 26, 38)
 

@@ -19,8 +19,12 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from framework.tiles import HEIGHTS, SLOPES
+
+__all__ = ["IMAGES", "TILE", "coin_sheet", "enemy", "enemy_sheet", "flag", "ground", "main", "plank", "player",
+           "player_sheet", "slope", "spikes", "step", "tileset", "write_png"]
 
 HERE = Path(__file__).parent
 IMAGES = HERE / "images"
@@ -35,7 +39,7 @@ PLANK_DARK = (128, 90, 52)
 SPIKE = (226, 70, 70)
 
 
-def _noise(h: int, w: int, seed: int) -> np.ndarray:
+def _noise(h: int, w: int, seed: int) -> NDArray[np.bool_]:
     """Deterministic speckle mask: about one pixel in nine."""
     y, x = np.mgrid[0:h, 0:w]
     v = (x * 374761393 + y * 668265263 + seed * 2246822519) & 0xFFFFFFFF
@@ -43,14 +47,14 @@ def _noise(h: int, w: int, seed: int) -> np.ndarray:
     return (v % 9) == 0
 
 
-def _fill(h: int, w: int, color: tuple[int, int, int]) -> np.ndarray:
+def _fill(h: int, w: int, color: tuple[int, int, int]) -> NDArray[np.uint8]:
     img = np.zeros((h, w, 4), dtype=np.uint8)
     img[..., :3] = color
     img[..., 3] = 255
     return img
 
 
-def ground(top: bool) -> np.ndarray:
+def ground(top: bool) -> NDArray[np.uint8]:
     img = _fill(TILE, TILE, GROUND)
     img[_noise(TILE, TILE, 1), :3] = GROUND_DARK
     img[-1, :, :3] = GROUND_DARK  # a faint seam between tiles
@@ -65,7 +69,7 @@ def ground(top: bool) -> np.ndarray:
     return img
 
 
-def slope(kind: str) -> np.ndarray:
+def slope(kind: str) -> NDArray[np.uint8]:
     """A slope tile: ground below the surface line of ``kind`` (``framework.tiles.HEIGHTS``), grass
     5-7 px deep (across the slope) under it, transparent above."""
     left, right = HEIGHTS[kind]
@@ -86,7 +90,7 @@ def slope(kind: str) -> np.ndarray:
     return img
 
 
-def step() -> np.ndarray:
+def step() -> NDArray[np.uint8]:
     """A quarter-tile step: the ground tile's top quarter (grass included) on the cell's bottom
     quarter, transparent above."""
     img = np.zeros((TILE, TILE, 4), dtype=np.uint8)
@@ -94,7 +98,7 @@ def step() -> np.ndarray:
     return img
 
 
-def plank() -> np.ndarray:
+def plank() -> NDArray[np.uint8]:
     img = _fill(8, TILE, PLANK)
     img[0, :, :3] = (214, 170, 112)
     img[-1, :, :3] = PLANK_DARK
@@ -103,7 +107,7 @@ def plank() -> np.ndarray:
     return img
 
 
-def spikes() -> np.ndarray:
+def spikes() -> NDArray[np.uint8]:
     img = np.zeros((TILE, TILE, 4), dtype=np.uint8)
     h = int(0.55 * TILE)
     for row in range(h):  # rows from the tip down (image rows are top first)
@@ -115,12 +119,12 @@ def spikes() -> np.ndarray:
     return img
 
 
-def _ellipse_mask(h: int, w: int, cy: float, cx: float, ry: float, rx: float) -> np.ndarray:
+def _ellipse_mask(h: int, w: int, cy: float, cx: float, ry: float, rx: float) -> NDArray[np.bool_]:
     y, x = np.mgrid[0:h, 0:w]
     return ((y + 0.5 - cy) / ry) ** 2 + ((x + 0.5 - cx) / rx) ** 2 <= 1.0
 
 
-def _outline(img: np.ndarray, color: tuple[int, int, int]) -> None:
+def _outline(img: NDArray[np.uint8], color: tuple[int, int, int]) -> None:
     """Darken the opaque pixels that touch a transparent one (or the edge)."""
     a = img[..., 3] > 0
     pad = np.pad(a, 1)
@@ -128,7 +132,7 @@ def _outline(img: np.ndarray, color: tuple[int, int, int]) -> None:
     img[a & ~inner, :3] = color
 
 
-def player(facing: int) -> np.ndarray:
+def player(facing: int) -> NDArray[np.uint8]:
     """24 x 28: a round-cornered blue fellow with eyes looking where he goes."""
     w, h = 24, 28
     img = np.zeros((h, w, 4), dtype=np.uint8)
@@ -145,7 +149,7 @@ def player(facing: int) -> np.ndarray:
     return img
 
 
-def enemy() -> np.ndarray:
+def enemy() -> NDArray[np.uint8]:
     """24 x 22: a grumpy purple dome on dark feet."""
     w, h = 24, 22
     img = np.zeros((h, w, 4), dtype=np.uint8)
@@ -163,7 +167,7 @@ def enemy() -> np.ndarray:
     return img
 
 
-def player_sheet() -> np.ndarray:
+def player_sheet() -> NDArray[np.uint8]:
     """7 frames of 24 x 28 in a row, facing right (the renderer mirrors them for left): idle (2:
     standing, then breathing in a pixel), run (4: the feet apart and together, bobbing), jump (1:
     feet tucked)."""
@@ -184,7 +188,7 @@ def player_sheet() -> np.ndarray:
     return np.concatenate(frames, axis=1)
 
 
-def enemy_sheet() -> np.ndarray:
+def enemy_sheet() -> NDArray[np.uint8]:
     """2 frames of 24 x 22 (walking: the feet step), facing left as :func:`enemy`."""
     a = enemy()
     b = a.copy()
@@ -194,7 +198,7 @@ def enemy_sheet() -> np.ndarray:
     return np.concatenate([a, b], axis=1)
 
 
-def coin_sheet() -> np.ndarray:
+def coin_sheet() -> NDArray[np.uint8]:
     """4 frames of 16 x 16: a gold coin turning (full, narrower, edge-on, narrower)."""
     frames = []
     for rx in (7.5, 5.0, 1.5, 5.0):
@@ -208,7 +212,7 @@ def coin_sheet() -> np.ndarray:
     return np.concatenate(frames, axis=1)
 
 
-def flag(width: int, color: tuple[int, int, int]) -> np.ndarray:
+def flag(width: int, color: tuple[int, int, int]) -> NDArray[np.uint8]:
     """``width`` x 32: a pole with a flag (the goal: 32 wide; a checkpoint: 16)."""
     img = np.zeros((32, width, 4), dtype=np.uint8)
     pole = 3 if width < 32 else 8
@@ -222,7 +226,7 @@ def flag(width: int, color: tuple[int, int, int]) -> np.ndarray:
     return img
 
 
-def tileset() -> np.ndarray:
+def tileset() -> NDArray[np.uint8]:
     """96 wide, for Tiled: solid, one-way (a plank on the top quarter), spikes; then the slopes, in
     the order of ``framework.tiles.SLOPES``, then the quarter-tile step, three a row."""
     tiles = [ground(True), np.pad(plank(), ((0, TILE - 8), (0, 0), (0, 0))), spikes()]
@@ -235,7 +239,7 @@ def tileset() -> np.ndarray:
     return img
 
 
-def write_png(path: Path, rgba: np.ndarray) -> None:
+def write_png(path: Path, rgba: NDArray[np.uint8]) -> None:
     """``(h, w, 4)`` uint8, top row first, as an RGBA PNG (stdlib only)."""
     h, w = rgba.shape[:2]
     raw = np.concatenate([np.zeros((h, 1), dtype=np.uint8), rgba.reshape(h, w * 4)], axis=1).tobytes()

@@ -11,6 +11,8 @@ from pathlib import Path
 
 from .levels import dump_tmj, load_level, parse_tmj, to_tmj
 
+__all__ = ["main"]
+
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv

@@ -147,7 +147,8 @@ class Game:
             for col, row in pc.cells:  # the pictures, cell by cell
                 kind = level.tiles[row][col]
                 image = "ground_top" if kind == "solid" else kind
-                piece("slope", Transform(*level.cell_center(col, row)), Visual(image=str(IMAGES[image]), z=0))
+                # (a slope piece's cells all hold a tile)
+                piece("slope", Transform(*level.cell_center(col, row)), Visual(image=str(IMAGES[image]), z=0))  # type: ignore[index]
         for row, cells in enumerate(level.tiles):
             for col, kind in enumerate(cells):
                 x, y = level.cell_center(col, row)
@@ -224,7 +225,8 @@ class Game:
 
     def _autoplay(self, scene: Scene, dt: float) -> None:
         playing = self.state.player is not None and self.state.pending is None
-        scene.resources[Input].set_held(self.autoplay.keys(self) if playing else ())
+        # (this system is added only with an autoplay)
+        scene.resources[Input].set_held(self.autoplay.keys(self) if playing else ())  # type: ignore[union-attr]
 
     # --- running ---------------------------------------------------------------------------------
 

@@ -45,10 +45,10 @@ import base64
 import json
 import math
 import zlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from framework import tiles as terrain
 
@@ -73,6 +73,8 @@ _TEXT_EMPTY = ". "
 _FLIP_BITS = 0xF0000000  # Tiled's flip / rotate flags in the high bits of a gid
 _FLIP_H = 0x80000000  # flipped horizontally
 _FLIP_V_OR_D = 0x60000000  # flipped vertically, or diagonally (a rotation by 90 degrees)
+
+Fail = Callable[[str], NoReturn]  # raises a LevelError naming the source
 
 
 class LevelError(ValueError):
@@ -141,7 +143,7 @@ class Level:
 
     def validate(self) -> Level:
         """Check what every level needs; raise :class:`LevelError` naming the source."""
-        def fail(msg: str) -> None:
+        def fail(msg: str) -> NoReturn:
             raise LevelError(f"{self.source}: {msg}")
 
         if not (math.isfinite(self.tile) and self.tile > 0):
@@ -191,7 +193,7 @@ def parse_text(
     limits: LevelLimits = DEFAULT_LIMITS,
 ) -> Level:
     """A :class:`Level` from a text map (see the module docstring for the characters)."""
-    def fail(msg: str) -> None:
+    def fail(msg: str) -> NoReturn:
         raise LevelError(f"{source}: {msg}")
 
     if not isinstance(text, str):
@@ -235,7 +237,7 @@ def parse_text(
     return Level(name or Path(source).stem, source, float(tile), width, height, tiles, objects).validate()
 
 
-def _text_platforms(grid: list[str], tile: float, fail) -> list[LevelObject]:
+def _text_platforms(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
     height, width = len(grid), len(grid[0])
     out = []
     used = set()
@@ -290,7 +292,7 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
               limits: LevelLimits = DEFAULT_LIMITS) -> Level:
     """A :class:`Level` from a decoded Tiled JSON map. What it declares is checked against
     ``limits`` and against what it holds before anything is allocated for it."""
-    def fail(msg: str) -> None:
+    def fail(msg: str) -> NoReturn:
         raise LevelError(f"{source}: {msg}")
 
     if not isinstance(data, dict):
@@ -369,7 +371,7 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
     return Level(str(title), source, float(tw), width, height, tiles, objects).validate()
 
 
-def _flat_layers(layers: list, fail, limits: LevelLimits) -> list[dict]:
+def _flat_layers(layers: list, fail: Fail, limits: LevelLimits) -> list[dict]:
     """The layers, groups opened (without recursion: a hostile file may nest them deeply)."""
     out: list[dict] = []
     todo = [iter(layers)]
@@ -392,7 +394,7 @@ def _flat_layers(layers: list, fail, limits: LevelLimits) -> list[dict]:
     return out
 
 
-def _props(thing: dict, fail, where: str) -> dict[str, Any]:
+def _props(thing: dict, fail: Fail, where: str) -> dict[str, Any]:
     """Tiled's ``properties`` (a list of ``{name, type, value}``; an old-style dict also works)."""
     raw = thing.get("properties", [])
     if isinstance(raw, dict):
@@ -407,7 +409,7 @@ def _props(thing: dict, fail, where: str) -> dict[str, Any]:
     return out
 
 
-def _tileset_kinds(tilesets: Any, fail) -> dict[int, str]:
+def _tileset_kinds(tilesets: Any, fail: Fail) -> dict[int, str]:
     if not isinstance(tilesets, list):
         fail("'tilesets' must be a list")
     kinds: dict[int, str] = {}
@@ -442,7 +444,7 @@ def _tileset_kinds(tilesets: Any, fail) -> dict[int, str]:
     return kinds
 
 
-def _layer_data(layer: dict, width: int, height: int, fail, where: str) -> list[int]:
+def _layer_data(layer: dict, width: int, height: int, fail: Fail, where: str) -> list[int]:
     if layer.get("width", width) != width or layer.get("height", height) != height:
         fail(f"{where} is {layer.get('width')} x {layer.get('height')} tiles, the map {width} x {height}")
     data = layer.get("data")
@@ -479,7 +481,7 @@ def _layer_data(layer: dict, width: int, height: int, fail, where: str) -> list[
     return gids
 
 
-def _tmj_object(obj: Any, map_h: float, fail, where: str) -> LevelObject:
+def _tmj_object(obj: Any, map_h: float, fail: Fail, where: str) -> LevelObject:
     if not isinstance(obj, dict):
         fail(f"{where}: an object must be a JSON object, got {obj!r:.60}")
     kind = str(obj.get("type") or obj.get("class") or obj.get("name") or "").lower()
@@ -617,5 +619,5 @@ def dump_tmj(tmj: dict[str, Any]) -> str:
             text = json.dumps(body)[:-1] + ', "objects": [\n        ' + objs + "\n      ]}"
         layers.append(text)
     head = {k: v for k, v in tmj.items() if k != "layers"}
-    body = ",\n      ".join(layers)
-    return json.dumps(head, indent=2)[:-2] + ',\n  "layers": [\n      ' + body + "\n  ]\n}\n"
+    joined = ",\n      ".join(layers)
+    return json.dumps(head, indent=2)[:-2] + ',\n  "layers": [\n      ' + joined + "\n  ]\n}\n"

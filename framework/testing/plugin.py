@@ -23,6 +23,11 @@ from typing import Any
 
 import pytest
 
+# pytest's hooks and the fixtures
+__all__ = ["SECTION", "UPDATE_GOLDEN", "golden_dir", "pytest_addoption", "pytest_configure", "pytest_runtest_call",
+           "pytest_runtest_makereport", "pytest_runtest_setup", "pytest_runtest_teardown", "pytest_unconfigure",
+           "scene"]
+
 SECTION = "framework picture"
 UPDATE_GOLDEN = "FRAMEWORK_UPDATE_GOLDEN"
 
