@@ -67,15 +67,20 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from functools import partial
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..arrays import BoolArray, F64Array
 from ..collision import collide
 from ..components import Hitbox, Transform, Velocity
 from ..shapes import AABB, Circle, Polygon
 from .progress import Progress
 from .report import Column, format_table, frozen_gc, machine_info, median
+
+if TYPE_CHECKING:
+    from ..scene import Scene
 
 __all__ = [
     "BULLET_MODES", "CONTROLLER_CASES", "CONTROLLER_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES",
@@ -105,10 +110,10 @@ CONTROLLER_MODES = ("substeps-1", "substeps-4")
 SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction", "controller")
 DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
 
-FULL = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3, "crate_steps": 10,
-        "crowds": 15}
-QUICK = {"lanes": 32, "crates": 2_000, "rest_steps": 240, "ball_steps": 1_000, "runs": 1, "crate_steps": 3,
-         "crowds": 5}
+FULL: dict[str, Any] = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3,
+                        "crate_steps": 10, "crowds": 15}
+QUICK: dict[str, Any] = {"lanes": 32, "crates": 2_000, "rest_steps": 240, "ball_steps": 1_000, "runs": 1,
+                         "crate_steps": 3, "crowds": 5}
 CROWD_MODES = REST_MODES[:-1]
 CROWD_BOXES = 64
 
@@ -118,7 +123,7 @@ ROW_KEYS = ["scenario", "mode", "speed", "ms_per_step", "missed", "undetected", 
 
 
 def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
-    row = {k: None for k in ROW_KEYS}
+    row: dict[str, Any] = {k: None for k in ROW_KEYS}
     row.update(scenario=scenario, mode=mode, **values)
     return row
 
@@ -164,7 +169,7 @@ def analytic_bullet_toi(x0: float, speed: float) -> float:
     return (-WALL_THICKNESS / 2 - BULLET_RADIUS - x0) / speed
 
 
-def bullet_lanes(lanes: int, speed: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def bullet_lanes(lanes: int, speed: float, seed: int = 0) -> tuple[F64Array, F64Array]:
     """Start ``(x0, y offset)`` of each lane's bullet: the first contact comes 1 to 2 steps in (so at
     every fraction of a step), the path meets the wall's flat face."""
     rng = np.random.default_rng(seed)
@@ -186,7 +191,7 @@ def run_bullets(mode: str, speed: float, lanes: int = 32, runs: int = 1, seed: i
     return _row("bullet", mode, speed=speed, ms_per_step=median(times), samples=lanes, steps=steps, **result)
 
 
-def _bullet_run(mode: str, speed: float, x0s: np.ndarray, dys: np.ndarray, steps: int):
+def _bullet_run(mode: str, speed: float, x0s: F64Array, dys: F64Array, steps: int):
     contact_x = -WALL_THICKNESS / 2 - BULLET_RADIUS
     scene = _scene_for("discrete" if mode == "swept" else mode)
     try:
@@ -220,7 +225,7 @@ def _bullet_run(mode: str, speed: float, x0s: np.ndarray, dys: np.ndarray, steps
 # --- crates -------------------------------------------------------------------------------------------
 
 
-def crate_placements(k: int, seed: int = 0) -> dict[str, np.ndarray]:
+def crate_placements(k: int, seed: int = 0) -> dict[str, F64Array]:
     """``k`` pairs of crates: sizes in [0.5, 2], any rotation; B's centre uniform over the disc in
     which the two crates' bounding circles overlap (about two thirds of the pairs then overlap)."""
     rng = np.random.default_rng(seed)
@@ -233,7 +238,7 @@ def crate_placements(k: int, seed: int = 0) -> dict[str, np.ndarray]:
             "bx": d * np.cos(phi), "by": d * np.sin(phi), "bw": bw, "bh": bh, "bt": bt}
 
 
-def crates_overlap_exact(p: dict[str, np.ndarray]) -> np.ndarray:
+def crates_overlap_exact(p: dict[str, F64Array]) -> BoolArray:
     """Exact answer: the rotated rectangles' interiors overlap (separating axis theorem over the
     four edge directions; touching is not an overlap)."""
     dx, dy = p["bx"] - p["ax"], p["by"] - p["ay"]
@@ -264,7 +269,7 @@ def crate_hitbox(mode: str, w: float, h: float, theta: float):
     raise ValueError(f"unknown crate mode {mode!r}; modes are {CRATE_MODES}")
 
 
-def crate_contacts(mode: str, p: dict[str, np.ndarray], steps: int = 1) -> tuple[np.ndarray, list[float]]:
+def crate_contacts(mode: str, p: dict[str, F64Array], steps: int = 1) -> tuple[BoolArray, list[float]]:
     """Which placements the pipeline reports in contact, with ``mode`` hitboxes; and step times.
 
     Every pair sits in its own cell of a grid (20 units apart), both crates kinematic (static pairs
@@ -437,7 +442,7 @@ def _ball_run(mode: str, steps: int):
 # --- crowd: overlaps among dynamic bodies -------------------------------------------------------------
 
 
-def _overlap_depths(scene, ents: list[int]) -> np.ndarray:
+def _overlap_depths(scene: Scene, ents: list[int]) -> F64Array:
     """Penetration depth of every overlapping pair among ``ents`` (exact ``collide``)."""
     poses = [(scene.get(e, Transform), scene.get(e, Hitbox).shape) for e in ents]
     out = []
@@ -591,7 +596,7 @@ def _controller_run(case: str, mode: str) -> tuple[list[float], dict[str, Any]]:
             scene.spawn(Transform(pc.x, pc.y), Hitbox(pc.shape, body="static"))
         up = not case.endswith("down")
         x0 = 2.0 if up else 20.0
-        kw = {"step_height": 0.3} if case == "step-up" else {}
+        kw: dict[str, Any] = {"step_height": 0.3} if case == "step-up" else {}
         if case == "step-up":
             scene.spawn(Transform(7.0, 1.125), Hitbox(AABB(2.0, 0.25), body="static"))  # 6 .. 8, top 1.25
         plat = None
@@ -614,7 +619,7 @@ def _controller_run(case: str, mode: str) -> tuple[list[float], dict[str, Any]]:
                 pv.x = 2.0 if (k // 20) % 2 == 0 else -2.0
                 pv.y = 1.0 if (k // 15) % 2 == 0 else -1.0
 
-            def watch(_k: int) -> None:
+            def watch(k: int) -> None:
                 drift[0] = max(drift[0], abs(t.x - pt.x - off0[0]), abs(t.y - pt.y - off0[1]))
 
             times = _timed_steps(scene, 240, steer, watch)
@@ -663,28 +668,28 @@ def run_accuracy(config: dict[str, Any] | None = None, progress: bool = True, qu
         for mode in BULLET_MODES:
             for s in speeds:
                 jobs.append((f"bullet {mode} {s:g}/step",
-                             lambda m=mode, s=s: run_bullets(m, s, cfg["lanes"], cfg["runs"])))
+                             partial(run_bullets, mode, s, cfg["lanes"], cfg["runs"])))
     if "crate" in want:
         for mode in CRATE_MODES:
-            jobs.append((f"crate {mode}", lambda m=mode: run_crates(m, cfg["crates"], cfg["crate_steps"])))
+            jobs.append((f"crate {mode}", partial(run_crates, mode, cfg["crates"], cfg["crate_steps"])))
     for scen in ("stack", "character", "character-walk"):
         if scen in want:
             for mode in REST_MODES:
-                jobs.append((f"{scen} {mode}", lambda sc=scen, m=mode: run_rest(sc, m, cfg["rest_steps"], cfg["runs"])))
+                jobs.append((f"{scen} {mode}", partial(run_rest, scen, mode, cfg["rest_steps"], cfg["runs"])))
     if "crowd" in want:
         for mode in CROWD_MODES:
-            jobs.append((f"crowd {mode}", lambda m=mode: run_crowd(m, cfg["crowds"])))
+            jobs.append((f"crowd {mode}", partial(run_crowd, mode, cfg["crowds"])))
     if "ball" in want:
         for mode in BALL_MODES:
-            jobs.append((f"ball {mode}", lambda m=mode: run_ball(m, cfg["ball_steps"], cfg["runs"])))
+            jobs.append((f"ball {mode}", partial(run_ball, mode, cfg["ball_steps"], cfg["runs"])))
     if "friction" in want:
         for case in FRICTION_CASES:
             for mode in FRICTION_MODES:
-                jobs.append((f"friction {case} {mode}", lambda c=case, m=mode: run_friction(c, m, cfg["runs"])))
+                jobs.append((f"friction {case} {mode}", partial(run_friction, case, mode, cfg["runs"])))
     if "controller" in want:
         for case in CONTROLLER_CASES:
             for mode in CONTROLLER_MODES:
-                jobs.append((f"controller {case} {mode}", lambda c=case, m=mode: run_controller(c, m, cfg["runs"])))
+                jobs.append((f"controller {case} {mode}", partial(run_controller, case, mode, cfg["runs"])))
     rows = []
     with Progress(len(jobs), "accuracy", enabled=progress) as bar:
         for name, job in jobs:

@@ -24,12 +24,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from functools import partial
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from ..arrays import F64Array, I64Array
 from ..collision.batch import aabb_aabb
 from ..collision.broad_phase import SpatialHash, brute_force_pairs
+from ..collision.grid import Bounds
 from ..components import Hitbox, Transform, Velocity
 from ..shapes import AABB
 from ..systems.geometry import widen_down, widen_up
@@ -46,6 +49,9 @@ from .report import (
     time_call,
 )
 
+if TYPE_CHECKING:
+    from ..scene import Scene
+
 __all__ = [
     "COLUMNS", "EFFECTS", "PairMismatch", "Workload", "brute_detection", "build_pymunk", "build_scene",
     "check_pairs", "goals", "make_boxes", "markdown", "run_perf", "text_report", "with_tiles",
@@ -57,9 +63,9 @@ SIZE_RANGE = (4.0, 16.0)
 MAX_SPEED = 0.5
 DT = 1.0
 TILES = 100_000
-FULL = {"sizes": (1_000, 10_000, 50_000), "rounds": {1_000: 100, 10_000: 50, 50_000: 20}, "check_up_to": 10_000,
-        "brute_sizes": (1_000, 10_000)}
-QUICK = {"sizes": (1_000, 10_000), "rounds": {1_000: 60, 10_000: 25}, "check_up_to": 1_000,
+FULL: dict[str, Any] = {"sizes": (1_000, 10_000, 50_000), "rounds": {1_000: 100, 10_000: 50, 50_000: 20},
+                        "check_up_to": 10_000, "brute_sizes": (1_000, 10_000)}
+QUICK: dict[str, Any] = {"sizes": (1_000, 10_000), "rounds": {1_000: 60, 10_000: 25}, "check_up_to": 1_000,
          "brute_sizes": (1_000,)}
 WARMUP = 5
 
@@ -94,15 +100,15 @@ class PairMismatch(AssertionError):
 class Workload:
     """Moving boxes (centres, sizes, velocities per step) and optional static unit tiles (centres)."""
 
-    x: np.ndarray
-    y: np.ndarray
-    w: np.ndarray
-    h: np.ndarray
-    vx: np.ndarray
-    vy: np.ndarray
+    x: F64Array
+    y: F64Array
+    w: F64Array
+    h: F64Array
+    vx: F64Array
+    vy: F64Array
     side: float
-    tile_x: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    tile_y: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    tile_x: F64Array = field(default_factory=lambda: np.zeros(0))
+    tile_y: F64Array = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n(self) -> int:
@@ -186,7 +192,7 @@ def build_pymunk(wl: Workload, pymunk: Any):
     return space
 
 
-def mover_boxes(scene) -> tuple[np.ndarray, ...]:
+def mover_boxes(scene: Scene) -> tuple[F64Array, F64Array, F64Array, F64Array, I64Array]:
     """``(x, y, half_width, half_height, entity)`` of the scene's moving boxes, read through the
     public components (independent of the pipeline's own arrays)."""
     rows = [(e, t.x, t.y, hb.shape.half_width, hb.shape.half_height)
@@ -195,13 +201,13 @@ def mover_boxes(scene) -> tuple[np.ndarray, ...]:
     return x, y, hw, hh, e.astype(np.int64)
 
 
-def mover_bounds(scene) -> tuple[np.ndarray, ...]:
+def mover_bounds(scene: Scene) -> tuple[F64Array, F64Array, F64Array, F64Array, I64Array]:
     """``(minx, miny, maxx, maxy, entity)`` of the scene's moving boxes (see :func:`mover_boxes`)."""
     x, y, hw, hh, e = mover_boxes(scene)
     return x - hw, y - hh, x + hw, y + hh, e
 
 
-def tile_bounds(wl: Workload) -> tuple[np.ndarray, ...]:
+def tile_bounds(wl: Workload) -> Bounds:
     return wl.tile_x - 0.5, wl.tile_y - 0.5, wl.tile_x + 0.5, wl.tile_y + 0.5
 
 
@@ -250,7 +256,7 @@ def check_pairs(wl: Workload, steps: int = 3) -> dict[str, Any]:
             # candidates are the brute-force overlaps of the widened bounds; its contacts, those of
             # the exact ones.
             wide = [(widen_down if k_ < 2 else widen_up)(v) for k_, v in enumerate(allb)]
-            i, j = brute_force_pairs(*wide, static=static)
+            i, j = brute_force_pairs(wide[0], wide[1], wide[2], wide[3], static=static)
             if seen["candidates"] != i.size:
                 raise PairMismatch(f"step {k}: the broad phase found {seen['candidates']} candidate pairs, "
                                    f"brute force {i.size} (N={wl.n}, tiles={n_tiles})")
@@ -337,11 +343,11 @@ def _row(name: str, wl: Workload, tasks: dict[str, Task], label: str, ctx: dict[
     ours = tasks[f"{label}/ours"]
     pm = tasks.get(f"{label}/pymunk")
     floor = tasks[f"{label}/floor"]
-    ms = median(ours.ms)
+    ms = cast(float, median(ours.ms))  # (timed rounds: never empty)
     stages = {k: median(e.get(k, 0.0) for e in ours.extra) for k in
               ("movement", "broad_phase", "narrow_phase", "response")}
     pm_ms = median(pm.ms) if pm is not None else None
-    floor_ms = median(floor.ms)
+    floor_ms = cast(float, median(floor.ms))
     pairs = median(e["pairs"] for e in ours.extra)
     # the rest of the median step: validation, hooks, event bookkeeping outside the stages, timing
     other = max(0.0, ms - sum(v for v in stages.values() if v is not None))
@@ -417,7 +423,7 @@ def run_perf(
             if n in brute_sizes:
                 minx, miny, maxx, maxy = ctx["bounds"]
                 every = 1 if n <= 2_000 else max(1, r // 8)
-                brute = Task(f"{label}/brute", lambda b=(minx, miny, maxx, maxy): brute_detection(*b), every=every)
+                brute = Task(f"{label}/brute", partial(brute_detection, minx, miny, maxx, maxy), every=every)
                 tasks.append(brute)
             bar.task(f"timing {label}" + (" (with the tiles level)" if ctx_t else ""))
             run_interleaved(tasks, r, bar=bar)

@@ -128,9 +128,9 @@ def plot_accuracy(report: dict[str, Any], path: Path) -> bool:
 
     for scen, ax, key, label in (("crowd", a_crowd, "residual", "overlap left after one step (%)"),
                                  ("ball", a_ball, "energy_drift", "energy drift per 1,000 steps (%)")):
-        sr = [r for r in rows if r["scenario"] == scen]
-        ax.plot([r["ms_per_step"] for r in sr], [100 * r[key] for r in sr], "o")
-        for r in sr:
+        srows = [r for r in rows if r["scenario"] == scen]
+        ax.plot([r["ms_per_step"] for r in srows], [100 * r[key] for r in srows], "o")
+        for r in srows:
             ax.annotate(r["mode"].replace("response-iterations-", "iter-"), (r["ms_per_step"], 100 * r[key]),
                         fontsize=8, xytext=(4, 3), textcoords="offset points")
         ax.set_xlabel("ms per step (median)")

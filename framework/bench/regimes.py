@@ -52,11 +52,13 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import AABB, Circle, Hitbox, Polygon, Shape, Transform, Velocity
+from ..arrays import BoolArray, F64Array
 from ..character import CharacterController
 from ..collision.batch import collide_many
 from ..collision.broad_phase import brute_force_pairs
@@ -77,16 +79,16 @@ DT = 1.0 / 60.0
 GRAVITY = (0.0, -10.0)
 GAP = 1.0 / 16.0  # spawn gap between rows of boxes: dyadic, so the exact heights are exact in floats
 SLEEP_TIME = 0.5  # s at rest before a peer body sleeps (Box2D's b2_timeToSleep; pymunk gets the same)
-CROWD = {"bodies": 120, "pit": 8.0, "gravity": (0.0, -20.0), "max_steps": 1_800, "overlap": 0.02}
+CROWD: dict[str, Any] = {"bodies": 120, "pit": 8.0, "gravity": (0.0, -20.0), "max_steps": 1_800, "overlap": 0.02}
 ENGINES = ("ours", "pymunk", "box2d")
 
 CROWDS = ("balls", "boxes", "mixed", "mixed-friction")
 #: untimed steps before timing, by scene kind (the same in --quick: the accuracy figures do not move)
 SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer": 0}
 # timed rounds by the number of moving bodies (the first bound that is >= it); the crowds' step cap
-FULL = {"rounds": ((100, 500), (1_000, 200), (10**9, 80)), "platformer_rounds": 900,
+FULL: dict[str, Any] = {"rounds": ((100, 500), (1_000, 200), (10**9, 80)), "platformer_rounds": 900,
         "crowd_steps": CROWD["max_steps"]}
-QUICK = {"rounds": ((100, 150), (1_000, 50), (10**9, 20)), "platformer_rounds": 300, "crowd_steps": 600}
+QUICK: dict[str, Any] = {"rounds": ((100, 150), (1_000, 50), (10**9, 20)), "platformer_rounds": 300, "crowd_steps": 600}
 
 
 # --- the engine-neutral description ---------------------------------------------------------------
@@ -161,7 +163,9 @@ def _pit(width: float, depth: float) -> list[Piece]:
             Piece(AABB(1.0, depth), width + 0.5, depth / 2, kind="static")]
 
 
-def pile_layout(cols: int, rows: int, size: float = 1.0, gap: float = GAP) -> tuple[np.ndarray, np.ndarray, float]:
+def pile_layout(
+    cols: int, rows: int, size: float = 1.0, gap: float = GAP,
+) -> tuple[NDArray[np.floating], NDArray[np.floating], float]:
     """Spawn centres of ``cols x rows`` boxes of side ``size`` over a floor at y = 0, in aligned
     columns, row ``r`` lifted ``(r + 1) * gap`` above its resting place; and the exact resting
     centre height of the top row, ``(rows - 1/2) * size``: with nothing to slide sideways (the pit
@@ -299,7 +303,7 @@ def _scaled(shape: Shape, s: float) -> Shape:
         return AABB(shape.width * s, shape.height * s)
     if isinstance(shape, Circle):
         return Circle(shape.radius * s)
-    return Polygon([(x * s, y * s) for x, y in shape.points])
+    return Polygon([(x * s, y * s) for x, y in cast(Polygon, shape).points])
 
 
 def platformer() -> Regime | None:
@@ -354,10 +358,10 @@ class Engine:
     def after_step(self) -> dict[str, float]:
         return {}
 
-    def state(self) -> tuple[np.ndarray, ...]:
+    def state(self) -> tuple[F64Array, F64Array, F64Array, F64Array, BoolArray]:  # x, y, vx, vy, alive
         raise NotImplementedError
 
-    def angles(self) -> np.ndarray:
+    def angles(self) -> F64Array:
         """Every piece's rotation (radians; 0 for those that cannot turn)."""
         return np.zeros(len(self.regime.pieces))
 
@@ -403,7 +407,7 @@ class Ours(Engine):
     def after_step(self) -> dict[str, float]:
         return {"stages_ms": sum(self.scene.stage_ms.values())}
 
-    def state(self) -> tuple[np.ndarray, ...]:
+    def state(self) -> tuple[F64Array, F64Array, F64Array, F64Array, BoolArray]:  # x, y, vx, vy, alive
         scene, s = self.scene, 1.0 / self.regime.scale
         out = np.zeros((len(self.entities), 5))
         for k, e in enumerate(self.entities):
@@ -413,7 +417,7 @@ class Ours(Engine):
         x, y, vx, vy, alive = out.T
         return x, y, vx, vy, alive.astype(bool)
 
-    def angles(self) -> np.ndarray:
+    def angles(self) -> F64Array:
         scene = self.scene
         return np.array([scene.get(e, Transform).rotation if scene.exists(e) else 0.0 for e in self.entities])
 
@@ -430,7 +434,7 @@ def _area(shape: Shape) -> float:
         return shape.width * shape.height
     if isinstance(shape, Circle):
         return math.pi * shape.radius ** 2
-    p = shape.points
+    p = cast(Polygon, shape).points
     return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(p, p[1:] + p[:1]))) / 2
 
 
@@ -439,7 +443,7 @@ def _outline(shape: Shape, ox: float, oy: float) -> list[tuple[float, float]]:
     if isinstance(shape, AABB):
         hw, hh = shape.half_width, shape.half_height
         return [(ox - hw, oy - hh), (ox + hw, oy - hh), (ox + hw, oy + hh), (ox - hw, oy + hh)]
-    return [(ox + x, oy + y) for x, y in shape.points]
+    return [(ox + x, oy + y) for x, y in cast(Polygon, shape).points]
 
 
 class Peer(Engine):
@@ -492,14 +496,14 @@ class Peer(Engine):
             self._set_vel(self.handles[i], (tx - x) / dist * speed, (ty - y) / dist * speed)
         return {}
 
-    def state(self) -> tuple[np.ndarray, ...]:
+    def state(self) -> tuple[F64Array, F64Array, F64Array, F64Array, BoolArray]:  # x, y, vx, vy, alive
         out = np.zeros((len(self.handles), 4))
         for k, (p, h) in enumerate(zip(self.regime.pieces, self.handles)):
             out[k] = (p.x, p.y, 0.0, 0.0) if h is None else (*self._pos(h), *self._vel(h))
         x, y, vx, vy = out.T
         return x, y, vx, vy, np.ones(x.size, dtype=bool)
 
-    def angles(self) -> np.ndarray:
+    def angles(self) -> F64Array:
         return np.array([0.0 if h is None else float(h.angle) for h in self.handles])
 
 
@@ -632,7 +636,8 @@ def _half_extents(shape: Shape) -> tuple[float, float]:
         return shape.half_width, shape.half_height
     if isinstance(shape, Circle):
         return shape.radius, shape.radius
-    return max(abs(x) for x, _ in shape.points), max(abs(y) for _, y in shape.points)
+    pts = cast(Polygon, shape).points
+    return max(abs(x) for x, _ in pts), max(abs(y) for _, y in pts)
 
 
 def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool = True, rot=None) -> float:
@@ -723,10 +728,10 @@ def run_scene(regime: Regime, rounds: int, settle: int = 0, peers: dict[str, Any
         row[f"{name}_ms"] = ms.get(name)
         if name in figures:
             row[f"sink_{name}"], row[f"pen_{name}"] = figures[name]["sink"], figures[name]["pen"]
-    peer_ms = {n: ms[n] for n in ("pymunk", "box2d") if ms.get(n)}
+    peer_ms = {n: cast(float, ms[n]) for n in ("pymunk", "box2d") if ms.get(n)}
     if peer_ms:
         row["faster_peer"] = min(peer_ms, key=peer_ms.__getitem__)
-        row["ratio"] = ms["ours"] / peer_ms[row["faster_peer"]]
+        row["ratio"] = cast(float, ms["ours"]) / peer_ms[row["faster_peer"]]  # (timed rounds: never empty)
         row["time_pass"] = bool(row["ratio"] <= row["target"])
     if row["sink_ours"] is not None:
         row["sink_pass"] = bool(row["sink_ours"] <= SINK_GOAL)
