@@ -12,11 +12,13 @@
   passes, fails when the behaviour changes).
 - The README's example runs and prints what its comments say; its links lead somewhere.
 - The site's navigation (mkdocs.yml) lists every page, and lists no page that is missing.
+- The site builds with ``mkdocs build --strict``; its API page shows each module's ``__all__`` only.
 """
 
 from __future__ import annotations
 
 import doctest
+import importlib
 import importlib.util
 import inspect
 import os
@@ -189,3 +191,16 @@ def test_site_builds_strict(tmp_path):
     api = (tmp_path / "site" / "api" / "index.html").read_text()
     assert "<code>Camera</code>" in api and not re.search(r":(class|func|meth|mod|attr):<code>", api), \
         "Sphinx roles in docstrings must render as plain code (docs_hooks/sphinx_roles.py)"
+    # The API page lists each module's public names: those in its __all__, and nothing else.
+    ids = set(re.findall(r'id="(framework[\w.]*)"', api))
+    modules = re.findall(r"^::: (framework(?:\.\w+)*)\s*$", (DOCS / "api.md").read_text(), flags=re.M)
+    for name in modules:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError:  # a function of a module (framework.collision.collide.collide)
+            continue
+        if not hasattr(module, "__all__") or name == "framework":  # (the package: members: false)
+            continue
+        shown = {i[len(name) + 1:] for i in ids if i.startswith(name + ".") and "." not in i[len(name) + 1:]}
+        extra = shown - set(module.__all__)
+        assert not extra, f"the API page shows {sorted(extra)} of {name}, which are not in its __all__"
