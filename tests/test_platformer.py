@@ -18,11 +18,20 @@ import pytest
 
 from examples.platformer import Game, LevelError, builtin_levels, load_level, parse_text, parse_tmj
 from examples.platformer.__main__ import main as cli_main
-from examples.platformer.components import Coin, Enemy, MovingPlatform, Player, Tuning
+from examples.platformer.components import Coin, Enemy, Hazard, MovingPlatform, Player, Tuning
 from examples.platformer.demo import Autoplay, level1, level2
 from examples.platformer.levels import to_tmj
 from framework import Hitbox, Transform, Velocity
-from framework.testing import run
+from framework.testing import (
+    EventLog,
+    assert_at_rest,
+    assert_inside,
+    assert_on_floor,
+    bounds,
+    feet,
+    run,
+    step_until,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 T = 32.0
@@ -31,15 +40,6 @@ RUN = TU.run_speed * T          # world units / s
 JUMP = TU.jump_speed * T
 G = TU.gravity * T
 DT = 1.0 / 60.0
-HALF_H = TU.player_size[1] * T / 2
-
-
-def make(text: str) -> Game:
-    return Game([parse_text(text, "test.txt")])
-
-
-def feet(g: Game) -> float:
-    return g.player_transform.y - HALF_H
 
 
 def vel(g: Game) -> Velocity:
@@ -117,24 +117,25 @@ def test_cli_screenshot(tmp_path):
 
 
 def test_lands_and_stands_still_for_thousands_of_frames():
-    g = make("""
+    g = Game([parse_text("""
 #..........#
 #....P.....#
 #..........#
 ############
-""")
+""")])
     run(g.scene, 40, keys=set())
     y0 = g.player_transform.y
-    assert feet(g) == pytest.approx(T, abs=1e-9)  # on top of the floor row (y 0..32)
+    assert feet(g.scene, g.player) == pytest.approx(T, abs=1e-9)  # on top of the floor row (y 0..32)
     for _ in range(2000):
         g.step(set())
         assert abs(g.player_transform.y - y0) <= 1e-9
         assert g.player_state.grounded
-    assert vel(g).y == 0.0
+        assert_on_floor(g.scene, g.player)
+    assert_at_rest(g.scene, g.player, speed=0.0)
 
 
 def test_runs_across_tile_seams_at_constant_speed():
-    g = make("#" + "." * 60 + "#\n#P" + "." * 58 + "G#\n" + "#" * 62)
+    g = Game([parse_text("#" + "." * 60 + "#\n#P" + "." * 58 + "G#\n" + "#" * 62)])
     run(g.scene, 10, keys=set())
     xs, ys = [], []
     for _ in range(200):
@@ -150,13 +151,13 @@ def test_runs_across_tile_seams_at_constant_speed():
 
 @pytest.mark.parametrize("direction", ["right", "left"])
 def test_cannot_run_through_a_thin_wall(direction):
-    g = make("""
+    g = Game([parse_text("""
 #...............#
 #...............#
 #.......#.......#
 #...P...#...G...#
 #################
-""")
+""")])
     wall_x = 8.5 * T
     side = -1 if direction == "right" else 1
     if direction == "left":
@@ -169,63 +170,63 @@ def test_cannot_run_through_a_thin_wall(direction):
 
 
 def test_cannot_fall_through_a_one_tile_floor_at_terminal_speed():
-    g = make("#....#\n#.P..#\n" + "#....#\n" * 40 + "######\n" + "#....#\n" * 3 + "#...G#\n")
+    g = Game([parse_text("#....#\n#.P..#\n" + "#....#\n" * 40 + "######\n" + "#....#\n" * 3 + "#...G#\n")])
     floor_top = 5 * T  # the floor is row 42 of 47
     vmin = 0.0
     for _ in range(400):
         g.step(set())
         vmin = min(vmin, vel(g).y)
-        assert feet(g) >= floor_top - 1e-9
+        assert feet(g.scene, g.player) >= floor_top - 1e-9
     assert vmin <= -TU.fall_speed * T  # it did reach terminal speed
-    assert feet(g) == pytest.approx(floor_top, abs=1e-9) and g.player_state.grounded
+    assert feet(g.scene, g.player) == pytest.approx(floor_top, abs=1e-9) and g.player_state.grounded
+    assert_on_floor(g.scene, g.player)
 
 
 def test_cannot_jump_through_a_one_tile_ceiling():
-    g = make("""
+    g = Game([parse_text("""
 #......#
 #......#
 ########
 #......#
 #..P..G#
 ########
-""")
+""")])
     run(g.scene, 10, keys=set())
     ceiling = 3 * T
     for _ in range(60):
         g.step({"space"})
-        assert g.player_transform.y + HALF_H <= ceiling + 1e-9
+        assert bounds(g.scene, g.player)[3] <= ceiling + 1e-9  # its head
 
 
 def test_diagonal_max_speed_into_a_corner_stays_inside():
-    g = make("""
+    g = Game([parse_text("""
 #......#
 #.P....#
 #......#
 #.....G#
 ########
-""")
+""")])
     for _ in range(120):
         vel(g).y = -TU.fall_speed * T  # the fastest the game ever moves the player, down and right
         g.step({"right"})
-        assert g.player_transform.x + TU.player_size[0] * T / 2 <= 7 * T + 1e-9
-        assert feet(g) >= T - 1e-9
+        assert_inside(g.scene, g.player, (T, T - 1e-9, 7 * T + 1e-9, 5 * T))  # the walls, the floor
 
 
 # --- jumping ---------------------------------------------------------------------------------------
 
 
 def _apex(g: Game, hold: int) -> float:
-    start = feet(g)
+    start = feet(g.scene, g.player)
     top = start
     for i in range(90):
         g.step({"space"} if i < hold else set())
-        top = max(top, feet(g))
+        top = max(top, feet(g.scene, g.player))
     return top - start
 
 
 def test_variable_jump_height():
     level = "#" + "." * 8 + "#\n"
-    g = make(level * 8 + "#...P...G#\n" + "#" * 10)
+    g = Game([parse_text(level * 8 + "#...P...G#\n" + "#" * 10)])
     run(g.scene, 10, keys=set())
     full = _apex(g, 60)
     run(g.scene, 10, keys=set())
@@ -250,35 +251,32 @@ LEDGE_LEVEL = """
 
 def _run_off_the_ledge(g: Game) -> None:
     run(g.scene, 10, keys=set())
-    while g.player_state.grounded:
-        g.step({"right"})
+    step_until(g.scene, lambda s: not g.player_state.grounded, within=120, keys={"right"}, what="running off the ledge")
 
 
 def test_coyote_time():
-    g = make(LEDGE_LEVEL)
+    g = Game([parse_text(LEDGE_LEVEL)])
     _run_off_the_ledge(g)
     run(g.scene, 4, keys={"right"})  # 5 frames in the air: still within coyote time (0.1 s)
     g.step({"right", "space"})
     assert vel(g).y > 0.5 * JUMP
-    g = make(LEDGE_LEVEL)
+    g = Game([parse_text(LEDGE_LEVEL)])
     _run_off_the_ledge(g)
     run(g.scene, 12, keys={"right"})  # too late
     g.step({"right", "space"})
     assert vel(g).y < 0
     run(g.scene, 60, keys=set())
-    assert g.player_state.grounded and feet(g) == pytest.approx(T, abs=1e-9)  # landed, no jump
+    assert g.player_state.grounded and feet(g.scene, g.player) == pytest.approx(T, abs=1e-9)  # landed, no jump
+    assert_on_floor(g.scene, g.player)
 
 
 def _jump_pressed_before_landing(early: int) -> float:
     """A full jump from the ledge, then the same jump with jump tapped ``early`` steps before it
     lands; the highest vertical velocity in the few steps after the landing."""
-    g = make(LEDGE_LEVEL)
+    g = Game([parse_text(LEDGE_LEVEL)])
     run(g.scene, 10, keys=set())
     g.step({"space"})
-    n = 1
-    while not g.player_state.grounded:
-        g.step(set())
-        n += 1
+    n = 1 + step_until(g.scene, lambda s: g.player_state.grounded, within=240, keys=set(), what="landing")
     run(g.scene, 5, keys=set())
     g.step({"space"})
     run(g.scene, n - 1 - early, keys=set())
@@ -311,44 +309,46 @@ ONE_WAY_LEVEL = """
 
 
 def test_one_way_platform_jump_up_through_land_stay_drop_down():
-    g = make(ONE_WAY_LEVEL)
+    g = Game([parse_text(ONE_WAY_LEVEL)])
     top = 4 * T  # the slab is the top quarter of row 4 of 8: 3 tiles above the floor
     run(g.scene, 10, keys=set())
     rise = []
     for _ in range(40):
         g.step({"space"})
-        rise.append(feet(g))
+        rise.append(feet(g.scene, g.player))
     assert max(rise) > top  # went up through it from below
     run(g.scene, 30, keys=set())
-    assert feet(g) == pytest.approx(top, abs=1e-9) and g.player_state.grounded  # and landed on it
+    assert feet(g.scene, g.player) == pytest.approx(top, abs=1e-9) and g.player_state.grounded  # and landed on it
     y = g.player_transform.y
     for _ in range(500):
         g.step(set())
         assert abs(g.player_transform.y - y) <= 1e-9
+        assert_on_floor(g.scene, g.player)
     g.step({"space"})  # a plain jump from it is a jump, not a drop
     assert vel(g).y > 0
     run(g.scene, 60, keys=set())
-    assert feet(g) == pytest.approx(top, abs=1e-9)
+    assert feet(g.scene, g.player) == pytest.approx(top, abs=1e-9)
     g.step({"down"})
     g.step({"down", "space"})  # down + jump: drop through
     run(g.scene, 40, keys={"down"})
-    assert feet(g) == pytest.approx(T, abs=1e-9) and g.player_state.grounded
+    assert feet(g.scene, g.player) == pytest.approx(T, abs=1e-9) and g.player_state.grounded
+    assert_on_floor(g.scene, g.player)
     hb = g.scene.get(g.player, Hitbox)
     assert hb.mask & 2  # the one-way layer is back in the mask
     run(g.scene, 10, keys=set())
     run(g.scene, 60, keys={"space"})  # and it is solid from above again after the drop
-    assert feet(g) == pytest.approx(top, abs=1e-9)
+    assert feet(g.scene, g.player) == pytest.approx(top, abs=1e-9)
 
 
 def test_walks_off_a_one_way_platform_edge_and_lands_on_the_floor():
-    g = make(ONE_WAY_LEVEL)
+    g = Game([parse_text(ONE_WAY_LEVEL)])
     run(g.scene, 10, keys=set())
     g.step({"space"})
     run(g.scene, 60, keys=set())
-    for _ in range(60):
-        g.step({"right"})
+    run(g.scene, 60, keys={"right"})
     run(g.scene, 30, keys=set())
-    assert feet(g) == pytest.approx(T, abs=1e-9)
+    assert feet(g.scene, g.player) == pytest.approx(T, abs=1e-9)
+    assert_on_floor(g.scene, g.player)
 
 
 # --- moving platforms ------------------------------------------------------------------------------
@@ -360,7 +360,7 @@ def test_rides_the_moving_platform(path):
         text = "#..............#\n#.......P......#\n#.......MMM~~~~#\n" + "#..............#\n" * 3
     else:
         text = "#..............#\n#.......P......#\n#.......MMM....#\n" + "#.......~......#\n" * 3
-    g = make(text + "#.............G#\n################")
+    g = Game([parse_text(text + "#.............G#\n################")])
     (pe, plat), = g.scene.query(MovingPlatform)
     run(g.scene, 10, keys=set())
     pt = g.scene.get(pe, Transform)
@@ -369,6 +369,7 @@ def test_rides_the_moving_platform(path):
     for _ in range(720):  # several trips both ways, pauses and turns included
         g.step(set())
         assert g.player_state.grounded and g.player_state.ground == pe
+        assert_on_floor(g.scene, g.player)
         offsets.add((round(g.player_transform.x - pt.x, 6), round(g.player_transform.y - pt.y, 6)))
         xs.add(round(pt.x if path == "horizontal" else pt.y))
     assert len(offsets) == 1  # carried exactly, never sliding or hopping
@@ -376,8 +377,8 @@ def test_rides_the_moving_platform(path):
 
 
 def test_can_walk_and_jump_on_a_moving_platform():
-    g = make("#..............#\n#.......P......#\n#.......MMM~~~~#\n" + "#..............#\n" * 3
-             + "#.............G#\n################")
+    g = Game([parse_text("#..............#\n#.......P......#\n#.......MMM~~~~#\n" + "#..............#\n" * 3
+             + "#.............G#\n################")])
     (pe, _), = g.scene.query(MovingPlatform)
     run(g.scene, 10, keys=set())
     pt = g.scene.get(pe, Transform)
@@ -393,25 +394,26 @@ def test_can_walk_and_jump_on_a_moving_platform():
 
 
 def test_coins_are_collected_exactly_once():
-    g = make("""
+    g = Game([parse_text("""
 #................#
 #................#
 #.P.CCCCC...CC..G#
 ##################
-""")
+""")])
     assert g.state.coin_total_in_level == 7
+    log = EventLog(g.scene)
     run(g.scene, 10, keys=set())
-    for _ in range(120):
-        g.step({"right"})
+    run(g.scene, 120, keys={"right"})
     assert g.state.coins == 7 and g.state.coins_in_level == 7
     assert not g.scene.query(Coin)
-    for _ in range(120):  # back over where they were
-        g.step({"left"})
-    assert g.state.coins == 7
+    touched = log.between(Player, Coin, "started")  # one touch per coin: each taken at its first
+    assert len(touched) == 7 and len({r.b if Coin in r.types_b else r.a for r in touched}) == 7
+    run(g.scene, 120, keys={"left"})  # back over where they were
+    assert g.state.coins == 7 and len(log.between(Player, Coin, "started")) == 7
 
 
 def test_stomping_an_enemy_kills_it():
-    g = make("""
+    g = Game([parse_text("""
 #............#
 #.....P......#
 #............#
@@ -419,61 +421,60 @@ def test_stomping_an_enemy_kills_it():
 #.....E......#
 #...........G#
 ##############
-""")
+""")])
     (e, en), = g.scene.query(Enemy)
     en.speed = 0.0  # stands still under the falling player
-    for _ in range(60):
-        g.step(set())
-        if not g.scene.query(Enemy):
-            break
-    assert not g.scene.query(Enemy) and g.state.deaths == 0
+    log = EventLog(g.scene)
+    step_until(g.scene, lambda s: not s.query(Enemy), within=60, keys=set(), what="the stomp")
+    log.assert_started(Player, e)
+    assert g.state.deaths == 0
     assert vel(g).y > 0  # bounced off it
 
 
 def test_touching_an_enemy_from_the_side_kills_and_respawns_at_the_checkpoint():
-    g = make("""
+    g = Game([parse_text("""
 #..................#
 #.P...K.........E.G#
 ####################
-""")
+""")])
     run(g.scene, 10, keys=set())
     checkpoint = (6.5 * T, T)
-    for _ in range(300):
-        g.step({"right"})
-        if g.state.deaths:
-            break
+    log = EventLog(g.scene)
+    step_until(g.scene, lambda s: g.state.deaths > 0, within=300, keys={"right"}, what="a death")
+    log.assert_started(Player, Enemy)
     assert g.state.deaths == 1
-    assert (g.player_transform.x, feet(g)) == pytest.approx(checkpoint)
-    assert vel(g).x == 0.0 and vel(g).y == 0.0
+    assert (g.player_transform.x, feet(g.scene, g.player)) == pytest.approx(checkpoint)
+    assert_at_rest(g.scene, g.player, speed=0.0)
     assert len(g.scene.query(Enemy)) == 1
 
 
 def test_spikes_and_falling_out_kill():
-    g = make("""
+    g = Game([parse_text("""
 #..........#
 #.P..^^....#
 #######...G#
-""")
+""")])
     run(g.scene, 10, keys=set())
-    for _ in range(60):
-        g.step({"right"})
-        if g.state.deaths:
-            break
+    log = EventLog(g.scene)
+    step_until(g.scene, lambda s: g.state.deaths > 0, within=60, keys={"right"}, what="a death")
+    log.assert_started(Player, Hazard)
     assert g.state.deaths == 1
     assert g.player_transform.x == pytest.approx(2.5 * T)  # no checkpoint: back to the start
     g.player_transform.x = 8.5 * T  # over the hole
     run(g.scene, 90, keys=set())
-    assert g.state.deaths == 2 and feet(g) == pytest.approx(T, abs=1e-9)
+    assert g.state.deaths == 2 and feet(g.scene, g.player) == pytest.approx(T, abs=1e-9)
+    assert_on_floor(g.scene, g.player)
 
 
 def test_enemies_turn_at_walls_and_spikes():
-    g = make("""
+    g = Game([parse_text("""
 #.......................#
 #P#..E....#...^..E..#..G#
 #########################
-""")
+""")])
     seen: dict[int, set[int]] = {}
     xs: dict[int, list[float]] = {}
+    log = EventLog(g.scene)
     for _ in range(600):
         g.step(set())
         for e, (en, t) in g.scene.query(Enemy, Transform):
@@ -483,23 +484,26 @@ def test_enemies_turn_at_walls_and_spikes():
     assert seen[a] == seen[b] == {-1, 1}
     assert 3.0 < min(xs[a]) < 3.6 and 9.4 < max(xs[a]) < 10.0  # between the walls
     assert 14.9 < min(xs[b]) < 15.6 and 19.4 < max(xs[b]) < 20.0  # between the spikes and the wall
+    log.assert_started(b, Hazard)  # the second turns where it touches the spikes ahead (its rule) ...
+    log.assert_never(a, Hazard)  # ... the first, between two walls, never meets them
     assert g.state.deaths == 0
 
 
 def test_enemy_turns_at_a_ledge():
-    g = make("""
+    g = Game([parse_text("""
 #.............#
 #....E........#
 #...####......#
 #............G#
 #.P...........#
 ###############
-""")
+""")])
     xs = []
     for _ in range(400):
         g.step(set())
-        ((_e, (_en, t)),) = g.scene.query(Enemy, Transform)
+        ((e, (_en, t)),) = g.scene.query(Enemy, Transform)
         xs.append(t.x / T)
+        assert_on_floor(g.scene, e)  # never over the edge
     assert 4.0 < min(xs) < 4.6 and 7.4 < max(xs) < 8.0
 
 
@@ -508,13 +512,11 @@ def test_goal_then_next_level_and_restart():
     lvl_b = parse_text("#......#\n#.C.P.G#\n########", "b.txt")
     g = Game([lvl_a, lvl_b])
     first = g.player
-    while not g.state.reached_goal:
-        g.step({"right"})
+    step_until(g.scene, lambda s: g.state.reached_goal, within=120, keys={"right"}, what="the goal")
     assert g.state.levels_completed == 1
-    for _ in range(80):  # a second to see it, then the next level
-        if g.state.level_index == 1 and g.state.player is not None:
-            break
-        g.step(set())
+    # A second to see it, then the next level.
+    step_until(g.scene, lambda s: g.state.level_index == 1 and g.state.player is not None, within=80, keys=set(),
+               what="the next level")
     assert g.state.level_index == 1 and g.player != first and not g.scene.exists(first)
     assert g.player_transform.x == pytest.approx(4.5 * T)
     run(g.scene, 40, keys={"left"})
@@ -526,7 +528,7 @@ def test_goal_then_next_level_and_restart():
 
 
 def test_camera_follows_the_player_within_the_level():
-    g = make("#" * 80 + "\n" + ("#" + "." * 78 + "#\n") * 3 + "#P" + "." * 76 + "G#\n" + "#" * 80)
+    g = Game([parse_text("#" * 80 + "\n" + ("#" + "." * 78 + "#\n") * 3 + "#P" + "." * 76 + "G#\n" + "#" * 80)])
     vw, vh = g.state.view
     w, h = g.level.size
     xs = []
@@ -640,24 +642,21 @@ def test_missing_level_file(tmp_path):
 
 
 def test_player_state_resets_on_death():
-    g = make("#.........#\n#.P..^...G#\n###########")
+    g = Game([parse_text("#.........#\n#.P..^...G#\n###########")])
     run(g.scene, 5, keys=set())
     g.scene.get(g.player, Player).drop_timer = 0.1
-    for _ in range(60):
-        g.step({"right"})
-        if g.state.deaths:
-            break
+    step_until(g.scene, lambda s: g.state.deaths > 0, within=60, keys={"right"}, what="a death")
     p = g.player_state
     assert g.state.deaths == 1 and p.drop_timer == 0.0 and not p.jumping
     assert math.isfinite(g.player_transform.x)
 
 
 def test_an_enemy_that_falls_out_of_the_level_is_removed():
-    g = make("""
+    g = Game([parse_text("""
 #.........#
 #.P.....E.#
 #######...#
-""")
+""")])
     g.scene.get(g.scene.query(Enemy)[0][0], Enemy).direction = 1
     run(g.scene, 90, keys=set())
     assert not g.scene.query(Enemy) and g.state.deaths == 0
@@ -673,11 +672,11 @@ def _prop(g: Game, kind: str) -> int:
 
 
 def test_a_crate_moves_while_the_player_pushes_it_and_stops_when_it_stops():
-    g = make("""
+    g = Game([parse_text("""
 ....................
 .P.B................
 ####################
-""")
+""")])
     crate = _prop(g, "crate")
     x0 = g.scene.get(crate, Transform).x
     run(g.scene, 60, keys={"right"})
@@ -685,20 +684,20 @@ def test_a_crate_moves_while_the_player_pushes_it_and_stops_when_it_stops():
     assert pushed > x0 + 3 * T  # pushed along, several tiles in a second
     assert g.scene.get(crate, Velocity).x > 0.5 * RUN
     run(g.scene, 60, keys=set())  # let go: friction (0.6 of g) stops it within a fraction of a second
-    v = g.scene.get(crate, Velocity).x
     stop = g.scene.get(crate, Transform).x
-    assert v == 0.0
+    assert_at_rest(g.scene, crate, speed=0.0)
     # it slides at most v^2 / (2 mu g) past where the push ended (plus a step of travel)
     assert stop - pushed <= RUN ** 2 / (2 * TU.prop_friction * G) + RUN * DT
     assert g.scene.get(crate, Transform).y == pytest.approx(T + TU.crate_size * T / 2, abs=1e-6)  # on the floor
+    assert_on_floor(g.scene, crate)
 
 
 def test_a_barrel_pushed_along_rolls_on_and_off_a_ledge():
-    g = make("""
+    g = Game([parse_text("""
 .......................
 .P.O...................
 ##########.............
-""")
+""")])
     barrel = _prop(g, "barrel")
     run(g.scene, 20, keys={"right"})
     v = g.scene.get(barrel, Velocity)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import random
 
 import numpy as np
@@ -10,18 +11,10 @@ from examples.platformer import Game, builtin_levels, parse_text
 from examples.platformer.components import Enemy, LevelPiece, Tuning
 from examples.platformer.demo import Autoplay, level3
 from framework import Hitbox, Polygon, Transform
-from framework.character import CharacterController
+from framework.testing import assert_inside, assert_on_floor, bounds, feet, run, step_until
 
 T = 32.0
 TU = Tuning()
-HALF_H = TU.player_size[1] * T / 2
-RUN = TU.run_speed * T
-DT = 1.0 / 60.0
-
-
-def feet(g: Game) -> float:
-    return g.player_transform.y - HALF_H
-
 
 def test_the_hills_level_has_slopes_a_step_a_v_and_a_lift_over_a_pit():
     g = Game([builtin_levels()[2]])
@@ -36,8 +29,7 @@ def test_the_hills_level_has_slopes_a_step_a_v_and_a_lift_over_a_pit():
 
 def test_demo_plays_the_hills_to_the_goal():
     g = Game([builtin_levels()[2]], autoplay=Autoplay(level3))
-    while not g.state.reached_goal and g.scene.frame < 2000:
-        g.step()
+    step_until(g.scene, lambda s: g.state.reached_goal, within=2000, what="the goal")
     assert g.state.reached_goal and g.state.deaths == 0 and g.state.stomps == 1
 
 
@@ -52,9 +44,7 @@ HILL = """
 
 def test_player_runs_up_and_over_the_hill_with_its_feet_on_the_ground():
     g = Game([parse_text(HILL, "hill.txt")])
-    for _ in range(20):
-        g.step(set())
-    ctrl = g.scene.get(g.player, CharacterController)
+    run(g.scene, 20, keys=set())
 
     def ground(x: float) -> float:
         c = x / T
@@ -77,8 +67,9 @@ def test_player_runs_up_and_over_the_hill_with_its_feet_on_the_ground():
         g.step({"right"})
         x = g.player_transform.x
         under = max(ground(x - half_w), ground(x + half_w))
-        assert ctrl.on_floor and g.player_state.grounded
-        assert 0.0 <= feet(g) - under <= 1e-9, (x / T, feet(g) - under)
+        assert_on_floor(g.scene, g.player)
+        assert g.player_state.grounded
+        assert 0.0 <= feet(g.scene, g.player) - under <= 1e-9, (x / T, feet(g.scene, g.player) - under)
     assert g.player_transform.x > 18 * T  # 150 steps at up to 7 tiles/s, never held up
 
 
@@ -95,9 +86,9 @@ def test_walker_walks_up_and_down_slopes_and_turns_at_walls():
     for _ in range(1800):
         g.step(set())
         ((e, (_en, t)),) = g.scene.query(Enemy, Transform)
-        ctrl = g.scene.get(e, CharacterController)
         xs.append(t.x / T)
-        assert ctrl.on_floor or g.scene.frame < 30
+        if g.scene.frame >= 30:
+            assert_on_floor(g.scene, e)
     assert min(xs) < 1.5 and max(xs) > 31.5  # over the hill to the left wall, up the 2:1 slope to the right wall
     assert g.state.deaths == 0
 
@@ -117,6 +108,7 @@ def test_random_input_on_the_hills_for_10000_frames_never_enters_terrain_or_leav
         g.step(keys)
         p, t = g.player, g.player_transform
         assert 0.0 < t.x < width and t.y < height
+        assert_inside(scene, p, (0.0, -math.inf, width, height))  # all of it, not only its centre
         c = scene.contacts
         for i in np.flatnonzero((c.a == p) | (c.b == p)).tolist():
             other = int(c.b[i]) if int(c.a[i]) == p else int(c.a[i])
@@ -137,9 +129,10 @@ def test_a_lift_that_carries_the_player_into_a_ceiling_kills_it():
 #########
 """, "crush.txt")])
     ceiling = 7 * T
-    for _ in range(300):
-        g.step(set())
-        assert g.player_transform.y + HALF_H <= ceiling + 1e-9
-        if g.state.deaths:
-            break
+
+    def crushed(scene) -> bool:  # ... and never through the ceiling on the way
+        assert bounds(scene, g.player)[3] <= ceiling + 1e-9
+        return g.state.deaths > 0
+
+    step_until(g.scene, crushed, within=300, keys=set())
     assert g.state.deaths == 1
