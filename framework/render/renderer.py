@@ -156,9 +156,11 @@ class Renderer:
             previous.set_current()
 
     def atlas_texture(self) -> int:
+        """The GL texture of the image atlas (uploaded again first if images were added)."""
         return self._atlas.texture_id()
 
     def table_texture(self) -> int:
+        """The GL texture of the slot table (the rows in use uploaded first if they changed)."""
         return self._table.texture_id()
 
     # --- the render stage -----------------------------------------------------------------
