@@ -141,9 +141,9 @@ class Replay:
         """Read a replay written by :meth:`save`; ``ValueError`` naming the file (and line) if it
         is not one, whatever it holds (a file over ``max_bytes``, or declaring more than
         ``max_frames`` frames, is refused before it is read). A missing file raises
-        ``FileNotFoundError``. Frames holding the same keys share one frozenset, so a replay
-        costs about 8 bytes of memory a frame beyond its distinct frames; parsing a line costs up
-        to about 25 bytes a byte while it is read, so the default limit keeps any file well under
+        ``FileNotFoundError``. Identical frame lines share one frozenset (read once), so a replay
+        costs about 8 bytes of memory a frame beyond its distinct frames; parsing costs up to
+        about 40 bytes a byte of distinct lines, so the default limit keeps any file well under
         1 GiB."""
         name = os.fspath(path)
         size = os.stat(name).st_size
@@ -159,12 +159,14 @@ class Replay:
         if not nlines:
             raise InvalidValue(f"{name}: not a replay: the file is empty")
 
-        def each_line() -> Iterator[str]:
-            start = 0
-            for _ in range(nlines):
-                end = text.find("\n", start)
-                end = len(text) if end < 0 else end
-                yield text[start:end]
+        def each_line() -> Iterator[str]:  # split a MiB at a time (never the whole text at once)
+            start, limit = 0, len(text) - 1 if text.endswith("\n") else len(text)
+            while True:
+                end = text.find("\n", min(start + (1 << 20), limit), limit)
+                end = limit if end < 0 else end
+                yield from text[start:end].split("\n")
+                if end >= limit:
+                    return
                 start = end + 1
 
         lines = each_line()
@@ -199,13 +201,16 @@ class Replay:
                                "(truncated or edited?)")
         replay = cls(dt=_dt(header.get("dt"), where), seed=_seed(header.get("seed"), where),
                      meta=_meta(header.get("meta", {}), where))
-        shared: dict[frozenset[str], frozenset[str]] = {}
+        seen: dict[str, frozenset[str]] = {}  # a line read before: the same frame, the same frozenset
+        frames = replay.frames
         for i, line in enumerate(lines, start=1):
-            frame = parse(i, line)
-            if not isinstance(frame, list):
-                raise InvalidValue(f"{name}: line {i + 1}: a frame must be a list of key names, got {line[:80]!r}")
-            held = _keys(frame, f"{name}: line {i + 1}")
-            replay.frames.append(shared.setdefault(held, held))
+            held = seen.get(line)
+            if held is None:
+                frame = parse(i, line)
+                if not isinstance(frame, list):
+                    raise InvalidValue(f"{name}: line {i + 1}: a frame must be a list of key names, got {line[:80]!r}")
+                held = seen[line] = _keys(frame, f"{name}: line {i + 1}")
+            frames.append(held)
         return replay
 
 
