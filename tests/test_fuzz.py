@@ -270,6 +270,270 @@ def test_snapshot_files(tmp_path_factory, blob):
     _write_report()
 
 
+# --- snapshot files: mutations of the description's structure ---------------------------------------
+
+def _description() -> tuple[dict, dict]:
+    import io
+
+    with np.load(io.BytesIO(SNAPSHOT), allow_pickle=False) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    return arrays, json.loads(arrays.pop("__meta__").tobytes())
+
+
+MARKER = Path(os.environ.get("TMPDIR", "/tmp")) / f"framework-fuzz-marker-{os.getpid()}"
+POPEN = "framework.frame:np.f2py.subprocess.Popen"
+HOSTILE = [{"E": [POPEN, {"L": [10**9, ["touch", str(MARKER)]]}]},  # the audit's file
+           {"O": [10**9, POPEN, [["args", ["touch", str(MARKER)]]]]}, {"NT": [POPEN, [["touch", str(MARKER)]]]},
+           {"C": "builtins:eval"}, {"C": "os:system"}, {"O": [10**9, "framework.scene:Scene", [["world", "default"]]]},
+           {"E": ["framework.components:Transform", 1]}, {"O": [10**9, "framework.components:Body", []]},
+           {"NT": ["framework.components:Transform", [1, 2, 3]]}, {"S": [10**9, [{"L": [10**9 + 1, []]}]]},
+           {"F": "nan"}, {"F": "inf"}, {"I": "9" * 5000}, {"I": "-1"}, {"B": "!!"}, {"DT": "O"}, {"DT": "<f8"},
+           {"SL": [1, 2, {"F": "0x1p+0"}]}, {"A": 10**6}, {"NS": 0}, {"R": 10**9}, {"R": 0}, {"P": "scene"},
+           {"P": "nope"}, {"Q": 1}, {"L": [0, []]}, {}, [], None, True, -1, 2**60, "x", {"T": []}]
+CLASSES = [POPEN, "builtins:eval", "os:system", "numpy:load", "framework.frame:np", "framework:Transform",
+           "framework.scene:Scene", "framework.components:Body", "framework.events:StepContacts",
+           "framework.components:Transform", "framework.store:BodyStore", "framework.frame:StepFrame",
+           "framework.shapes:Circle", "framework.validation:InvalidValue", "", 7, None]
+TAGS = ["I", "F", "P", "A", "NS", "C", "E", "B", "SL", "DT", "T", "NT", "R", "L", "D", "S", "FS", "O", "?"]
+
+
+def _slots(node, out, depth=0):
+    """Every place in a JSON tree a value sits: (its container, its key or index)."""
+    if depth > 200:
+        return
+    items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
+    for k, v in items:
+        out.append((node, k))
+        _slots(v, out, depth + 1)
+
+
+def _state_parts(meta):
+    """(name, fields) of each part of the state whose layout earlier mutations left intact."""
+    try:
+        pairs = meta["state"]["D"][1]
+        return [(p[0], p[1]["D"][1]) for p in pairs if isinstance(p, list) and len(p) == 2
+                and isinstance(p[1], dict) and isinstance(p[1].get("D"), list) and len(p[1]["D"]) == 2
+                and isinstance(p[1]["D"][1], list) and all(isinstance(f, list) and f for f in p[1]["D"][1])]
+    except (KeyError, IndexError, TypeError):
+        return []
+
+
+@st.composite
+def mutated_description(draw) -> bytes:
+    """A valid snapshot file whose description is changed as a tree, not as bytes: a class name,
+    a tag, a key or a stage name replaced, dropped or added, a node replaced by a hostile one,
+    two nodes swapped, nodes nested deeply; each inside a valid zip."""
+    import io
+
+    arrays, meta = _description()
+    rng = random.Random(draw(st.integers(0, 2**32)))
+    for _ in range(draw(st.integers(1, 3))):
+        how = draw(st.sampled_from(["class", "tag", "key", "stage", "scene", "hostile", "swap", "nest", "drop",
+                                    "number", "part"]))
+        slots: list = []
+        _slots(meta, slots)
+        parent, k = rng.choice(slots)
+        v = parent[k]
+        if how == "class":  # a class name of an O, E, NT or C node
+            named = [(n, key) for n, key in slots if isinstance(n, dict) and key in ("O", "E", "NT", "C")]
+            if named:
+                n, key = rng.choice(named)
+                cname = rng.choice(CLASSES)
+                if key == "C":
+                    n[key] = cname
+                elif isinstance(n[key], list) and n[key]:
+                    n[key][1 if key == "O" and len(n[key]) > 1 else 0] = cname
+        elif how == "tag" and isinstance(v, dict) and len(v) == 1:
+            (tag, body), = v.items()
+            parent[k] = {rng.choice(TAGS): body}
+        elif how == "key":  # a dict node's key, or an object's attribute name, renamed / duplicated
+            pairs = [n for n, key in slots if isinstance(n, dict) and key in ("D", "O")]
+            if pairs:
+                n = rng.choice(pairs)
+                fields = n.get("D", n.get("O"))[-1] if isinstance(n.get("D", n.get("O")), list) else None
+                if isinstance(fields, list) and fields and isinstance(fields[0], list):
+                    pair = rng.choice(fields)
+                    choice = rng.choice(["rename", "duplicate", "drop", "add"])
+                    if not isinstance(pair, list) or not pair:
+                        pass
+                    elif choice == "rename":
+                        pair[0] = rng.choice(["bogus", "__class__", "__dict__", "", "x y", 1, None, "_store", "n"])
+                    elif choice == "duplicate":
+                        fields.append([pair[0], rng.choice(HOSTILE)])
+                    elif choice == "drop":
+                        fields.remove(pair)
+                    else:
+                        fields.append([rng.choice(["bogus", "closed", "_pipeline", "frame"]), rng.choice(HOSTILE)])
+        elif how in ("stage", "scene"):  # a stage name or a scene field added, dropped or renamed
+            for part in _state_parts(meta):
+                if part[0] == ("stages" if how == "stage" else "scene"):
+                    fields = part[1]
+                    choice = rng.choice(["add", "drop", "rename"])
+                    if choice == "add":
+                        fields.append([rng.choice(["bogus", "render", "frame", "time"]), {"D": [10**9, []]}])
+                    elif fields and choice == "drop":
+                        fields.pop(rng.randrange(len(fields)))
+                    elif fields:
+                        fields[rng.randrange(len(fields))][0] = rng.choice(["bogus", "closed", "narrow_phase"])
+        elif how == "hostile":
+            parent[k] = rng.choice(HOSTILE)
+        elif how == "swap":
+            other_parent, other_k = rng.choice(slots)
+            parent[k], other_parent[other_k] = other_parent[other_k], v
+        elif how == "nest":
+            depth = rng.choice([2, 50, 400, 5000])
+            for i in range(depth):
+                v = rng.choice([{"T": [v]}, {"L": [10**9 + i, [v]]}])
+            parent[k] = v
+        elif how == "drop" and isinstance(v, list) and v:
+            v.pop(rng.randrange(len(v)))
+        elif how == "number":
+            ints = [(n, key) for n, key in slots if type(n[key]) is int]
+            if ints:
+                n, key = rng.choice(ints)
+                n[key] = rng.choice([-1, 0, 2**53, -(2**53), 10**9, True, None, {"F": "0x1p+0"}, {"I": "1" * 400}])
+        elif how == "part":
+            key = rng.choice(sorted(meta))
+            meta[key] = rng.choice(HOSTILE + [meta.get(rng.choice(sorted(meta)))])
+    try:
+        text = json.dumps(meta)
+    except (RecursionError, ValueError):  # nested too deeply to write, or a node swapped into itself
+        text = json.dumps({"format": "framework-snapshot"})
+    arrays["__meta__"] = np.frombuffer(text.encode(), dtype=np.uint8)
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+@FUZZ
+@given(mutated_description())
+def test_snapshot_file_descriptions(tmp_path_factory, blob):
+    """Structure-aware: the description's tree mutated (see :func:`mutated_description`). Refused
+    or loaded; refused, the scene is as it was; and nothing a hostile class name names ever runs."""
+    from test_snapshot import state_hash
+
+    from framework.snapshot_file import load_snapshot
+
+    path = tmp_path_factory.mktemp("snapd") / "s.npz"
+    path.write_bytes(blob)
+    scene = _snapshot_scene()
+    before = state_hash(scene)
+    try:
+        outcome = []
+
+        def load():
+            load_snapshot(scene, path)
+            outcome.append("loaded")
+
+        attempt("snapshot file description (structure)", load, (InvalidValue,))
+        if not outcome:
+            assert state_hash(scene) == before
+    finally:
+        scene.close()
+    assert not MARKER.exists(), "a class named in the file ran"
+    _write_report()
+
+
+# --- the limits at their maximum --------------------------------------------------------------------
+#
+# A file as large as each loader's default limit allows, of the worst shape for memory, under the
+# same bound as the fuzzing. Slow (a few seconds each): run with RUN_SLOW=1.
+
+AT_MAXIMUM = pytest.mark.skipif(os.environ.get("RUN_SLOW") != "1", reason="files at the size limits: RUN_SLOW=1")
+
+
+def _bounded_load(load, allowed, seconds=30.0):
+    t0 = time.perf_counter()
+    with bounded():
+        try:
+            load()
+        except allowed:
+            pass
+    assert time.perf_counter() - t0 < seconds
+
+
+@pytest.mark.slow
+@AT_MAXIMUM
+@pytest.mark.parametrize("shape", ["sets", "lists", "objects"])
+def test_a_snapshot_description_at_the_limit_stays_within_the_bound(tmp_path, shape):
+    import io
+
+    from framework.snapshot_file import MAX_DESCRIPTION_BYTES, load_snapshot
+
+    arrays, meta = _description()
+    room = MAX_DESCRIPTION_BYTES - len(json.dumps(meta)) - 64
+    item = {"sets": lambda i: {"S": [10**6 + i, []]}, "lists": lambda i: {"L": [10**6 + i, []]},
+            "objects": lambda i: {"O": [10**6 + i, "framework.shapes:Circle", [["radius", 1]]]}}[shape]
+    meta["state"] = {"L": [0, [item(i) for i in range(room // (len(json.dumps(item(0), separators=(",", ":"))) + 1))]]}
+    arrays["__meta__"] = np.frombuffer(json.dumps(meta, separators=(",", ":")).encode(), dtype=np.uint8)
+    assert 0.99 * MAX_DESCRIPTION_BYTES < arrays["__meta__"].size <= MAX_DESCRIPTION_BYTES
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    path = tmp_path / "s.npz"
+    path.write_bytes(buf.getvalue())
+    del arrays, meta, buf
+    scene = _snapshot_scene()
+    _bounded_load(lambda: load_snapshot(scene, path), (InvalidValue,))
+    scene.close()
+
+
+@pytest.mark.slow
+@AT_MAXIMUM
+@pytest.mark.parametrize("shape", ["distinct frames", "empty frames", "header"])
+def test_a_replay_at_the_limit_stays_within_the_bound(tmp_path, shape):
+    import itertools
+
+    from framework.replay import MAX_BYTES
+
+    header = {"format": "framework-replay", "version": 1, "dt": 1 / 60, "seed": 0, "frames": 0, "meta": {}}
+    lines: list[str] = []
+    if shape == "header":
+        header["meta"] = {"k": [[]] * ((MAX_BYTES - 200) // 3)}
+    elif shape == "empty frames":
+        lines = ["[]"] * ((MAX_BYTES - 200) // 3)
+    else:
+        size, names = 200, ["".join(p) for p in itertools.product("abcdefghijklmnopqrstuvwxyz", repeat=2)]
+        for pick in itertools.chain(itertools.combinations(names, 2), itertools.combinations(names, 3)):
+            line = json.dumps(list(pick), separators=(",", ":"))
+            if size + len(line) + 1 > MAX_BYTES:
+                break
+            lines.append(line)
+            size += len(line) + 1
+    header["frames"] = len(lines)
+    path = tmp_path / "r.jsonl"
+    path.write_text(json.dumps(header, separators=(",", ":")) + "\n" + "".join(line + "\n" for line in lines))
+    assert 0.99 * MAX_BYTES < path.stat().st_size <= MAX_BYTES
+    del lines, header
+    _bounded_load(lambda: Replay.load(path), (InvalidValue,))
+
+
+@pytest.mark.slow
+@AT_MAXIMUM
+def test_a_golden_trace_at_the_limit_stays_within_the_bound(tmp_path):
+    from framework.testing import GoldenMismatch, check_golden
+    from framework.testing.golden import MAX_BYTES
+
+    path = tmp_path / "g.json"
+    path.write_text('{"format":1,"framework":"x","dt":0,"steps":0,"trace":[' + ",".join(["[]"] * ((MAX_BYTES - 100)
+                                                                                                 // 3)) + "]}")
+    assert 0.99 * MAX_BYTES < path.stat().st_size <= MAX_BYTES
+    scene = _golden_scene()
+    _bounded_load(lambda: check_golden(scene, path, 20, update=False), (InvalidValue, GoldenMismatch))
+    scene.close()
+
+
+def test_a_golden_trace_over_its_limit_is_refused_and_the_limit_can_be_raised(tmp_path):
+    from framework.testing import check_golden
+
+    path = tmp_path / "g.json"
+    path.write_bytes(GOLDEN)
+    with pytest.raises(InvalidValue, match=r"more than the limit of 1000 for a golden trace \(max_bytes\)"):
+        check_golden(_golden_scene(), path, 20, max_bytes=1000)
+    check_golden(_golden_scene(), path, 20, max_bytes=len(GOLDEN))  # raised: it loads and matches
+    with pytest.raises(InvalidValue, match="max_bytes must be an int > 0"):
+        check_golden(_golden_scene(), path, 20, max_bytes=0)
+
+
 # --- found by fuzzing, kept ------------------------------------------------------------------------
 
 
