@@ -13,6 +13,8 @@ from pathlib import Path
 
 from framework.sprites import Animation, SpriteSheet
 
+__all__ = ["IMAGES", "SHEETS", "animations"]
+
 IMAGES = Path(__file__).with_name("images")
 SHEETS = ("player_sheet", "enemy_sheet", "coin_sheet")
 
