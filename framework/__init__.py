@@ -3,11 +3,16 @@
 Importing it (and running scenes without a renderer) never imports pyglet's GL modules.
 """
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .components import Body, Hitbox, Transform, Velocity
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .validation import InvalidValue
+
+if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type checkers see them
+    from .collision import Contact, Impact, RayHit, Vec2, collide
+    from .events import CollisionEvent
+    from .scene import STAGES, Scene, SceneClosed, SceneHit
 
 __all__ = [
     "AABB", "Body", "Capsule", "Circle", "CollisionEvent", "Contact", "Hitbox", "Impact", "InvalidValue", "Polygon",
