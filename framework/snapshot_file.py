@@ -32,7 +32,8 @@ Everything is checked before anything changes: the format and framework versions
 shape (its systems, processors, collision handlers and substeps), the limits below, every class
 name, and the state's structure, so that applying it cannot fail halfway: its parts, stage names
 and the fields of the bodies, the pipeline, every stage and the scene (frame, time) are exactly
-the scene's, each of the type the scene holds there (or ``None`` where either holds ``None``);
+the scene's, each of the type the scene holds there (``None`` on either side only for a private
+field, a cache named with ``_`` that the framework rebuilds);
 entity ids, the next id, dead and pending entities are consistent; the body store's row count,
 capacity, columns (names, dtypes, lengths) and its rows' entities agree with each other and with
 the entities that have a ``Transform``; every resource is named by its class and holds what its
@@ -45,10 +46,12 @@ are taken as the file gives them, so a hostile file can still describe a scene w
 raises or behaves oddly, and the text it holds (a ``Visual``'s image path, say) is used as the
 game would use it. Treat what a stranger's save puts in your scene as you would their level.
 
-Limits (each raisable by the caller): :data:`MAX_BYTES` for the zip members summed (checked
-from the zip's directory before anything is inflated), :data:`MAX_DESCRIPTION_BYTES` for the JSON
-description (which costs up to about 50 bytes of memory per byte while it is parsed and turned
-into objects), and :data:`MAX_MEMBERS` arrays in a file, which ``save_snapshot`` keeps to.
+Limits: :data:`MAX_BYTES` (64 MiB) for the zip members summed, checked from the zip's directory
+before anything is inflated (``max_bytes=``); :data:`MAX_DESCRIPTION_BYTES` (8 MiB, about 5,000
+entities like the platformer's) for the JSON description, which costs up to about 40 bytes of
+memory per byte while it is parsed and turned into objects: at the default, at most about 300 MiB
+and a few seconds (``max_description_bytes=``); both can be raised. :data:`MAX_MEMBERS` (65,535)
+arrays in a file is fixed (a zip without ZIP64 records), and ``save_snapshot`` keeps to it.
 
 In-process copies (:meth:`Scene.snapshot`) and Ray keep using pickle, which is faster and takes
 any picklable component; these files are for what crosses a trust boundary.
@@ -629,8 +632,8 @@ def _read_array(zf: zipfile.ZipFile, member: zipfile.ZipInfo, bad: Callable[[str
         if size > member.file_size:
             raise bad(f"not a snapshot file ({where}: its header declares {size} bytes of data, the member holds "
                       f"{member.file_size})")
-        buf = bytearray(size)
-        view, got = memoryview(buf), 0
+        flat = np.empty(count, dtype=dtype)  # (an array owning its data, as numpy.load gives)
+        view, got = memoryview(flat.view(np.uint8)), 0
         while got < size:
             n = fp.readinto(view[got:])
             if not n:
@@ -638,7 +641,7 @@ def _read_array(zf: zipfile.ZipFile, member: zipfile.ZipInfo, bad: Callable[[str
             got += n
         if got != size or fp.read(1):
             raise bad(f"not a snapshot file ({where}: its data is not the {size} bytes its header declares)")
-    return np.frombuffer(buf, dtype=dtype, count=count).reshape(shape, order="F" if fortran else "C")
+    return flat.reshape(shape, order="F" if fortran else "C")
 
 
 def _read_description(raw: np.ndarray | None, bad: Callable[[str], InvalidValue]) -> Any:
@@ -693,8 +696,17 @@ def _resource_payloads(dec: _Decoder, raw: Any, headers: list[tuple[str, Any, ty
     return out
 
 
+def _fits(name: Any, value: Any, now: Any) -> bool:
+    """Whether a field read from a file may replace the scene's: the same type; or, for a private
+    field (a cache the framework rebuilds, named with ``_``: a fresh scene holds None in some),
+    None on either side."""
+    if type(value) is type(now):
+        return True
+    return type(name) is str and name.startswith("_") and (value is None or now is None)
+
+
 def _same_fields(got: Any, now: Any, where: str) -> None:
-    """``got`` has exactly the fields of ``now``, each of the same type (or None on either side)."""
+    """``got`` has exactly the fields of ``now``, each fitting (see :func:`_fits`)."""
     if type(got) is not dict:
         raise ValueError(f"{where} is not a set of fields")
     if set(got) != set(now):
@@ -704,7 +716,7 @@ def _same_fields(got: Any, now: Any, where: str) -> None:
             [f"unknown {', '.join(unknown)}"] if unknown else [])
         raise ValueError(f"{where}: " + "; ".join(parts))
     for k, v in got.items():
-        if v is not None and now[k] is not None and type(v) is not type(now[k]):
+        if not _fits(k, v, now[k]):
             raise ValueError(f"{where}: {k} is of type {type(v).__name__}, where this scene's is of type "
                              f"{type(now[k]).__name__}")
 
@@ -762,7 +774,7 @@ def _check_store(store: Any, now: Any, placed: set[int]) -> None:
             raise ValueError(f"the body store has no {k}")
     current = vars(now)
     for k, v in got.items():
-        if k in current and v is not None and current[k] is not None and type(v) is not type(current[k]):
+        if k in current and not _fits(k, v, current[k]):
             raise ValueError(f"the body store's {k} is of type {type(v).__name__}, where this scene's is of type "
                              f"{type(current[k]).__name__}")
     n, cap, cols, row_of = got["n"], got["cap"], got["cols"], got["row_of"]

@@ -395,6 +395,20 @@ def pair(tmp_path):
     return path, future, target, twin
 
 
+def _set(meta, part, key, node):
+    """Set the field ``key`` of the state's part ``part`` to ``node``."""
+    next(pair for pair in _part(meta, part)["D"][1] if pair[0] == key)[1] = node
+
+
+def test_a_private_cache_may_be_none_either_way(pair):
+    """A fresh scene holds None in some caches (named with _) that a stepped one has filled: a
+    file of either loads into the other."""
+    path, future, target, _twin = pair
+    _edit_meta(path, lambda m: (_set(m, "bodies", "_geometry_stamp", None), _set(m, "scene", "_totals", None)))
+    load_snapshot(target, path)
+    assert run(target, 40) == future
+
+
 def _positions(scene):
     return {e: (t.x, t.y) for e, t in scene.query(Transform)}
 
@@ -413,6 +427,9 @@ def _positions(scene):
     (lambda m: _part(m, "pipeline")["D"][1].append(["renderer", None]), "the pipeline part: unknown 'renderer'"),
     (lambda m: _part(m, "pipeline")["D"][1].__setitem__(2, ["response_iterations", {"F": "0x1p+0"}]),
      "response_iterations is of type float, where this scene's is of type int"),
+    (lambda m: _set(m, "bodies", "store", None), "store is of type NoneType, where this scene's is of type BodyStore"),
+    (lambda m: _set(m, "pipeline", "frame", None), "frame is of type NoneType, where this scene's is of type StepFr"),
+    (lambda m: _set(m, "bodies", "n_static", None), "n_static is of type NoneType"),
     (lambda m: _part(m, "pending")["L"][1].append(99_999), "pending despawn entity 99999"),
     (lambda m: m["state"]["D"][1].append(["extra", 1]), "the state: unknown 'extra'"),
     (lambda m: m.__setitem__("resources", []), "the resources' states are not"),
