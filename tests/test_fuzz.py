@@ -1,10 +1,15 @@
 """Files from strangers: every loader, fed mutations of valid files, raises only its documented
 error, within a memory bound (a resource limit on the process while it loads) and a time bound.
 
+Snapshot files are also fuzzed by structure: their JSON description mutated as a tree (class
+names, tags, keys, stage names, hostile nodes, nesting), never letting a named class run.
+
 A short run is part of the normal test command (``FUZZ_EXAMPLES`` per loader, default 40). A long
-run on request: ``FUZZ_EXAMPLES=2000 FUZZ_REPORT=docs/data/fuzz.json pytest tests/test_fuzz.py``
+run on request: ``FUZZ_EXAMPLES=3000 FUZZ_REPORT=docs/data/fuzz.json pytest tests/test_fuzz.py``
 writes how many inputs each loader was given and how each ended. Every crash a run finds stays
-below as a regression test with its input (``test_found_...``).
+below as a regression test with its input (``test_found_...``). Files at each loader's default
+size limit, in the shape that costs the most memory, are loaded under the same bounds with
+``RUN_SLOW=1`` (``-k at_the_limit``).
 """
 
 from __future__ import annotations
