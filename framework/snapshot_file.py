@@ -633,7 +633,7 @@ def _read_array(zf: zipfile.ZipFile, member: zipfile.ZipInfo, bad: Callable[[str
             raise bad(f"not a snapshot file ({where}: its header declares {size} bytes of data, the member holds "
                       f"{member.file_size})")
         flat = np.empty(count, dtype=dtype)  # (an array owning its data, as numpy.load gives)
-        view, got = memoryview(flat.view(np.uint8)), 0
+        view, got = flat.view(np.uint8).data, 0
         while got < size:
             n = fp.readinto(view[got:])
             if not n:
