@@ -396,6 +396,16 @@ class Visual:
 
     __slots__ = ("color", "z", "image", "visible", "frame", "animation", "flip_x", "started", "_store", "_entity")
     _TRACKED = frozenset(("color", "z", "image", "visible", "frame", "animation", "flip_x", "started"))
+    color: tuple[int, int, int, int]
+    z: int
+    image: str | None
+    visible: bool
+    frame: Frame | None
+    animation: Animation | None
+    flip_x: bool
+    started: float | None
+    _store: BodyStore | None
+    _entity: int
 
     def __init__(
         self, color: tuple[int, ...] = (255, 255, 255), z: int = 0, image: str | None = None,

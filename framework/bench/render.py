@@ -165,6 +165,7 @@ class Naive(_OneBatch):
         self.x, self.y, self.vx, self.vy = _layout(n)
         self.angle = np.zeros(n)
         self.kind = kind
+        self.objs: list[Any] = []  # pyglet shapes or sprites, one per body
         shapes = pyglet.shapes
         if kind in ("images", "animated"):
             sheet = pyglet.image.load(str(sheet_path(directory)))
@@ -249,11 +250,12 @@ class Floor(_OneBatch):
 
         self.window = offscreen_window()
         self.batch = pyglet.graphics.Batch()
-        self.program = pyglet.gl.current_context.create_program((_FLOOR_VERTEX, "vertex"),
-                                                                (_FLOOR_FRAGMENT, "fragment"))
+        ctx = pyglet.gl.current_context
+        assert ctx is not None  # offscreen_window() made it current
+        self.program = ctx.create_program((_FLOOR_VERTEX, "vertex"), (_FLOOR_FRAGMENT, "fragment"))
         self.x, self.y, self.vx, self.vy = _layout(n)
         self.corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, -1], [1, 1], [-1, 1]], dtype=np.float32) * SIZE / 2
-        self.vlist = self.program.vertex_list(6 * n, gl.GL_TRIANGLES, self.batch,
+        self.vlist: Any = self.program.vertex_list(6 * n, gl.GL_TRIANGLES, self.batch,
                                               colors=("Bn", (200, 80, 60, 255) * (6 * n)))
         self.n = n
 

@@ -95,6 +95,8 @@ def program() -> Any:
     ctx = gl.current_context
     prog = _programs.get(ctx)
     if prog is None:
+        if ctx is None:
+            raise RuntimeError("the render system's shader needs a current GL context")
         prog = ctx.create_program((_VERTEX, "vertex"), (_FRAGMENT, "fragment"))
         prog.use()
         prog["atlas"] = 0

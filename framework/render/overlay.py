@@ -26,6 +26,7 @@ are drawn half a pixel in, so an edge on a whole pixel coordinate lights exactly
 
 from __future__ import annotations
 
+import ctypes
 import math
 from typing import Any
 
@@ -294,6 +295,8 @@ class DebugOverlay:
 
     def __init__(self) -> None:
         ctx = gl.current_context
+        if ctx is None:
+            raise RuntimeError("the debug overlay needs a current GL context")
         self._program = ctx.create_program((_VERTEX, "vertex"), (_FRAGMENT, "fragment"))
         self._vao = pyglet.graphics.vertexarray.VertexArray()
         self._vbo = pyglet.graphics.vertexbuffer.BufferObject(_VERTEX_DTYPE.itemsize * 64,
@@ -356,7 +359,7 @@ class DebugOverlay:
         self.count = 2 * m
         if m:
             self._vbo.size = data.nbytes
-            self._vbo.set_data(data.ctypes.data)
+            self._vbo.set_data(data.ctypes.data_as(ctypes.POINTER(ctypes.c_ubyte)))
 
     # --- drawing ----------------------------------------------------------------------------
 

@@ -363,7 +363,7 @@ class Renderer:
         again only when it changes between fill and sprite or its shape changes; moved to another
         layer, recoloured, or given another frame or animation in place."""
         sprite = visual.animation is not None or frame is not None
-        color = tuple(visual.color)
+        color = visual.color
         group = self._group(visual.z)
         vlist = self._s_vlist[slot]
         remake = new or vlist is None or bool(self._s_fill[slot]) == sprite or (
@@ -385,7 +385,9 @@ class Renderer:
         else:
             z, old_color = self._s_key[slot]
             if z != visual.z:
-                self._batch.migrate(vlist, gl.GL_TRIANGLES, group, self._batch)
+                batch = self._batch
+                assert batch is not None  # made by _make_current before any draw
+                batch.migrate(vlist, gl.GL_TRIANGLES, group, batch)
             if old_color != color:
                 vlist.colors[:] = color * vlist.count
             self._s_key[slot] = (visual.z, color)
