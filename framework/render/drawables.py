@@ -12,7 +12,7 @@ from typing import Any
 
 from ..shapes import AABB, Capsule, Circle, Polygon
 
-__all__ = ["capsule_outline", "circle_segments", "fill_triangles"]
+__all__ = ["capsule_outline", "circle_segments", "fan_indices", "fill_outline", "fill_triangles"]
 
 
 def circle_segments(radius_px: float) -> int:
@@ -38,18 +38,28 @@ def capsule_outline(shape: Capsule, zoom: float = 1.0) -> list[tuple[float, floa
     return top + [(-x, -y) for x, y in top]
 
 
-def fill_triangles(shape: Any, zoom: float = 1.0) -> list[float]:
-    """The triangles (flat, local coordinates) filling a hitbox shape."""
+def fill_outline(shape: Any, zoom: float = 1.0) -> list[tuple[float, float]]:
+    """The convex outline (local coordinates, in order) of a hitbox shape; a circle's and a
+    capsule's round parts as chords fine enough at ``zoom``."""
     if isinstance(shape, AABB):
         hw, hh = shape.width * 0.5, shape.height * 0.5
-        return _fan([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
+        return [(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)]
     if isinstance(shape, Circle):
         r = shape.radius
         n = circle_segments(r * zoom)
-        pts = [(r * math.cos(2.0 * math.pi * i / n), r * math.sin(2.0 * math.pi * i / n)) for i in range(n)]
-        return _fan(pts)
+        return [(r * math.cos(2.0 * math.pi * i / n), r * math.sin(2.0 * math.pi * i / n)) for i in range(n)]
     if isinstance(shape, Capsule):
-        return _fan(capsule_outline(shape, zoom))
+        return capsule_outline(shape, zoom)
     if isinstance(shape, Polygon):
-        return _fan(shape.points)
+        return list(shape.points)
     raise TypeError(f"cannot fill a {type(shape).__name__}")
+
+
+def fill_triangles(shape: Any, zoom: float = 1.0) -> list[float]:
+    """The triangles (flat, local coordinates) filling a hitbox shape: a fan over its outline."""
+    return _fan(fill_outline(shape, zoom))
+
+
+def fan_indices(n: int) -> list[int]:
+    """The indices of a fan of triangles over ``n`` outline points (``0, i, i + 1``)."""
+    return [k for i in range(1, n - 1) for k in (0, i, i + 1)]

@@ -23,6 +23,8 @@ import numpy as np
 from pyglet import gl
 from pyglet.graphics import Group
 
+from .drawables import fan_indices
+
 __all__ = ["DISC", "DISC_QUAD", "FILL", "SLOTS_PER_ROW", "SPRITE", "SPRITE_QUAD", "InstanceTable", "LayerGroup",
            "program", "vertex_list"]
 
@@ -202,13 +204,15 @@ FILL, SPRITE, DISC = 0, 1, 2  # a vertex list's mode (see the vertex shader)
 
 def vertex_list(batch: Any, group: LayerGroup, local: np.ndarray, color: tuple[int, int, int, int], slot: int,
                 mode: int) -> Any:
-    """A drawable's vertex list: triangles ``local`` (flat x, y pairs), one colour, its slot, its mode."""
+    """A drawable's indexed vertex list: the convex outline ``local`` (flat x, y pairs, in order)
+    as a fan of triangles, one colour, its slot, its mode. Indexed, each outline point runs the
+    vertex shader once (a box 4 times, not 6; a hexagon 6, not 12)."""
     n = local.size // 2
-    return group.program.vertex_list(
-        n, gl.GL_TRIANGLES, batch, group,
+    return group.program.vertex_list_indexed(
+        n, gl.GL_TRIANGLES, fan_indices(n), batch, group,
         local=("f", local.tolist()), colors=("Bn", tuple(color) * n),
         slot=("f", (float(slot),) * n), draw_as=("f", (float(mode),) * n))
 
 
-SPRITE_QUAD = np.array([0, 0, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1], dtype=np.float64)  # unit square, two triangles
-DISC_QUAD = 2.0 * SPRITE_QUAD - 1.0  # the square [-1, 1]^2, two triangles
+SPRITE_QUAD = np.array([0, 0, 1, 0, 1, 1, 0, 1], dtype=np.float64)  # the unit square's corners, in order
+DISC_QUAD = 2.0 * SPRITE_QUAD - 1.0  # the square [-1, 1]^2

@@ -47,7 +47,7 @@ from ..sprites import Animation, Frame
 from ..store import KIND_CAPSULE, KIND_POLYGON, STATIC
 from .atlas import Atlas
 from .camera import Camera
-from .drawables import fill_triangles
+from .drawables import fill_outline
 from .instances import DISC, DISC_QUAD, FILL, SPRITE, SPRITE_QUAD, InstanceTable, LayerGroup, vertex_list
 from .offscreen import OffscreenTarget, offscreen_window, write_png
 from .overlay import DebugOverlay
@@ -377,7 +377,7 @@ class Renderer:
                 local, mode = DISC_QUAD, DISC
                 self._table.rows[slot, 2, :2] = shape.radius
             else:
-                local, mode = np.asarray(fill_triangles(shape, self.camera.zoom), dtype=np.float64), FILL
+                local, mode = np.asarray(fill_outline(shape, self.camera.zoom), dtype=np.float64).ravel(), FILL
             self._s_vlist[slot] = vertex_list(self._batch, group, local, color, slot, mode)
             self._s_key[slot] = (visual.z, color)
             self._s_pose[slot] = np.nan  # placed again by the next sync
