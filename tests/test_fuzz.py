@@ -249,9 +249,9 @@ def mutated_snapshot(draw) -> bytes:
     return buf.getvalue()
 
 
-@FUZZ
-@given(mutated_snapshot())
-def test_snapshot_files(tmp_path_factory, blob):
+def _load_or_refuse(tmp_path_factory, blob: bytes, label: str) -> None:
+    """Load ``blob`` as a snapshot file into a fresh scene: loaded, or refused with an InvalidValue
+    and the scene as it was."""
     from test_snapshot import state_hash
 
     from framework.snapshot_file import load_snapshot
@@ -267,11 +267,17 @@ def test_snapshot_files(tmp_path_factory, blob):
             load_snapshot(scene, path)
             outcome.append("loaded")
 
-        attempt("snapshot file (.npz)", load, (InvalidValue,))
+        attempt(label, load, (InvalidValue,))
         if not outcome:
             assert state_hash(scene) == before  # refused: the scene is as it was
     finally:
         scene.close()
+
+
+@FUZZ
+@given(mutated_snapshot())
+def test_snapshot_files(tmp_path_factory, blob):
+    _load_or_refuse(tmp_path_factory, blob, "snapshot file (.npz)")
     _write_report()
 
 
@@ -415,26 +421,7 @@ def mutated_description(draw) -> bytes:
 def test_snapshot_file_descriptions(tmp_path_factory, blob):
     """Structure-aware: the description's tree mutated (see :func:`mutated_description`). Refused
     or loaded; refused, the scene is as it was; and nothing a hostile class name names ever runs."""
-    from test_snapshot import state_hash
-
-    from framework.snapshot_file import load_snapshot
-
-    path = tmp_path_factory.mktemp("snapd") / "s.npz"
-    path.write_bytes(blob)
-    scene = _snapshot_scene()
-    before = state_hash(scene)
-    try:
-        outcome = []
-
-        def load():
-            load_snapshot(scene, path)
-            outcome.append("loaded")
-
-        attempt("snapshot file description (structure)", load, (InvalidValue,))
-        if not outcome:
-            assert state_hash(scene) == before
-    finally:
-        scene.close()
+    _load_or_refuse(tmp_path_factory, blob, "snapshot file description (structure)")
     assert not MARKER.exists(), "a class named in the file ran"
     _write_report()
 
