@@ -351,7 +351,6 @@ class Renderer:
             return False
         slot = self._new_slot()
         self._s_entity[slot] = entity
-        self._s_pose[slot] = np.nan
         self._s_shown[slot] = False
         self._slot_of[entity] = slot
         self._update_slot(slot, entity, visual, shape, kind, frame, new=True)
