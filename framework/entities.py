@@ -14,7 +14,22 @@ from .components import Body, Hitbox, Transform, Velocity, check_component
 from .store import BodyStore
 from .validation import InvalidValue
 
-__all__ = ["check_added_component", "spawn_components"]
+__all__ = ["MissingComponent", "check_added_component", "spawn_components"]
+
+
+class MissingComponent(KeyError):
+    """``scene.get(entity, Type)`` for an entity without a ``Type`` component, or one that does not
+    exist (despawned): a ``KeyError`` whose message names the entity and the type.
+
+    ``entity`` and ``component_type`` are what was asked for."""
+
+    def __init__(self, message: str, entity: Any, component_type: Any) -> None:
+        super().__init__(message)
+        self.entity = entity
+        self.component_type = component_type
+
+    def __str__(self) -> str:  # KeyError's own quotes the message as a repr
+        return str(self.args[0])
 
 
 def spawn_components(components: tuple[Any, ...]) -> tuple[Any, Any, Any]:

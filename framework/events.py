@@ -11,6 +11,7 @@ bookkeeping is a couple of vectorised set operations, whatever the number of pai
 
 from __future__ import annotations
 
+import functools
 import inspect
 from collections.abc import Callable, Iterable
 from typing import Any, Literal, NamedTuple
@@ -160,6 +161,45 @@ def _takes_one_argument(fn: Callable[..., Any]) -> bool:
     return sum(p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) for p in params) == 1
 
 
+def _event_only(one: Callable[[CollisionEvent], Any]) -> Handler:
+    """A handler that takes only the event, called as ``handler(scene, event)``."""
+
+    @functools.wraps(one)  # keeps its name (``__wrapped__``) for error messages
+    def handler(scene: Any, event: CollisionEvent) -> Any:
+        return one(event)
+
+    return handler
+
+
+def _handler_name(handler: Callable[..., Any]) -> str:
+    """How an error names a handler: its qualified name (``Game.on_hit``, ``<lambda>``), with its
+    module, or the repr of a callable object that has none."""
+    fn = getattr(handler, "__wrapped__", handler)
+    name = getattr(fn, "__qualname__", None)
+    if not isinstance(name, str):
+        return repr(fn)
+    module = getattr(fn, "__module__", None)
+    return f"{module}.{name}" if isinstance(module, str) else name
+
+
+def _type_name(t: type) -> str:
+    return getattr(t, "__name__", repr(t))
+
+
+def _component_class(role: str, value: object) -> type:
+    """``value`` if it is a class, else :class:`InvalidValue` naming what was passed."""
+    if isinstance(value, type):
+        return value
+    if isinstance(value, str):
+        hint = f"pass the class itself ({value}), not its name"
+    elif value is None:
+        hint = "pass a component class"
+    else:
+        cls = type(value).__name__
+        hint = f"pass the class {cls} itself, not an instance of it ({cls}())"
+    raise InvalidValue(f"on_collision takes component classes, got {value!r} as {role}: {hint}")
+
+
 class CollisionHandlers:
     """The scene's collision handlers (``scene.on_collision``) and their dispatch after each sub-step.
 
@@ -173,15 +213,17 @@ class CollisionHandlers:
         self._ghosts: dict[int, set[type]] = {}
 
     def add(self, type_a: type, type_b: type, handler: Callable[..., Any], kinds: Iterable[str] | str) -> None:
-        """Register ``handler`` (see ``Scene.on_collision``); ``ValueError`` for unknown kinds."""
+        """Register ``handler`` (see ``Scene.on_collision``); :class:`InvalidValue` for a type that
+        is not a class (an instance, a string), a handler that is not callable, unknown kinds."""
+        type_a = _component_class("type_a", type_a)
+        type_b = _component_class("type_b", type_b)
         ks = frozenset([kinds] if isinstance(kinds, str) else kinds)
         if not ks <= {STARTED, ONGOING, ENDED}:
             raise InvalidValue(f"kinds must be among 'started', 'ongoing', 'ended', got {sorted(ks)!r}")
         if not callable(handler):
             raise InvalidValue(f"handler must be callable, got {handler!r}")
         if _takes_one_argument(handler):
-            one = handler
-            handler = lambda scene, event: one(event)  # noqa: E731
+            handler = _event_only(handler)
         self._handlers.append((type_a, type_b, handler, ks))
 
     def remember(self, entity: int, types: set[type]) -> None:
@@ -207,9 +249,14 @@ class CollisionHandlers:
             mask[rows] = True
         return mask
 
-    def dispatch(self, scene: Any, events: Callable[[], list[CollisionEvent]]) -> None:
+    def dispatch(self, scene: Any, events: Callable[[], list[CollisionEvent]], errors: list[Exception],
+                 where: str = "") -> None:
         """Call the handlers for ``events()`` (made only if some handler is registered), each event
-        turned so that ``event.a`` has the handler's first type; then forget the despawned."""
+        turned so that ``event.a`` has the handler's first type; then forget the despawned.
+
+        A handler that raises does not stop the others: its exception gets a note naming the
+        handler, the event and ``where`` (the step), and is appended to ``errors``, for the scene
+        to raise once the step is complete."""
         ghosts = self._ghosts
         self._ghosts = {}
         if not self._handlers:
@@ -225,6 +272,16 @@ class CollisionHandlers:
                 if ev.kind not in ks:
                     continue
                 if has(ev.a, ta) and has(ev.b, tb):
-                    handler(scene, ev)
+                    turned = ev
                 elif has(ev.b, ta) and has(ev.a, tb):
-                    handler(scene, ev.flipped())
+                    turned = ev.flipped()
+                else:
+                    continue
+                try:
+                    handler(scene, turned)
+                except Exception as exc:
+                    exc.add_note(f"raised by the collision handler {_handler_name(handler)} "
+                                 f"(on_collision({_type_name(ta)}, {_type_name(tb)})) for the {turned.kind!r} event "
+                                 f"of entity {turned.a} ({_type_name(ta)}) and entity {turned.b} ({_type_name(tb)})"
+                                 f"{where}")
+                    errors.append(exc)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Callable, Iterable
 from numbers import Integral
 from typing import Any, cast
@@ -26,7 +27,7 @@ from .character import CharacterController
 from .collision.broad_phase import SpatialHash
 from .components import Hitbox, Transform, Velocity, Visual
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
-from .entities import check_added_component, spawn_components
+from .entities import MissingComponent, check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
 from .frame import StepFrame, add_counters
 from .input import Input
@@ -44,8 +45,8 @@ from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
 from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister
 from .validation import InvalidValue, positive, vector2
 
-__all__ = ["DEFAULT_EFFECTS", "EFFECTS", "SLEEP_SPEED", "SLEEP_STEPS", "STAGES", "Scene", "SceneClosed", "SceneHit",
-           "ShapeHit", "resolve_effects"]
+__all__ = ["DEFAULT_EFFECTS", "EFFECTS", "SLEEP_SPEED", "SLEEP_STEPS", "STAGES", "MissingComponent", "Scene",
+           "SceneClosed", "SceneHit", "ShapeHit", "resolve_effects"]
 
 _scene_ids = itertools.count(1)
 # Called with each new scene (the test plugin, framework.testing.plugin, follows the scenes a test
@@ -108,6 +109,7 @@ class Scene:
         self._totals: tuple[list[CollisionEvent], dict[str, Any]] | None = None  # a step of several sub-steps
         self._systems: list[SystemProcessor] = []
         self._stepping = False
+        self._dispatching = False  # collision handlers are running
         self._pending_despawn: list[int] = []
         esper.switch_world(self.world)
         self._stages = {stage.name: stage for stage in pipeline_stages(self._pipeline)}
@@ -257,9 +259,14 @@ class Scene:
     def despawn(self, entity: int) -> None:
         """Remove ``entity``; its pairs end (``ended`` events) in the next step's events.
 
-        During a step (from a system or a handler) the removal waits until the step ends."""
+        During a step (from a system or a handler) the removal waits until the step ends.
+        Despawning an entity that is gone already (despawned, or waiting to be) is refused, except
+        from a collision handler, where it does nothing: two events of one step may well name the
+        same bullet. An id that never named an entity of this scene is always refused."""
         self._activate()
         if not self.exists(entity):
+            if self._dispatching and self._was_entity(entity):
+                return
             raise InvalidValue(f"entity {entity!r} does not exist (despawned already?)")
         if self._stepping:
             self._pending_despawn.append(entity)
@@ -276,6 +283,14 @@ class Scene:
                 self.bodies.wake_near(row)
             store.remove(entity, comps)
         esper.delete_entity(entity, immediate=True)
+
+    def _was_entity(self, entity: Any) -> bool:
+        """Whether ``entity`` is an id this scene gave out (esper never gives one out twice): one
+        that does not exist any more was despawned."""
+        if isinstance(entity, bool) or not isinstance(entity, Integral):
+            return False
+        count = re.fullmatch(r"count\((-?\d+)\)", repr(esper._entity_count))  # the next id esper gives out
+        return count is not None and 1 <= int(entity) < int(count.group(1))
 
     def exists(self, entity: int) -> bool:
         """Whether ``entity`` is an entity of this scene (not despawned, nor waiting to be)."""
@@ -332,9 +347,23 @@ class Scene:
         return comp
 
     def get(self, entity: int, component_type: type) -> Any:
-        """The ``component_type`` component of ``entity`` (KeyError if it has none)."""
+        """The ``component_type`` component of ``entity``; :class:`MissingComponent` (a
+        ``KeyError``) naming the entity and the type if it has none or does not exist."""
         self._activate()
-        return esper.component_for_entity(entity, component_type)
+        try:
+            return esper.component_for_entity(entity, component_type)
+        except KeyError:
+            pass
+        name = getattr(component_type, "__name__", repr(component_type))
+        if esper.entity_exists(entity):
+            comps: tuple[Any, ...] = esper.components_for_entity(entity)
+            has = ", ".join(sorted(type(c).__name__ for c in comps)) or "nothing"
+            msg = f"entity {entity} has no {name} component (it has {has})"
+        elif self._was_entity(entity):
+            msg = f"entity {entity} was despawned, so it has no {name} component"
+        else:
+            msg = f"entity {entity!r} does not exist (no entity of this scene has that id), so it has no {name}"
+        raise MissingComponent(msg, entity, component_type)
 
     def try_get(self, entity: int, component_type: type) -> Any:
         self._activate()
@@ -398,7 +427,8 @@ class Scene:
         component and one with a ``type_b`` component. The event is turned so that ``event.a``
         is the ``type_a`` entity (its normal then points from it toward the ``type_b`` one).
         A handler that takes a single argument is called as ``handler(event)``. ``kinds`` may be
-        one kind name or several."""
+        one kind name or several. ``type_a`` and ``type_b`` must be classes (``Bullet``, not
+        ``Bullet()`` or ``"Bullet"``): anything else is an :class:`InvalidValue`."""
         self.handlers.add(type_a, type_b, handler, kinds)
         self._pipeline.wanted_pairs = self.handlers.wanted
 
@@ -412,7 +442,13 @@ class Scene:
         (from a system or a handler), or that overflows, is reported at the end of the step (which
         is then complete: frame, time and events included). With several sub-steps, each runs the whole
         pipeline (game systems and handlers included; rendering only after the last), the events
-        of all sub-steps are reported in order, and the counters add up."""
+        of all sub-steps are reported in order, and the counters add up.
+
+        A collision handler that raises does not cut the step short: the other handlers still run
+        (every sub-step too), the step completes (frame, time, events, despawns), and then the
+        first handler's exception is raised, unchanged in type, with a note naming the handler,
+        the event's kind and entities, and the step (and a note listing any other handler that
+        raised)."""
         self._activate()
         if self._stepping:
             raise InvalidValue("step() was called from inside a step (a system or a collision handler)")
@@ -424,13 +460,15 @@ class Scene:
             characters.check()
         self._totals = None
         n = self.substeps
+        errors: list[Exception] = []  # raised by collision handlers, raised once the step is complete
         if n == 1:
-            self._substep(dt, render=True, checked=True)
+            self._substep(dt, render=True, checked=True, errors=errors, where=f", in step {self.frame + 1}")
         else:
             events: list[CollisionEvent] = []
             total: dict[str, Any] = {}
             for k in range(n):
-                self._substep(dt / n, render=k == n - 1, checked=k == 0)
+                self._substep(dt / n, render=k == n - 1, checked=k == 0, errors=errors,
+                              where=f", in step {self.frame + 1} (sub-step {k + 1} of {n})")
                 events.extend(self.events)
                 add_counters(total, self.counters)
             self._totals = (events, total)
@@ -444,11 +482,24 @@ class Scene:
             # motion that overflowed: reported now, by the step that made it.
             store.check()
         except InvalidValue as exc:
-            raise InvalidValue(f"{exc} (at the end of step {self.frame}: written by a system or a collision "
-                               "handler during the step, or an overflow)") from None
+            bad = InvalidValue(f"{exc} (at the end of step {self.frame}: written by a system or a collision "
+                               "handler during the step, or an overflow)")
+            if not errors:
+                raise bad from None
+            errors[0].add_note(f"and at the end of step {self.frame}: {bad}")
+        if errors:
+            first = errors[0]
+            if len(errors) > 1:
+                others = "; ".join(f"{type(e).__name__}: {e} ({e.__notes__[-1]})" for e in errors[1:4])
+                more = f"; and {len(errors) - 4} more" if len(errors) > 4 else ""
+                first.add_note(f"{len(errors) - 1} other collision handler call(s) raised in step {self.frame} "
+                               f"too: {others}{more}")
+            raise first
 
-    def _substep(self, dt: float, render: bool, checked: bool = False) -> None:
-        """One pass of the pipeline (``checked``: the store was just checked, nothing ran since)."""
+    def _substep(self, dt: float, render: bool, checked: bool, errors: list[Exception], where: str) -> None:
+        """One pass of the pipeline (``checked``: the store was just checked, nothing ran since).
+        Exceptions raised by collision handlers are appended to ``errors`` (each with a note ending
+        in ``where``), not raised."""
         store = self.bodies.store
         self._stepping = True
         frame = self._pipeline.frame = self._pipeline.frame.next(dt, render)
@@ -457,9 +508,10 @@ class Scene:
                 store.check()
             store.apply_hitbox_changes()
             esper.process(dt)
-            self.handlers.dispatch(self, lambda: frame.events)
+            self._dispatching = True
+            self.handlers.dispatch(self, lambda: frame.events, errors, where)
         finally:
-            self._stepping = False
+            self._stepping = self._dispatching = False
             pending, self._pending_despawn = self._pending_despawn, []
             for e in pending:
                 if esper.entity_exists(e):
