@@ -40,6 +40,7 @@ import numpy as np
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
+from ..collision.kinds import KIND_CIRCLE
 from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
@@ -196,13 +197,17 @@ class Solve:
             still = np.zeros(C, dtype=bool)
             self.share_a, self.share_b, self.turn_shares = self._rigid_shares(still, still)
         self.fr = fr = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, arms, inertia) if self.friction else None
-        # The position solve's friction (``fpos``) turns bodies only against immovable ones: with
-        # tangential pushes turning both bodies of a pair, a pyramid of 20 rows crept apart.
+        # The position solve's friction (``fpos``) turns only circles, and only against immovable
+        # bodies (rolling): with tangential pushes turning both bodies of a pair, a pyramid of 20
+        # rows crept apart; turning a box by them coupled its turn to its slip, so a box landing
+        # on a ledge slid 1e-8 before static friction caught the solver's residual turn.
         self.fpos = fr
         if self.rigid and fr is not None:
             imm = self.immovable
-            self.fpos = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation, (imm * self.rt_a, imm * self.rt_b),
-                                    inertia)
+            roll_a = imm & (store.kind[cs.ra] == KIND_CIRCLE)
+            roll_b = imm & (store.kind[cs.rb] == KIND_CIRCLE)
+            self.fpos = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation,
+                                    (roll_a * self.rt_a, roll_b * self.rt_b), inertia)
         self.order = self._order()
         share_a, share_b, self.position_turns = self._shock_shares()
         self.position_shares = (share_a, share_b)
