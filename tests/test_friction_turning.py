@@ -67,7 +67,7 @@ def _assert_stops_flat(track, h, distance):
     step it stops, and at rest where the analytic answer puts it."""
     assert max(abs(r) for _, _, r, _ in track) < 1e-6
     assert max(abs(y - h / 2) for _, y, _, _ in track) < 1e-6
-    for x, y, rot, vx in track[16:]:
+    for _, y, rot, _ in track[16:]:
         assert abs(rot) < 1e-9 and y == pytest.approx(h / 2, abs=1e-9)
     x, y, rot, vx = track[-1]
     assert abs(vx) < 1e-9
