@@ -40,11 +40,11 @@ MAX_FRAMES = 10_000_000        # frames a replay may declare (46 hours at 60 Hz)
 
 def _keys(keys: object, where: str) -> frozenset[str]:
     if isinstance(keys, (str, bytes)) or not isinstance(keys, Iterable):
-        raise InvalidValue(f"{where}: the held keys must be a list of key names, got {keys!r}")
+        raise InvalidValue(f"{where}: the held keys must be a list of key names, got {_short(keys)}")
     out = []
     for k in keys:
         if not isinstance(k, str) or not k:
-            raise InvalidValue(f"{where}: a key name must be a non-empty string, got {k!r}")
+            raise InvalidValue(f"{where}: a key name must be a non-empty string, got {_short(k)}")
         out.append(k)
     held = frozenset(out)
     if len(held) != len(out):
@@ -53,20 +53,37 @@ def _keys(keys: object, where: str) -> frozenset[str]:
 
 
 def _dt(value: object, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value) and value > 0):
-        raise InvalidValue(f"{where}: dt must be a finite number > 0, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (_finite(value) and value > 0):
+        raise InvalidValue(f"{where}: dt must be a finite number > 0, got {_short(value)}")
     return float(value)
+
+
+def _finite(value: int | float) -> bool:
+    """``math.isfinite`` that says False for an int beyond float64 (``10**400``) instead of raising."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def _short(value: object) -> str:
+    """``repr(value)`` cut to 80 characters (a file's value may be 4,300 digits long)."""
+    try:
+        text = repr(value)
+    except (RecursionError, ValueError):  # nested deeper than repr goes; an int of more than 4,300 digits
+        return f"a {type(value).__name__} too deep or too long to show"
+    return text if len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
 
 
 def _seed(value: object, where: str) -> int | None:
     if value is not None and (isinstance(value, bool) or not isinstance(value, int)):
-        raise InvalidValue(f"{where}: seed must be an int or null, got {value!r}")
+        raise InvalidValue(f"{where}: seed must be an int or null, got {_short(value)}")
     return value
 
 
 def _meta(value: object, where: str) -> dict[str, Any]:
     if not isinstance(value, dict) or not all(isinstance(k, str) for k in value):
-        raise InvalidValue(f"{where}: meta must be an object with string keys, got {value!r}")
+        raise InvalidValue(f"{where}: meta must be an object with string keys, got {_short(value)}")
     try:
         json.dumps(value, allow_nan=False)
     except (TypeError, ValueError) as exc:
@@ -174,7 +191,7 @@ class Replay:
 
         def parse(i: int, line: str) -> Any:
             try:
-                return json.loads(line, parse_constant=_no_constant)
+                return _DECODER.decode(line)
             except ValueError as exc:
                 raise InvalidValue(f"{name}: line {i + 1}: not JSON ({exc})") from None
             except RecursionError:
@@ -185,7 +202,7 @@ class Replay:
             raise InvalidValue(f"{name}: line 1: not a replay header (expected an object with "
                                f'"format": "{FORMAT}"), got {first[:80]!r}')
         if header.get("version") != VERSION:
-            raise InvalidValue(f"{name}: line 1: unsupported replay version {header.get('version')!r} "
+            raise InvalidValue(f"{name}: line 1: unsupported replay version {_short(header.get('version'))} "
                                f"(this framework reads version {VERSION})")
         unknown = set(header) - {"format", "version", "dt", "seed", "frames", "meta"}
         if unknown:
@@ -193,7 +210,7 @@ class Replay:
         where = f"{name}: line 1"
         count = header.get("frames")
         if isinstance(count, bool) or not isinstance(count, int) or count < 0:
-            raise InvalidValue(f"{where}: frames must be an int >= 0, got {count!r}")
+            raise InvalidValue(f"{where}: frames must be an int >= 0, got {_short(count)}")
         if count > max_frames:
             raise InvalidValue(f"{where}: {count} frames, more than the limit of {max_frames} (max_frames)")
         if count != nlines - 1:
@@ -203,16 +220,33 @@ class Replay:
                      meta=_meta(header.get("meta", {}), where))
         seen: dict[str, frozenset[str]] = {}  # a line read before: the same frame, the same frozenset
         frames = replay.frames
+        scan = _DECODER.scan_once  # one JSON value from the start of a line, no decoder made per line
         for i, line in enumerate(lines, start=1):
             held = seen.get(line)
             if held is None:
-                frame = parse(i, line)
-                if not isinstance(frame, list):
+                try:
+                    frame, end = scan(line, 0)
+                except (StopIteration, ValueError, RecursionError):
+                    end = -1
+                if end != len(line):  # not one bare JSON value: the full decoder says what is wrong
+                    frame = parse(i, line)
+                if type(frame) is not list:
                     raise InvalidValue(f"{name}: line {i + 1}: a frame must be a list of key names, got {line[:80]!r}")
-                held = seen[line] = _keys(frame, f"{name}: line {i + 1}")
+                try:  # the common case at C speed: distinct non-empty key names
+                    held = frozenset(frame)
+                    "".join(frame)  # a TypeError unless every member is text
+                    ok = len(held) == len(frame) and "" not in held
+                except TypeError:
+                    ok = False
+                if not ok:
+                    held = _keys(frame, f"{name}: line {i + 1}")  # raises, naming what is wrong
+                seen[line] = held
             frames.append(held)
         return replay
 
 
 def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not JSON")
+
+
+_DECODER = json.JSONDecoder(parse_constant=_no_constant)

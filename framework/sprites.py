@@ -20,8 +20,10 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import stat
 import struct
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,9 +32,17 @@ import numpy as np
 
 from .validation import InvalidValue
 
-__all__ = ["Animation", "Frame", "SpriteSheet", "image_size"]
+__all__ = ["MAX_FRAMES", "MAX_TILESET_BYTES", "Animation", "Frame", "SpriteSheet", "image_size"]
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+#: Frames a sheet may have, by default (``SpriteSheet(..., max_frames=)``, ``from_tiled(max_frames=)``):
+#: a 4,096 x 4,096 image (a texture size every desktop GPU takes) cut into 16-pixel tiles. An image's
+#: header is a few bytes, so without a bound a 55-byte tileset declaring 2**31 one-pixel tiles
+#: asked for 2**31 frames.
+MAX_FRAMES = 65_536
+#: A tileset file's size, by default (``from_tiled(max_bytes=)``): parsing JSON costs up to about
+#: 25 bytes of memory a byte of text.
+MAX_TILESET_BYTES = 16 * 1024 * 1024
 
 
 def image_size(path: str | Path) -> tuple[int, int]:
@@ -40,6 +50,8 @@ def image_size(path: str | Path) -> tuple[int, int]:
     decoding it. A missing or unreadable file, or another format, is an ``InvalidValue`` naming it."""
     p = Path(path)
     try:
+        if not stat.S_ISREG(os.stat(p).st_mode):  # a FIFO or a device named by a file would block or never end
+            raise InvalidValue(f"image file {str(path)!r} is not a regular file")
         with open(p, "rb") as f:
             head = f.read(32)
     except OSError as exc:
@@ -60,7 +72,7 @@ def image_size(path: str | Path) -> tuple[int, int]:
 
 def _count(what: str, value: Any, minimum: int = 0) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise InvalidValue(f"{what} must be an int >= {minimum}, got {value!r}")
+        raise InvalidValue(f"{what} must be an int >= {minimum}, got {_show(value)}")
     return int(value)
 
 
@@ -95,9 +107,54 @@ def _grid_side(path: str, axis: str, size: int, frame: int, margin: int, spacing
     usable = size - 2 * margin + spacing
     if usable <= 0 or usable % (frame + spacing):
         raise InvalidValue(
-            f"sprite sheet {path!r}: a grid of frames {frame} px {axis} (margin {margin}, spacing {spacing}) "
+            f"sprite sheet {path!r}: a grid of frames {_show(frame)} px {axis} (margin {_show(margin)}, "
+            f"spacing {_show(spacing)}) "
             f"does not divide the image's {size} px {axis}")
     return usable // (frame + spacing)
+
+
+class _Frames(Sequence[Frame]):
+    """A sheet's frames, made when asked for (a sheet of 65,536 tiles costs nothing until used);
+    each made once and then shared."""
+
+    __slots__ = ("_sheet", "_made")
+
+    def __init__(self, sheet: SpriteSheet) -> None:
+        self._sheet = sheet
+        self._made: dict[int, Frame] = {}
+
+    def __len__(self) -> int:
+        return self._sheet.rows * self._sheet.columns
+
+    def __getitem__(self, index: Any) -> Any:
+        if isinstance(index, slice):
+            return tuple(self[i] for i in range(*index.indices(len(self))))
+        i = int(index)
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"frame {i} of {n}")
+        i %= n
+        frame = self._made.get(i)
+        if frame is None:
+            sh = self._sheet
+            r, c = divmod(i, sh.columns)
+            frame = self._made[i] = Frame(sh.image, sh.margin + c * (sh.frame_width + sh.spacing),
+                                          sh.margin + r * (sh.frame_height + sh.spacing), sh.frame_width,
+                                          sh.frame_height)
+        return frame
+
+    def __iter__(self) -> Iterator[Frame]:
+        return (self[i] for i in range(len(self)))
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, (_Frames, tuple, list)):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"<{len(self)} frames of {self._sheet.image!r}>"
 
 
 class SpriteSheet:
@@ -105,24 +162,28 @@ class SpriteSheet:
 
     ``margin``: pixels around the grid; ``spacing``: pixels between frames (Tiled's terms). The grid
     must cover the image exactly, else ``InvalidValue`` naming the file. ``sheet[i]`` is frame
-    ``i``, counted row by row from the top-left; ``len(sheet)`` their number."""
+    ``i``, counted row by row from the top-left; ``len(sheet)`` their number, at most
+    ``max_frames`` (:data:`MAX_FRAMES`, 65,536, by default), checked before any frame is made;
+    ``sheet.frames`` makes each frame when it is first asked for."""
 
     def __init__(self, image: str | Path, frame_width: int, frame_height: int, *, margin: int = 0,
-                 spacing: int = 0) -> None:
+                 spacing: int = 0, max_frames: int = MAX_FRAMES) -> None:
         path = str(image)
         fw = _count(f"sprite sheet {path!r} frame_width", frame_width, 1)
         fh = _count(f"sprite sheet {path!r} frame_height", frame_height, 1)
         margin = _count(f"sprite sheet {path!r} margin", margin)
         spacing = _count(f"sprite sheet {path!r} spacing", spacing)
+        max_frames = _count(f"sprite sheet {path!r} max_frames", max_frames, 1)
         width, height = image_size(path)
         self.image = path
         self.frame_width, self.frame_height = fw, fh
         self.margin, self.spacing = margin, spacing
         self.columns = _grid_side(path, "wide", width, fw, margin, spacing)
         self.rows = _grid_side(path, "high", height, fh, margin, spacing)
-        self.frames: tuple[Frame, ...] = tuple(
-            Frame(path, margin + c * (fw + spacing), margin + r * (fh + spacing), fw, fh)
-            for r in range(self.rows) for c in range(self.columns))
+        if self.columns * self.rows > max_frames:
+            raise InvalidValue(f"sprite sheet {path!r}: {self.columns} x {self.rows} = {self.columns * self.rows} "
+                               f"frames, more than the limit of {max_frames} (max_frames)")
+        self.frames: Sequence[Frame] = _Frames(self)
         #: Animations the sheet declares (Tiled tile animations), by the first tile's index.
         self.animations: dict[int, Animation] = {}
 
@@ -131,7 +192,7 @@ class SpriteSheet:
 
     def __getitem__(self, index: int) -> Frame:
         if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not -len(self) <= index < len(self):
-            raise InvalidValue(f"sprite sheet {self.image!r} has {len(self)} frames; there is no frame {index!r}")
+            raise InvalidValue(f"sprite sheet {self.image!r} has {len(self)} frames; there is no frame {_show(index)}")
         return self.frames[int(index)]
 
     def animation(self, indices: Sequence[int], duration: float | Sequence[float], *,
@@ -144,17 +205,27 @@ class SpriteSheet:
                 f"spacing={self.spacing})")
 
     @classmethod
-    def from_tiled(cls, tileset: str | Path) -> SpriteSheet:
+    def from_tiled(cls, tileset: str | Path, *, max_frames: int = MAX_FRAMES,
+                   max_bytes: int = MAX_TILESET_BYTES) -> SpriteSheet:
         """A sheet from a Tiled tileset file (JSON: ``.tsj`` or ``.json``) with one image; its tiles'
         animations (Tiled's per-tile ``animation``, durations in milliseconds) in ``animations``.
-        Anything malformed is an ``InvalidValue`` naming the file and the field."""
+        Anything malformed is an ``InvalidValue`` naming the file and the field, whatever the file
+        holds (a tileset is a file from strangers: see ``docs/reliability.md``): a file over
+        ``max_bytes`` is refused before it is read, a sheet of more than ``max_frames`` frames
+        before any frame is made."""
         path = Path(tileset)
+        max_bytes = _count("from_tiled max_bytes", max_bytes, 1)
         try:
-            data = json.loads(path.read_text(encoding="utf-8"))
+            size = path.stat().st_size
+            if size <= max_bytes:
+                data = json.loads(path.read_text(encoding="utf-8"))
         except OSError as exc:
             raise InvalidValue(f"tileset {str(path)!r} cannot be read: {exc.strerror or exc}") from None
         except (ValueError, RecursionError) as exc:
             raise InvalidValue(f"tileset {str(path)!r} is not valid JSON: {exc}") from None
+        if size > max_bytes:
+            raise InvalidValue(f"tileset {str(path)!r}: the file is {size} bytes, more than the limit of {max_bytes} "
+                               "(max_bytes)")
         if not isinstance(data, dict):
             raise InvalidValue(f"tileset {str(path)!r}: not a JSON object")
 
@@ -166,10 +237,10 @@ class SpriteSheet:
 
         image = field("image")
         if not isinstance(image, str):
-            raise InvalidValue(f"tileset {str(path)!r}: 'image' must be a file name, got {image!r}")
+            raise InvalidValue(f"tileset {str(path)!r}: 'image' must be a file name, got {_show(image)}")
         try:
             sheet = cls(path.parent / image, field("tilewidth"), field("tileheight"), margin=field("margin", 0),
-                        spacing=field("spacing", 0))
+                        spacing=field("spacing", 0), max_frames=max_frames)
         except InvalidValue as exc:
             raise InvalidValue(f"tileset {str(path)!r}: {exc}") from None
         tiles = data.get("tiles", [])
@@ -194,17 +265,33 @@ class SpriteSheet:
 
 def _milliseconds(what: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InvalidValue(f"{what} must be a number of milliseconds, got {value!r}")
-    return float(value) / 1000.0
+        raise InvalidValue(f"{what} must be a number of milliseconds, got {_show(value)}")
+    try:
+        return float(value) / 1000.0
+    except OverflowError:  # an int beyond float64 (10**400)
+        raise InvalidValue(f"{what} must be a finite number of milliseconds, got {_show(value)}") from None
 
 
 def _duration(what: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidValue(f"{what} must be a number of seconds, got {value!r}")
-    d = float(value)
+        raise InvalidValue(f"{what} must be a number of seconds, got {_show(value)}")
+    try:
+        d = float(value)
+    except OverflowError:  # an int beyond float64 (10**400)
+        d = math.inf
     if not math.isfinite(d) or d <= 0.0:
-        raise InvalidValue(f"{what} must be finite and > 0 seconds, got {value!r}")
+        raise InvalidValue(f"{what} must be finite and > 0 seconds, got {_show(value)}")
     return d
+
+
+def _show(value: Any) -> str:
+    """``repr`` of a value a file gave, for a message: cut to 80 characters, never raising (a list
+    nested near the recursion limit; an int of more than 4,300 digits)."""
+    try:
+        text = repr(value)
+    except (ValueError, RecursionError):
+        return f"a {type(value).__name__} too long or too deeply nested to show"
+    return text if len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
 
 
 class Animation:
@@ -229,10 +316,15 @@ class Animation:
             durations = tuple(_duration(f"Animation duration of frame {i}", d) for i, d in enumerate(duration))
         else:
             durations = (_duration("Animation duration", duration),) * len(frames)
+        with np.errstate(over="ignore"):
+            ends = np.cumsum(durations)
+        if not math.isfinite(ends[-1]):
+            raise InvalidValue(f"Animation durations add up to more seconds than a float64 holds "
+                               f"({len(frames)} frames)")
         self.frames: tuple[Frame, ...] = frames
         self.durations: tuple[float, ...] = durations
         self.loop = bool(loop)
-        self._ends = np.cumsum(durations)
+        self._ends = ends
 
     @property
     def total(self) -> float:

@@ -167,7 +167,7 @@ class Level:
                 for key in ("dx", "dy", "speed"):
                     if not _is_number(o.props.get(key, 0.0)):
                         fail(f"platform at ({o.x:g}, {o.y:g}): {key} must be a number, "
-                             f"got {o.props[key]!r}")
+                             f"got {_show(o.props[key])}")
                 if o.props.get("dx", 0) == 0 and o.props.get("dy", 0) == 0:
                     fail(f"platform at ({o.x:g}, {o.y:g}) does not move: give it dx or dy")
                 if not float(o.props.get("speed", 2.0)) > 0:
@@ -177,12 +177,35 @@ class Level:
                     fail(f"enemy at ({o.x:g}, {o.y:g}): speed must be a number >= 0")
                 if o.props.get("direction", -1) not in (-1, 1):
                     fail(f"enemy at ({o.x:g}, {o.y:g}): direction must be -1 or 1, "
-                         f"got {o.props.get('direction')!r}")
+                         f"got {_show(o.props.get('direction'))}")
         return self
 
 
 def _is_number(v: object) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    """A finite number that float64 holds (an int beyond it, ``10**400``, is not: False, no
+    ``OverflowError``)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
+
+
+def _show(v: object) -> str:
+    """``repr`` of a value a file gave, for a message: cut to 80 characters, and never raising
+    (an int of more than 4,300 digits cannot be printed, a list nested near the recursion limit
+    cannot be repr'd from a deeper frame than the one that parsed it)."""
+    try:
+        text = repr(v)
+    except (ValueError, RecursionError):
+        return f"a {type(v).__name__} too long or too deeply nested to show"
+    return text if len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
+
+
+def _text(v: object) -> str:
+    """A name a file gave (a layer's, an object's type), as text: itself if it is text, else :func:`_show`."""
+    return v if isinstance(v, str) else _show(v)
 
 
 # --- text maps -------------------------------------------------------------------------------------
@@ -298,9 +321,9 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
     if not isinstance(data, dict):
         fail(f"a Tiled map must be a JSON object, got {type(data).__name__}")
     if data.get("type", "map") != "map":
-        fail(f"not a Tiled map (type is {data.get('type')!r})")
+        fail(f"not a Tiled map (type is {_show(data.get('type'))})")
     if data.get("orientation", "orthogonal") != "orthogonal":
-        fail(f"only orthogonal maps are supported, got {data.get('orientation')!r}")
+        fail(f"only orthogonal maps are supported, got {_show(data.get('orientation'))}")
     if data.get("infinite"):
         fail("infinite maps are not supported; save the map as finite (Map > Map Properties)")
     for key in ("width", "height", "tilewidth", "tileheight", "layers"):
@@ -309,28 +332,32 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
     width, height, tw, th = data["width"], data["height"], data["tilewidth"], data["tileheight"]
     for key, v in (("width", width), ("height", height), ("tilewidth", tw), ("tileheight", th)):
         if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-            fail(f"{key!r} must be a positive integer, got {v!r}")
+            fail(f"{_show(key)} must be a positive integer, got {_show(v)}")
     if tw != th:
-        fail(f"tiles must be square, got tilewidth {tw} and tileheight {th}")
+        fail(f"tiles must be square, got tilewidth {_show(tw)} and tileheight {_show(th)}")
     if not isinstance(data["layers"], list):
         fail("'layers' must be a list")
     if width * height > limits.max_tiles:
-        fail(f"the map declares {width} x {height} = {width * height} tiles, more than the limit of "
+        fail(f"the map declares {_show(width)} x {_show(height)} = {_show(width * height)} tiles, more than the "
+             f"limit of "
              f"{limits.max_tiles} (LevelLimits.max_tiles)")
+    if not (_is_number(width * tw) and _is_number(height * th)):  # 10**400: beyond float64
+        fail(f"the map is {_show(width)} x {_show(height)} tiles of {_show(tw)} pixels: its size in pixels is "
+             "too large for a float64")
     layers = _flat_layers(data["layers"], fail, limits)
     for layer in layers:  # what each tile layer holds must match the size declared, before any grid exists
         held = layer.get("data")
         if layer.get("type") == "tilelayer" and isinstance(held, list) and len(held) != width * height:
-            fail(f"layer {str(layer.get('name', ''))!r} has {len(held)} tiles, expected width x height = "
+            fail(f"layer {_show(layer.get('name', ''))} has {len(held)} tiles, expected width x height = "
                  f"{width} x {height} = {width * height}")
     gid_kinds = _tileset_kinds(data.get("tilesets", []), fail)
     tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
     objects: list[LevelObject] = []
     map_h = float(height * th)
     for layer in layers:
-        lname = str(layer.get("name", ""))
+        lname = _text(layer.get("name", ""))
         ltype = layer.get("type")
-        where = f"layer {lname!r}"
+        where = f"layer {_show(lname)}"
         if ltype == "tilelayer":
             kind = _props(layer, fail, where).get("kind", lname.lower())
             if kind in DECORATION or lname.lower() in DECORATION:
@@ -366,9 +393,9 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
         elif ltype in ("imagelayer",):
             continue
         else:
-            fail(f"{where}: unknown layer type {ltype!r}")
+            fail(f"{where}: unknown layer type {_show(ltype)}")
     title = _props(data, fail, "map").get("title") or name or Path(source).stem
-    return Level(str(title), source, float(tw), width, height, tiles, objects).validate()
+    return Level(_text(title), source, float(tw), width, height, tiles, objects).validate()
 
 
 def _flat_layers(layers: list, fail: Fail, limits: LevelLimits) -> list[dict]:
@@ -381,11 +408,11 @@ def _flat_layers(layers: list, fail: Fail, limits: LevelLimits) -> list[dict]:
             todo.pop()
             continue
         if not isinstance(layer, dict):
-            fail(f"a layer must be a JSON object, got {layer!r:.60}")
+            fail(f"a layer must be a JSON object, got {_show(layer)}")
         if layer.get("type") == "group":
             inner = layer.get("layers", [])
             if not isinstance(inner, list):
-                fail(f"group layer {str(layer.get('name', ''))!r}: 'layers' must be a list")
+                fail(f"group layer {_show(layer.get('name', ''))}: 'layers' must be a list")
             todo.append(iter(inner))
         else:
             out.append(layer)
@@ -404,7 +431,7 @@ def _props(thing: dict, fail: Fail, where: str) -> dict[str, Any]:
     out = {}
     for p in raw:
         if not isinstance(p, dict) or not isinstance(p.get("name"), str) or "value" not in p:
-            fail(f"{where}: a property needs a 'name' (text) and a 'value', got {p!r:.80}")
+            fail(f"{where}: a property needs a 'name' (text) and a 'value', got {_show(p)}")
         out[p["name"]] = p["value"]
     return out
 
@@ -415,31 +442,33 @@ def _tileset_kinds(tilesets: Any, fail: Fail) -> dict[int, str]:
     kinds: dict[int, str] = {}
     for ts in tilesets:
         if not isinstance(ts, dict) or "firstgid" not in ts:
-            fail(f"a tileset needs 'firstgid', got {ts!r:.80}")
+            fail(f"a tileset needs 'firstgid', got {_show(ts)}")
         if "source" in ts:
-            fail(f"external tileset {ts['source']!r} is not supported: embed the tileset in the map")
+            fail(f"external tileset {_show(ts['source'])} is not supported: embed the tileset in the map")
         first = ts["firstgid"]
         if isinstance(first, bool) or not isinstance(first, int) or first < 1:
-            fail(f"tileset {ts.get('name')!r}: 'firstgid' must be a positive integer, got {first!r}")
+            fail(f"tileset {_show(ts.get('name'))}: 'firstgid' must be a positive integer, got {_show(first)}")
         tiles = ts.get("tiles", [])
         if not isinstance(tiles, list):
-            fail(f"tileset {ts.get('name')!r}: 'tiles' must be a list")
+            fail(f"tileset {_show(ts.get('name'))}: 'tiles' must be a list")
         for tile in tiles:
             if not isinstance(tile, dict):
-                fail(f"tileset {ts.get('name')!r}: a tile must be a JSON object, got {tile!r:.60}")
-            kind = _props(tile, fail, f"tileset {ts.get('name')!r}").get(
+                fail(f"tileset {_show(ts.get('name'))}: a tile must be a JSON object, got {_show(tile)}")
+            kind = _props(tile, fail, f"tileset {_show(ts.get('name'))}").get(
                 "kind", tile.get("type") or tile.get("class"))
             if not isinstance(kind, str | None):
-                fail(f"tileset {ts.get('name')!r}: tile {tile.get('id')!r} has a kind that is not text: {kind!r:.60}")
+                fail(f"tileset {_show(ts.get('name'))}: tile {_show(tile.get('id'))} has a kind that is not text: "
+                     f"{_show(kind)}")
             if kind in DECORATION:
                 continue
             if kind is not None:
                 if kind not in TILE_KINDS:
-                    fail(f"tileset {ts.get('name')!r}: tile {tile.get('id')} has unknown kind {kind!r} "
+                    fail(f"tileset {_show(ts.get('name'))}: tile {_show(tile.get('id'))} has unknown kind "
+                         f"{_show(kind)} "
                          f"(known: {', '.join(TILE_KINDS)})")
                 tid = tile.get("id")
                 if isinstance(tid, bool) or not isinstance(tid, int) or tid < 0:
-                    fail(f"tileset {ts.get('name')!r}: a tile's 'id' must be an integer >= 0, got {tid!r:.60}")
+                    fail(f"tileset {_show(ts.get('name'))}: a tile's 'id' must be an integer >= 0, got {_show(tid)}")
                 kinds[first + tid] = kind
     return kinds
 
@@ -464,7 +493,7 @@ def _layer_data(layer: dict, width: int, height: int, fail: Fail, where: str) ->
                     fail(f"{where}: the compressed tile data holds more than the {want} bytes the map's "
                          f"{width} x {height} tiles need")
             elif comp:
-                fail(f"{where}: unsupported compression {comp!r} (use none, zlib or gzip)")
+                fail(f"{where}: unsupported compression {_show(comp)} (use none, zlib or gzip)")
         except (ValueError, zlib.error, OSError) as exc:
             fail(f"{where}: bad base64 tile data ({exc})")
         if len(raw) % 4:
@@ -483,16 +512,16 @@ def _layer_data(layer: dict, width: int, height: int, fail: Fail, where: str) ->
 
 def _tmj_object(obj: Any, map_h: float, fail: Fail, where: str) -> LevelObject:
     if not isinstance(obj, dict):
-        fail(f"{where}: an object must be a JSON object, got {obj!r:.60}")
-    kind = str(obj.get("type") or obj.get("class") or obj.get("name") or "").lower()
-    label = f"{where}: object {obj.get('id', '?')} ({kind or 'no type'})"
+        fail(f"{where}: an object must be a JSON object, got {_show(obj)}")
+    kind = _text(obj.get("type") or obj.get("class") or obj.get("name") or "").lower()
+    label = f"{where}: object {_text(obj.get('id', '?'))} ({kind or 'no type'})"
     if kind not in OBJECT_KINDS:
-        fail(f"{label}: unknown object type {kind!r} (known: {', '.join(OBJECT_KINDS)})")
+        fail(f"{label}: unknown object type {_show(kind)} (known: {', '.join(OBJECT_KINDS)})")
     vals = []
     for key in ("x", "y", "width", "height"):
         v = obj.get(key, 0.0)
         if not _is_number(v):
-            fail(f"{label}: {key!r} must be a finite number, got {v!r}")
+            fail(f"{label}: {_show(key)} must be a finite number, got {_show(v)}")
         vals.append(float(v))
     x, y, w, h = vals
     if w < 0 or h < 0:
@@ -526,7 +555,7 @@ def load_level(path: str | Path, *, limits: LevelLimits = DEFAULT_LIMITS) -> Lev
     if suffix in (".tmj", ".json"):
         try:
             data = json.loads(text)
-        except json.JSONDecodeError as exc:
+        except ValueError as exc:  # JSONDecodeError, or an int of more than 4,300 digits (int max str digits)
             raise LevelError(f"{p}: not valid JSON ({exc})") from None
         except RecursionError:
             raise LevelError(f"{p}: the JSON is nested too deeply to be a level") from None

@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -68,7 +69,7 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
     from .. import __version__
 
     n = _steps(steps, None, dt, "check_golden")
-    if not (isinstance(atol, (int, float)) and atol >= 0 and math.isfinite(atol)):
+    if not (isinstance(atol, (int, float)) and _a_float(atol) and atol >= 0 and math.isfinite(atol)):
         raise InvalidValue(f"atol must be a finite number >= 0, got {atol!r}")
     if isinstance(max_bytes, bool) or not isinstance(max_bytes, int) or max_bytes <= 0:
         raise InvalidValue(f"max_bytes must be an int > 0, got {max_bytes!r}")
@@ -98,11 +99,13 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
     except RecursionError:
         raise InvalidValue(f"{path}: not a golden trace (nested too deeply)") from None
     if fmt != GOLDEN_FORMAT or version != __version__:
-        raise InvalidValue(f"{path}: a golden trace from another version (trace format {fmt}, framework {version!r}; "
+        raise InvalidValue(f"{path}: a golden trace from another version (trace format {_show(fmt)}, "
+                           f"framework {_show(version)}; "
                            f"this is format {GOLDEN_FORMAT}, framework {__version__!r}); rerun with update to "
                            "record it again")
     if golden.get("dt") != dt or golden.get("steps") != n:
-        raise InvalidValue(f"{path}: recorded with dt={golden.get('dt')!r} over {golden.get('steps')!r} steps; "
+        raise InvalidValue(f"{path}: recorded with dt={_show(golden.get('dt'))} over "
+                           f"{_show(golden.get('steps'))} steps; "
                            f"this run asks dt={dt!r} over {n} steps")
     if not isinstance(trace, list) or len(trace) != n or not all(_step_ok(t) for t in trace):
         raise InvalidValue(f"{path}: not a golden trace (the trace must be {n} steps of bodies and events)")
@@ -116,14 +119,42 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
                                  f"{problem}", k + 1, before)
 
 
+_ENTITY = re.compile(r"-?[0-9]{1,19}")  # what str(int) writes for an entity id: ASCII digits ('²' is not one)
+
+
 def _step_ok(step: Any) -> bool:
-    """Whether one step of a trace read from a file has the shape :func:`trace_step` writes."""
+    """Whether one step of a trace read from a file has the shape :func:`trace_step` writes: entity
+    keys of ASCII digits (``int()`` takes them all), values that are numbers float64 holds."""
     if not isinstance(step, dict) or not isinstance(step.get("bodies"), dict) or not isinstance(step.get("events"),
                                                                                                   list):
         return False
-    return all(isinstance(k, str) and k.lstrip("-").isdigit() and isinstance(v, list) and len(v) == len(FIELDS)
-               and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
+    return all(isinstance(k, str) and _ENTITY.fullmatch(k) and isinstance(v, list) and len(v) == len(FIELDS)
+               and all(_a_float(x) for x in v)
                for k, v in step["bodies"].items())
+
+
+def _a_float(x: Any) -> bool:
+    """A number float64 holds (NaN and the infinities too: a different run, not a bad file); not
+    ``True``, not ``10**400``."""
+    if isinstance(x, float):
+        return True
+    if isinstance(x, bool) or not isinstance(x, int):
+        return False
+    try:
+        float(x)
+    except OverflowError:
+        return False
+    return True
+
+
+def _show(value: Any, width: int = 80) -> str:
+    """``repr`` of a value read from a file, cut to ``width`` characters, never raising (a list
+    nested near the recursion limit)."""
+    try:
+        text = repr(value)
+    except (ValueError, RecursionError):
+        return f"a {type(value).__name__} too long or too deeply nested to show"
+    return text if len(text) <= width else f"{text[:width - 20]}... ({len(text)} characters)"
 
 
 def _difference(want: dict[str, Any], got: dict[str, Any], atol: float) -> str | None:
@@ -136,5 +167,5 @@ def _difference(want: dict[str, Any], got: dict[str, Any], atol: float) -> str |
             if not (a == b or abs(a - b) <= atol):
                 return f"entity {e} {name}: golden {a!r}, now {b!r} (differs by {b - a:.3g})"
     if want["events"] != got["events"]:
-        return f"events: golden {want['events']}, now {got['events']}"
+        return f"events: golden {_show(want['events'], 400)}, now {got['events']}"
     return None
