@@ -12,7 +12,8 @@ platforms have already moved). The game sets the velocity it wants (``Velocity``
   up or down); landing keeps the horizontal part of the motion;
 - **walls**: in the air the motion slides along them (jumping into a wall never sticks); on the
   floor a wall (or a slope too steep to walk) stops the walk, unless it is a step no higher than
-  ``step_height``, which the body steps up;
+  ``step_height``, which the body steps up at any walking speed (a round bottom goes across as
+  far as it must to rest on the step's edge at a standing angle);
 - **ceilings**: the motion slides along them and an upward velocity is cut;
 - **snap**: walking down a slope, over a crest or down a small step, the body stays on the floor
   (it is pulled down by up to ``snap_length`` plus what the floor angle allows for the step's
@@ -27,10 +28,13 @@ platforms have already moved). The game sets the velocity it wants (``Velocity``
 The body is kept ``skin`` away from what it touches (by default a gap of 2**-40 of its size, and
 at least 256 units of rounding of its coordinates), so floating-point rounding never leaves it
 inside a surface and sliding along a row of tiles meets no seams. Its state after each step:
-``on_floor``, ``floor_normal``, ``floor_entity``, ``on_wall``, ``wall_normal``, ``on_ceiling``,
-``crushed``. Gravity (the scene's, times
-``gravity_scale``) accelerates it while it is not on a floor. Velocity is relative to the floor
-it stands on; leaving a moving platform adds the platform's velocity.
+``on_floor``, ``floor_normal``, ``floor_entity`` (where it ends the step: a floor within the skin
+under its feet; one met on the way and left again is not kept), ``on_wall``, ``wall_normal``,
+``on_ceiling``, ``crushed``. The velocity loses its part into every surface the move met, the
+same step (on a floor: no vertical velocity, and a walk into a wall or ceiling met stops; in the
+air: it slides along them; a dynamic body pushed keeps the walk's velocity). Gravity (the
+scene's, times ``gravity_scale``) accelerates it while it is not on a floor. Velocity is
+relative to the floor it stands on; leaving a moving platform adds the platform's velocity.
 
 What blocks it: hitboxes in ``solid_mask`` (default: its own hitbox's mask) that are not sensors.
 Other overlaps (coins, enemies, hazards) are left to the pipeline's events, as for any body.

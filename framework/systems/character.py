@@ -14,7 +14,7 @@ import esper
 import numpy as np
 
 from ..arrays import BoolArray, IntpArray
-from ..casting import candidate_rows, cast_rows, overlapping_rows, shape_bounds
+from ..casting import candidate_rows, cast_rows, overlapping_rows, shape_bounds, touch_point
 from ..character import CharacterController
 from ..collision import collide
 from ..components import Velocity
@@ -48,8 +48,8 @@ class _Move:
     rows: IntpArray | None = None  # candidate rows in ``box``: mask, sensors, itself, dropped out
     floor: tuple[int, float, float] | None = None  # (row, nx, ny)
     wall: tuple[int, float, float] | None = None
-    wall_stopped: bool = False  # a wall took motion away (not only touched at the end of the move)
     ceiling: bool = False
+    hits: list[tuple[int, float, float]] = field(default_factory=list)  # surfaces the own motion met
     pushed: list[tuple[int, float, float]] = field(default_factory=list)
 
 
@@ -139,7 +139,8 @@ class CharacterStage(Stage):
             self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
             mv.ignore.discard(floor_row)
             mv.floor = mv.wall = None
-            mv.ceiling = mv.wall_stopped = False
+            mv.ceiling = False
+            mv.hits.clear()
         # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
         if not self._depenetrate(mv, start_bottom, frame, moved):
             ctrl.crushed = True
@@ -165,30 +166,29 @@ class CharacterStage(Stage):
         px = mv.x
         self._slide(mv, mx, my, on_floor=on_floor_now, step=ctrl.step_height, max_slides=ctrl.max_slides)
         # 4. Snap down onto the floor (down slopes, over crests, down small steps); also after a
-        # floor was met on the way, since the walk may have gone on along it past a crest.
+        # floor was met on the way, since the walk may have gone on along it past a crest. What
+        # the body ends on is measured where it ends: a floor met on the way (or one it was lifted
+        # onto) and left again is not kept.
         if on_floor_now or (mv.floor is not None and not jumping):
             snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
             reach = snap + abs(mv.x - px) * math.tan(math.radians(ctrl.max_floor_angle)) + 2.0 * skin
-            hit = self._cast(mv, 0.0, -reach)
-            if hit is not None and hit[3] >= cos_f:
-                r, f, nx, ny = hit
-                self._advance(mv, 0.0, -reach, f, nx, ny)
-                mv.floor = (r, nx, ny)
+            mv.floor = self._land(mv, reach)
+        elif mv.floor is not None:  # jumping: only a floor it still touches (no pull down)
+            mv.floor = self._land(mv, 4.0 * skin)
         # 5. State and velocity.
         ctrl.on_floor = mv.floor is not None
         if mv.floor is not None:
             r, nx, ny = mv.floor
             ctrl.floor_normal, ctrl.floor_entity = (nx, ny), int(store.entity[r])
-            vy = min(vy, 0.0) if jumping else 0.0
+            vy = 0.0  # (a jump that ends on a floor is cut; velocity on a floor is along it)
         else:
             ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
         ctrl.on_wall = mv.wall is not None
         ctrl.wall_normal = (mv.wall[1], mv.wall[2]) if mv.wall is not None else (0.0, 0.0)
-        if mv.wall is not None and mv.wall_stopped and vx * mv.wall[1] < 0.0 and store.body[mv.wall[0]] != DYNAMIC:
-            vx = 0.0
-        ctrl.on_ceiling = mv.ceiling
         if mv.ceiling and vy > 0.0:
             vy = 0.0
+        vx, vy = self._unblocked(mv, vx, vy)
+        ctrl.on_ceiling = mv.ceiling
         if ctrl.push_mass > 0.0 and dt > 0.0:
             self._push(mv, ctrl.push_mass, mx / dt, my / dt)
         store.place(row, mv.x - ox, mv.y - oy)
@@ -322,23 +322,24 @@ class CharacterStage(Stage):
             rx, ry = mx * (1.0 - f), my * (1.0 - f)
             if ny >= cos_f:  # a floor
                 mv.floor = (r, nx, ny)
+                mv.hits.append((r, nx, ny))
                 on_floor = True
                 # Keep walking: the horizontal part goes on along the floor; the fall stops.
                 mx, my = rx, -rx * nx / ny
             elif ny <= -cos_f:  # a ceiling: slide along it
                 mv.ceiling = True
+                mv.hits.append((r, nx, ny))
                 d = rx * nx + ry * ny
                 mx, my = (rx - d * nx, ry - d * ny) if d < 0.0 else (rx, ry)
             else:  # a wall, or a slope too steep to walk
-                mv.wall = (r, nx, ny)
                 if self.bodies.store.body[r] == DYNAMIC:
                     mv.pushed.append((r, nx, ny))  # it may give way: the walk keeps its velocity
                 if on_floor and step > 0.0 and rx != 0.0 and abs(ny) < cos_f and self._step_up(mv, rx, step):
-                    mv.wall = None
-                    return
+                    return  # (climbed: the step's face is behind it, not a wall it stands at)
+                mv.wall = (r, nx, ny)
+                mv.hits.append((r, nx, ny))
                 d = rx * nx + ry * ny
                 mx, my = (rx - d * nx, ry - d * ny) if d < 0.0 else (rx, ry)
-                mv.wall_stopped |= d < -mv.skin
                 if on_floor and my > 0.0:
                     mx = my = 0.0  # no climbing a steep slope from the floor
             for px, py in planes:
@@ -347,33 +348,138 @@ class CharacterStage(Stage):
             planes.append((nx, ny))
 
     def _step_up(self, mv: _Move, rx: float, step: float) -> bool:
-        """Try to step up onto a ledge at most ``step`` high in the way of ``rx``: up, across,
-        down onto a floor. On success the body is on it (and True); otherwise it is untouched."""
+        """Try to step up onto a ledge at most ``step`` high in the way of ``rx``: up, across, down
+        onto a floor. On success the body is on it (and True); otherwise it is untouched.
+
+        Across is the rest of the frame's move, or further if that would leave the body's bottom
+        on the ledge's edge at a slope too steep to stand on (a round bottom, moving slowly): then
+        it goes as far as its bottom must for the edge to be under it at a standing angle (for a
+        circle or capsule of radius r, at most r (1 - sin(0.9 max_floor_angle)) further), so a
+        step that may be climbed is climbed at any speed."""
         x0, y0, cos_f = mv.x, mv.y, mv.floor_cos
+        bottom = _bounds(mv)[1]
         up = self._cast(mv, 0.0, step)
         rise = step
         if up is not None:
             rise = max(0.0, step * up[1] - mv.skin)
         if rise <= mv.skin:
             return False
-        mv.y += rise
-        across = self._cast(mv, rx, 0.0)
-        f = 1.0 if across is None else across[1]
-        if across is not None:
-            self._advance(mv, rx, 0.0, f, across[2], across[3])
-        else:
-            mv.x += rx
-        if abs(mv.x - x0) <= mv.skin:
-            mv.x, mv.y = x0, y0
-            return False
-        down = self._cast(mv, 0.0, -rise)
-        if down is None or down[3] < cos_f:
-            mv.x, mv.y = x0, y0
-            return False
-        r, fd, nx, ny = down
-        self._advance(mv, 0.0, -rise, fd, nx, ny)
-        mv.floor = (r, nx, ny)
-        return True
+        top = y0 + rise
+        go = rx
+        further = nudged = False
+        for _ in range(3):
+            mv.x, mv.y = x0, top
+            across = self._cast(mv, go, 0.0)
+            if across is not None:
+                self._advance(mv, go, 0.0, across[1], across[2], across[3])
+            else:
+                mv.x += go
+            if abs(mv.x - x0) <= mv.skin:  # the rest of the move is too short to get onto it
+                if not nudged and across is None:
+                    go, nudged = go + math.copysign(4.0 * mv.skin, rx), True
+                    continue
+                break
+            down = self._cast(mv, 0.0, -rise)
+            if down is None:
+                break
+            r, fd, nx, ny = down
+            if ny >= cos_f:
+                self._advance(mv, 0.0, -rise, fd, nx, ny)
+                if self._contact_height(mv, r, nx, ny) > bottom + step + 4.0 * mv.skin:
+                    break  # resting on the edge of something higher than a step (a round bottom)
+                mv.floor = (r, nx, ny)
+                if across is not None:
+                    mv.wall = (across[0], across[2], across[3])
+                    mv.hits.append((across[0], across[2], across[3]))
+                return True
+            extra = self._to_stand(mv, nx, ny, rx) if not further and across is None else 0.0
+            if not extra > 0.0:
+                break
+            go, further = go + math.copysign(extra, rx), True
+        mv.x, mv.y = x0, y0
+        return False
+
+    def _contact_height(self, mv: _Move, r: int, nx: float, ny: float) -> float:
+        """The height of where the body touches row ``r`` (met at normal ``n``, facing the body)."""
+        store, geom = self.bodies.store, self.bodies.ensure_geometry()
+        other = store.hitboxes[r]
+        assert other is not None  # (a cast meets only rows with a hitbox)
+        at = touch_point(mv.shape, (mv.x, mv.y, mv.rot), other.shape,
+                         (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])), -nx, -ny)
+        return float(at.y)
+
+    def _to_stand(self, mv: _Move, nx: float, ny: float, rx: float) -> float:
+        """How much further across a round bottom (a circle's, a capsule's end) resting on an edge
+        at normal ``n`` must go for the edge to hold it at a standing angle (0: not round, or not
+        an edge ahead of it)."""
+        radius = getattr(mv.shape, "radius", None)
+        if radius is None or nx * rx >= 0.0:
+            return 0.0
+        if mv.shape.kind == "capsule" and mv.shape.length > 0.0:  # type: ignore[attr-defined]
+            # The contact must be on an end's half disc: a normal square to the axis is its side.
+            c, s = math.cos(mv.rot), math.sin(mv.rot)
+            if abs(-s * nx + c * ny) <= 1e-9:
+                return 0.0
+        angle = 0.9 * math.acos(mv.floor_cos)  # well inside the floor's cone
+        want = math.sin(angle)
+        return radius * (abs(nx) - want) if abs(nx) > want else 0.0
+
+    def _land(self, mv: _Move, reach: float) -> tuple[int, float, float] | None:
+        """Cast down by ``reach``; if it meets a floor, move down onto it and return it (row and
+        normal), else None (the body does not move). A steep surface met first does not hide a floor
+        met at the same height (a body in the corner of a floor and a wall, a round bottom against
+        a step's edge): the body stops at the steep one and stands on the floor."""
+        cos_f = mv.floor_cos
+        hit = self._cast(mv, 0.0, -reach)
+        first = hit
+        ignored: list[int] = []
+        found = None
+        for _ in range(3):
+            if hit is None or first is None:
+                break
+            if hit[3] >= cos_f:
+                if (hit[1] - first[1]) * reach <= 4.0 * mv.skin:
+                    found = hit
+                break
+            ignored.append(hit[0])
+            mv.ignore.add(hit[0])
+            hit = self._cast(mv, 0.0, -reach)
+        for r in ignored:
+            mv.ignore.discard(r)
+        if found is None or first is None:
+            return None
+        self._advance(mv, 0.0, -reach, first[1], first[2], first[3])
+        return found[0], found[2], found[3]
+
+    def _unblocked(self, mv: _Move, vx: float, vy: float) -> tuple[float, float]:
+        """The velocity without its part into the surfaces the move met this step (dynamic bodies
+        excepted: pushed, they may give way). On a floor the velocity is a walk along it: walking
+        into a wall or ceiling met stops the walk (``vx`` = 0). In the air its part into each
+        surface met is taken away (it slides along them); if that cannot be done for all of them
+        at once (a crease), it stops."""
+        store = self.bodies.store
+        planes = [(nx, ny) for r, nx, ny in mv.hits if store.body[r] != DYNAMIC]
+        if not planes:
+            return vx, vy
+        if mv.floor is not None:
+            _r, fx, fy = mv.floor
+            tx, ty = 1.0, -fx / fy  # the walk's direction for vx = 1
+            if any(ny < mv.floor_cos and vx * (tx * nx + ty * ny) < 0.0 for nx, ny in planes):
+                vx = 0.0
+            return vx, vy
+        tol = 1e-12 * math.hypot(vx, vy)  # (what rounding leaves of a part taken away)
+        for _ in range(3):
+            into = False
+            for nx, ny in planes:
+                d = vx * nx + vy * ny
+                if d < -tol:
+                    vx, vy = vx - d * nx, vy - d * ny
+                    into = True
+            if not into:
+                return vx, vy
+        if any(vx * nx + vy * ny < -tol for nx, ny in planes):
+            return 0.0, 0.0  # in a crease: no way along all of them
+        return vx, vy
 
     def _depenetrate(self, mv: _Move, start_bottom: float, frame: StepFrame, moved: bool) -> bool:
         """Push the body out of what it overlaps (something that moved into it this step); a
