@@ -6,26 +6,40 @@ positions and sizes are scaled by one power of two (the shape about one unit acr
 direction by another (both exact), so that neither huge nor tiny scenes overflow or underflow and
 integer / dyadic input keeps its exact decisions.
 
-Boxes and polygons are clipped with Cyrus-Beck on *unnormalised* edge normals: the sign tests
-``n . (v - o)`` and ``n . d`` are exact for dyadic input, so a ray along an edge line or exactly
-through a corner is a graze, hence a miss. Circles use the discriminant written as
-``|d|^2 r^2 - (m x d)^2`` (no cancellation) and the numerically stable root ``c / q``. A capsule
-is the union of an open rectangle (its segment pushed out both ways by the radius) and two open
-discs at the segment's ends: the ray enters it where it first enters one of those
-(:func:`rounded_segment`).
+A ray that only grazes the boundary (along an edge, exactly through a corner from outside, tangent
+to a circle or to a capsule's side or cap) misses, on any float input, not only on round numbers:
+floats decide wherever the answer is clear by far more than their rounding, and wherever a test is
+within :data:`~framework.collision.exact.BAND` of touching it is decided again on exact integers,
+as :func:`~framework.collision.collide.collide` decides touching.
 
-The helpers below (local frames, clipping, disc intervals, normal tie-breaks) are shared with
-:mod:`framework.collision.sweep`, which casts the relative motion against a Minkowski difference.
+- Boxes and polygons are clipped with Cyrus-Beck on *unnormalised* edge normals
+  (:func:`clip_polygon`). Where the signs of ``n . (v - o)`` or ``n . d``, or the order of the
+  entry and exit times (a ray through a corner) or their signs, are within rounding, the clip is
+  redone on exact rationals.
+- Circles use the discriminant written as ``|d|^2 r^2 - (m x d)^2`` and the numerically stable
+  root (:func:`~framework.collision.pieces.disc_interval`, exact near tangency).
+- A capsule is the union of an open rectangle (its segment pushed out both ways by the radius) and
+  two open discs at the segment's ends (:func:`~framework.collision.pieces.rounded_segment`). Each
+  piece's interval is kept on its own and the ray enters where it first enters one of them: a ray
+  along a side is tangent to both discs, and taking the span over the pieces would turn the
+  rounding slivers of two tangents into a hit.
+
+The helpers below (local frames, clipping) are shared with :mod:`framework.collision.sweep`, which
+casts the relative motion against a Minkowski difference; the pieces of rounded shapes are in
+:mod:`framework.collision.pieces`.
 """
 
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 from numbers import Real
 from typing import cast
 
 from ..shapes import AABB, Capsule, Circle, Polygon, Shape
 from ..validation import InvalidValue, vector2
+from .exact import BAND, TINY
+from .pieces import TIE, disc_interval, first_entry, ints, rounded_segment
 from .placement import check_shape, pose
 from .results import RayHit, Vec2
 from .tiebreak import pick
@@ -33,10 +47,6 @@ from .tiebreak import pick
 __all__ = ["raycast"]
 
 Pts = list[tuple[float, float]]
-
-# Entry times (in the scaled local frame, where the shapes are about 1 unit across) closer than
-# this (relative to the time, when above 1) count as a tie, broken by a fixed rule, not rounding.
-TIE = 1e-12
 
 
 def raycast(
@@ -133,22 +143,18 @@ def _ray_polygon(pts: Pts, ox: float, oy: float, dx: float, dy: float, dlen: flo
 
 
 def _ray_circle(mx: float, my: float, r: float, dx: float, dy: float) -> _Res | None:
-    mm = mx * mx + my * my
-    rr = r * r
-    if mm < rr:
-        return 0.0, None
-    if mx * dx + my * dy >= 0.0:
-        return None  # heading away, tangent, or on the circle heading out
-    if mm == rr:  # on the circle, heading inward
-        ln = math.hypot(mx, my)
-        return 0.0, (mx / ln, my / ln)
-    iv = disc_interval(mx, my, r, dx, dy)
+    iv = disc_interval(0.0, 0.0, mx, my, r, (r,), dx, dy)
     if iv is None:
-        return None
-    t = iv[0]
-    hx, hy = mx + t * dx, my + t * dy
+        return None  # the line misses the open disc, or is tangent to it
+    t1, t2 = iv
+    if not t2 > 0.0:
+        return None  # behind the origin (or the origin on the circle, heading out)
+    if t1 < 0.0:
+        return 0.0, None
+    # t1 == 0: on the circle, heading inward (exact signs near there: disc_interval).
+    hx, hy = mx + t1 * dx, my + t1 * dy
     ln = math.hypot(hx, hy)
-    return t, (hx / ln, hy / ln)
+    return t1, ((hx / ln, hy / ln) if ln > 0.0 else (0.0, 1.0))
 
 
 def _ray_capsule(mx: float, my: float, shape: Capsule, rot: float, k: int, dx: float, dy: float) -> _Res | None:
@@ -156,19 +162,15 @@ def _ray_capsule(mx: float, my: float, shape: Capsule, rot: float, k: int, dx: f
 
     sx, sy = segment(shape, rot, k)
     r = math.ldexp(shape.radius, -k)
-    # Strictly inside: nearer the segment than r.
-    cx, cy = closest_on_segment(mx, my, -sx, -sy, sx, sy)
-    if (mx - cx) ** 2 + (my - cy) ** 2 < r * r:
+    pieces = rounded_segment(mx, my, -sx, -sy, sx, sy, (r,), dx, dy)
+    # Strictly inside the open capsule (the union of the pieces): inside one piece at tau = 0.
+    if any(a < 0.0 < b for a, b, _ in pieces):
         return 0.0, None
-    found = rounded_segment(mx, my, -sx, -sy, sx, sy, r, dx, dy)
+    found = first_entry(pieces, math.inf)
     if found is None:
-        return None
-    t_in, t_out, cands = found
-    if not t_out > 0.0:
-        return None
-    t_in = max(t_in, 0.0)  # (< 0 only by rounding: on the boundary, heading in)
-    tol = TIE * max(1.0, t_in)
-    _, nx, ny = pick([(0.0, nx, ny) for t, nx, ny in cands if t <= t_in + tol or t <= 0.0], 1.0)
+        return None  # no piece entered ahead of the origin: a miss, or a graze
+    t_in, near = found
+    _, nx, ny = pick([(0.0, nx, ny) for _, nx, ny in near], 1.0)
     return t_in, (nx, ny)
 
 
@@ -186,50 +188,6 @@ def closest_on_segment(px: float, py: float, s0x: float, s0y: float, s1x: float,
     if t >= 1.0:
         return s1x, s1y
     return s0x + t * ex, s0y + t * ey
-
-
-def rounded_segment(
-    cx: float, cy: float, s0x: float, s0y: float, s1x: float, s1y: float, r: float, vx: float, vy: float
-) -> tuple[float, float, list[tuple[float, float, float]]] | None:
-    """The open interval ``(t_in, t_out)`` where ``c + t v`` is strictly inside the segment s0 s1
-    rounded by ``r`` (an open rectangle and two open discs), with the entry normals ``(t, nx, ny)``
-    of the pieces entered (unit, outward), or ``None`` if it never is (a graze). ``v`` non-zero."""
-    t_in, t_out = math.inf, -math.inf
-    cands: list[tuple[float, float, float]] = []
-    ex, ey = s1x - s0x, s1y - s0y
-    e2 = ex * ex + ey * ey
-    if e2 > 0.0:
-        nx, ny = ey, -ex
-        ln = math.sqrt(e2)
-        rl = r * ln
-        qx, qy = cx - s0x, cy - s0y
-        along, across = ex * qx + ey * qy, nx * qx + ny * qy
-        ev, nv = ex * vx + ey * vy, nx * vx + ny * vy
-        # 0 < e.(x - s0) < e.e and -r|e| < n.(x - s0) < r|e|, each as f0 + t f1 < 0.
-        from .sweep import clip_constraints
-
-        rect = clip_constraints([(-along, -ev, "start"), (along - e2, ev, "end"), (across - rl, nv, "pos"),
-                                 (-across - rl, -nv, "neg")])
-        if rect is not None:
-            a, b, tags = rect
-            t_in, t_out = min(t_in, a), max(t_out, b)
-            if "pos" in tags:
-                cands.append((a, nx / ln, ny / ln))
-            elif "neg" in tags:
-                cands.append((a, -nx / ln, -ny / ln))
-            # (entered through an end only: next to a disc, entered no later, which gives the normal)
-    for px, py in ((s0x, s0y), (s1x, s1y)):
-        iv = disc_interval(cx - px, cy - py, r, vx, vy)
-        if iv is not None:
-            a, b = iv
-            t_in, t_out = min(t_in, a), max(t_out, b)
-            t = a if a > 0.0 else 0.0
-            hx, hy = cx - px + t * vx, cy - py + t * vy
-            hl = math.hypot(hx, hy)
-            cands.append((a, hx / hl, hy / hl) if hl > 0.0 else (a, 0.0, 1.0))
-    if not t_in < t_out:
-        return None
-    return t_in, t_out, cands
 
 
 def safe_ldexp(x: float, e: int) -> float:
@@ -297,52 +255,94 @@ def clip_polygon(
 ) -> tuple[float, float, list[tuple[float, float, float]]] | None:
     """Cyrus-Beck: the open interval ``(t_in, t_out)`` where ``o + t d`` is strictly inside the convex
     CCW outline, with the entering faces ``(t, nx, ny)`` (unnormalised outward normals), or
-    ``None`` when the line never enters the interior (a graze along an edge or through a corner)."""
+    ``None`` when the line never enters the interior (a graze along an edge or through a corner).
+
+    Each face's time ``t = n.(v - o) / n.d`` is computed in floats with a bound on its rounding
+    (:data:`~framework.collision.exact.BAND` relative to the magnitudes of the products summed).
+    Where a decision is within those bounds (``n.d`` or, for a face parallel to the ray, ``n.(v - o)``
+    within rounding of 0; ``t_in`` against ``t_out``, as at a corner; either against 0), the clip
+    is redone on exact rationals (:func:`_clip_exact`)."""
     t_in, t_out = -math.inf, math.inf
+    # Bounds on the exact t_in and t_out: each is in [lo, hi].
+    in_lo = in_hi = -math.inf
+    out_lo = out_hi = math.inf
     faces = []
     n = len(pts)
     for i in range(n):
         x0, y0 = pts[i]
         x1, y1 = pts[(i + 1) % n]
         nx, ny = y1 - y0, x0 - x1  # outward normal of a CCW outline, unnormalised
-        num = nx * (x0 - ox) + ny * (y0 - oy)
-        den = nx * dx + ny * dy
-        if den == 0.0:
-            if num <= 0.0:
-                return None  # parallel, on or outside this face's line
-        elif den < 0.0:
-            t = num / den
+        ax, ay = nx * (x0 - ox), ny * (y0 - oy)
+        bx, by = nx * dx, ny * dy
+        num, den = ax + ay, bx + by
+        mag = BAND * (abs(ax) + abs(ay))
+        if abs(den) <= BAND * (abs(bx) + abs(by)) and (bx != 0.0 or by != 0.0):
+            return _clip_exact(pts, ox, oy, dx, dy)  # within rounding of parallel
+        if den == 0.0:  # parallel (exactly: each product is 0)
+            if abs(num) <= mag:
+                return _clip_exact(pts, ox, oy, dx, dy)  # within rounding of the face's line
+            if num < 0.0:
+                return None  # outside this face's line
+            continue
+        t = num / den
+        err = (mag + abs(t) * BAND * (abs(bx) + abs(by))) / abs(den)
+        if den < 0.0:
             faces.append((t, nx, ny))
-            if t > t_in:
-                t_in = t
+            t_in = max(t_in, t)
+            in_lo, in_hi = max(in_lo, t - err), max(in_hi, t + err)
         else:
-            t = num / den
-            if t < t_out:
-                t_out = t
+            t_out = min(t_out, t)
+            out_lo, out_hi = min(out_lo, t - err), min(out_hi, t + err)
+    if in_lo < out_hi and out_lo <= in_hi:
+        return _clip_exact(pts, ox, oy, dx, dy)  # t_in < t_out within rounding (a corner)
     if not t_in < t_out:
         return None
+    if out_lo <= 0.0 < out_hi or in_lo <= 0.0 <= in_hi:
+        return _clip_exact(pts, ox, oy, dx, dy)  # the origin within rounding of the boundary
     return t_in, t_out, faces
 
 
-def disc_interval(mx: float, my: float, r: float, dx: float, dy: float) -> tuple[float, float] | None:
-    """The open interval ``(t1, t2)`` where ``|m + t d| < r``, or ``None`` if empty (tangent lines
-    touch at one point only: a graze). ``d`` must be non-zero."""
-    a = dx * dx + dy * dy
-    cross = mx * dy - my * dx
-    # Discriminant b^2 - a c rewritten (Lagrange) as a r^2 - cross^2: no cancellation, and exact
-    # on dyadic input, so a tangent ray is decided exactly.
-    disc = a * (r * r) - cross * cross
-    if not disc > 0.0:
+def _clip_exact(
+    pts: Pts, ox: float, oy: float, dx: float, dy: float
+) -> tuple[float, float, list[tuple[float, float, float]]] | None:
+    """:func:`clip_polygon` on exact rationals: every float is an integer times a power of two, so
+    ``n.(v - o)`` and ``n.d`` are exact integers over one power of two, and the times their
+    exact ratios. Faces whose exact times tie get the same float time."""
+    vals, _ = ints((ox, oy, dx, dy, *(c for p in pts for c in p)))
+    iox, ioy, idx, idy = vals[:4]
+    ipts = [(vals[4 + 2 * i], vals[5 + 2 * i]) for i in range(len(pts))]
+    t_in: Fraction | None = None
+    t_out: Fraction | None = None
+    enter: list[tuple[Fraction, int]] = []
+    n = len(ipts)
+    for i in range(n):
+        (x0, y0), (x1, y1) = ipts[i], ipts[(i + 1) % n]
+        nx, ny = y1 - y0, x0 - x1
+        num = nx * (x0 - iox) + ny * (y0 - ioy)
+        den = nx * idx + ny * idy
+        if den == 0:
+            if num <= 0:
+                return None  # parallel, on or outside this face's line
+            continue
+        t = Fraction(num, den)
+        if den < 0:
+            enter.append((t, i))
+            if t_in is None or t > t_in:
+                t_in = t
+        elif t_out is None or t < t_out:
+            t_out = t
+    if t_in is None or (t_out is not None and not t_in < t_out):
         return None
-    b = mx * dx + my * dy
-    c = (mx * mx + my * my) - r * r
-    sq = math.sqrt(disc)
-    if b < 0.0:
-        q = sq - b  # > 0, no cancellation
-        t1, t2 = c / q, q / a
-    else:
-        q = -b - sq  # < 0, no cancellation
-        t1, t2 = q / a, c / q
-    if not t1 < t2:
-        return None
-    return t1, t2
+    faces: list[tuple[float, float, float]] = []
+    for t, i in enter:
+        (fx0, fy0), (fx1, fy1) = pts[i], pts[(i + 1) % n]
+        faces.append((_signed_float(t), fy1 - fy0, fx0 - fx1))  # the float normal, as clip_polygon's
+    return _signed_float(t_in), math.inf if t_out is None else _signed_float(t_out), faces
+
+
+def _signed_float(t: Fraction) -> float:
+    """``t`` as a float, never rounded to 0 unless it is 0."""
+    f = float(t)
+    if f == 0.0 and t != 0:
+        return math.copysign(TINY, t)
+    return f

@@ -14,7 +14,7 @@ a sweep is a ray cast of B's offset against ``M``, with the same grazing rules:
 - a capsule vs anything: ``M`` is the cores' Minkowski difference (the convex hull of the
   differences of their points: a polygon, or a segment where both cores are parallel segments or
   one is a point) rounded by the radii summed: the same pieces (for a segment, one rectangle and
-  two discs, as :func:`~framework.collision.ray.rounded_segment`).
+  two discs, :func:`~framework.collision.pieces.rounded_segment`).
 
 A sweep is a list of *pieces*, each the open interval of ``tau`` during which B's offset is inside
 one piece of ``M`` (for the swept SAT, the one interval of the whole of ``M``). The impact is the
@@ -46,18 +46,17 @@ from .capsule import capsule_first, core_points
 from .collide import collide
 from .exact import BAND, float_approx
 from .kinds import CAPSULES, CIRCLES, PAIRS, POLYGON_CIRCLE, kind_of
+from .pieces import Piece, disc_interval, first_entry, ints, rect_interval, rounded_segment
 from .placement import check_shape, pose
-from .ray import TIE, extent, local_exponent, relative, scale_exponent, scaled_outline
+from .ray import extent, local_exponent, relative, scale_exponent, scaled_outline
 from .results import Impact, Vec2
 from .tiebreak import pick
 
 __all__ = ["time_of_impact"]
 
 Pts = list[tuple[float, float]]
-Cands = list[tuple[float, float, float]]
-# One piece of a sweep: (t_in, t_out, candidates (t, nx, ny) with unit normals from A toward B):
-# the open interval of tau inside that piece of the Minkowski difference.
-Piece = tuple[float, float, Cands]
+# A sweep is a list of pieces (:data:`~framework.collision.pieces.Piece`): each the open interval of
+# tau inside one piece of the Minkowski difference, with candidate normals from A toward B.
 
 
 def time_of_impact(
@@ -100,7 +99,7 @@ def time_of_impact(
     end = math.inf if j - k > 1023 else math.ldexp(1.0, j - k)
 
     pieces = _sweep_pair(shape_a, (ax, ay, ar), shape_b, (bx, by, br), dx, dy, vx, vy, k)
-    found = _first_entry(pieces, end)
+    found = first_entry(pieces, end)
     if found is None:
         return None
     t_in, near = found
@@ -109,33 +108,6 @@ def time_of_impact(
     # in (or an overlap that collide's rounding missed): contact from the start.
     fraction = math.ldexp(t_in, k - j) if t_in > 0.0 else 0.0
     return Impact(fraction + 0.0, Vec2(nx + 0.0, ny + 0.0))
-
-
-def _first_entry(pieces: list[Piece], end: float) -> tuple[float, Cands] | None:
-    """The first moment of the step ``[0, end)`` inside one of the pieces, and the candidate normals
-    of the pieces entered then (within :data:`TIE`), or ``None`` if no piece's open interval meets
-    the step. Pieces that only touch (an empty interval: a tangent or a slide along a side) and
-    pieces wholly before the start or at or after the end do not count, whatever the others span."""
-    valid = [(max(a, 0.0), a, cands) for a, b, cands in pieces if a < b and b > 0.0 and a < end]
-    if not valid:
-        return None
-    first = min(v[0] for v in valid)
-    tol = TIE * max(1.0, first)
-    near = []
-    for entry, a, cands in valid:
-        if entry <= first + tol:
-            ta = TIE * max(1.0, abs(a))
-            near += [c for c in cands if abs(c[0] - a) <= ta]
-    if not near:
-        # Entered through an end of a rounded segment's rectangle only: the disc there is entered
-        # no later in exact arithmetic (by a hair later in rounding), and gives the normal.
-        later = sorted((v for v in valid if v[2]), key=lambda v: v[0])
-        if not later:
-            return None
-        _, a, cands = later[0]
-        ta = TIE * max(1.0, abs(a))
-        near = [c for c in cands if abs(c[0] - a) <= ta]
-    return first, near
 
 
 def _sweep_pair(
@@ -197,98 +169,6 @@ def _order_key(shape: Shape, x: float, y: float, rotation: float) -> tuple[objec
     return (x, y, rotation, kind_of(shape), params)
 
 
-# --- exact decisions near touching ---------------------------------------------------------------
-
-def _ints(values: tuple[float, ...]) -> tuple[list[int], int]:
-    """``(ints, e)``: ``values`` as integers over one common power of two, each ``n * 2**e``."""
-    parts = [float(v).as_integer_ratio() for v in values]  # each denominator a power of two
-    top = max(den.bit_length() for _, den in parts)
-    return [num << (top - den.bit_length()) for num, den in parts], 1 - top
-
-
-def _minus_root(s: int, root: int, e: int) -> float:
-    """``(s - sqrt(root)) * 2**e`` with its exact sign (``root`` in units of ``2**(2e)``), as a
-    float: ``(s^2 - root) / (s + sqrt(root))`` where they nearly cancel."""
-    if s > 0:
-        return float_approx(s * s - root, 2 * e) / (float_approx(s, e) + math.sqrt(float_approx(root, 2 * e)))
-    return -(float_approx(-s, e) + math.sqrt(float_approx(root, 2 * e)))
-
-
-def _rect(x0: float, y0: float, x1: float, y1: float, cx: float, cy: float, r: float, radii: tuple[float, ...],
-          vx: float, vy: float) -> tuple[float, float, set[str]] | None:
-    """:func:`clip_constraints` of the open rectangle of the edge p0 p1 pushed out and in by ``r``
-    (the sum of ``radii``), ``0 < e.(x - p0) < e.e``, ``-r|e| < n.(x - p0) < r|e|``, for
-    ``c + tau v``; tags ``start``, ``end``, ``face`` (the side pushed out along ``n = (ey, -ex)``),
-    ``inner``. Where the start is within rounding of a side, the constraints are worked again
-    from exact integers (the start's offsets from the sides and the motion across them, each
-    with its exact sign): touching and sliding along, or moving away, is then never an entry, and
-    moving in by a hair always is."""
-    ex, ey = x1 - x0, y1 - y0
-    nx, ny = ey, -ex
-    e2 = ex * ex + ey * ey
-    rl = r * math.sqrt(e2)
-    qx, qy = cx - x0, cy - y0
-    along = ex * qx + ey * qy
-    across = nx * qx + ny * qy
-    ev = ex * vx + ey * vy
-    nv = nx * vx + ny * vy
-    f_start, f_end, f_face, f_inner = -along, along - e2, across - rl, -across - rl
-    if (min(abs(f_start), abs(f_end)) <= BAND * (abs(ex * qx) + abs(ey * qy) + e2)
-            or min(abs(f_face), abs(f_inner)) <= BAND * (abs(nx * qx) + abs(ny * qy) + rl)):
-        (ix0, iy0, ix1, iy1, icx, icy, ivx, ivy, *irs), e = _ints((x0, y0, x1, y1, cx, cy, vx, vy, *radii))
-        iex, iey, iqx, iqy, ir = ix1 - ix0, iy1 - iy0, icx - ix0, icy - iy0, sum(irs)
-        ialong = iex * iqx + iey * iqy
-        iacross = iey * iqx - iex * iqy
-        ie2 = iex * iex + iey * iey
-        f_start = float_approx(-ialong, 2 * e)
-        f_end = float_approx(ialong - ie2, 2 * e)
-        f_face = _minus_root(iacross, ir * ir * ie2, 2 * e)
-        f_inner = _minus_root(-iacross, ir * ir * ie2, 2 * e)
-        ev = float_approx(iex * ivx + iey * ivy, 2 * e)
-        nv = float_approx(iey * ivx - iex * ivy, 2 * e)
-    return clip_constraints([(f_start, -ev, "start"), (f_end, ev, "end"), (f_face, nv, "face"),
-                             (f_inner, -nv, "inner")])
-
-
-def _disc_interval(px: float, py: float, cx: float, cy: float, r: float, radii: tuple[float, ...],
-                   vx: float, vy: float) -> tuple[float, float] | None:
-    """The open interval ``(t1, t2)`` where ``|c + t v - p| < r`` (``r`` the sum of ``radii``), or
-    ``None`` if it is empty: a tangent line touches at one point only, a graze. As
-    :func:`~framework.collision.ray.disc_interval` (the discriminant as ``|v|^2 r^2 - (m x v)^2``,
-    the stable root), but where the discriminant or ``|m|^2 - r^2`` (the start against the circle)
-    is within rounding of 0, their signs are decided exactly (``v`` non-zero)."""
-    mx, my = cx - px, cy - py
-    a = vx * vx + vy * vy
-    cross = mx * vy - my * vx
-    rr = r * r
-    disc = a * rr - cross * cross
-    mm = mx * mx + my * my
-    c = mm - rr
-    b = mx * vx + my * vy
-    if abs(disc) <= BAND * (a * rr + cross * cross) or abs(c) <= BAND * (mm + rr):
-        (ipx, ipy, icx, icy, ivx, ivy, *irs), e = _ints((px, py, cx, cy, vx, vy, *radii))
-        imx, imy, ir = icx - ipx, icy - ipy, sum(irs)
-        icross = imx * ivy - imy * ivx
-        idisc = (ivx * ivx + ivy * ivy) * ir * ir - icross * icross
-        if idisc <= 0:
-            return None  # tangent (or apart)
-        disc = float_approx(idisc, 4 * e)
-        c = float_approx(imx * imx + imy * imy - ir * ir, 2 * e)
-        b = float_approx(imx * ivx + imy * ivy, 2 * e)  # (touching at the start: in or out)
-    if not disc > 0.0:
-        return None
-    sq = math.sqrt(disc)
-    if b < 0.0:
-        q = sq - b  # > 0, no cancellation
-        t1, t2 = c / q, q / a
-    else:
-        q = -b - sq  # < 0, no cancellation
-        t1, t2 = q / a, c / q
-    if not t1 < t2:
-        return None
-    return t1, t2
-
-
 # --- pairs of kinds, in the scaled local frame --------------------------------------------------
 
 def _unit(x: float, y: float) -> tuple[float, float]:
@@ -299,7 +179,7 @@ def _unit(x: float, y: float) -> tuple[float, float]:
 
 
 def _circle_circle(dx: float, dy: float, radii: tuple[float, float], vx: float, vy: float) -> list[Piece]:
-    iv = _disc_interval(0.0, 0.0, dx, dy, radii[0] + radii[1], radii, vx, vy)
+    iv = disc_interval(0.0, 0.0, dx, dy, radii[0] + radii[1], radii, vx, vy)
     if iv is None:
         return []
     t1, t2 = iv
@@ -339,7 +219,7 @@ def _polygon_polygon(pa: Pts, pb: Pts, vx: float, vy: float) -> list[Piece]:
             if abs(vp) <= BAND * (abs(pvx) + abs(pvy)) and (pvx != 0.0 or pvy != 0.0):
                 # Motion within rounding of parallel to the axis: its sign decided exactly (a
                 # slide along a face of touching shapes is no entry; moving in by a hair is one).
-                (iux, iuy, ivx, ivy), e = _ints((ux, uy, vx, vy))
+                (iux, iuy, ivx, ivy), e = ints((ux, uy, vx, vy))
                 vp = float_approx(iux * ivx + iuy * ivy, 2 * e)
             if vp == 0.0:
                 if amax <= bmin or bmax <= amin:
@@ -366,7 +246,7 @@ def _polygon_circle(poly: Pts, cx: float, cy: float, radii: tuple[float, ...], v
     normals point from the polygon toward the circle): one piece per face (the open rectangle of the
     face swept out and in by ``r``) and one per vertex (the open disc around it). Near the rounded
     polygon's boundary its interior is the union of those pieces, so the first entry into it is the
-    first entry into one of them (:func:`_first_entry`)."""
+    first entry into one of them (:func:`~framework.collision.pieces.first_entry`)."""
     r = radii[0] if len(radii) == 1 else radii[0] + radii[1]
     pieces: list[Piece] = []
     n = len(poly)
@@ -376,7 +256,7 @@ def _polygon_circle(poly: Pts, cx: float, cy: float, radii: tuple[float, ...], v
         ex, ey = x1 - x0, y1 - y0
         nx, ny = ey, -ex  # outward, unnormalised
         ln = math.sqrt(ex * ex + ey * ey)
-        rect = _rect(x0, y0, x1, y1, cx, cy, r, radii, vx, vy)
+        rect = rect_interval(x0, y0, x1, y1, cx, cy, r, radii, vx, vy)
         if rect is not None:
             a, b, tags = rect
             hx, hy = cx + a * vx, cy + a * vy
@@ -398,44 +278,12 @@ def _polygon_circle(poly: Pts, cx: float, cy: float, radii: tuple[float, ...], v
             else:
                 pieces.append((a, b, [(a, nx / ln, ny / ln)]))
         # Open disc around vertex p0.
-        iv = _disc_interval(x0, y0, cx, cy, r, radii, vx, vy)
+        iv = disc_interval(x0, y0, cx, cy, r, radii, vx, vy)
         if iv is not None:
             a, b = iv
             t = a if a > 0.0 else 0.0
             hx, hy = _unit(cx - x0 + t * vx, cy - y0 + t * vy)
             pieces.append((a, b, [(a, hx, hy)]))
-    return pieces
-
-
-def _rounded_segment(cx: float, cy: float, s0x: float, s0y: float, s1x: float, s1y: float,
-                     radii: tuple[float, float], vx: float, vy: float) -> list[Piece]:
-    """``c + tau v`` against the segment s0 s1 rounded by the sum of ``radii``: an open rectangle
-    and two open discs, with the normals of :func:`~framework.collision.ray.rounded_segment`
-    (a rectangle entered through an end only has none: the disc there gives it)."""
-    r = radii[0] + radii[1]
-    pieces: list[Piece] = []
-    ex, ey = s1x - s0x, s1y - s0y
-    e2 = ex * ex + ey * ey
-    if e2 > 0.0:
-        nx, ny = ey, -ex
-        ln = math.sqrt(e2)
-        rect = _rect(s0x, s0y, s1x, s1y, cx, cy, r, radii, vx, vy)
-        if rect is not None:
-            a, b, tags = rect
-            if "face" in tags:
-                pieces.append((a, b, [(a, nx / ln, ny / ln)]))
-            elif "inner" in tags:
-                pieces.append((a, b, [(a, -nx / ln, -ny / ln)]))
-            else:
-                pieces.append((a, b, []))
-    for px, py in ((s0x, s0y), (s1x, s1y)):
-        iv = _disc_interval(px, py, cx, cy, r, radii, vx, vy)
-        if iv is not None:
-            a, b = iv
-            t = a if a > 0.0 else 0.0
-            hx, hy = cx - px + t * vx, cy - py + t * vy
-            hl = math.hypot(hx, hy)
-            pieces.append((a, b, [(a, hx / hl, hy / hl) if hl > 0.0 else (a, 0.0, 1.0)]))
     return pieces
 
 
@@ -468,28 +316,4 @@ def _capsule_pair(sa: Shape, rot_a: float, sb: Shape, rot_b: float, dx: float, d
     if len(hull) >= 3:
         return _polygon_circle(hull, dx, dy, (ra, rb), vx, vy)
     (s0x, s0y), (s1x, s1y) = hull if len(hull) == 2 else hull * 2
-    return _rounded_segment(dx, dy, s0x, s0y, s1x, s1y, (ra, rb), vx, vy)
-
-
-def clip_constraints(cons: list[tuple[float, float, str]]) -> tuple[float, float, set[str]] | None:
-    """The open interval of ``tau`` where every ``f0 + tau f1 < 0`` holds, with the tags of the
-    constraints that set its start (within :data:`TIE`), or ``None`` if it is empty."""
-    t_in, t_out = -math.inf, math.inf
-    enters = []
-    for f0, f1, tag in cons:
-        if f1 == 0.0:
-            if f0 >= 0.0:
-                return None
-        elif f1 < 0.0:
-            t = -f0 / f1
-            enters.append((t, tag))
-            if t > t_in:
-                t_in = t
-        else:
-            t = -f0 / f1
-            if t < t_out:
-                t_out = t
-    if not t_in < t_out or not enters:
-        return None
-    tol = TIE * max(1.0, abs(t_in))
-    return t_in, t_out, {tag for t, tag in enters if t >= t_in - tol}
+    return rounded_segment(dx, dy, s0x, s0y, s1x, s1y, (ra, rb), vx, vy)
