@@ -244,6 +244,14 @@ class Hitbox:
         # Kept as given; checked when the scene next steps (or at once outside a scene).
         if self._store is None:
             value = check_hitbox_field(name, value)
+            if name in ("mass", "density"):  # a mass and a density: refused, as the scene's step does
+                mass = value if name == "mass" else object.__getattribute__(self, "_mass")
+                density = value if name == "density" else object.__getattribute__(self, "_density")
+                try:
+                    _check_mass_and_density(mass, density)
+                except InvalidValue as exc:
+                    fix = "set its mass back to 1.0 first" if name == "density" else "set its density to None first"
+                    raise InvalidValue(f"{exc}; to change from one to the other, {fix}") from None
         else:
             self._store.hitbox_changed(self._entity)
         object.__setattr__(self, "_" + name, value)

@@ -6,15 +6,78 @@ component belongs to one entity; a Transform is given at spawn and never replace
 
 from __future__ import annotations
 
+import types
 from typing import Any
 
 import esper
 
 from .components import Body, Hitbox, Transform, Velocity, check_component
+from .shapes import Shape
+from .sprites import Animation, Frame
 from .store import BodyStore
 from .validation import InvalidValue
 
-__all__ = ["MissingComponent", "check_added_component", "spawn_components"]
+__all__ = ["MissingComponent", "check_added_component", "check_is_component", "spawn_components"]
+
+# Modules whose types are values, not components: Python's built-in types (str, int, float, bool,
+# bytes, tuple, list, dict, set, None, functions, modules, ...), the standard library's numbers and
+# containers, numpy's scalars and arrays. A game's own classes (plain classes, dataclasses,
+# namedtuples, subclasses of built-in types) are components.
+_VALUE_MODULES = frozenset(("builtins", "numpy", "fractions", "decimal", "collections", "array", "functools"))
+_FUNCTIONS = (types.FunctionType, types.BuiltinFunctionType, types.MethodType, types.BuiltinMethodType)
+
+
+def _a(noun: str) -> str:
+    return ("an " if noun[:1].lower() in "aeiou" else "a ") + noun
+
+
+def _short(value: object, limit: int = 120) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 4] + " ..."
+
+
+def is_value_type(cls: type) -> bool:
+    """Whether instances of ``cls`` are plain values (built-in or library types), not components."""
+    return str(getattr(cls, "__module__", "")).partition(".")[0] in _VALUE_MODULES
+
+
+def check_is_component(call: str, value: object) -> None:
+    """:class:`InvalidValue` if ``value`` cannot be a component of an entity, with what was meant.
+
+    A component is an instance of a class the game (or the framework) defines. Refused: None,
+    classes, tuples and lists (components are passed one by one), shapes (held by a Hitbox), a
+    Body kind (a Hitbox field), a Frame or Animation (held by a Visual), functions, and the values
+    of built-in and library types (str, int, float, bool, bytes, dict, set, numpy scalars, ...)."""
+    shown = _short(value)
+    if value is None:
+        raise InvalidValue(f"{call} takes component instances, got None: None is not a component; leave it out")
+    if isinstance(value, type):
+        name = value.__name__
+        raise InvalidValue(f"{call} takes component instances, got the class {name}: pass an instance ({name}())")
+    if isinstance(value, Shape):
+        name = type(value).__name__
+        raise InvalidValue(f"{call} got {_a(name)}: a shape is not a component; wrap a shape in a Hitbox, "
+                           f"e.g. Hitbox({shown})")
+    if isinstance(value, Body):
+        raise InvalidValue(f"{call} got {shown}: a body kind is not a component; give it to the Hitbox, "
+                           f"e.g. Hitbox(shape, body=Body.{value.name})")
+    if isinstance(value, (Frame, Animation)):
+        field = "frame" if isinstance(value, Frame) else "animation"
+        raise InvalidValue(f"{call} got {_a(type(value).__name__)}, {shown}: it is not a component; give it to "
+                           f"a Visual, e.g. Visual({field}=...)")
+    cls = type(value)
+    if isinstance(value, (tuple, list)) and is_value_type(cls):
+        kind = cls.__name__
+        fix = ("pass the components themselves, one argument each: spawn(*components)" if call == "spawn"
+               else "add the components one at a time")
+        raise InvalidValue(f"{call} takes components, not a {kind}: got {shown}; {fix}")
+    if isinstance(value, _FUNCTIONS) or (is_value_type(cls) and callable(value)):
+        raise InvalidValue(f"{call} got the function {shown}: a function is not a component (a system is "
+                           "added with scene.add_system, a collision handler with scene.on_collision)")
+    if is_value_type(cls):
+        kind = _a(cls.__name__)
+        raise InvalidValue(f"{call} got {shown}, {kind}: {kind} is not a component; use an instance of a "
+                           "component class (a class of your own holding the value, e.g. class Name: ...)")
 
 
 class MissingComponent(KeyError):
@@ -35,10 +98,10 @@ class MissingComponent(KeyError):
 def spawn_components(components: tuple[Any, ...]) -> tuple[Any, Any, Any]:
     """Check the components of a new entity; return its ``(Transform, Velocity, Hitbox)`` (each
     or None). ``ValueError`` naming the problem otherwise."""
+    for comp in components:  # before anything is checked (or normalised) in place
+        check_is_component("spawn", comp)
     kinds: dict[type, Any] = {}
     for comp in components:
-        if comp is None or isinstance(comp, type):
-            raise InvalidValue(f"spawn takes component instances, got {comp!r}")
         check_component(comp)
         if type(comp) in kinds:
             raise InvalidValue(f"spawn got two {type(comp).__name__} components: {components!r}")
@@ -58,6 +121,7 @@ def spawn_components(components: tuple[Any, ...]) -> tuple[Any, Any, Any]:
 
 def check_added_component(store: BodyStore, entity: int, component: Any) -> None:
     """Check ``component`` before it is added to ``entity`` (in the current esper world)."""
+    check_is_component("add_component", component)
     if isinstance(component, Transform):
         raise InvalidValue("a Transform is given at spawn and edited in place; it cannot be replaced")
     try:

@@ -21,6 +21,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .collision.results import Vec2
+from .entities import is_value_type
+from .shapes import Shape
 from .validation import InvalidValue
 
 __all__ = ["CollisionEvent", "CollisionHandlers", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_find",
@@ -187,8 +189,15 @@ def _type_name(t: type) -> str:
 
 
 def _component_class(role: str, value: object) -> type:
-    """``value`` if it is a class, else :class:`InvalidValue` naming what was passed."""
+    """``value`` if it is a class whose instances may be components, else :class:`InvalidValue`
+    naming what was passed."""
     if isinstance(value, type):
+        if issubclass(value, Shape):
+            raise InvalidValue(f"on_collision got the shape class {value.__name__} as {role}: a shape is held by a "
+                               "Hitbox, never a component of its own; pass Hitbox (or a class of your own)")
+        if is_value_type(value):
+            raise InvalidValue(f"on_collision got the class {value.__name__} as {role}: {value.__name__} is not a "
+                               "component class (spawn refuses its instances); pass a class of your own")
         return value
     if isinstance(value, str):
         hint = f"pass the class itself ({value}), not its name"

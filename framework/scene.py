@@ -304,8 +304,6 @@ class Scene:
         self._activate()
         if not self.exists(entity):
             raise InvalidValue(f"entity {entity!r} does not exist")
-        if component is None or isinstance(component, type):
-            raise InvalidValue(f"add_component takes a component instance, got {component!r}")
         store = self.bodies.store
         check_added_component(store, entity, component)
         old = esper.try_component(entity, type(component))
