@@ -236,12 +236,67 @@ class Response(Stage):
     def redirect(
         self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, depth: F64Array, hit: BoolArray,
     ) -> None:
-        """Re-aim (in place) pushes that would leave a tile through a face another tile covers."""
+        """Re-aim (in place) pushes of bodies deep inside a static box (:meth:`_deep_inside`),
+        and pushes that would leave a tile through a face another tile covers."""
         b = self.bodies
         if b.n_static == 0:
             return
+        self._deep_inside(ra, rb, nx, ny, depth, hit)
         rank = depth.copy()
         self.internal_faces.redirect(b.store, b.geometry, b.hash, b.rows_of, ra, rb, nx, ny, depth, hit, rank)
+
+    def _deep_inside(self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, depth: F64Array,
+                     hit: BoolArray) -> None:
+        """Re-aim (in place) the pushes of movable bodies whose centre lies inside a static AABB.
+
+        The least push out of a slab is through its nearer face: a box spawned or teleported into
+        the middle of a floor one unit thick was pushed out of its bottom (the tie between top and
+        bottom goes down by the contract's order) and fell forever (issue 34). So for such a body:
+        if its centre was outside the box at the step's start, it came in this step and goes back
+        out the side it came from; otherwise (spawned or teleported there) out of the face against
+        gravity where that push is at most the body's own extent along gravity longer than the
+        least (a box in a floor pops up on top; a ball in the middle of a tall wall still goes out
+        of the near side), else the least. Each push is along the face's normal, exactly as far as
+        takes the body's bounds clear of that face. (Faces other tiles cover: see
+        :mod:`~framework.systems.internal_faces`, which runs after this.)"""
+        store = self.bodies.store
+        static_a = (store.body[ra] == STATIC) & (store.kind[ra] == KIND_AABB)
+        static_b = (store.body[rb] == STATIC) & (store.kind[rb] == KIND_AABB)
+        pick = np.flatnonzero(hit & (static_a ^ static_b))
+        if pick.size == 0:
+            return
+        flip = static_b[pick]  # the static box is b: the normal (a to b) is the push, negated
+        s = np.where(flip, rb[pick], ra[pick])
+        m = np.where(flip, ra[pick], rb[pick])
+        geom = self.bodies.geometry
+        geom.update_rows(store, m)  # (the solve may have moved them since the bounds were computed)
+        cx, cy = geom.hx[m], geom.hy[m]
+        inside = (geom.minx[s] < cx) & (cx < geom.maxx[s]) & (geom.miny[s] < cy) & (cy < geom.maxy[s])
+        if not inside.any():
+            return
+        pick, flip, s, m, cx, cy = pick[inside], flip[inside], s[inside], m[inside], cx[inside], cy[inside]
+        # the four pushes that take the body's bounds clear of each face: +x, -x, +y, -y
+        pushes = np.stack([geom.maxx[s] - geom.minx[m], geom.maxx[m] - geom.minx[s],
+                           geom.maxy[s] - geom.miny[m], geom.maxy[m] - geom.miny[s]])
+        face_x = np.array([1.0, -1.0, 0.0, 0.0])
+        face_y = np.array([0.0, 0.0, 1.0, -1.0])
+        choice = np.argmin(pushes, axis=0)
+        gx, gy = self.pipeline.active_gravity()
+        if gx or gy:  # the face against gravity, if not much farther
+            up = int(np.argmax(-(face_x * gx + face_y * gy)))
+            extent = np.where(face_x[up] != 0.0, geom.maxx[m] - geom.minx[m], geom.maxy[m] - geom.miny[m])
+            least = pushes[choice, np.arange(pick.size)]
+            choice = np.where(pushes[up] <= least + extent, up, choice)
+        frame = self.pipeline.frame
+        sx, sy = frame.start_x, frame.start_y
+        if sx.size > int(m.max()):  # came in this step: back out the way it came
+            x0, y0 = cx - (store.x[m] - sx[m]), cy - (store.y[m] - sy[m])
+            came = np.select([x0 >= geom.maxx[s], x0 <= geom.minx[s], y0 >= geom.maxy[s], y0 <= geom.miny[s]],
+                             [0, 1, 2, 3], -1)
+            choice = np.where(came >= 0, came, choice)
+        sign = np.where(flip, -1.0, 1.0)
+        nx[pick], ny[pick] = sign * face_x[choice], sign * face_y[choice]
+        depth[pick] = pushes[choice, np.arange(pick.size)]
 
     def remeasure(self, ra: IntpArray, rb: IntpArray) -> batch.ContactArrays:
         """The pairs ``(ra, rb)`` measured again where the bodies now are (pairs within rounding of
