@@ -56,6 +56,10 @@ def image_size(path: str | Path) -> tuple[int, int]:
             head = f.read(32)
     except OSError as exc:
         raise InvalidValue(f"image file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    except ValueError as exc:  # a name with a NUL character in it ("embedded null byte")
+        if isinstance(exc, InvalidValue):
+            raise
+        raise InvalidValue(f"image file {str(path)!r} cannot be read: {exc}") from None
     if head[:8] == _PNG_SIGNATURE and head[12:16] == b"IHDR" and len(head) >= 24:
         w, h = struct.unpack(">II", head[16:24])
     elif head[:6] in (b"GIF87a", b"GIF89a") and len(head) >= 10:

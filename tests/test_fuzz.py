@@ -18,6 +18,7 @@ import contextlib
 import json
 import os
 import random
+import re
 import resource
 import time
 from collections import Counter
@@ -423,6 +424,198 @@ def test_snapshot_file_descriptions(tmp_path_factory, blob):
     or loaded; refused, the scene is as it was; and nothing a hostile class name names ever runs."""
     _load_or_refuse(tmp_path_factory, blob, "snapshot file description (structure)")
     assert not MARKER.exists(), "a class named in the file ran"
+    _write_report()
+
+
+# --- hostile values: every number and literal of a valid file ----------------------------------------
+#
+# What found issue 34's loader escapes: each number, literal or string of a valid file (chosen by the
+# key it belongs to, so that a map's few header numbers are as likely as its hundreds of tile ids)
+# replaced by a value that breaks the usual conversions: ints beyond float64 (10**400) or beyond
+# Python's int max str digits (4,301 digits), unicode digits ('²', '٣'), 1e999, -0.0, NaN, nesting
+# just under and over the decoder's recursion limit. Tilesets are fuzzed with their image's header
+# too (the image is the stranger's file as well).
+
+SLOW = os.environ.get("RUN_SLOW") == "1"
+HOSTILE_EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "1000" if SLOW else "100"))  # a loader, in the normal run
+HOSTILE_FUZZ = settings(max_examples=HOSTILE_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
+HOSTILE_FUZZ_SNAPSHOTS = settings(HOSTILE_FUZZ, max_examples=max(1, HOSTILE_EXAMPLES // 3))  # each builds a scene
+_DEPTH = 1000  # sys.getrecursionlimit(): the decoder gives up around here
+HOSTILE_NUMBERS = [b"1" + b"0" * 400, b"-1" + b"0" * 400, b"9" * 4301, b"-" + b"9" * 4301, b"1" + b"0" * 4300,
+                   b"1e999", b"-1e999", b"-0.0", b"-0", b"NaN", b"-Infinity", b"1e-400", b"5e-324",
+                   b"1.7976931348623157e308",
+                   b"2147483648", b"4294967296", b"18446744073709551616", b"-2147483649", b"0", b"-1", b"0.5",
+                   b'"\xc2\xb2"', b'"\xd9\xa3"', b'"--2"', b'"1e999"', b'"' + b"9" * 5000 + b'"', b"true", b"null",
+                   b"[]", b"{}", b"[" * (_DEPTH - 40) + b"]" * (_DEPTH - 40), b"[" * (_DEPTH - 5) + b"]" * (_DEPTH - 5),
+                   b'{"a":' * (_DEPTH - 40) + b"0" + b"}" * (_DEPTH - 40)]
+HOSTILE_STRINGS = [b'"\xc2\xb2"', b'"\xd9\xa3"', b'"--2"', b'"-"', b'""', b'"+1"', b'" 1"',
+                   b'"1' + b"0" * 400 + b'"', b'"' + b"9" * 5000 + b'"', b'"\\ud800"', b'"NaN"', b'"-0.0"',
+                   b'"\\u0000"', b'"solid"', b'"platform"']
+_TOKEN = re.compile(rb'"(?:[^"\\]|\\.)*"|-?(?:0|[1-9][0-9]*)(?:\.[0-9]+)?(?:[eE][+-]?[0-9]+)?|true|false|null')
+_KEY = re.compile(rb'"((?:[^"\\]|\\.)*)"\s*:\s*$')
+
+
+def _spots(data: bytes) -> dict[bytes, list[tuple[int, int, bool]]]:
+    """The file's tokens grouped by the key they belong to (the nearest key before them):
+    ``(start, end, is_a_string)``."""
+    groups: dict[bytes, list[tuple[int, int, bool]]] = {}
+    key = b""
+    for m in _TOKEN.finditer(data):
+        before = _KEY.search(data, max(0, m.start() - 200), m.start())
+        if before:
+            key = before.group(1)
+        is_key = data[m.end():m.end() + 3].lstrip()[:1] == b":"
+        groups.setdefault(b"<key>" if is_key else key, []).append((m.start(), m.end(), m.group().startswith(b'"')))
+    return groups
+
+
+@st.composite
+def hostile(draw, data: bytes) -> bytes:
+    """``data`` with one to three of its numbers, literals or strings replaced by hostile values (a
+    string by a hostile string or value, so keys stay keys)."""
+    rng = random.Random(draw(st.integers(0, 2**32)))
+    groups = _spots(data)
+    names = sorted(groups)
+    picks = []
+    for _ in range(draw(st.integers(1, 3))):
+        start, end, text = rng.choice(groups[rng.choice(names)])
+        key = data[end:end + 3].lstrip()[:1] == b":"
+        picks.append((start, end, rng.choice(HOSTILE_STRINGS if key else
+                                             (HOSTILE_STRINGS + HOSTILE_NUMBERS) if text else HOSTILE_NUMBERS)))
+    out, last = [], 0
+    for start, end, value in sorted(set(picks)):
+        if start >= last:
+            out += [data[last:start], value]
+            last = end
+    return b"".join(out) + data[last:]
+
+
+@HOSTILE_FUZZ
+@given(st.data())
+def test_tiled_maps_with_hostile_values(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("tmj") / "map.tmj"
+    path.write_bytes(data.draw(hostile(TMJ)))
+    attempt("Tiled map (.tmj), hostile values", lambda: load_level(path), (LevelError,))
+    _write_report()
+
+
+@HOSTILE_FUZZ
+@given(st.data())
+def test_text_levels_with_hostile_characters(tmp_path_factory, data):
+    rng = random.Random(data.draw(st.integers(0, 2**32)))
+    text = bytearray(TEXT)
+    for _ in range(rng.randint(1, 3)):
+        i = rng.randrange(len(text))
+        text[i:i + 1] = rng.choice(["\u00b2", "\u0663", "\u2028", "\x85", "\x00", "\ufeff", "\r", "M~~", "~"]).encode()
+    path = tmp_path_factory.mktemp("txt") / "map.txt"
+    path.write_bytes(bytes(text))
+    attempt("text level (.txt), hostile characters", lambda: load_level(path), (LevelError,))
+    _write_report()
+
+
+@HOSTILE_FUZZ
+@given(st.data())
+def test_replays_with_hostile_values(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("replay") / "r.jsonl"
+    path.write_bytes(data.draw(hostile(REPLAY)))
+    attempt("replay, hostile values", lambda: Replay.load(path), (InvalidValue,))
+    _write_report()
+
+
+GOLDEN_SHORT = None  # a 5-step trace: the hostile fuzzing replays the scene, so fewer steps, more inputs
+
+
+def _golden_short() -> bytes:
+    global GOLDEN_SHORT
+    if GOLDEN_SHORT is None:
+        import tempfile
+
+        from framework.testing import check_golden
+
+        with tempfile.TemporaryDirectory() as tmp:
+            p = Path(tmp) / "g.json"
+            check_golden(_golden_scene(), p, 5, update=True)
+            GOLDEN_SHORT = p.read_bytes()
+    return GOLDEN_SHORT
+
+
+@HOSTILE_FUZZ
+@given(st.data())
+def test_golden_traces_with_hostile_values(tmp_path_factory, data):
+    from framework.testing import GoldenMismatch, check_golden
+
+    path = tmp_path_factory.mktemp("golden") / "g.json"
+    path.write_bytes(data.draw(hostile(_golden_short())))
+    scene = _golden_scene()
+    try:
+        attempt("golden trace, hostile values", lambda: check_golden(scene, path, 5, update=False),
+                (InvalidValue, GoldenMismatch))
+    finally:
+        scene.close()
+    _write_report()
+
+
+@HOSTILE_FUZZ_SNAPSHOTS
+@given(st.data())
+def test_snapshot_file_descriptions_with_hostile_values(tmp_path_factory, data):
+    import io
+
+    arrays, meta = _description()
+    arrays["__meta__"] = np.frombuffer(data.draw(hostile(json.dumps(meta).encode())), dtype=np.uint8)
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    _load_or_refuse(tmp_path_factory, buf.getvalue(), "snapshot file description, hostile values")
+    assert not MARKER.exists(), "a class named in the file ran"
+    _write_report()
+
+
+TILESET = json.dumps({
+    "type": "tileset", "name": "hero", "image": "hero.png", "imagewidth": 64, "imageheight": 32, "tilewidth": 16,
+    "tileheight": 16, "margin": 0, "spacing": 0, "columns": 4, "tilecount": 8, "tiledversion": "1.10.2",
+    "tiles": [{"id": 0, "type": "run", "animation": [{"tileid": 0, "duration": 100}, {"tileid": 1, "duration": 150},
+                                                      {"tileid": 7, "duration": 0.5}]},
+              {"id": 4, "properties": [{"name": "speed", "type": "float", "value": 2.5}],
+               "animation": [{"tileid": 4, "duration": 1000}]}],
+}).encode()
+IMAGE_SIZES = [0, 1, 15, 16, 17, 64, 4096, 4112, 40_000, 65_536, 2**31 - 1, 2**31, 2**32 - 1]
+
+
+def _png_header(width: int, height: int) -> bytes:
+    import struct
+
+    return b"\x89PNG\r\n\x1a\n\x00\x00\x00\x0dIHDR" + struct.pack(">II", width, height) + b"\x08\x06\x00\x00\x00"
+
+
+def test_the_valid_tileset_loads():
+    import tempfile
+
+    from framework.sprites import SpriteSheet
+
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "hero.png").write_bytes(_png_header(64, 32))
+        (Path(tmp) / "hero.tsj").write_bytes(TILESET)
+        sheet = SpriteSheet.from_tiled(Path(tmp) / "hero.tsj")
+        assert len(sheet) == 8 and sorted(sheet.animations) == [0, 4]
+
+
+@HOSTILE_FUZZ
+@given(st.data())
+def test_tilesets_with_hostile_values(tmp_path_factory, data):
+    from framework.sprites import SpriteSheet
+
+    where = tmp_path_factory.mktemp("tileset")
+    rng = random.Random(data.draw(st.integers(0, 2**32)))
+    width, height = 64, 32
+    what = data.draw(st.sampled_from(["json", "json", "image", "both"]))
+    text = TILESET
+    if what in ("image", "both"):
+        width, height = rng.choice(IMAGE_SIZES + [64]), rng.choice(IMAGE_SIZES + [32])
+    if what in ("json", "both"):
+        text = data.draw(hostile(TILESET))
+    (where / "hero.png").write_bytes(_png_header(width, height))
+    path = where / "hero.tsj"
+    path.write_bytes(text)
+    attempt("tileset (.tsj), hostile values", lambda: SpriteSheet.from_tiled(path), (InvalidValue,))
     _write_report()
 
 

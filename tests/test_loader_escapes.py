@@ -278,6 +278,13 @@ def test_a_tileset_image_that_is_not_a_regular_file_is_refused(tmp_path):
     assert "not a regular file" in _refused(path, lambda: SpriteSheet.from_tiled(path), InvalidValue)
 
 
+def test_a_tileset_image_named_with_a_nul_character_is_refused(tmp_path):
+    """Found by the hostile-value fuzzing: ``"image": "\\u0000"`` raised ``os.stat``'s ValueError."""
+    path = tmp_path / "nul.tsj"
+    path.write_text('{"image":"\\u0000","tilewidth":16,"tileheight":16}')
+    assert "cannot be read" in _refused(path, lambda: SpriteSheet.from_tiled(path), InvalidValue)
+
+
 def test_animation_durations_beyond_float64_are_refused():
     frame = Frame("x.png", 0, 0, 1, 1)
     with pytest.raises(InvalidValue, match="finite and > 0 seconds"):
