@@ -12,6 +12,7 @@ from typing import Any
 import esper
 
 from .components import Body, Hitbox, Transform, Velocity, check_component
+from .limits import check_hitbox_limits, check_position
 from .shapes import Shape
 from .sprites import Animation, Frame
 from .store import BodyStore
@@ -116,6 +117,10 @@ def spawn_components(components: tuple[Any, ...]) -> tuple[Any, Any, Any]:
         raise InvalidValue("a static body never moves: give it no Velocity (or make it kinematic)")
     if v is not None and t is None:
         raise InvalidValue("an entity with a Velocity needs a Transform")
+    if t is not None:
+        check_position(t.x, t.y)
+    if h is not None:
+        check_hitbox_limits(h)
     return t, v, h
 
 
@@ -128,6 +133,11 @@ def check_added_component(store: BodyStore, entity: int, component: Any) -> None
         check_component(component)
     except InvalidValue as exc:
         raise InvalidValue(f"entity {entity}: {exc}") from None
+    if isinstance(component, Hitbox):
+        try:
+            check_hitbox_limits(component)
+        except InvalidValue as exc:
+            raise InvalidValue(f"entity {entity}: {exc}") from None
     if isinstance(component, (Velocity, Hitbox)):
         if entity not in store.row_of:
             raise InvalidValue(f"entity {entity} has no Transform")

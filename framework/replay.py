@@ -220,9 +220,11 @@ class Replay:
                      meta=_meta(header.get("meta", {}), where))
         seen: dict[str, frozenset[str]] = {}  # a line read before: the same frame, the same frozenset
         frames = replay.frames
-        scan = _DECODER.scan_once  # one JSON value from the start of a line, no decoder made per line
+        # one JSON value from the start of a line, no decoder made per line (scan_once is set by
+        # JSONDecoder.__init__; typeshed does not declare it)
+        scan = _DECODER.scan_once  # type: ignore[attr-defined]
         for i, line in enumerate(lines, start=1):
-            held = seen.get(line)
+            held: frozenset[str] | None = seen.get(line)
             if held is None:
                 try:
                     frame, end = scan(line, 0)
@@ -232,15 +234,16 @@ class Replay:
                     frame = parse(i, line)
                 if type(frame) is not list:
                     raise InvalidValue(f"{name}: line {i + 1}: a frame must be a list of key names, got {line[:80]!r}")
+                keys: frozenset[str] | None = None
                 try:  # the common case at C speed: distinct non-empty key names
-                    held = frozenset(frame)
+                    keys = frozenset(frame)
                     "".join(frame)  # a TypeError unless every member is text
-                    ok = len(held) == len(frame) and "" not in held
+                    ok = len(keys) == len(frame) and "" not in keys
                 except TypeError:
                     ok = False
-                if not ok:
-                    held = _keys(frame, f"{name}: line {i + 1}")  # raises, naming what is wrong
-                seen[line] = held
+                if not ok or keys is None:
+                    keys = _keys(frame, f"{name}: line {i + 1}")  # raises, naming what is wrong
+                seen[line] = held = keys
             frames.append(held)
         return replay
 

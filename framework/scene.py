@@ -31,7 +31,9 @@ from .entities import MissingComponent, check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
 from .frame import StepFrame, add_counters
 from .input import Input
+from .limits import check_motion
 from .queries import ALL_LAYERS, SceneHit, ShapeHit, SpatialQueries
+from .rollback import StepRollback
 from .shapes import Shape
 from .snapshot import Snapshot
 from .snapshot import restore as restore_snapshot
@@ -435,18 +437,23 @@ class Scene:
     def step(self, dt: float) -> None:
         """Advance the scene by ``dt`` seconds (finite, > 0), in ``substeps`` equal sub-steps.
 
-        A component holding NaN, inf or a non-number makes this raise ``ValueError`` naming the
-        entity and the field, before anything changes. One that game code spoils during the step
-        (from a system or a handler), or that overflows, is reported at the end of the step (which
-        is then complete: frame, time and events included). With several sub-steps, each runs the whole
-        pipeline (game systems and handlers included; rendering only after the last), the events
-        of all sub-steps are reported in order, and the counters add up.
+        A component holding NaN, inf or a non-number, a body beyond the scene's coordinates or a
+        hitbox beyond its sizes and masses (:mod:`framework.limits`), or a ``dt`` that could carry a
+        body beyond those coordinates, makes this raise ``ValueError`` naming the entity and the
+        field, before anything changes. A step that fails (a stage, system or processor raises,
+        or one writes a bad value into a body, or a motion overflows) is undone before the
+        exception propagates: the scene is exactly as it was before the step (see
+        :mod:`framework.rollback`), with a note on the exception saying so. With several
+        sub-steps, each runs the whole pipeline (game systems and handlers included; rendering
+        only after the last), the events of all sub-steps are reported in order, and the counters
+        add up.
 
         A collision handler that raises does not cut the step short: the other handlers still run
         (every sub-step too), the step completes (frame, time, events, despawns), and then the
         first handler's exception is raised, unchanged in type, with a note naming the handler,
         the event's kind and entities, and the step (and a note listing any other handler that
-        raised)."""
+        raised). A bad value a handler writes is reported at the end of the step (which is then
+        complete), and the next step refuses to start until it is mended."""
         self._activate()
         if self._stepping:
             raise InvalidValue("step() was called from inside a step (a system or a collision handler)")
@@ -456,32 +463,44 @@ class Scene:
         characters = self._stages["character"]
         if isinstance(characters, CharacterStage) and characters.wanted():
             characters.check()
-        self._totals = None
+        movers = store.active()[0]
+        check_motion(store.entity[movers], store.x[movers], store.y[movers], store.vx[movers], store.vy[movers],
+                     dt, self._pipeline.active_gravity())
+        before = StepRollback(self)
         n = self.substeps
         errors: list[Exception] = []  # raised by collision handlers, raised once the step is complete
-        if n == 1:
-            self._substep(dt, render=True, checked=True, errors=errors, where=f", in step {self.frame + 1}")
-        else:
-            events: list[CollisionEvent] = []
-            total: dict[str, Any] = {}
-            for k in range(n):
-                self._substep(dt / n, render=k == n - 1, checked=k == 0, errors=errors,
-                              where=f", in step {self.frame + 1} (sub-step {k + 1} of {n})")
-                events.extend(self.events)
-                add_counters(total, self.counters)
-            self._totals = (events, total)
+        try:
+            self._totals = None
+            if n == 1:
+                self._substep(dt, render=True, checked=True, errors=errors, where=f", in step {self.frame + 1}")
+            else:
+                events: list[CollisionEvent] = []
+                total: dict[str, Any] = {}
+                for k in range(n):
+                    self._substep(dt / n, render=k == n - 1, checked=k == 0, errors=errors,
+                                  where=f", in step {self.frame + 1} (sub-step {k + 1} of {n})")
+                    events.extend(self.events)
+                    add_counters(total, self.counters)
+                self._totals = (events, total)
+        except Exception as exc:
+            if before.restore(self):
+                exc.add_note(f"step {self.frame + 1} failed and was undone: the scene is as it was before it")
+            else:
+                exc.add_note(f"step {self.frame + 1} failed after a system changed the scene's structure (a Hitbox "
+                             "or Velocity added or removed): the scene is left as the failure found it")
+            raise
         self.frame += 1
         self.time += dt
         inp = self.resources.get(Input)
         if inp is not None:
             inp.end_step()
         try:
-            # A bad value written by game code during the step (a system or a handler), or a
-            # motion that overflowed: reported now, by the step that made it.
+            # A bad value written by a collision handler (after the step's physics was done, and
+            # kept): reported now, by the step that made it.
             store.check()
         except InvalidValue as exc:
-            bad = InvalidValue(f"{exc} (at the end of step {self.frame}: written by a system or a collision "
-                               "handler during the step, or an overflow)")
+            bad = InvalidValue(f"{exc} (at the end of step {self.frame}: written by a collision handler during "
+                               "the step)")
             if not errors:
                 raise bad from None
             errors[0].add_note(f"and at the end of step {self.frame}: {bad}")
@@ -501,17 +520,24 @@ class Scene:
         store = self.bodies.store
         self._stepping = True
         frame = self._pipeline.frame = self._pipeline.frame.next(dt, render)
+        done = False
         try:
             if not checked:
                 store.check()
             store.apply_hitbox_changes()
             esper.process(dt)
+            try:  # a bad value a system wrote, or a motion that overflowed: the step failed
+                store.check()
+            except InvalidValue as exc:
+                raise InvalidValue(f"{exc} (written during step {self.frame + 1} by a system or processor, or "
+                                   "an overflow)") from None
             self._dispatching = True
             self.handlers.dispatch(self, lambda: frame.events, errors, where)
+            done = True
         finally:
             self._stepping = self._dispatching = False
             pending, self._pending_despawn = self._pending_despawn, []
-            for e in pending:
+            for e in pending if done else ():  # (a failed step drops them: it is undone)
                 if esper.entity_exists(e):
                     self._remove(e)
 

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import Body, Hitbox, Transform, Velocity, Visual, check_hitbox_field, check_mass_and_density
+from .limits import MAX_COORD, check_hitbox_limits, check_position
 from .shapes import AABB, Capsule, Circle
 from .validation import InvalidValue
 
@@ -499,9 +500,21 @@ class BodyStore:
                 if name == "body" and value is Body.STATIC and self.cols["has_vel"][self.row_of[e]]:
                     raise InvalidValue(f"entity {e}: Hitbox body is static, but a static body never moves: "
                                        "remove its Velocity first (or make it kinematic)")
+            try:
+                check_mass_and_density(hb)
+                check_hitbox_limits(hb)
+            except InvalidValue as exc:
+                raise InvalidValue(f"entity {e}: {exc}") from None
         if problems:
             e, col, v = min(problems, key=lambda p: (p[0], p[1]))
             raise InvalidValue(f"entity {e}: {_FIELD_NAMES[col]} must be a finite number, got {v!r}")
+        # positions within the scene's range (framework.limits)
+        with np.errstate(invalid="ignore"):
+            far = np.maximum(np.abs(self.cols["x"][sel]), np.abs(self.cols["y"][sel])) > MAX_COORD
+        if far.any():
+            row = int(np.atleast_1d(rows)[np.flatnonzero(far)[0]])
+            e = int(self.cols["entity"][row])
+            check_position(float(self.cols["x"][row]), float(self.cols["y"][row]), f"entity {e}: Transform")
         self.written.clear()
 
     def apply_hitbox_changes(self) -> set[int]:

@@ -404,7 +404,8 @@ class Solve:
             cs = self.cs
             wx, wy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.rows.size)
             far = np.hypot(wx, wy)
-            scale = np.minimum(1.0, self.reach / np.maximum(far, 1e-300))
+            with np.errstate(over="ignore"):  # (a large reach over a tiny move: no scaling)
+                scale = np.minimum(1.0, self.reach / np.maximum(far, 1e-300))
             return push0 * np.minimum(scale[self.a], scale[self.b])
         return push0.copy()
 
