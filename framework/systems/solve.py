@@ -262,7 +262,8 @@ class Solve:
         (the floor, or a body resting on it...), the lower body keeps still and the push lifts the
         upper one: a stack is pushed out from the ground up, each body exactly onto the one below
         (Gauss-Seidel alone converges on a stack only geometrically, and a body on top would press
-        the one below into it). Elsewhere the push is shared by inverse mass. (Velocities: see
+        the one below into it). Elsewhere the push is shared by inverse mass, and so it is at a
+        contact whose friction rolls a circle (:meth:`_rolling`). (Velocities: see
         :meth:`_velocity_shares`.) With the turns of contacts at points (None elsewhere):
         ``(share_a, share_b, turns)``."""
         gx, gy = self.gravity
@@ -275,9 +276,24 @@ class Solve:
         up = -(cs.nx * gx + cs.ny * gy) / g  # > 0.5: b rests on a
         fixed_a, fixed_b = self.share_a == 0.0, self.share_b == 0.0
         held = solver.supported(self.order, self.a, self.b, up, fixed_a, fixed_b, self.rows.size)
-        self.b_on_a = b_on_a = both & (up > 0.5) & held[self.a]
-        self.a_on_b = a_on_b = both & (up < -0.5) & held[self.b]
+        rests = both & ~self._rolling()
+        self.b_on_a = b_on_a = rests & (up > 0.5) & held[self.a]
+        self.a_on_b = a_on_b = rests & (up < -0.5) & held[self.b]
         return self._lower_stays(b_on_a, a_on_b)
+
+    def _rolling(self) -> BoolArray:
+        """The contacts whose friction rolls a circle (one of its bodies is a circle that friction
+        turns). These keep shares by inverse mass in both halves: a rolling circle is held still
+        in a pile only by the friction of the bodies resting on it, pressed on it by their weight;
+        kept still for the normal push and impulse of the body above, it carried its own weight
+        alone, the friction that stops it rolling was bounded by that, and a pile of rolling
+        circles flowed on for ever (issue 33 item 5a)."""
+        fr = self.fr
+        if fr is None or not fr.turns:
+            return np.zeros(self.cs.size, dtype=bool)
+        store, cs = self.store, self.cs
+        circle_a, circle_b = store.kind[cs.ra] == KIND_CIRCLE, store.kind[cs.rb] == KIND_CIRCLE
+        return (circle_a & (fr.turn_a != 0.0)) | (circle_b & (fr.turn_b != 0.0))
 
     def _lower_stays(self, b_on_a: BoolArray, a_on_b: BoolArray) -> tuple[Any, ...]:
         """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still, and
