@@ -435,6 +435,8 @@ class HandlerMachine(RuleBasedStateMachine):
                 scene.despawn(10**6)
             scene.despawn(10**6)  # refused: the handler's exception
         elif action == "spawn":
+            if len(scene.entities) >= 40:  # (both scenes alike: spawns from handlers make contacts whose
+                return  # handlers spawn again; unbounded, a run reached thousands and ran out of memory)
             e = self._spawn(scene, 0.3 * (self.cursor[who] % 7) - 1.0, 1.0, 0.5, 0.0, A, 0.3)
             if main:
                 self._born(e, {Transform, Velocity, Hitbox, A})
