@@ -291,8 +291,12 @@ class Scene:
         that does not exist any more was despawned."""
         if isinstance(entity, bool) or not isinstance(entity, Integral):
             return False
-        count = re.fullmatch(r"count\((-?\d+)\)", repr(esper._entity_count))  # the next id esper gives out
-        return count is not None and 1 <= int(entity) < int(count.group(1))
+        return 1 <= int(entity) < self._next_entity()
+
+    def _next_entity(self) -> int:
+        """The next id esper gives out in this scene's world."""
+        count = re.fullmatch(r"count\((-?\d+)\)", repr(esper._entity_count))
+        return int(count.group(1)) if count is not None else 0
 
     def exists(self, entity: int) -> bool:
         """Whether ``entity`` is an entity of this scene (not despawned, nor waiting to be)."""
