@@ -139,17 +139,23 @@ def deepest_overlap(s: Scene, ents: list[int]) -> float:
     return worst
 
 
+MIXED_NOT_YET = pytest.mark.xfail(
+    strict=True, reason="without friction this crowd rests after 33 s (13-39 s over five seeds): a box sliding on a "
+    "flat top stops only at a wall; with friction it rests within 2.4 s (the friction case below). (Issue 33's "
+    "shock-propagation change let it rest in 16 s while it applied to every hit; limited to a heavier body hitting a "
+    "lighter one, since a 20-row pyramid of turning boxes fell apart without it, it is back to 33 s.)")
+
+
 @pytest.mark.parametrize(("kind", "seconds", "friction"), [
-    ("balls", 30, None), ("boxes", 30, None), ("mixed", 30, None),
+    ("balls", 30, None), ("boxes", 30, None), pytest.param("mixed", 30, None, marks=MIXED_NOT_YET),
     ("mixed", 60, None), ("mixed", 30, 0.5)])
 def test_a_crowd_dropped_into_a_pit_comes_to_rest(kind, seconds, friction):
     """The issue's goal: a crowd rests within 30 s, with no overlap deeper than 0.02 and nobody
     outside. Balls alone (9 to 15 s over five seeds) and boxes alone (under 2 s) meet it. Half and
     half, without friction, a box that lands on a flat top with some sideways speed slides on until
-    it meets a wall: that crowd rested after 13 to 39 s depending on the seed (measured 2026-11-25),
-    and this seed's within 30 s once a body hitting another no longer meets it as immovable support
-    (issue 33 item 5; it was a strict xfail before). With friction 0.5 the same crowd rests in
-    1.7 to 2.4 s over five seeds (2026-11-25)."""
+    it meets a wall: that crowd rests after 13 to 39 s depending on the seed (measured 2026-11-25).
+    Its 30 s case is a strict xfail (frictionless boxes do slide on); the 60 s case guards what
+    holds. With friction 0.5 the same crowd rests in 1.7 to 2.4 s over five seeds (2026-11-25)."""
     s, ents = crowd(kind, friction=friction)
     with s:
         for _ in range(60 * seconds):
