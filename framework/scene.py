@@ -467,7 +467,7 @@ class Scene:
         characters = self._stages["character"]
         if isinstance(characters, CharacterStage) and characters.wanted():
             characters.check()
-        movers = store.active()[0]
+        movers = store.active_sel()[0]  # (a slice where the movers are one run: views, no copies)
         check_motion(store.entity[movers], store.x[movers], store.y[movers], store.vx[movers], store.vy[movers],
                      dt, self._pipeline.active_gravity())
         before = StepRollback(self)

@@ -144,17 +144,16 @@ class Response(Stage):
         they met last; overlapping along both, the least overlap as before. The events keep the
         contract's normal; only the solve's changes."""
         store = self.bodies.store
-        sx, sy = frame.start_x, frame.start_y
         boxes = np.flatnonzero((store.kind[ra] == KIND_AABB) & (store.kind[rb] == KIND_AABB))
-        if boxes.size == 0 or sx.size <= max(int(ra.max()), int(rb.max())):
-            return nx, ny, depth
         a, b = ra[boxes], rb[boxes]
+        ma, mb = self._moved(frame, a), self._moved(frame, b)
+        if boxes.size == 0 or ma is None or mb is None:
+            return nx, ny, depth
         geom = self.bodies.ensure_geometry()
         wx, wy = store.hw[a] + store.hw[b], store.hh[a] + store.hh[b]
         # centre offsets (b - a) now and at the step's start (the hitboxes moved with their bodies)
         cx, cy = geom.hx[b] - geom.hx[a], geom.hy[b] - geom.hy[a]
-        cx0 = cx - ((store.x[b] - sx[b]) - (store.x[a] - sx[a]))
-        cy0 = cy - ((store.y[b] - sy[b]) - (store.y[a] - sy[a]))
+        cx0, cy0 = cx - (mb[0] - ma[0]), cy - (mb[1] - ma[1])
         ox, oy = wx - np.abs(cx), wy - np.abs(cy)  # overlaps now (> 0 along both: they overlap)
         ox0, oy0 = wx - np.abs(cx0), wy - np.abs(cy0)  # ... and at the start (<= 0: apart)
         hair = 1e-6 * np.minimum(wx, wy)
@@ -199,16 +198,23 @@ class Response(Stage):
         return ((geom.minx[ra] - gx < geom.maxx[rb]) & (geom.minx[rb] - gx < geom.maxx[ra])
                 & (geom.miny[ra] - gy < geom.maxy[rb]) & (geom.miny[rb] - gy < geom.maxy[ra]))
 
+    def _moved(self, frame: StepFrame, rows: IntpArray) -> tuple[F64Array, F64Array] | None:
+        """How far each of ``rows`` has moved since the step began, or None if one was spawned
+        during the step (it has no start)."""
+        sx, sy, store = frame.start_x, frame.start_y, self.bodies.store
+        if rows.size and sx.size <= int(rows.max()):
+            return None
+        return store.x[rows] - sx[rows], store.y[rows] - sy[rows]
+
     def _support_gaps(self, frame: StepFrame, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array) -> F64Array:
         """How far the step's movement took last step's pairs apart along their normal, as a depth
         (<= 0; the caller subtracts the gap they ended last step with): a pair that fell together
         stays where it was (and is pushed apart again if a push below makes them overlap), one
         flying apart starts this much farther from touching."""
-        sx, sy, store = frame.start_x, frame.start_y, self.bodies.store
-        if ra.size == 0 or sx.size <= max(int(ra.max()), int(rb.max())):
+        ma, mb = self._moved(frame, ra), self._moved(frame, rb)
+        if ra.size == 0 or ma is None or mb is None:
             return np.zeros(ra.size)
-        gap = (((store.x[rb] - sx[rb]) - (store.x[ra] - sx[ra])) * nx
-               + ((store.y[rb] - sy[rb]) - (store.y[ra] - sy[ra])) * ny)
+        gap = (mb[0] - ma[0]) * nx + (mb[1] - ma[1]) * ny
         return np.minimum(-gap, 0.0)
 
     def _lands_on_one_way(self, frame: StepFrame, cs: Contacts) -> BoolArray:
@@ -301,13 +307,13 @@ class Response(Stage):
         flip = static_b[pick]  # the static box is b: the normal (a to b) is the push, negated
         s = np.where(flip, rb[pick], ra[pick])
         m = np.where(flip, ra[pick], rb[pick])
-        geom = self.bodies.geometry
-        geom.update_rows(store, m)  # (the solve may have moved them since the bounds were computed)
+        geom = self.bodies.geometry  # (the callers' measures brought the origins up to date)
         cx, cy = geom.hx[m], geom.hy[m]
         inside = (geom.minx[s] < cx) & (cx < geom.maxx[s]) & (geom.miny[s] < cy) & (cy < geom.maxy[s])
         if not inside.any():
             return
         pick, flip, s, m, cx, cy = pick[inside], flip[inside], s[inside], m[inside], cx[inside], cy[inside]
+        geom.update_rows(store, m)  # (their bounds: the solve may have moved them since they were computed)
         # the four pushes that take the body's bounds clear of each face: +x, -x, +y, -y
         pushes = np.stack([geom.maxx[s] - geom.minx[m], geom.maxx[m] - geom.minx[s],
                            geom.maxy[s] - geom.miny[m], geom.maxy[m] - geom.miny[s]])
@@ -320,10 +326,9 @@ class Response(Stage):
             extent = np.where(face_x[up] != 0.0, geom.maxx[m] - geom.minx[m], geom.maxy[m] - geom.miny[m])
             least = pushes[choice, np.arange(pick.size)]
             choice = np.where(pushes[up] <= least + extent, up, choice)
-        frame = self.pipeline.frame
-        sx, sy = frame.start_x, frame.start_y
-        if sx.size > int(m.max()):  # came in this step: back out the way it came
-            x0, y0 = cx - (store.x[m] - sx[m]), cy - (store.y[m] - sy[m])
+        moved = self._moved(self.pipeline.frame, m)
+        if moved is not None:  # came in this step: back out the way it came
+            x0, y0 = cx - moved[0], cy - moved[1]
             came = np.select([x0 >= geom.maxx[s], x0 <= geom.minx[s], y0 >= geom.maxy[s], y0 <= geom.miny[s]],
                              [0, 1, 2, 3], -1)
             choice = np.where(came >= 0, came, choice)
