@@ -500,8 +500,10 @@ class Scene:
             inp.end_step()
         try:
             # A bad value written by a collision handler (after the step's physics was done, and
-            # kept): reported now, by the step that made it.
-            store.check()
+            # kept): reported now, by the step that made it. (The pipeline's own values were
+            # checked before the handlers ran; only what game code wrote since needs a look.)
+            if store.written or store.bad or store.dirty_hitboxes:
+                store.check()
         except InvalidValue as exc:
             bad = InvalidValue(f"{exc} (at the end of step {self.frame}: written by a collision handler during "
                                "the step)")
