@@ -28,12 +28,13 @@ import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from .shapes import Shape
 from .validation import InvalidValue
 
 __all__ = ["MAX_COORD", "MAX_MASS", "MAX_SIZE", "MIN_INERTIA", "MIN_MASS", "MIN_SIZE", "check_hitbox_limits",
-           "check_motion", "check_position", "check_shape_limits"]
+           "check_motion", "check_position", "check_shape_limits", "motion_within", "rows_sound"]
 
 MIN_SIZE = 1e-6
 MAX_SIZE = 1e9
@@ -84,6 +85,32 @@ def check_position(x: float, y: float, what: str = "Transform") -> None:
     if max(abs(x), abs(y)) > MAX_COORD:
         raise InvalidValue(f"{what} ({x!r}, {y!r}) is beyond {MAX_COORD:g} from the origin: a scene takes "
                            f"coordinates within {MAX_COORD:g} (see framework.limits)")
+
+
+@njit(cache=True)
+def rows_sound(x, y, rot, vx, vy, w, rows, max_coord):
+    """Whether the ``rows`` of the six pose and velocity columns are all finite, with positions
+    within ``max_coord``: the common case of the step's checks, in one compiled pass (the checks
+    look column by column, for the message, only when this says no)."""
+    for k in range(rows.size):
+        r = rows[k]
+        if not (abs(x[r]) <= max_coord and abs(y[r]) <= max_coord):  # (NaN fails too)
+            return False
+        if not (math.isfinite(rot[r]) and math.isfinite(vx[r]) and math.isfinite(vy[r]) and math.isfinite(w[r])):
+            return False
+    return True
+
+
+@njit(cache=True)
+def motion_within(x, y, vx, vy, rows, dt, gx, gy, max_coord):
+    """The first of ``rows`` that a step of ``dt`` could carry beyond ``max_coord`` (see
+    :func:`check_motion`), or -1."""
+    ex, ey = abs(gx) * dt * dt, abs(gy) * dt * dt
+    for k in range(rows.size):
+        r = rows[k]
+        if not (abs(x[r]) + abs(vx[r]) * dt + ex <= max_coord and abs(y[r]) + abs(vy[r]) * dt + ey <= max_coord):
+            return k
+    return -1
 
 
 def check_motion(entities: np.ndarray, x: np.ndarray, y: np.ndarray, vx: np.ndarray, vy: np.ndarray,

@@ -3,11 +3,13 @@
 A step fails when its pipeline raises (a stage, or a game system or processor among them) or
 leaves a bad value in a body (a game system wrote NaN, a motion overflowed). The scene then puts
 back what the pipeline changes: every body's pose, velocity and sleep, the pairs the narrow phase
-tracks and the last step's frame (contacts, events, the solver's warm start), the sleeping
-stage's links, the character controllers' state, the step counter and clock; entities spawned
-during the step are removed and despawns it asked for are dropped. It costs a copy of eight
-columns a step (about 30 us at 10,000 bodies, about 1% of such a step). What game code did outside the scene (its own
-components' fields, resources, files) is the game's: the scene cannot take that back.
+tracks and the last step's frame (contacts, events, the solver's warm start), the soft step's
+candidate pairs and warm starts (kept by reference: its kernel never changes them in place), the
+sleeping stage's links, the character controllers' state, the step counter and clock; entities
+spawned during the step are removed and despawns it asked for are dropped. It costs a copy of eight
+columns a step (about 30 us at 10,000 bodies, about 1% of such a step). What game code did outside
+the scene (its own components' fields, resources, files) is the game's: the scene cannot take that
+back.
 
 If a system changed the scene's structure before the failure (added or removed a Hitbox or a
 Velocity), the rows no longer line up with what was kept: the scene is then left as the failure
@@ -46,6 +48,7 @@ class StepRollback:
         self.tracker = (tracker.active, tracker.keys)
         sleeping = scene._stages.get("sleeping")
         self.sleeping = None if sleeping is None else (sleeping.links, sleeping.wakes_seen)
+        self.soft = scene._stages["soft_step"].state()
         self.controllers = [(c, {name: getattr(c, name) for name in _CONTROLLER_STATE}, set(c.dropping))
                             for _e, c in esper.get_component(CharacterController)]
         self.clock = (scene.frame, scene.time, scene._totals)
@@ -70,6 +73,7 @@ class StepRollback:
         scene._pipeline.frame = self.frame
         tracker = scene.tracker
         tracker.active, tracker.keys = self.tracker
+        scene._stages["soft_step"].restore(self.soft)
         sleeping = scene._stages.get("sleeping")
         if sleeping is not None and self.sleeping is not None:
             sleeping.links, sleeping.wakes_seen = self.sleeping

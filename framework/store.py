@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import Body, Hitbox, Transform, Velocity, Visual, check_hitbox_field, check_mass_and_density
-from .limits import MAX_COORD, check_hitbox_limits, check_position
+from .limits import MAX_COORD, check_hitbox_limits, check_position, rows_sound
 from .shapes import AABB, Capsule, Circle
 from .validation import InvalidValue
 
@@ -466,13 +466,19 @@ class BodyStore:
         """Raise :class:`InvalidValue` naming the entity and field of the first bad value.
 
         Changes nothing, so a failed step leaves the scene exactly as it was."""
-        problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
         # Static rows change only through game code's writes: check those and the rows that move.
         rows = self.active()[2]
         sel = self.active_sel()[2]
         if self.written:
             extra = [self.row_of[e] for e in self.written if e in self.row_of]
             rows = sel = np.union1d(rows, np.array(extra, dtype=np.int64))
+        if not self.bad and not self.dirty_hitboxes:
+            c, n = self.cols, self.n
+            if rows_sound(c["x"][:n], c["y"][:n], c["rot"][:n], c["vx"][:n], c["vy"][:n], c["w"][:n], rows,
+                          MAX_COORD):
+                self.written.clear()
+                return
+        problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
         cols = ("x", "y", "rot", "vx", "vy", "w")
         # First all six at once: the sum of finite values is finite unless it overflows, which
         # only sends us to the column-by-column look below.

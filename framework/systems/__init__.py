@@ -12,18 +12,20 @@ from .narrow_phase import NarrowPhase
 from .render import Render
 from .response import Response
 from .sleeping import Sleeping
+from .soft_step import SoftStep
 from .stage import STAGES, Pipeline, Stage
 
 __all__ = ["BroadPhase", "CharacterStage", "ContinuousDetection", "Movement", "NarrowPhase", "Pipeline", "Render",
            "Response",
-           "STAGES", "Sleeping", "Stage", "pipeline_stages"]
+           "STAGES", "Sleeping", "SoftStep", "Stage", "pipeline_stages"]
 
 _ORDER: tuple[type[Stage], ...] = (
     Movement, CharacterStage, ContinuousDetection, BroadPhase, NarrowPhase, Response, Sleeping, Render)
 
 
 def pipeline_stages(pipeline: Pipeline) -> list[Stage]:
-    """One instance of every stage, in pipeline order, sharing ``pipeline``."""
+    """One instance of every stage, in pipeline order, sharing ``pipeline``; then the soft step,
+    which runs in place of movement, detection and response when the scene's solver is soft."""
     stages = [cls(pipeline) for cls in _ORDER]
     assert tuple(s.name for s in stages) == STAGES
-    return stages
+    return [*stages, SoftStep(pipeline)]

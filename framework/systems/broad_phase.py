@@ -24,6 +24,7 @@ class BroadPhase(Stage):
 
     name = "broad_phase"
     needs = frozenset({"detection"})
+    solver = "exact"
 
     def run(self, frame: StepFrame) -> bool:
         bodies = self.bodies

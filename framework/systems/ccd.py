@@ -30,6 +30,7 @@ class ContinuousDetection(Stage):
 
     name = "ccd"
     needs = frozenset({"continuous", "movement"})
+    solver = "exact"
 
     def run(self, frame: StepFrame) -> bool:
         rows = frame.ccd_rows

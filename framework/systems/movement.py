@@ -54,6 +54,7 @@ class Movement(Stage):
 
     name = "movement"
     needs = frozenset({"movement"})
+    solver = "exact"
 
     def __init__(self, pipeline) -> None:
         super().__init__(pipeline)

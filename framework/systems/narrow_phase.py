@@ -161,6 +161,7 @@ class NarrowPhase(Stage):
 
     name = "narrow_phase"
     needs = frozenset({"detection"})
+    solver = "exact"
 
     def __init__(self, pipeline) -> None:
         super().__init__(pipeline)

@@ -37,6 +37,7 @@ class Response(Stage):
 
     name = "response"
     needs = frozenset({"response"})
+    solver = "exact"
 
     def __init__(self, pipeline) -> None:
         super().__init__(pipeline)

@@ -38,7 +38,10 @@ class Pipeline:
     with the gravity effect); ``response_iterations``: passes of the response; ``renderer``: the
     render stage's renderer; ``view``: what the renderer is handed to draw (the scene);
     ``wanted_pairs``: without the events effect, which pairs some handler reads (rows a, rows b ->
-    mask; see :meth:`framework.events.CollisionHandlers.wanted`)."""
+    mask; see :meth:`framework.events.CollisionHandlers.wanted`); ``solver``: ``"exact"`` (the
+    stages one by one) or ``"soft"`` (movement, detection and response as one compiled call, see
+    :mod:`framework.systems.soft_step`); ``length_unit``: world units per metre, which scales the
+    soft solver's tolerances."""
 
     bodies: Bodies
     effects: frozenset[str]
@@ -48,6 +51,8 @@ class Pipeline:
     view: Any = None
     wanted_pairs: Any = None
     frame: StepFrame = field(default_factory=StepFrame)
+    solver: str = "exact"
+    length_unit: float = 1.0
 
     def active_gravity(self) -> tuple[float, float]:
         """Gravity as the stages apply it: none unless the scene declared the gravity effect."""
@@ -60,15 +65,16 @@ class Stage(esper.Processor):
 
     name: ClassVar[str]
     needs: ClassVar[frozenset[str]] = frozenset()
+    solver: ClassVar[str | None] = None  # the solver mode the stage belongs to (None: both)
 
     def __init__(self, pipeline: Pipeline) -> None:
         self.pipeline = pipeline
         self.bodies = pipeline.bodies
-        self.priority = PRIORITY[self.name]
+        self.priority = PRIORITY.get(self.name, 0)
 
     def wanted(self) -> bool:
-        """Whether the scene's effects call for this stage."""
-        return self.needs <= self.pipeline.effects
+        """Whether the scene's effects (and its solver mode) call for this stage."""
+        return self.needs <= self.pipeline.effects and self.solver in (None, self.pipeline.solver)
 
     def process(self, dt: float) -> None:  # esper's entry point
         frame = self.pipeline.frame

@@ -1,0 +1,280 @@
+"""Contact manifolds in Box2D v3's form, compiled: up to two points with separations and feature ids.
+
+Used by the soft step (:mod:`framework.systems.soft_kernel`). Every shape is a *rounded polygon*
+in world coordinates: ``count`` vertices (counter-clockwise), their outward edge normals and a
+rounding radius. A box or polygon has radius 0; a circle is one vertex with its radius; a capsule
+is two vertices (its segment) with its radius, as Box2D's ``b2MakeCapsule``. So three functions
+cover every pair: circle-circle, polygon-circle and polygon-polygon (Box2D's ``manifold.c``:
+``b2CollideCircles``, ``b2CollidePolygonAndCircle``, ``b2CollidePolygons`` with ``b2ClipPolygons``).
+
+Invariants: the normal points from A to B; a point's separation is negative where the shapes
+overlap; a manifold is reported up to ``speculative`` apart (its points may be apart: the solver
+lets them close, no further). Polygons are given as rows of the world vertex and normal tables
+``V[row, i]``, ``N[row, i]`` (indexing, not views: a view per call cost more than the arithmetic).
+Each function writes into ``out`` (rows: point 0, point 1; columns: x, y, separation, id) and
+returns ``(count, nx, ny)``. Floats only: these are the soft step's measurements, not the
+contract's exact decisions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["box_box", "circle_circle", "polygon_circle", "polygon_polygon"]
+
+_EPS = 1.1920929e-07  # Box2D's FLT_EPSILON, the scale of "safely outside"
+
+
+@njit(cache=True, inline="always")
+def circle_circle(ax, ay, ra, bx, by, rb, speculative, out):
+    """Two circles (centres, radii)."""
+    dx, dy = bx - ax, by - ay
+    dist = math.sqrt(dx * dx + dy * dy)
+    sep = dist - ra - rb
+    if sep > speculative:
+        return 0, 0.0, 0.0
+    if dist > 0.0:
+        nx, ny = dx / dist, dy / dist
+    else:  # concentric: any direction is as good; up, as the contract's tie-break
+        nx, ny = 0.0, 1.0
+    # the point halfway between the two surfaces
+    cax, cay = ax + ra * nx, ay + ra * ny
+    cbx, cby = bx - rb * nx, by - rb * ny
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = 0.5 * (cax + cbx), 0.5 * (cay + cby), sep, 0.0
+    return 1, nx, ny
+
+
+@njit(cache=True, inline="always")
+def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out):
+    """Two axis-aligned boxes (centres, half extents): what :func:`polygon_polygon` gives them, in a
+    few operations (the common case of boxes that never turn). The axis of least overlap (y on a
+    tie: a resting stack's normal is vertical); two points at the ends of the faces' common run,
+    one where the runs do not meet (boxes apart across a corner). Ids: 0, 1 along y, 2, 3 along x."""
+    dx, dy = bx - ax, by - ay
+    sx = abs(dx) - (aw + bw)
+    sy = abs(dy) - (ah + bh)
+    if sx > speculative or sy > speculative:
+        return 0, 0.0, 0.0
+    if sx > sy:  # normal along x; the run is along y
+        sgn = 1.0 if dx >= 0.0 else -1.0
+        lo, hi = max(ay - ah, by - bh), min(ay + ah, by + bh)
+        face = 0.5 * (ax + sgn * aw + bx - sgn * bw)
+        if lo > hi:
+            out[0, 0], out[0, 1], out[0, 2], out[0, 3] = face, 0.5 * (lo + hi), sx, 2.0
+            return 1, sgn, 0.0
+        out[0, 0], out[0, 1], out[0, 2], out[0, 3] = face, lo, sx, 2.0
+        out[1, 0], out[1, 1], out[1, 2], out[1, 3] = face, hi, sx, 3.0
+        return 2, sgn, 0.0
+    sgn = 1.0 if dy >= 0.0 else -1.0
+    lo, hi = max(ax - aw, bx - bw), min(ax + aw, bx + bw)
+    face = 0.5 * (ay + sgn * ah + by - sgn * bh)
+    if lo > hi:
+        out[0, 0], out[0, 1], out[0, 2], out[0, 3] = 0.5 * (lo + hi), face, sy, 0.0
+        return 1, 0.0, sgn
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = lo, face, sy, 0.0
+    out[1, 0], out[1, 1], out[1, 2], out[1, 3] = hi, face, sy, 1.0
+    return 2, 0.0, sgn
+
+
+@njit(cache=True, inline="always")
+def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out):
+    """Polygon A (world vertices ``V[a, :count]``, normals ``N[a]``, rounding ``ra``) and circle B."""
+    sep = -1e300
+    best = 0
+    for i in range(count):
+        s = N[a, i, 0] * (cx - V[a, i, 0]) + N[a, i, 1] * (cy - V[a, i, 1])
+        if s > sep:
+            sep, best = s, i
+    radius = ra + rb
+    if sep - radius > speculative:
+        return 0, 0.0, 0.0
+    i1 = best
+    i2 = i1 + 1 if i1 + 1 < count else 0
+    v1x, v1y, v2x, v2y = V[a, i1, 0], V[a, i1, 1], V[a, i2, 0], V[a, i2, 1]
+    u1 = (cx - v1x) * (v2x - v1x) + (cy - v1y) * (v2y - v1y)
+    u2 = (cx - v2x) * (v1x - v2x) + (cy - v2y) * (v1y - v2y)
+    if (u1 < 0.0 or u2 < 0.0 or count == 1) and sep > _EPS:
+        # the centre is nearest a vertex, safely outside: the normal runs from the vertex
+        px, py = (v1x, v1y) if (u1 < 0.0 or count == 1) else (v2x, v2y)
+        dx, dy = cx - px, cy - py
+        d = math.sqrt(dx * dx + dy * dy)
+        if d - radius > speculative:
+            return 0, 0.0, 0.0
+        nx, ny = dx / d, dy / d
+        cax, cay = px + ra * nx, py + ra * ny
+        cbx, cby = cx - rb * nx, cy - rb * ny
+        out[0, 0], out[0, 1] = 0.5 * (cax + cbx), 0.5 * (cay + cby)
+        out[0, 2], out[0, 3] = (cbx - cax) * nx + (cby - cay) * ny, 0.0
+        return 1, nx, ny
+    nx, ny = N[a, best, 0], N[a, best, 1]
+    # cA: the centre projected onto the (rounded) reference face; cB: the circle's deepest point
+    proj = ra - ((cx - v1x) * nx + (cy - v1y) * ny)
+    cax, cay = cx + proj * nx, cy + proj * ny
+    cbx, cby = cx - rb * nx, cy - rb * ny
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = 0.5 * (cax + cbx), 0.5 * (cay + cby), sep - radius, 0.0
+    return 1, nx, ny
+
+
+@njit(cache=True, inline="always")
+def _max_separation(V, N, p1, c1, p2, c2):
+    """The edge of polygon 1 whose normal separates the two the most, and that separation."""
+    best, best_sep = 0, -1e300
+    for i in range(c1):
+        si = 1e300
+        for j in range(c2):
+            s = N[p1, i, 0] * (V[p2, j, 0] - V[p1, i, 0]) + N[p1, i, 1] * (V[p2, j, 1] - V[p1, i, 1])
+            if s < si:
+                si = s
+        if si > best_sep:
+            best_sep, best = si, i
+    return best, best_sep
+
+
+@njit(cache=True, inline="always")
+def _incident_edge(nx, ny, N, p2, c2):
+    """The edge of polygon 2 most anti-parallel to the reference normal."""
+    best, low = 0, 1e300
+    for i in range(c2):
+        d = nx * N[p2, i, 0] + ny * N[p2, i, 1]
+        if d < low:
+            low, best = d, i
+    return best
+
+
+@njit(cache=True, inline="always")
+def _segment_fractions(p1x, p1y, q1x, q1y, p2x, p2y, q2x, q2y):
+    """Box2D's ``b2SegmentDistance``: the fractions along segments 1 and 2 of their closest points."""
+    d1x, d1y, d2x, d2y = q1x - p1x, q1y - p1y, q2x - p2x, q2y - p2y
+    rx, ry = p1x - p2x, p1y - p2y
+    dd1 = d1x * d1x + d1y * d1y
+    dd2 = d2x * d2x + d2y * d2y
+    rd1 = rx * d1x + ry * d1y
+    rd2 = rx * d2x + ry * d2y
+    eps2 = _EPS * _EPS
+    if dd1 < eps2 or dd2 < eps2:
+        if dd1 >= eps2:
+            return min(max(-rd1 / dd1, 0.0), 1.0), 0.0
+        if dd2 >= eps2:
+            return 0.0, min(max(rd2 / dd2, 0.0), 1.0)
+        return 0.0, 0.0
+    d12 = d1x * d2x + d1y * d2y
+    denom = dd1 * dd2 - d12 * d12
+    f1 = 0.0
+    if denom != 0.0:
+        f1 = min(max((d12 * rd2 - rd1 * dd2) / denom, 0.0), 1.0)
+    f2 = (d12 * f1 + rd2) / dd2
+    if f2 < 0.0:
+        f2 = 0.0
+        f1 = min(max(-rd1 / dd1, 0.0), 1.0)
+    elif f2 > 1.0:
+        f2 = 1.0
+        f1 = min(max((d12 - rd1) / dd1, 0.0), 1.0)
+    return f1, f2
+
+
+@njit(cache=True, inline="always")
+def _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out):
+    """Box2D's ``b2ClipPolygons``: reference edge ``e1`` of polygon 1, incident edge ``e2`` of
+    polygon 2; ``flip``: polygon 1 is B (the normal is turned to point from A to B)."""
+    i11, i12 = e1, (e1 + 1 if e1 + 1 < c1 else 0)
+    i21, i22 = e2, (e2 + 1 if e2 + 1 < c2 else 0)
+    nx, ny = N[p1, i11, 0], N[p1, i11, 1]
+    v11x, v11y, v12x, v12y = V[p1, i11, 0], V[p1, i11, 1], V[p1, i12, 0], V[p1, i12, 1]
+    v21x, v21y, v22x, v22y = V[p2, i21, 0], V[p2, i21, 1], V[p2, i22, 0], V[p2, i22, 1]
+    tx, ty = -ny, nx  # cross(1, normal)
+    lower1 = 0.0
+    upper1 = (v12x - v11x) * tx + (v12y - v11y) * ty
+    upper2 = (v21x - v11x) * tx + (v21y - v11y) * ty  # the incident edge runs against the tangent
+    lower2 = (v22x - v11x) * tx + (v22y - v11y) * ty
+    if upper2 < lower1 or upper1 < lower2:
+        return 0, 0.0, 0.0
+    span = upper2 - lower2
+    if lower2 < lower1 and span > _EPS:
+        t = (lower1 - lower2) / span
+        lox, loy = v22x + t * (v21x - v22x), v22y + t * (v21y - v22y)
+    else:
+        lox, loy = v22x, v22y
+    if upper2 > upper1 and span > _EPS:
+        t = (upper1 - lower2) / span
+        upx, upy = v22x + t * (v21x - v22x), v22y + t * (v21y - v22y)
+    else:
+        upx, upy = v21x, v21y
+    slo = (lox - v11x) * nx + (loy - v11y) * ny
+    sup = (upx - v11x) * nx + (upy - v11y) * ny
+    # points halfway between the rounded surfaces
+    lox, loy = lox + 0.5 * (r1 - r2 - slo) * nx, loy + 0.5 * (r1 - r2 - slo) * ny
+    upx, upy = upx + 0.5 * (r1 - r2 - sup) * nx, upy + 0.5 * (r1 - r2 - sup) * ny
+    radius = r1 + r2
+    if not flip:
+        out[0, 0], out[0, 1], out[0, 2], out[0, 3] = lox, loy, slo - radius, float((i11 << 8) | i22)
+        out[1, 0], out[1, 1], out[1, 2], out[1, 3] = upx, upy, sup - radius, float((i12 << 8) | i21)
+        return 2, nx, ny
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = upx, upy, sup - radius, float((i21 << 8) | i12)
+    out[1, 0], out[1, 1], out[1, 2], out[1, 3] = lox, loy, slo - radius, float((i22 << 8) | i11)
+    return 2, -nx, -ny
+
+
+@njit(cache=True, inline="always")
+def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out):
+    """Two rounded polygons (world vertices, normals, counts, radii), ``slop``: Box2D's linear slop.
+    Returns ``(count, nx, ny)``; points beyond ``speculative`` apart are dropped."""
+    ea, sa = _max_separation(V, N, a, ca, b, cb)
+    eb, sb = _max_separation(V, N, b, cb, a, ca)
+    radius = ra + rb
+    if sa > speculative + radius or sb > speculative + radius:
+        return 0, 0.0, 0.0
+    flip = not (sa >= sb)
+    if flip:
+        ea = _incident_edge(N[b, eb, 0], N[b, eb, 1], N, a, ca)
+    else:
+        eb = _incident_edge(N[a, ea, 0], N[a, ea, 1], N, b, cb)
+    if sa > 0.1 * slop or sb > 0.1 * slop:
+        # Apart: if the nearest features are two vertices, one point along the line between them.
+        i11, i12 = ea, (ea + 1 if ea + 1 < ca else 0)
+        i21, i22 = eb, (eb + 1 if eb + 1 < cb else 0)
+        f1, f2 = _segment_fractions(V[a, i11, 0], V[a, i11, 1], V[a, i12, 0], V[a, i12, 1],
+                                    V[b, i21, 0], V[b, i21, 1], V[b, i22, 0], V[b, i22, 1])
+        if (f1 == 0.0 or f1 == 1.0) and (f2 == 0.0 or f2 == 1.0):
+            ia = i11 if f1 == 0.0 else i12
+            ib = i21 if f2 == 0.0 else i22
+            dx, dy = V[b, ib, 0] - V[a, ia, 0], V[b, ib, 1] - V[a, ia, 1]
+            d = math.sqrt(dx * dx + dy * dy)
+            if d - radius > speculative:
+                return 0, 0.0, 0.0
+            if d > 0.0:
+                nx, ny = dx / d, dy / d
+                cax, cay = V[a, ia, 0] + ra * nx, V[a, ia, 1] + ra * ny
+                cbx, cby = V[b, ib, 0] - rb * nx, V[b, ib, 1] - rb * ny
+                out[0, 0], out[0, 1] = 0.5 * (cax + cbx), 0.5 * (cay + cby)
+                out[0, 2], out[0, 3] = d - radius, float((ia << 8) | ib)
+                return 1, nx, ny
+    if flip:
+        k, nx, ny = _clip(V, N, b, cb, rb, eb, a, ca, ra, ea, True, out)
+    else:
+        k, nx, ny = _clip(V, N, a, ca, ra, ea, b, cb, rb, eb, False, out)
+    if k == 2:  # drop a point beyond the speculative distance (keep the order of the rest)
+        keep0 = out[0, 2] <= speculative
+        keep1 = out[1, 2] <= speculative
+        if not keep0 and not keep1:
+            return 0, 0.0, 0.0
+        if not keep0:
+            out[0, 0], out[0, 1], out[0, 2], out[0, 3] = out[1, 0], out[1, 1], out[1, 2], out[1, 3]
+            return 1, nx, ny
+        if not keep1:
+            return 1, nx, ny
+    return k, nx, ny
+
+
+def _warm_up() -> None:  # (a tiny call of each, for tests that time nothing but want them compiled)
+    out = np.zeros((2, 4))
+    sq = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    nm = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    circle_circle(0.0, 0.0, 1.0, 1.5, 0.0, 1.0, 0.02, out)
+    box_box(0.0, 0.0, 1.0, 1.0, 0.5, 1.9, 1.0, 1.0, 0.02, out)
+    V = np.stack([sq, sq + np.array([0.0, 1.9])])
+    N = np.stack([nm, nm])
+    polygon_circle(V, N, 0, 4, 0.0, 0.0, 1.9, 1.0, 0.02, out)
+    polygon_polygon(V, N, 0, 4, 0.0, 1, 4, 0.0, 0.005, 0.02, out)

@@ -1,0 +1,562 @@
+"""The soft step as one compiled call: broad phase, manifolds and Box2D v3's soft-step solver.
+
+Read top to bottom, one step is:
+
+1. **shapes**: every hitbox as a rounded polygon in world coordinates, and its bounds swept by
+   this step's motion (:func:`_world_shapes`);
+2. **broad phase**: sort the bounds along x and sweep (:func:`_candidate_pairs`); pairs of two
+   idle bodies (static, asleep, without velocity) and pairs whose layers do not meet are skipped;
+3. **narrow phase**: a manifold per pair (:mod:`framework.collision.soft_manifold`), reported up
+   to a speculative distance that grows with the pair's motion this step, so a fast body meets a
+   wall it would otherwise pass in one step (no tunnelling, without a separate sweep);
+4. **prepare**: anchors relative to each body's origin, effective masses, the impulses of last
+   step's matching points (by pair and feature id) to warm start with;
+5. **sub-steps** (Box2D's ``b2SolverStage``): integrate velocities (gravity), warm start, solve
+   with soft constraints (the bias pushes overlap out at most ``push_speed``), integrate
+   positions, relax (solve again without the bias);
+6. **restitution**, then **store** the impulses and report the touching pairs sorted by entity
+   ids (started ones flagged, ended ones as indices into last step's), and the sleepers an awake
+   body touched (to wake).
+
+The separation of a point during the sub-steps is measured from the anchors and the bodies'
+motion since the step began (Box2D's ``contact_solver.c`` derivation), so nothing is re-measured
+geometrically inside the solve. Sequential impulses over contacts in a fixed order: bit-identical
+results for identical inputs.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..collision.soft_manifold import box_box, circle_circle, polygon_circle, polygon_polygon
+
+__all__ = ["PARAMS", "SLOT", "soft_step"]
+
+# The layout of the ``params`` float array (one argument instead of fourteen scalars).
+PARAMS = ("dt", "substeps", "gx", "gy", "slop", "speculative", "hertz", "damping", "push_speed",
+          "restitution_threshold", "layers_open", "response", "rotation", "friction", "fat_margin")
+_DT, _SUB, _GX, _GY, _SLOP, _SPEC, _HZ, _ZETA, _PUSH, _REST, _LAYERS, _RESPONSE, _ROT, _FRIC, _FAT = range(len(PARAMS))
+
+_DYNAMIC, _STATIC = 0, 2
+_AABB, _CIRCLE = 0, 1
+
+
+@njit(cache=True)
+def _soft(hertz, zeta, h):
+    """Box2D's ``b2MakeSoft``: (bias rate, mass scale, impulse scale) of a soft constraint."""
+    if hertz == 0.0:
+        return 0.0, 1.0, 0.0
+    omega = 2.0 * math.pi * hertz
+    a1 = 2.0 * zeta + h * omega
+    a2 = h * omega * a1
+    a3 = 1.0 / (1.0 + a2)
+    return omega / a1, a2 * a3, a3
+
+
+@njit(cache=True)
+def _world_shapes(x, y, rot, vx, vy, w, moving, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
+                  wc, wv, wn, lo, hi, reach):
+    """World centres, vertices and normals of every hitbox (``cnt == 0``: none) and its bounds, widened by
+    ``margin0`` and swept by the body's motion this step; ``reach``: how far the body may move."""
+    n = x.size
+    g = (abs(gx) + abs(gy)) * dt * dt
+    for r in range(n):
+        k = cnt[r]
+        if k == 0:
+            continue
+        c, s = math.cos(rot[r]), math.sin(rot[r])
+        ox, oy = off[r, 0], off[r, 1]
+        hx, hy = x[r] + c * ox - s * oy, y[r] + s * ox + c * oy
+        wc[r, 0], wc[r, 1] = hx, hy
+        if not spin[r]:
+            c, s = 1.0, 0.0
+        mnx, mny, mxx, mxy = 1e300, 1e300, -1e300, -1e300
+        for i in range(k):
+            px, py = lv[r, i, 0], lv[r, i, 1]
+            qx, qy = hx + c * px - s * py, hy + s * px + c * py
+            wv[r, i, 0], wv[r, i, 1] = qx, qy
+            wn[r, i, 0] = c * ln[r, i, 0] - s * ln[r, i, 1]
+            wn[r, i, 1] = s * ln[r, i, 0] + c * ln[r, i, 1]
+            mnx, mxx = min(mnx, qx), max(mxx, qx)
+            mny, mxy = min(mny, qy), max(mxy, qy)
+        rad = rr[r] + margin0
+        mnx, mny, mxx, mxy = mnx - rad, mny - rad, mxx + rad, mxy + rad
+        m = 0.0
+        if moving[r]:
+            ex, ey = vx[r] * dt, vy[r] * dt
+            m = abs(ex) + abs(ey) + abs(w[r]) * bound[r] * dt + g
+            turn = abs(w[r]) * bound[r] * dt + g
+            mnx += min(ex, 0.0) - turn
+            mxx += max(ex, 0.0) + turn
+            mny += min(ey, 0.0) - turn
+            mxy += max(ey, 0.0) + turn
+        lo[r, 0], lo[r, 1], hi[r, 0], hi[r, 1] = mnx, mny, mxx, mxy
+        reach[r] = m
+
+
+@njit(cache=True)
+def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
+    """Sort-and-sweep along x over the fat bounds: the pairs of rows whose fat bounds overlap
+    (never two fixed ones; layers that meet), as rows ``(a, b)`` with ``entity[a] < entity[b]``,
+    sorted by that pair of entities."""
+    n = fat.shape[0]
+    order = np.argsort(fat[:, 0], kind="mergesort")
+    cap = 4 * n + 16
+    pa = np.empty(cap, dtype=np.int64)
+    pb = np.empty(cap, dtype=np.int64)
+    m = 0
+    for ii in range(n):
+        i = order[ii]
+        if cnt[i] == 0:
+            continue
+        xmax = fat[i, 2]
+        for jj in range(ii + 1, n):
+            j = order[jj]
+            if fat[j, 0] > xmax:
+                break
+            if cnt[j] == 0 or (fixed[i] and fixed[j]):
+                continue
+            if fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3]:
+                continue
+            if not layers_open and ((layer[i] & mask[j]) == 0 or (layer[j] & mask[i]) == 0):
+                continue
+            if m == cap:
+                cap *= 2
+                na = np.empty(cap, dtype=np.int64)
+                nb = np.empty(cap, dtype=np.int64)
+                na[:m], nb[:m] = pa[:m], pb[:m]
+                pa, pb = na, nb
+            if entity[j] < entity[i]:
+                pa[m], pb[m] = j, i
+            else:
+                pa[m], pb[m] = i, j
+            m += 1
+    keys = np.empty(m, dtype=np.int64)
+    for k in range(m):
+        keys[k] = (entity[pa[k]] << 32) | entity[pb[k]]
+    srt = np.argsort(keys, kind="mergesort")
+    pairs = np.empty((m, 2), dtype=np.int64)
+    out_keys = np.empty(m, dtype=np.int64)
+    for k in range(m):
+        pairs[k, 0], pairs[k, 1] = pa[srt[k]], pb[srt[k]]
+        out_keys[k] = keys[srt[k]]
+    return pairs, out_keys
+
+
+@njit(cache=True)
+def _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, spec, out):
+    """The manifold of rows ``a``, ``b`` (normal from a to b)."""
+    if kind[a] == _AABB and kind[b] == _AABB:  # (an AABB's local corner 2 is its half extents)
+        return box_box(wc[a, 0], wc[a, 1], lv[a, 2, 0], lv[a, 2, 1], wc[b, 0], wc[b, 1], lv[b, 2, 0], lv[b, 2, 1],
+                       spec, out)
+    if kind[a] == _CIRCLE and kind[b] == _CIRCLE:
+        return circle_circle(wv[a, 0, 0], wv[a, 0, 1], rr[a], wv[b, 0, 0], wv[b, 0, 1], rr[b], spec, out)
+    if kind[b] == _CIRCLE:
+        return polygon_circle(wv, wn, a, cnt[a], rr[a], wv[b, 0, 0], wv[b, 0, 1], rr[b], spec, out)
+    if kind[a] == _CIRCLE:
+        k, nx, ny = polygon_circle(wv, wn, b, cnt[b], rr[b], wv[a, 0, 0], wv[a, 0, 1], rr[a], spec, out)
+        return k, -nx, -ny
+    return polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, spec, out)
+
+
+# Columns of a candidate pair's slot (kept between steps): the feature ids and accumulated normal and
+# tangent impulses of its two points, how many points it had, whether it touched, and the contact it
+# reported (normal, depth, deepest point).
+SLOT = ("id0", "id1", "ni0", "ni1", "ti0", "ti1", "points", "touching", "nx", "ny", "depth", "px", "py")
+_ID, _NI, _TI, _NP, _TOUCH, _NX, _NY, _DEPTH, _PX, _PY = 0, 2, 4, 6, 7, 8, 9, 10, 11, 12
+# Columns of a contact point in the solve.
+_RAX, _RAY, _RBX, _RBY, _BASE, _NMASS, _TMASS, _PNI, _PTI, _TOTAL, _RELV, _PID = range(12)
+
+
+@njit(cache=True)
+def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
+    """The slots of the new (sorted) candidate pairs, carried over from the old ones by key; the
+    old pairs that touched and are no longer candidates are written to ``ended_*`` (how many)."""
+    slots = np.zeros((new_keys.size, len(SLOT)))
+    i, n_end = 0, 0
+    for k in range(new_keys.size):
+        key = new_keys[k]
+        while i < old_keys.size and old_keys[i] < key:
+            if old_slots[i, _TOUCH] != 0.0:
+                ended_keys[n_end] = old_keys[i]
+                ended_f[n_end, :] = old_slots[i, _NX:_PY + 1]
+                n_end += 1
+            i += 1
+        if i < old_keys.size and old_keys[i] == key:
+            slots[k, :] = old_slots[i, :]
+            i += 1
+    while i < old_keys.size:
+        if old_slots[i, _TOUCH] != 0.0:
+            ended_keys[n_end] = old_keys[i]
+            ended_f[n_end, :] = old_slots[i, _NX:_PY + 1]
+            n_end += 1
+        i += 1
+    return slots, n_end
+
+
+@njit(cache=True)
+def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, friction, restitution, layer, mask,
+              sensor, one_way, asleep, has_vel, entity, bound, off, lv, ln, cnt, rr, spin,
+              fat, pairs, keys, slots, rebuild):
+    """One step of ``params[_DT]`` over the rows (the body columns modified in place).
+    ``fat``: each row's fat bounds; ``pairs, keys, slots``: the candidate pairs kept from the last
+    step (``rebuild``: the rows changed, find them again); these are not modified: new ones are
+    returned. See the module docstring for the stages.
+
+    Returns ``(fat, pairs, keys, slots, ra, rb, ea, eb, f, started, ended_a, ended_b, ended_f, wake,
+    rebuilt, contacts)``: the fat bounds, candidate pairs and their slots for the next step; the
+    pairs touching now (rows, entities, their contact's nx, ny, depth, px, py as rows of ``f``) and
+    which of them started; the pairs that stopped touching (entities, last contact); the sleepers
+    to wake; whether the pairs were found again; how many contacts the solver used."""
+    dt = params[_DT]
+    nsub = int(params[_SUB])
+    gx, gy = params[_GX], params[_GY]
+    slop, spec = params[_SLOP], params[_SPEC]
+    response, rotation, use_friction = params[_RESPONSE] != 0.0, params[_ROT] != 0.0, params[_FRIC] != 0.0
+    n = x.size
+    K = lv.shape[1]
+
+    # --- bodies: who moves, who takes impulses ----------------------------------------------
+    moving = np.zeros(n, dtype=np.bool_)
+    fixed = np.zeros(n, dtype=np.bool_)  # never moves by itself: static, or without a velocity
+    im = np.zeros(n)
+    ii = np.zeros(n)
+    for r in range(n):
+        fixed[r] = body[r] == _STATIC or not has_vel[r]
+        moving[r] = not fixed[r] and not asleep[r]
+        if moving[r] and body[r] == _DYNAMIC and response:
+            im[r] = inv_mass[r]
+            if rotation:
+                ii[r] = inv_inertia[r]
+    # A scene where nothing turns runs the translation-only solve (no angular terms).
+    turns = False
+    for r in range(n):
+        if ii[r] > 0.0 or (moving[r] and w[r] != 0.0):
+            turns = True
+            break
+    rotation = rotation and turns
+
+    # --- shapes, fat bounds and the broad phase ----------------------------------------------------
+    wc = np.empty((n, 2))
+    wv = np.empty((n, K, 2))
+    wn = np.empty((n, K, 2))
+    lo = np.empty((n, 2))
+    hi = np.empty((n, 2))
+    reach = np.zeros(n)
+    margin0 = 0.5 * spec if response else 0.0
+    _world_shapes(x, y, rot, vx, vy, w, moving, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
+                  wc, wv, wn, lo, hi, reach)
+    fat_margin = params[_FAT]
+    fat = fat.copy()  # (the step's inputs stay as they were: a failed step is undone by keeping them)
+    slots = slots.copy()
+    for r in range(n):
+        if cnt[r] == 0:
+            continue
+        inside = (lo[r, 0] >= fat[r, 0] and lo[r, 1] >= fat[r, 1] and hi[r, 0] <= fat[r, 2]
+                  and hi[r, 1] <= fat[r, 3])
+        if rebuild or not inside:
+            e = 0.0 if fixed[r] else fat_margin
+            fat[r, 0], fat[r, 1], fat[r, 2], fat[r, 3] = lo[r, 0] - e, lo[r, 1] - e, hi[r, 0] + e, hi[r, 1] + e
+            rebuild = True
+    n_end = 0
+    ended_keys = np.empty(keys.size, dtype=np.int64)
+    ended_f = np.empty((keys.size, 5))
+    rebuilt = rebuild
+    if rebuild:
+        pairs, new_keys = _candidate_pairs(fat, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity)
+        slots, n_end = _merge_slots(keys, slots, new_keys, ended_keys, ended_f)
+        keys = new_keys
+    m = keys.size
+
+    # --- narrow phase: manifolds -> contacts ---------------------------------------------------
+    ci = np.empty((m, 2), dtype=np.int64)  # the contact's pair slot, points the solver uses
+    cf = np.empty((m, 5))  # nx, ny, friction, restitution, stiff (against an idle body)
+    cp = np.empty((m, 2, 12))
+    touching_idx = np.empty(m, dtype=np.int64)
+    started = np.empty(m, dtype=np.bool_)
+    n_touch = 0
+    wake = np.zeros(n, dtype=np.bool_)
+    out = np.empty((2, 4))
+    nc = 0
+    for p in range(m):
+        a, b = pairs[p, 0], pairs[p, 1]
+        sl = slots[p]
+        was = sl[_TOUCH] != 0.0
+        if not moving[a] and not moving[b]:  # asleep (or still): keeps what it had
+            if was:
+                touching_idx[n_touch] = p
+                started[n_touch] = False
+                n_touch += 1
+            sl[_NP] = 0.0
+            continue
+        s_pair = spec + reach[a] + reach[b] if response else 0.0
+        if kind[a] == _AABB and kind[b] == _AABB:  # the common case, inline (an AABB's corner 2: its half extents)
+            k, nx, ny = box_box(wc[a, 0], wc[a, 1], lv[a, 2, 0], lv[a, 2, 1], wc[b, 0], wc[b, 1], lv[b, 2, 0],
+                                lv[b, 2, 1], s_pair, out)
+        else:
+            k, nx, ny = _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, s_pair, out)
+        low = 0.0
+        if k > 0:
+            low = out[0, 2]
+            deep = 0
+            if k == 2 and out[1, 2] < low:
+                low, deep = out[1, 2], 1
+        # In contact: overlapping, or within the slop and either in contact last step or holding
+        # the bodies apart then (a body resting on a sleeper sits at a separation of 0, give or take
+        # rounding: it touches it, and wakes it).
+        held = sl[_NI] > 0.0 or sl[_NI + 1] > 0.0
+        touching = k > 0 and (low < 0.0 or ((was or held) and low < slop))
+        if touching:
+            touching_idx[n_touch] = p
+            started[n_touch] = not was
+            n_touch += 1
+            sl[_NX], sl[_NY], sl[_DEPTH] = nx, ny, -low
+            sl[_PX], sl[_PY] = out[deep, 0], out[deep, 1]
+            if not (sensor[a] or sensor[b]):
+                if asleep[a] and moving[b]:
+                    wake[a] = True
+                if asleep[b] and moving[a]:
+                    wake[b] = True
+        elif was:
+            ended_keys[n_end] = keys[p]
+            ended_f[n_end, 0], ended_f[n_end, 1], ended_f[n_end, 2] = sl[_NX], sl[_NY], sl[_DEPTH]
+            ended_f[n_end, 3], ended_f[n_end, 4] = sl[_PX], sl[_PY]
+            n_end += 1
+        sl[_TOUCH] = 1.0 if touching else 0.0
+        use = response and k > 0 and not (sensor[a] or sensor[b])
+        if use and (one_way[a] or one_way[b]):
+            up = ny if one_way[a] else -ny  # the normal from the platform to the other body
+            use = up > 0.5 and low > -4.0 * slop
+        if use and im[a] == 0.0 and im[b] == 0.0 and ii[a] == 0.0 and ii[b] == 0.0:
+            use = False
+        if not use:
+            sl[_NP] = 0.0
+            continue
+        # prepare the contact: anchors, effective masses, warm starts from the slot by feature id
+        ci[nc, 0], ci[nc, 1] = p, k
+        fa, fb = friction[a], friction[b]
+        mu = 0.0
+        if use_friction:
+            if fa >= 0.0 and fb >= 0.0:
+                mu = math.sqrt(fa * fb)
+            elif fa >= 0.0:
+                mu = fa
+            elif fb >= 0.0:
+                mu = fb
+        cf[nc, 0], cf[nc, 1], cf[nc, 2] = nx, ny, mu
+        cf[nc, 3] = max(restitution[a], restitution[b])
+        cf[nc, 4] = 1.0 if (not moving[a] or not moving[b]) else 0.0
+        tx, ty = ny, -nx  # Box2D's right perp
+        old_np = int(sl[_NP])
+        for j in range(k):
+            px, py = out[j, 0], out[j, 1]
+            ax_, ay_ = px - x[a], py - y[a]
+            bx_, by_ = px - x[b], py - y[b]
+            cp[nc, j, _RAX], cp[nc, j, _RAY], cp[nc, j, _RBX], cp[nc, j, _RBY] = ax_, ay_, bx_, by_
+            cp[nc, j, _BASE] = out[j, 2] - ((bx_ - ax_) * nx + (by_ - ay_) * ny)
+            rna = ax_ * ny - ay_ * nx
+            rnb = bx_ * ny - by_ * nx
+            kn = im[a] + im[b] + ii[a] * rna * rna + ii[b] * rnb * rnb
+            cp[nc, j, _NMASS] = 1.0 / kn if kn > 0.0 else 0.0
+            rta = ax_ * ty - ay_ * tx
+            rtb = bx_ * ty - by_ * tx
+            kt = im[a] + im[b] + ii[a] * rta * rta + ii[b] * rtb * rtb
+            cp[nc, j, _TMASS] = 1.0 / kt if kt > 0.0 else 0.0
+            cp[nc, j, _RELV] = (nx * (vx[b] - w[b] * by_ - vx[a] + w[a] * ay_)
+                                + ny * (vy[b] + w[b] * bx_ - vy[a] - w[a] * ax_))
+            cp[nc, j, _PID] = out[j, 3]
+            cp[nc, j, _PNI], cp[nc, j, _PTI], cp[nc, j, _TOTAL] = 0.0, 0.0, 0.0
+            for o in range(old_np):
+                if sl[_ID + o] == out[j, 3]:
+                    cp[nc, j, _PNI], cp[nc, j, _PTI] = sl[_NI + o], sl[_TI + o]
+        nc += 1
+
+    # --- sub-steps ------------------------------------------------------------------------------
+    h = dt / nsub if nsub > 0 else 0.0
+    inv_h = 1.0 / h if h > 0.0 else 0.0
+    hertz = min(params[_HZ], 0.125 * inv_h)
+    soft_c = _soft(hertz, params[_ZETA], h)
+    soft_s = _soft(2.0 * hertz, params[_ZETA], h)
+    push = params[_PUSH]
+    x0 = x.copy()
+    y0 = y.copy()
+    r0 = rot.copy()
+    qc = np.ones(n)
+    qs = np.zeros(n)
+    turning = np.zeros(n, dtype=np.bool_)
+    for r in range(n):
+        turning[r] = moving[r] and (ii[r] > 0.0 or w[r] != 0.0)
+    for _sub in range(nsub):
+        for r in range(n):  # integrate velocities
+            if moving[r] and body[r] == _DYNAMIC:
+                vx[r] += h * gx
+                vy[r] += h * gy
+        _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
+        _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, True, rotation, soft_c, soft_s,
+               inv_h, push)
+        for r in range(n):  # integrate positions
+            if moving[r]:
+                x[r] += h * vx[r]
+                y[r] += h * vy[r]
+                if turning[r]:
+                    rot[r] += h * w[r]
+                    qc[r] = math.cos(rot[r] - r0[r])
+                    qs[r] = math.sin(rot[r] - r0[r])
+        _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, False, rotation, soft_c, soft_s,
+               inv_h, push)
+    _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
+
+    # --- store the impulses in the slots ----------------------------------------------------------
+    for c in range(nc):
+        sl = slots[ci[c, 0]]
+        k = ci[c, 1]
+        sl[_NP] = k
+        for j in range(k):
+            sl[_ID + j], sl[_NI + j], sl[_TI + j] = cp[c, j, _PID], cp[c, j, _PNI], cp[c, j, _PTI]
+    # the touching pairs, as the frame's contact columns
+    t_ra = np.empty(n_touch, dtype=np.int64)
+    t_rb = np.empty(n_touch, dtype=np.int64)
+    t_ea = np.empty(n_touch, dtype=np.int64)
+    t_eb = np.empty(n_touch, dtype=np.int64)
+    t_f = np.empty((5, n_touch))
+    for i in range(n_touch):
+        p = touching_idx[i]
+        a, b = pairs[p, 0], pairs[p, 1]
+        t_ra[i], t_rb[i], t_ea[i], t_eb[i] = a, b, entity[a], entity[b]
+        for q in range(5):
+            t_f[q, i] = slots[p, _NX + q]
+    e_ea = np.empty(n_end, dtype=np.int64)
+    e_eb = np.empty(n_end, dtype=np.int64)
+    e_f = np.empty((5, n_end))
+    for i in range(n_end):
+        e_ea[i], e_eb[i] = ended_keys[i] >> 32, ended_keys[i] & 0xFFFFFFFF
+        for q in range(5):
+            e_f[q, i] = ended_f[i, q]
+    return (fat, pairs, keys, slots, t_ra, t_rb, t_ea, t_eb, t_f, started[:n_touch], e_ea, e_eb, e_f,
+            np.flatnonzero(wake), rebuilt, nc)
+
+
+@njit(cache=True)
+def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
+    """Apply each point's accumulated impulses (Box2D's ``b2WarmStartContacts``)."""
+    for c in range(nc):
+        p = ci[c, 0]
+        a, b = pairs[p, 0], pairs[p, 1]
+        nx, ny = cf[c, 0], cf[c, 1]
+        tx, ty = ny, -nx
+        for j in range(ci[c, 1]):
+            Px = cp[c, j, _PNI] * nx + cp[c, j, _PTI] * tx
+            Py = cp[c, j, _PNI] * ny + cp[c, j, _PTI] * ty
+            cp[c, j, _TOTAL] += cp[c, j, _PNI]
+            vx[a] -= im[a] * Px
+            vy[a] -= im[a] * Py
+            w[a] -= ii[a] * (cp[c, j, _RAX] * Py - cp[c, j, _RAY] * Px)
+            vx[b] += im[b] * Px
+            vy[b] += im[b] * Py
+            w[b] += ii[b] * (cp[c, j, _RBX] * Py - cp[c, j, _RBY] * Px)
+
+
+@njit(cache=True)
+def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_bias, rotation, soft_c, soft_s,
+           inv_h, push):
+    """One pass over the contacts (Box2D's ``b2SolveContact``): the normal impulses with soft
+    constraints (``use_bias``) or rigid ones without bias (the relax), then friction."""
+    for c in range(nc):
+        p = ci[c, 0]
+        k = ci[c, 1]
+        a, b = pairs[p, 0], pairs[p, 1]
+        mA, iA, mB, iB = im[a], ii[a], im[b], ii[b]
+        vax, vay, wa = vx[a], vy[a], w[a]
+        vbx, vby, wb = vx[b], vy[b], w[b]
+        dpx = (x[b] - x0[b]) - (x[a] - x0[a])
+        dpy = (y[b] - y0[b]) - (y[a] - y0[a])
+        nx, ny = cf[c, 0], cf[c, 1]
+        bias_rate, mass_scale, imp_scale = soft_s if cf[c, 4] != 0.0 else soft_c
+        for j in range(k):
+            ax_, ay_, bx_, by_ = cp[c, j, _RAX], cp[c, j, _RAY], cp[c, j, _RBX], cp[c, j, _RBY]
+            if rotation:  # the anchors turned by each body's rotation since the step began
+                pax, pay = qc[a] * ax_ - qs[a] * ay_, qs[a] * ax_ + qc[a] * ay_
+                pbx, pby = qc[b] * bx_ - qs[b] * by_, qs[b] * bx_ + qc[b] * by_
+                s = cp[c, j, _BASE] + (dpx + pbx - pax) * nx + (dpy + pby - pay) * ny
+                vn = (vbx - wb * by_ - vax + wa * ay_) * nx + (vby + wb * bx_ - vay - wa * ax_) * ny
+            else:
+                s = cp[c, j, _BASE] + (dpx + bx_ - ax_) * nx + (dpy + by_ - ay_) * ny
+                vn = (vbx - vax) * nx + (vby - vay) * ny
+            vbias, ms, isc = 0.0, 1.0, 0.0
+            if s > 0.0:
+                vbias = s * inv_h  # speculative: close the gap, no further
+            elif use_bias:
+                vbias = max(bias_rate * s, -push)
+                ms, isc = mass_scale, imp_scale
+            old = cp[c, j, _PNI]
+            new = max(old - cp[c, j, _NMASS] * (ms * vn + vbias) - isc * old, 0.0)
+            imp = new - old
+            cp[c, j, _PNI] = new
+            cp[c, j, _TOTAL] += imp
+            Px, Py = imp * nx, imp * ny
+            vax -= mA * Px
+            vay -= mA * Py
+            vbx += mB * Px
+            vby += mB * Py
+            if rotation:
+                wa -= iA * (ax_ * Py - ay_ * Px)
+                wb += iB * (bx_ * Py - by_ * Px)
+        f = cf[c, 2]
+        if f > 0.0:
+            tx, ty = ny, -nx
+            for j in range(k):
+                ax_, ay_, bx_, by_ = cp[c, j, _RAX], cp[c, j, _RAY], cp[c, j, _RBX], cp[c, j, _RBY]
+                if rotation:
+                    vt = (vbx - wb * by_ - vax + wa * ay_) * tx + (vby + wb * bx_ - vay - wa * ax_) * ty
+                else:
+                    vt = (vbx - vax) * tx + (vby - vay) * ty
+                old = cp[c, j, _PTI]
+                lim = f * cp[c, j, _PNI]
+                new = min(max(old - cp[c, j, _TMASS] * vt, -lim), lim)
+                imp = new - old
+                cp[c, j, _PTI] = new
+                Px, Py = imp * tx, imp * ty
+                vax -= mA * Px
+                vay -= mA * Py
+                vbx += mB * Px
+                vby += mB * Py
+                if rotation:
+                    wa -= iA * (ax_ * Py - ay_ * Px)
+                    wb += iB * (bx_ * Py - by_ * Px)
+        if mA > 0.0 or iA > 0.0:
+            vx[a], vy[a], w[a] = vax, vay, wa
+        if mB > 0.0 or iB > 0.0:
+            vx[b], vy[b], w[b] = vbx, vby, wb
+
+
+@njit(cache=True)
+def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
+    """Bounce the points that approached faster than ``threshold`` and took an impulse (Box2D's
+    ``b2ApplyRestitution``): the relative normal velocity becomes ``-e`` times the approach."""
+    for c in range(nc):
+        e = cf[c, 3]
+        if e == 0.0:
+            continue
+        p = ci[c, 0]
+        a, b = pairs[p, 0], pairs[p, 1]
+        nx, ny = cf[c, 0], cf[c, 1]
+        for j in range(ci[c, 1]):
+            if cp[c, j, _RELV] > -threshold or cp[c, j, _TOTAL] == 0.0:
+                continue
+            ax_, ay_, bx_, by_ = cp[c, j, _RAX], cp[c, j, _RAY], cp[c, j, _RBX], cp[c, j, _RBY]
+            vn = ((vx[b] - w[b] * by_ - vx[a] + w[a] * ay_) * nx
+                  + (vy[b] + w[b] * bx_ - vy[a] - w[a] * ax_) * ny)
+            old = cp[c, j, _PNI]
+            new = max(old - cp[c, j, _NMASS] * (vn + e * cp[c, j, _RELV]), 0.0)
+            imp = new - old
+            cp[c, j, _PNI] = new
+            Px, Py = imp * nx, imp * ny
+            vx[a] -= im[a] * Px
+            vy[a] -= im[a] * Py
+            w[a] -= ii[a] * (ax_ * Py - ay_ * Px)
+            vx[b] += im[b] * Px
+            vy[b] += im[b] * Py
+            w[b] += ii[b] * (bx_ * Py - by_ * Px)
