@@ -128,7 +128,8 @@ class Scene:
         esper.switch_world(self.world)
         self._stages = {stage.name: stage for stage in pipeline_stages(self._pipeline)}
         for stage in self._stages.values():
-            esper.add_processor(stage, stage.priority)
+            if stage.solver in (None, solver):  # (the other solver's stages never run here)
+                esper.add_processor(stage, stage.priority)
         for hook in SCENE_CREATED:
             hook(self)
 

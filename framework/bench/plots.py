@@ -152,16 +152,16 @@ def plot_regimes(report: dict[str, Any], path: Path) -> bool:
         return False
     rows = report["rows"]
     names = [r["scene"] for r in rows]
-    engines = (("ours", "ours"), ("pymunk", "pymunk"), ("box2d", "Box2D v3 (pyb2d3)"))
+    engines = (("ours", "ours (exact)"), ("soft", "ours (soft)"), ("pymunk", "pymunk"), ("box2d", "Box2D v3 (pyb2d3)"))
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(13, 8.5), sharex=True)
-    width = 0.27
+    width = 0.2
     xs = range(len(rows))
     for k, (key, label) in enumerate(engines):
         ms = [r[f"{key}_ms"] or 0.0 for r in rows]
         pen = [r[f"pen_{key}"] if r[f"pen_{key}"] is not None else float("nan") for r in rows]
         if any(ms):
-            ax.bar([x + (k - 1) * width for x in xs], ms, width, label=label)
-            bx.bar([x + (k - 1) * width for x in xs], pen, width, label=label)
+            ax.bar([x + (k - 1.5) * width for x in xs], ms, width, label=label)
+            bx.bar([x + (k - 1.5) * width for x in xs], pen, width, label=label)
     for x, r in zip(xs, rows):
         if r["ratio"] is not None:
             top = max(r[f"{k}_ms"] or 0.0 for k, _ in engines)

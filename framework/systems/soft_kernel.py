@@ -100,8 +100,8 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, off, lv, ln, cnt, rr, spin, boun
 @njit(cache=True)
 def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
     """Sort-and-sweep along x over the fat bounds: the pairs of rows whose fat bounds overlap
-    (never two fixed ones; layers that meet), as rows ``(a, b)`` with ``entity[a] < entity[b]``,
-    sorted by that pair of entities."""
+    (never two fixed ones; layers that meet), as rows ``(a, b, key)`` with ``entity[a] < entity[b]``
+    and ``key = entity[a] << 32 | entity[b]``, sorted by key."""
     n = fat.shape[0]
     order = np.argsort(fat[:, 0], kind="mergesort")
     cap = 4 * n + 16
@@ -138,15 +138,13 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
     for k in range(m):
         keys[k] = (entity[pa[k]] << 32) | entity[pb[k]]
     srt = np.argsort(keys, kind="mergesort")
-    pairs = np.empty((m, 2), dtype=np.int64)
-    out_keys = np.empty(m, dtype=np.int64)
+    pairs = np.empty((m, 3), dtype=np.int64)
     for k in range(m):
-        pairs[k, 0], pairs[k, 1] = pa[srt[k]], pb[srt[k]]
-        out_keys[k] = keys[srt[k]]
-    return pairs, out_keys
+        pairs[k, 0], pairs[k, 1], pairs[k, 2] = pa[srt[k]], pb[srt[k]], keys[srt[k]]
+    return pairs
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, spec, out):
     """The manifold of rows ``a``, ``b`` (normal from a to b)."""
     if kind[a] == _AABB and kind[b] == _AABB:  # (an AABB's local corner 2 is its half extents)
@@ -160,6 +158,74 @@ def _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, spec, out):
         k, nx, ny = polygon_circle(wv, wn, b, cnt[b], rr[b], wv[a, 0, 0], wv[a, 0, 1], rr[a], spec, out)
         return k, -nx, -ny
     return polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, spec, out)
+
+
+@njit(cache=True, inline="always")
+def _fat_overlap(fat, i, j):
+    return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
+
+
+@njit(cache=True)
+def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs):
+    """The candidate pairs after the ``moved`` rows took new fat bounds: exactly what
+    :func:`_candidate_pairs` would find (pairs of unmoved rows keep their overlap), at the cost of a
+    pass over the pairs and one over the rows per moved row."""
+    n = fat.shape[0]
+    m = pairs.shape[0]
+    keep = np.empty(m, dtype=np.bool_)
+    n_keep = 0
+    for p in range(m):
+        a, b = pairs[p, 0], pairs[p, 1]
+        keep[p] = not (moved[a] or moved[b]) or _fat_overlap(fat, a, b)
+        if keep[p]:
+            n_keep += 1
+    old_keys = pairs[:, 2]
+    cap = 16
+    add = np.empty((cap, 3), dtype=np.int64)
+    n_add = 0
+    for e in range(n):
+        if not moved[e] or cnt[e] == 0:
+            continue
+        for j in range(n):
+            if j == e or cnt[j] == 0 or (moved[j] and j < e) or (fixed[e] and fixed[j]):
+                continue
+            if not _fat_overlap(fat, e, j):
+                continue
+            if not layers_open and ((layer[e] & mask[j]) == 0 or (layer[j] & mask[e]) == 0):
+                continue
+            a, b = (e, j) if entity[e] < entity[j] else (j, e)
+            key = (entity[a] << 32) | entity[b]
+            lo_, hi_ = 0, m  # already a candidate (and kept: it still overlaps)?
+            while lo_ < hi_:
+                mid = (lo_ + hi_) >> 1
+                if old_keys[mid] < key:
+                    lo_ = mid + 1
+                else:
+                    hi_ = mid
+            if lo_ < m and old_keys[lo_] == key:
+                continue
+            if n_add == cap:
+                cap *= 2
+                grown = np.empty((cap, 3), dtype=np.int64)
+                grown[:n_add] = add[:n_add]
+                add = grown
+            add[n_add, 0], add[n_add, 1], add[n_add, 2] = a, b, key
+            n_add += 1
+    order = np.argsort(add[:n_add, 2], kind="mergesort")
+    out = np.empty((n_keep + n_add, 3), dtype=np.int64)
+    i, k, o = 0, 0, 0
+    while i < m or k < n_add:
+        if i < m and not keep[i]:
+            i += 1
+            continue
+        if k < n_add and (i >= m or add[order[k], 2] < pairs[i, 2]):
+            out[o, :] = add[order[k], :]
+            k += 1
+        else:
+            out[o, :] = pairs[i, :]
+            i += 1
+        o += 1
+    return out
 
 
 # Columns of a candidate pair's slot (kept between steps): the feature ids and accumulated normal and
@@ -200,17 +266,18 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 @njit(cache=True)
 def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, friction, restitution, layer, mask,
               sensor, one_way, asleep, has_vel, entity, bound, off, lv, ln, cnt, rr, spin,
-              fat, pairs, keys, slots, rebuild):
+              fat, pairs, slots, rebuild):
     """One step of ``params[_DT]`` over the rows (the body columns modified in place).
-    ``fat``: each row's fat bounds; ``pairs, keys, slots``: the candidate pairs kept from the last
-    step (``rebuild``: the rows changed, find them again); these are not modified: new ones are
-    returned. See the module docstring for the stages.
+    ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
+    (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
+    not modified: new ones are returned. See the module docstring for the stages.
 
-    Returns ``(fat, pairs, keys, slots, ra, rb, ea, eb, f, started, ended_a, ended_b, ended_f, wake,
-    rebuilt, contacts)``: the fat bounds, candidate pairs and their slots for the next step; the
-    pairs touching now (rows, entities, their contact's nx, ny, depth, px, py as rows of ``f``) and
-    which of them started; the pairs that stopped touching (entities, last contact); the sleepers
-    to wake; whether the pairs were found again; how many contacts the solver used."""
+    Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info)`` (few objects: each
+    array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
+    slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
+    entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
+    (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
+    were found again, how many contacts the solver used, then the rows of the sleepers to wake."""
     dt = params[_DT]
     nsub = int(params[_SUB])
     gx, gy = params[_GX], params[_GY]
@@ -252,6 +319,8 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     fat_margin = params[_FAT]
     fat = fat.copy()  # (the step's inputs stay as they were: a failed step is undone by keeping them)
     slots = slots.copy()
+    moved = np.zeros(n, dtype=np.bool_)  # left its fat bounds (or the rows changed): new fat bounds
+    n_moved = 0
     for r in range(n):
         if cnt[r] == 0:
             continue
@@ -260,16 +329,20 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         if rebuild or not inside:
             e = 0.0 if fixed[r] else fat_margin
             fat[r, 0], fat[r, 1], fat[r, 2], fat[r, 3] = lo[r, 0] - e, lo[r, 1] - e, hi[r, 0] + e, hi[r, 1] + e
-            rebuild = True
+            moved[r] = True
+            n_moved += 1
     n_end = 0
-    ended_keys = np.empty(keys.size, dtype=np.int64)
-    ended_f = np.empty((keys.size, 5))
-    rebuilt = rebuild
-    if rebuild:
-        pairs, new_keys = _candidate_pairs(fat, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity)
-        slots, n_end = _merge_slots(keys, slots, new_keys, ended_keys, ended_f)
-        keys = new_keys
-    m = keys.size
+    ended_keys = np.empty(pairs.shape[0], dtype=np.int64)
+    ended_f = np.empty((pairs.shape[0], 5))
+    rebuilt = rebuild or 8 * n_moved > n
+    if rebuilt or n_moved:
+        if rebuilt:  # everything again: sort and sweep
+            new = _candidate_pairs(fat, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity)
+        else:  # a few bodies left their fat bounds: only their pairs change
+            new = _moved_pairs(fat, moved, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity, pairs)
+        slots, n_end = _merge_slots(pairs[:, 2], slots, new[:, 2], ended_keys, ended_f)
+        pairs = new
+    m = pairs.shape[0]
 
     # --- narrow phase: manifolds -> contacts ---------------------------------------------------
     ci = np.empty((m, 2), dtype=np.int64)  # the contact's pair slot, points the solver uses
@@ -283,14 +356,13 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     nc = 0
     for p in range(m):
         a, b = pairs[p, 0], pairs[p, 1]
-        sl = slots[p]
-        was = sl[_TOUCH] != 0.0
+        was = slots[p, _TOUCH] != 0.0
         if not moving[a] and not moving[b]:  # asleep (or still): keeps what it had
             if was:
                 touching_idx[n_touch] = p
                 started[n_touch] = False
                 n_touch += 1
-            sl[_NP] = 0.0
+            slots[p, _NP] = 0.0
             continue
         s_pair = spec + reach[a] + reach[b] if response else 0.0
         if kind[a] == _AABB and kind[b] == _AABB:  # the common case, inline (an AABB's corner 2: its half extents)
@@ -307,25 +379,25 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         # In contact: overlapping, or within the slop and either in contact last step or holding
         # the bodies apart then (a body resting on a sleeper sits at a separation of 0, give or take
         # rounding: it touches it, and wakes it).
-        held = sl[_NI] > 0.0 or sl[_NI + 1] > 0.0
+        held = slots[p, _NI] > 0.0 or slots[p, _NI + 1] > 0.0
         touching = k > 0 and (low < 0.0 or ((was or held) and low < slop))
         if touching:
             touching_idx[n_touch] = p
             started[n_touch] = not was
             n_touch += 1
-            sl[_NX], sl[_NY], sl[_DEPTH] = nx, ny, -low
-            sl[_PX], sl[_PY] = out[deep, 0], out[deep, 1]
+            slots[p, _NX], slots[p, _NY], slots[p, _DEPTH] = nx, ny, -low
+            slots[p, _PX], slots[p, _PY] = out[deep, 0], out[deep, 1]
             if not (sensor[a] or sensor[b]):
                 if asleep[a] and moving[b]:
                     wake[a] = True
                 if asleep[b] and moving[a]:
                     wake[b] = True
         elif was:
-            ended_keys[n_end] = keys[p]
-            ended_f[n_end, 0], ended_f[n_end, 1], ended_f[n_end, 2] = sl[_NX], sl[_NY], sl[_DEPTH]
-            ended_f[n_end, 3], ended_f[n_end, 4] = sl[_PX], sl[_PY]
+            ended_keys[n_end] = pairs[p, 2]
+            ended_f[n_end, 0], ended_f[n_end, 1], ended_f[n_end, 2] = slots[p, _NX], slots[p, _NY], slots[p, _DEPTH]
+            ended_f[n_end, 3], ended_f[n_end, 4] = slots[p, _PX], slots[p, _PY]
             n_end += 1
-        sl[_TOUCH] = 1.0 if touching else 0.0
+        slots[p, _TOUCH] = 1.0 if touching else 0.0
         use = response and k > 0 and not (sensor[a] or sensor[b])
         if use and (one_way[a] or one_way[b]):
             up = ny if one_way[a] else -ny  # the normal from the platform to the other body
@@ -333,7 +405,7 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         if use and im[a] == 0.0 and im[b] == 0.0 and ii[a] == 0.0 and ii[b] == 0.0:
             use = False
         if not use:
-            sl[_NP] = 0.0
+            slots[p, _NP] = 0.0
             continue
         # prepare the contact: anchors, effective masses, warm starts from the slot by feature id
         ci[nc, 0], ci[nc, 1] = p, k
@@ -350,7 +422,7 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         cf[nc, 3] = max(restitution[a], restitution[b])
         cf[nc, 4] = 1.0 if (not moving[a] or not moving[b]) else 0.0
         tx, ty = ny, -nx  # Box2D's right perp
-        old_np = int(sl[_NP])
+        old_np = int(slots[p, _NP])
         for j in range(k):
             px, py = out[j, 0], out[j, 1]
             ax_, ay_ = px - x[a], py - y[a]
@@ -370,8 +442,8 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
             cp[nc, j, _PID] = out[j, 3]
             cp[nc, j, _PNI], cp[nc, j, _PTI], cp[nc, j, _TOTAL] = 0.0, 0.0, 0.0
             for o in range(old_np):
-                if sl[_ID + o] == out[j, 3]:
-                    cp[nc, j, _PNI], cp[nc, j, _PTI] = sl[_NI + o], sl[_TI + o]
+                if slots[p, _ID + o] == out[j, 3]:
+                    cp[nc, j, _PNI], cp[nc, j, _PTI] = slots[p, _NI + o], slots[p, _TI + o]
         nc += 1
 
     # --- sub-steps ------------------------------------------------------------------------------
@@ -411,35 +483,35 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
 
     # --- store the impulses in the slots ----------------------------------------------------------
     for c in range(nc):
-        sl = slots[ci[c, 0]]
+        p = ci[c, 0]
         k = ci[c, 1]
-        sl[_NP] = k
+        slots[p, _NP] = k
         for j in range(k):
-            sl[_ID + j], sl[_NI + j], sl[_TI + j] = cp[c, j, _PID], cp[c, j, _PNI], cp[c, j, _PTI]
+            slots[p, _ID + j], slots[p, _NI + j], slots[p, _TI + j] = cp[c, j, _PID], cp[c, j, _PNI], cp[c, j, _PTI]
     # the touching pairs, as the frame's contact columns
-    t_ra = np.empty(n_touch, dtype=np.int64)
-    t_rb = np.empty(n_touch, dtype=np.int64)
-    t_ea = np.empty(n_touch, dtype=np.int64)
-    t_eb = np.empty(n_touch, dtype=np.int64)
-    t_f = np.empty((5, n_touch))
+    touch_i = np.empty((5, n_touch), dtype=np.int64)
+    touch_f = np.empty((5, n_touch))
     for i in range(n_touch):
         p = touching_idx[i]
         a, b = pairs[p, 0], pairs[p, 1]
-        t_ra[i], t_rb[i], t_ea[i], t_eb[i] = a, b, entity[a], entity[b]
+        touch_i[0, i], touch_i[1, i], touch_i[2, i], touch_i[3, i] = a, b, entity[a], entity[b]
+        touch_i[4, i] = 1 if started[i] else 0
         for q in range(5):
-            t_f[q, i] = slots[p, _NX + q]
-    e_ea = np.empty(n_end, dtype=np.int64)
-    e_eb = np.empty(n_end, dtype=np.int64)
-    e_f = np.empty((5, n_end))
+            touch_f[q, i] = slots[p, _NX + q]
+    end_i = np.empty((2, n_end), dtype=np.int64)
+    end_f = np.empty((5, n_end))
     for i in range(n_end):
-        e_ea[i], e_eb[i] = ended_keys[i] >> 32, ended_keys[i] & 0xFFFFFFFF
+        end_i[0, i], end_i[1, i] = ended_keys[i] >> 32, ended_keys[i] & 0xFFFFFFFF
         for q in range(5):
-            e_f[q, i] = ended_f[i, q]
-    return (fat, pairs, keys, slots, t_ra, t_rb, t_ea, t_eb, t_f, started[:n_touch], e_ea, e_eb, e_f,
-            np.flatnonzero(wake), rebuilt, nc)
+            end_f[q, i] = ended_f[i, q]
+    woken = np.flatnonzero(wake)
+    info = np.empty(2 + woken.size, dtype=np.int64)
+    info[0], info[1] = 1 if rebuilt else 0, nc
+    info[2:] = woken
+    return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
     """Apply each point's accumulated impulses (Box2D's ``b2WarmStartContacts``)."""
     for c in range(nc):
@@ -459,7 +531,7 @@ def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
             w[b] += ii[b] * (cp[c, j, _RBX] * Py - cp[c, j, _RBY] * Px)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_bias, rotation, soft_c, soft_s,
            inv_h, push):
     """One pass over the contacts (Box2D's ``b2SolveContact``): the normal impulses with soft
@@ -532,7 +604,7 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
             vx[b], vy[b], w[b] = vbx, vby, wb
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
     """Bounce the points that approached faster than ``threshold`` and took an impulse (Box2D's
     ``b2ApplyRestitution``): the relative normal velocity becomes ``-e`` times the approach."""

@@ -101,8 +101,7 @@ class SoftStep(Stage):
 
     def reset(self) -> None:
         """Forget the candidate pairs and their contacts (warm starts and touching pairs)."""
-        self.pairs = np.zeros((0, 2), dtype=np.int64)
-        self.keys = np.zeros(0, dtype=np.int64)
+        self.pairs = np.zeros((0, 3), dtype=np.int64)  # rows a, b and key (entity a << 32 | entity b)
         self.slots = np.zeros((0, len(SLOT)))
         self.fat = np.zeros((0, 4))
         self._pairs_key: tuple[int, int] | None = None
@@ -110,11 +109,11 @@ class SoftStep(Stage):
     def state(self) -> tuple[Any, ...]:
         """What the next step starts from (the kernel never modifies these arrays in place: a
         step replaces them, so keeping the references keeps the state)."""
-        return self.fat, self.pairs, self.keys, self.slots, self._pairs_key
+        return self.fat, self.pairs, self.slots, self._pairs_key
 
     def restore(self, state: tuple[Any, ...]) -> None:
         """Start the next step from ``state`` (of :meth:`state`)."""
-        self.fat, self.pairs, self.keys, self.slots, self._pairs_key = state
+        self.fat, self.pairs, self.slots, self._pairs_key = state
 
     def wanted(self) -> bool:
         effects = self.pipeline.effects
@@ -170,23 +169,23 @@ class SoftStep(Stage):
             self.fat = np.zeros((store.n, 4))
             self._pairs_key = key
         out = soft_step(self._settings(frame), *self._columns(), off, lv, ln, cnt, rr, spin, self.fat, self.pairs,
-                        self.keys, self.slots, rebuild)
-        (self.fat, self.pairs, self.keys, self.slots, ra, rb, ea, eb, f, started, end_a, end_b, end_f, wake, rebuilt,
-         solved) = out
+                        self.slots, rebuild)
+        self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info = out
         if "movement" in effects:
             store.motion += 1
-        frame.contacts = StepContacts(ea, eb, f[0], f[1], f[2], f[3], f[4])
-        frame.contact_rows, frame.started = (ra, rb), started
-        frame.ended = StepContacts(end_a, end_b, end_f[0], end_f[1], end_f[2], end_f[3], end_f[4])
+        ra, rb, ea, eb, started = touch_i
+        frame.contacts = StepContacts(ea, eb, *touch_f)
+        frame.contact_rows, frame.started = (ra, rb), started.astype(bool)
+        frame.ended = StepContacts(end_i[0], end_i[1], *end_f)
         frame._events = None
-        if wake.size:
-            store.wake(wake)
+        if info.size > 2:
+            store.wake(info[2:])
         counters = frame.counters
         counters["integrated"] = int(store.active()[0].size)
-        counters["candidate_pairs"] = int(self.keys.size)
-        counters["rehashed"] = int(rebuilt)
+        counters["candidate_pairs"] = int(self.pairs.shape[0])
+        counters["rehashed"] = int(info[0])
         counters["contacts"] = int(ea.size)
-        counters["events"] = int(ea.size + end_a.size)
-        counters["resolved"] = int(solved)
+        counters["events"] = int(ea.size + end_i.shape[1])
+        counters["resolved"] = int(info[1])
         counters["asleep"] = frame.n_asleep = int(np.count_nonzero(store.asleep[store.active_sel()[2]]))
         return True
