@@ -207,14 +207,30 @@ def test_a_head_on_hit_keeps_momentum():
 # --- what game makers try first ---------------------------------------------------------------------
 
 
-def test_a_fast_bullet_never_passes_a_thin_wall():
+def test_a_fast_bullet_never_passes_a_thin_wall_and_its_hit_is_an_event():
     for speed in (100.0, 1000.0, 30000.0):
         s = soft(gravity=(0.0, 0.0))
-        s.spawn(Transform(10.0, 0.0), Hitbox(AABB(0.1, 4.0), body="static"))
+        wall = s.spawn(Transform(10.0, 0.0), Hitbox(AABB(0.1, 4.0), body="static"))
         b = s.spawn(Transform(0.0, 0.0), Velocity(speed, 0.0), Hitbox(AABB(0.1, 0.1)))
+        kinds = []
         for _ in range(30):
             s.step(1 / 60)
             assert s.get(b, Transform).x <= 9.9 + 1e-9
+            kinds += [ev.kind for ev in s.events if {ev.a, ev.b} == {wall, b}]
+        assert kinds[0] == "started" and kinds.count("started") == 1  # stopped at the face: it hit
+
+
+def test_a_ball_bouncing_off_a_wall_starts_and_ends_once():
+    s = soft(gravity=(0.0, 0.0))
+    wall = s.spawn(Transform(10.0, 0.0), Hitbox(AABB(1.0, 4.0), body="static"))
+    b = s.spawn(Transform(0.0, 0.0), Velocity(30.0, 0.0), Hitbox(Circle(0.25), restitution=1.0))
+    kinds = []
+    for _ in range(60):
+        s.step(1 / 60)
+        kinds += [ev.kind for ev in s.events if {ev.a, ev.b} == {wall, b}]
+    assert kinds[0] == "started" and kinds[-1] == "ended"
+    assert kinds.count("started") == 1 and kinds.count("ended") == 1
+    assert s.get(b, Velocity).x == pytest.approx(-30.0, rel=1e-9)
 
 
 def test_a_crate_that_can_turn_tips_off_a_ledge_only_past_its_centre():
@@ -388,3 +404,47 @@ def test_candidate_pairs_kept_between_steps_are_those_a_full_sweep_finds():
         incremental += s.counters["rehashed"] == 0 and not np.array_equal(before, stage.pairs)
         before = stage.pairs
     assert incremental >= 10
+
+
+def test_a_snapshot_restored_continues_bit_for_bit():
+    s, ents = _mixed_pile(13)
+    for _ in range(40):
+        s.step(1 / 60)
+    snap = s.snapshot()
+    for _ in range(40):
+        s.step(1 / 60)
+    expected = _state(s, ents)
+    other, ents2 = _mixed_pile(13)  # another scene built the same way
+    other.restore(snap)
+    for _ in range(40):
+        other.step(1 / 60)
+    assert _state(other, ents2) == expected
+    s.restore(snap)  # and the scene itself
+    for _ in range(40):
+        s.step(1 / 60)
+    assert _state(s, ents) == expected
+
+
+def test_a_snapshot_file_restored_continues_bit_for_bit(tmp_path):
+    from framework.snapshot_file import load_snapshot, save_snapshot
+
+    s, ents = _mixed_pile(17)
+    for _ in range(30):
+        s.step(1 / 60)
+    save_snapshot(s, tmp_path / "soft.npz")
+    for _ in range(30):
+        s.step(1 / 60)
+    other, ents2 = _mixed_pile(17)
+    load_snapshot(other, tmp_path / "soft.npz")
+    for _ in range(30):
+        other.step(1 / 60)
+    assert _state(other, ents2) == _state(s, ents)
+
+
+def test_a_soft_snapshot_does_not_restore_into_an_exact_scene():
+    s, _ = _mixed_pile(1)
+    s.step(1 / 60)
+    snap = s.snapshot()
+    exact = Scene(gravity=(0.0, -10.0))
+    with pytest.raises(InvalidValue, match="another shape"):
+        exact.restore(snap)

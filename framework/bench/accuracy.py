@@ -98,12 +98,12 @@ BULLET_RADIUS = 0.125
 LANE_SPACING = 8.0
 #: bullet speeds in units per step (x 60 for units per second)
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 64.0)
-BULLET_MODES = ("discrete", "swept", "substeps-2", "substeps-4", "substeps-8")
+BULLET_MODES = ("discrete", "swept", "substeps-2", "substeps-4", "substeps-8", "soft")
 CRATE_MODES = ("aabb", "aabb-bounds", "circle", "polygon")
 REST_MODES = ("response-iterations-1", "response-iterations-2", "response-iterations-4",
-              "response-iterations-8", "substeps-2", "substeps-4", "substeps-8", "default-sleeping")
-BALL_MODES = ("substeps-1", "substeps-2", "substeps-4", "substeps-8")
-FRICTION_MODES = ("substeps-1", "substeps-2", "substeps-4")
+              "response-iterations-8", "substeps-2", "substeps-4", "substeps-8", "soft", "default-sleeping")
+BALL_MODES = ("substeps-1", "substeps-2", "substeps-4", "substeps-8", "soft")
+FRICTION_MODES = ("substeps-1", "substeps-2", "substeps-4", "soft")
 FRICTION_CASES = ("crate-stop", "slope-hold", "slope-slide", "disk-roll", "disk-slip", "box-tip", "box-tip-one-point")
 CONTROLLER_CASES = ("slope-45-up", "slope-45-down", "slope-2:1-up", "slope-2:1-down", "step-up", "ride-reverse")
 CONTROLLER_MODES = ("substeps-1", "substeps-4")
@@ -129,12 +129,14 @@ def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
 
 
 def _scene_for(mode: str, gravity=(0.0, 0.0), effects=None):
-    """A scene configured by a mode name: ``substeps-N``, ``response-iterations-N``, else defaults.
-    Sleeping is off unless the mode is ``default-sleeping``."""
+    """A scene configured by a mode name: ``substeps-N``, ``response-iterations-N``, ``soft`` (the
+    soft-step solver), else defaults. Sleeping is off unless the mode is ``default-sleeping``."""
     from ..scene import DEFAULT_EFFECTS, Scene
 
     kw: dict[str, Any] = {}
-    if mode.startswith("substeps-"):
+    if mode == "soft":
+        kw["solver"] = "soft"
+    elif mode.startswith("substeps-"):
         kw["substeps"] = int(mode.rsplit("-", 1)[1])
     elif mode.startswith("response-iterations-"):
         kw["response_iterations"] = int(mode.rsplit("-", 1)[1])

@@ -84,7 +84,7 @@ ENGINES = ("ours", "soft", "pymunk", "box2d")  # soft: ours with Scene(solver="s
 
 CROWDS = ("balls", "boxes", "mixed", "mixed-friction")
 #: untimed steps before timing, by scene kind (the same in --quick: the accuracy figures do not move)
-SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer": 0}
+SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer": 0, "toy": 0}
 # timed rounds by the number of moving bodies (the first bound that is >= it); the crowds' step cap
 FULL: dict[str, Any] = {"rounds": ((100, 500), (1_000, 200), (10**9, 80)), "platformer_rounds": 900,
         "crowd_steps": CROWD["max_steps"]}
@@ -100,7 +100,8 @@ class Piece:
 
     ``judged``: taken into account by the penetration oracle (not sensors, not one-way slabs that
     bodies may pass through from below). ``role``/``params``: what the peers' untimed game logic
-    does with it in the platformer (``enemy``: patrol; ``platform``: back and forth)."""
+    does with it in the platformer (``enemy``: patrol; ``platform``: back and forth). ``mass``: a
+    dynamic piece's, in every engine (its inertia scales with it)."""
 
     shape: Shape
     x: float
@@ -112,6 +113,7 @@ class Piece:
     judged: bool = True
     role: str | None = None
     params: tuple = ()
+    mass: float = 1.0
 
 
 @dataclass
@@ -226,6 +228,29 @@ def pyramid(rows: int) -> Regime:
         pieces += [Piece(AABB(1.0, 1.0), i - (k - 1) / 2, y) for i in range(k)]
     return Regime(f"pyramid-{rows}", "pyramid", pieces, top=[len(pieces) - 1], exact_top=rows - 0.5,
                   height=float(rows))
+
+
+def stack_tumbling(n: int) -> Regime:
+    """:func:`stack` with boxes that can tip (friction 0.6, every box turns): ``stack-N-tumbling``."""
+    return with_friction(stack(n), 0.6, tumbling=True)
+
+
+def physics_toy() -> Regime:
+    """The issue's physics toy (62 bodies, every one turns, friction 0.6): a pyramid of 55 boxes
+    (10 rows), a heavy ball (mass 20) thrown at it, three crates and a barrel on a slope."""
+    pieces = [Piece(AABB(60.0, 1.0), 0.0, -0.5, kind="static"),
+              Piece(Polygon([(0.0, 0.0), (8.0, 0.0), (0.0, 4.0)]), 14.0, 0.0, kind="static")]  # the slope
+    top = None
+    for r in range(10):
+        k = 10 - r
+        for i in range(k):
+            pieces.append(Piece(AABB(1.0, 1.0), i - (k - 1) / 2, r + 0.5 + (r + 1) * GAP))
+        top = len(pieces) - 1
+    pieces.append(Piece(Circle(0.75), -14.0, 2.0, vx=12.0, vy=3.0, mass=20.0))
+    pieces += [Piece(AABB(1.5, 1.5), x, 0.75 + GAP) for x in (-9.0, -7.0, 8.0)]
+    pieces.append(Piece(Circle(0.5), 15.0, 4.5))  # the barrel, dropped onto the slope
+    regime = with_friction(Regime("toy", "toy", pieces, top=[top], height=10.0), 0.6, tumbling=True)
+    return replace(regime, name="toy-62")
 
 
 def scattered(n: int, seed: int = 0) -> Regime:
@@ -397,6 +422,7 @@ class Ours(Engine):
                          if p.kind == "static" else
                          scene.spawn(Transform(p.x, p.y), Velocity(p.vx, p.vy),
                                      Hitbox(_ours_shape(regime, p.shape), body=p.kind, sensor=p.sensor, friction=mu,
+                                            mass=p.mass if p.kind == "dynamic" else 1.0,
                                             inertia=None if _turns(regime, p.shape) else math.inf))
                          for p in regime.pieces]
         dt = regime.dt
@@ -536,8 +562,8 @@ class PymunkEngine(Peer):
             if p.kind == "static":
                 body, ox, oy, handle = space.static_body, p.x, p.y, None
             else:
-                moment = p.shape.second_moment if _turns(regime, p.shape) else math.inf
-                body = handle = (pymunk.Body(1.0, moment) if p.kind == "dynamic"
+                moment = p.mass * p.shape.second_moment if _turns(regime, p.shape) else math.inf
+                body = handle = (pymunk.Body(p.mass, moment) if p.kind == "dynamic"
                                  else pymunk.Body(body_type=pymunk.Body.KINEMATIC))
                 body.position, body.velocity, ox, oy = (p.x, p.y), (p.vx, p.vy), 0.0, 0.0
                 items.append(body)
@@ -588,7 +614,7 @@ class Box2DEngine(Peer):
                 body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy),
                                      fixed_rotation=not _turns(regime, p.shape))
                 ox = oy = 0.0
-            sd = b2.shape_def(density=1.0 / _area(p.shape), is_sensor=p.sensor,
+            sd = b2.shape_def(density=p.mass / _area(p.shape), is_sensor=p.sensor,
                               material=b2.surface_material(friction=regime.friction, restitution=0.0))
             if isinstance(p.shape, Circle):
                 body.create_circle_shape(sd, b2.circle(center=(ox, oy), radius=p.shape.radius))
@@ -806,6 +832,8 @@ SCENES: dict[str, Callable[[], Regime | None]] = {
     "pyramid-20-friction": lambda: with_friction(pyramid(20)),
     "pile-circles-1000-rolling": lambda: with_friction(shape_pile("circles", 40, 25), rolling=True),
     "pyramid-20-tumbling": lambda: with_friction(pyramid(20), 0.6, tumbling=True),
+    "stack-20-tumbling": lambda: stack_tumbling(20),
+    "toy-62": physics_toy,
     "pile-boxes-1000-tumbling": lambda: with_friction(box_pile(40, 25), tumbling=True),
     "scattered-10": lambda: scattered(10),
     "scattered-100": lambda: scattered(100),

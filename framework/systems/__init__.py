@@ -24,8 +24,10 @@ _ORDER: tuple[type[Stage], ...] = (
 
 
 def pipeline_stages(pipeline: Pipeline) -> list[Stage]:
-    """One instance of every stage, in pipeline order, sharing ``pipeline``; then the soft step,
-    which runs in place of movement, detection and response when the scene's solver is soft."""
+    """One instance of every stage, in pipeline order, sharing ``pipeline``, with the soft step
+    where it runs (at the response's place: it stands for movement, detection and response when the
+    scene's solver is soft)."""
     stages = [cls(pipeline) for cls in _ORDER]
     assert tuple(s.name for s in stages) == STAGES
-    return [*stages, SoftStep(pipeline)]
+    at = STAGES.index("response") + 1
+    return [*stages[:at], SoftStep(pipeline), *stages[at:]]

@@ -234,7 +234,7 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
 SLOT = ("id0", "id1", "ni0", "ni1", "ti0", "ti1", "points", "touching", "nx", "ny", "depth", "px", "py")
 _ID, _NI, _TI, _NP, _TOUCH, _NX, _NY, _DEPTH, _PX, _PY = 0, 2, 4, 6, 7, 8, 9, 10, 11, 12
 # Columns of a contact point in the solve.
-_RAX, _RAY, _RBX, _RBY, _BASE, _NMASS, _TMASS, _PNI, _PTI, _TOTAL, _RELV, _PID = range(12)
+_RAX, _RAY, _RBX, _RBY, _BASE, _NMASS, _TMASS, _PNI, _PTI, _TOTAL, _RELV, _PID, _PEAK = range(13)
 
 
 @njit(cache=True)
@@ -347,10 +347,9 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     # --- narrow phase: manifolds -> contacts ---------------------------------------------------
     ci = np.empty((m, 2), dtype=np.int64)  # the contact's pair slot, points the solver uses
     cf = np.empty((m, 5))  # nx, ny, friction, restitution, stiff (against an idle body)
-    cp = np.empty((m, 2, 12))
-    touching_idx = np.empty(m, dtype=np.int64)
-    started = np.empty(m, dtype=np.bool_)
-    n_touch = 0
+    cp = np.empty((m, 2, 13))
+    tnow = np.zeros(m, dtype=np.int8)  # in contact now: 1 yes, 0 no, -1 not measured (keeps its state)
+    evd = np.empty((m, 5))  # the contact measured now: nx, ny, depth, px, py
     wake = np.zeros(n, dtype=np.bool_)
     out = np.empty((2, 4))
     nc = 0
@@ -358,10 +357,7 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         a, b = pairs[p, 0], pairs[p, 1]
         was = slots[p, _TOUCH] != 0.0
         if not moving[a] and not moving[b]:  # asleep (or still): keeps what it had
-            if was:
-                touching_idx[n_touch] = p
-                started[n_touch] = False
-                n_touch += 1
+            tnow[p] = -1
             slots[p, _NP] = 0.0
             continue
         s_pair = spec + reach[a] + reach[b] if response else 0.0
@@ -376,28 +372,11 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
             deep = 0
             if k == 2 and out[1, 2] < low:
                 low, deep = out[1, 2], 1
-        # In contact: overlapping, or within the slop and either in contact last step or holding
-        # the bodies apart then (a body resting on a sleeper sits at a separation of 0, give or take
-        # rounding: it touches it, and wakes it).
-        held = slots[p, _NI] > 0.0 or slots[p, _NI + 1] > 0.0
-        touching = k > 0 and (low < 0.0 or ((was or held) and low < slop))
-        if touching:
-            touching_idx[n_touch] = p
-            started[n_touch] = not was
-            n_touch += 1
-            slots[p, _NX], slots[p, _NY], slots[p, _DEPTH] = nx, ny, -low
-            slots[p, _PX], slots[p, _PY] = out[deep, 0], out[deep, 1]
-            if not (sensor[a] or sensor[b]):
-                if asleep[a] and moving[b]:
-                    wake[a] = True
-                if asleep[b] and moving[a]:
-                    wake[b] = True
-        elif was:
-            ended_keys[n_end] = pairs[p, 2]
-            ended_f[n_end, 0], ended_f[n_end, 1], ended_f[n_end, 2] = slots[p, _NX], slots[p, _NY], slots[p, _DEPTH]
-            ended_f[n_end, 3], ended_f[n_end, 4] = slots[p, _PX], slots[p, _PY]
-            n_end += 1
-        slots[p, _TOUCH] = 1.0 if touching else 0.0
+            evd[p, 0], evd[p, 1], evd[p, 2] = nx, ny, max(-low, 0.0)
+            evd[p, 3], evd[p, 4] = out[deep, 0], out[deep, 1]
+        # In contact: overlapping, or in contact last step and still within the slop (and, after
+        # the solve, any pair a solve pushed apart: a speculative contact that stopped a fast body).
+        tnow[p] = 1 if k > 0 and (low < 0.0 or (was and low < slop)) else 0
         use = response and k > 0 and not (sensor[a] or sensor[b])
         if use and (one_way[a] or one_way[b]):
             up = ny if one_way[a] else -ny  # the normal from the platform to the other body
@@ -440,7 +419,7 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
             cp[nc, j, _RELV] = (nx * (vx[b] - w[b] * by_ - vx[a] + w[a] * ay_)
                                 + ny * (vy[b] + w[b] * bx_ - vy[a] - w[a] * ax_))
             cp[nc, j, _PID] = out[j, 3]
-            cp[nc, j, _PNI], cp[nc, j, _PTI], cp[nc, j, _TOTAL] = 0.0, 0.0, 0.0
+            cp[nc, j, _PNI], cp[nc, j, _PTI], cp[nc, j, _TOTAL], cp[nc, j, _PEAK] = 0.0, 0.0, 0.0, 0.0
             for o in range(old_np):
                 if slots[p, _ID + o] == out[j, 3]:
                     cp[nc, j, _PNI], cp[nc, j, _PTI] = slots[p, _NI + o], slots[p, _TI + o]
@@ -481,13 +460,40 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
                inv_h, push)
     _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
 
-    # --- store the impulses in the slots ----------------------------------------------------------
+    # --- store the impulses in the slots; which pairs are in contact ----------------------------
     for c in range(nc):
         p = ci[c, 0]
         k = ci[c, 1]
         slots[p, _NP] = k
         for j in range(k):
             slots[p, _ID + j], slots[p, _NI + j], slots[p, _TI + j] = cp[c, j, _PID], cp[c, j, _PNI], cp[c, j, _PTI]
+            if cp[c, j, _PEAK] > 0.0:  # a solve pushed the bodies apart: they met this step
+                tnow[p] = 1
+    touching_idx = np.empty(m, dtype=np.int64)
+    started = np.empty(m, dtype=np.bool_)
+    n_touch = 0
+    for p in range(m):
+        was = slots[p, _TOUCH] != 0.0
+        touching = was if tnow[p] < 0 else tnow[p] == 1
+        if touching:
+            touching_idx[n_touch] = p
+            started[n_touch] = not was
+            n_touch += 1
+            if tnow[p] > 0:
+                for q in range(5):
+                    slots[p, _NX + q] = evd[p, q]
+                a, b = pairs[p, 0], pairs[p, 1]
+                if not (sensor[a] or sensor[b]):  # a sleeper an awake body touches wakes
+                    if asleep[a] and moving[b]:
+                        wake[a] = True
+                    if asleep[b] and moving[a]:
+                        wake[b] = True
+        elif was:
+            ended_keys[n_end] = pairs[p, 2]
+            for q in range(5):
+                ended_f[n_end, q] = slots[p, _NX + q]
+            n_end += 1
+        slots[p, _TOUCH] = 1.0 if touching else 0.0
     # the touching pairs, as the frame's contact columns
     touch_i = np.empty((5, n_touch), dtype=np.int64)
     touch_f = np.empty((5, n_touch))
@@ -568,6 +574,8 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
             imp = new - old
             cp[c, j, _PNI] = new
             cp[c, j, _TOTAL] += imp
+            if new > cp[c, j, _PEAK]:  # (the largest impulse a solve left: did the bodies meet?)
+                cp[c, j, _PEAK] = new
             Px, Py = imp * nx, imp * ny
             vax -= mA * Px
             vay -= mA * Py

@@ -95,7 +95,7 @@ class SoftStep(Stage):
         self._tables: tuple[np.ndarray, ...] = ()
         self._params = np.zeros(len(PARAMS))
         self._settings_key: tuple[Any, ...] | None = None
-        self._columns_key: tuple[int, int, int] | None = None
+        self._columns_key: tuple[int, int] | None = None
         self._cols: tuple[np.ndarray, ...] = ()
         self.reset()
 
@@ -132,8 +132,10 @@ class SoftStep(Stage):
         or the columns' storage change."""
         store = self.bodies.store
         c = store.cols
-        key = (store.version, store.n, id(c["x"]))
-        if key != self._columns_key:
+        key = (store.version, store.n)
+        # (views of these very columns: a restored scene's copies are views of nothing, and an
+        # unpickled copy of a column is not the column)
+        if key != self._columns_key or not self._cols or self._cols[0].base is not c["x"]:
             n = store.n
             self._cols = tuple(c[name][:n] for name in _KERNEL_COLUMNS)
             self._columns_key = key
