@@ -448,3 +448,40 @@ def test_a_soft_snapshot_does_not_restore_into_an_exact_scene():
     exact = Scene(gravity=(0.0, -10.0))
     with pytest.raises(InvalidValue, match="another shape"):
         exact.restore(snap)
+
+
+# --- the platformer and its characters -------------------------------------------------------------------
+
+
+def test_the_platformers_demo_plays_the_same_in_the_soft_step():
+    from examples.platformer import Game
+    from examples.platformer.demo import Autoplay, level1
+
+    summaries = []
+    for solver in ("exact", "soft"):
+        game = Game(autoplay=Autoplay(level1), scene=Scene(solver=solver, length_unit=32.0))
+        frames = 0
+        while frames < 3600 and not game.state.reached_goal:
+            game.step()
+            frames += 1
+        summaries.append((frames, game.summary()))
+        game.scene.close()
+    assert summaries[0] == summaries[1]
+    assert summaries[1][1]["reached_goal"] and summaries[1][1]["deaths"] == 0
+
+
+def test_a_character_rides_a_moving_platform_and_is_not_moved_twice():
+    from framework.character import CharacterController
+
+    for solver in ("exact", "soft"):
+        s = Scene(gravity=(0.0, -20.0), solver=solver)
+        platform = s.spawn(Transform(0.0, 0.0), Velocity(2.0, 0.0), Hitbox(AABB(4.0, 0.5), body="kinematic"))
+        hero = s.spawn(Transform(0.0, 0.25 + 0.5), Velocity(0.0, 0.0),
+                       Hitbox(AABB(0.5, 1.0), body="kinematic"), CharacterController())
+        for _ in range(60):
+            s.step(1 / 60)
+        hx, px = s.get(hero, Transform).x, s.get(platform, Transform).x
+        assert px == pytest.approx(2.0, abs=1e-9), solver
+        # carried along from the second step on (the first finds the floor), and no faster
+        assert hx == pytest.approx(px - 2.0 / 60, abs=1e-6), solver
+        assert s.get(hero, Transform).y == pytest.approx(0.75, abs=1e-3), solver

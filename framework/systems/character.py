@@ -19,7 +19,7 @@ from ..character import CharacterController
 from ..collision import collide
 from ..components import Velocity
 from ..frame import StepFrame
-from ..store import DYNAMIC, KINEMATIC
+from ..store import DYNAMIC, KINEMATIC, STATIC
 from ..validation import InvalidValue
 from .stage import Stage
 
@@ -133,6 +133,10 @@ class CharacterStage(Stage):
         if was_on_floor and floor_row is not None and moved and floor_row < frame.start_x.size:
             carried = (float(store.x[floor_row] - frame.start_x[floor_row]),
                        float(store.y[floor_row] - frame.start_y[floor_row]))
+        elif (was_on_floor and floor_row is not None and self.pipeline.solver == "soft"
+              and store.has_vel[floor_row] and store.body[floor_row] != STATIC and not store.asleep[floor_row]):
+            # (the soft step moves what it stands on after this stage: by its velocity, as here)
+            carried = (float(store.vx[floor_row]) * dt, float(store.vy[floor_row]) * dt)
         self._gather(mv, ctrl, carried, vx, vy, dt, size)
         if carried != (0.0, 0.0) and floor_row is not None:
             mv.ignore.add(floor_row)

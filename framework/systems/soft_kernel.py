@@ -57,7 +57,7 @@ def _soft(hertz, zeta, h):
 
 
 @njit(cache=True)
-def _world_shapes(x, y, rot, vx, vy, w, moving, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
+def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
                   wc, wv, wn, lo, hi, reach):
     """World centres, vertices and normals of every hitbox (``cnt == 0``: none) and its bounds, widened by
     ``margin0`` and swept by the body's motion this step; ``reach``: how far the body may move."""
@@ -85,7 +85,7 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, off, lv, ln, cnt, rr, spin, boun
         rad = rr[r] + margin0
         mnx, mny, mxx, mxy = mnx - rad, mny - rad, mxx + rad, mxy + rad
         m = 0.0
-        if moving[r]:
+        if moving[r] and not driven[r]:
             ex, ey = vx[r] * dt, vy[r] * dt
             m = abs(ex) + abs(ey) + abs(w[r]) * bound[r] * dt + g
             turn = abs(w[r]) * bound[r] * dt + g
@@ -266,9 +266,10 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 @njit(cache=True)
 def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, friction, restitution, layer, mask,
               sensor, one_way, asleep, has_vel, entity, bound, off, lv, ln, cnt, rr, spin,
-              fat, pairs, slots, rebuild):
+              driven, fat, pairs, slots, rebuild):
     """One step of ``params[_DT]`` over the rows (the body columns modified in place).
-    ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
+    ``driven``: rows a character controller moved this step (they are not moved again, and take
+    no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
     not modified: new ones are returned. See the module docstring for the stages.
 
@@ -277,7 +278,8 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
     entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
     (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
-    were found again, how many contacts the solver used, then the rows of the sleepers to wake."""
+    were found again, how many contacts the solver used, how many bodies sleep (before this step's
+    wakes), then the rows of the sleepers to wake."""
     dt = params[_DT]
     nsub = int(params[_SUB])
     gx, gy = params[_GX], params[_GY]
@@ -314,7 +316,7 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     hi = np.empty((n, 2))
     reach = np.zeros(n)
     margin0 = 0.5 * spec if response else 0.0
-    _world_shapes(x, y, rot, vx, vy, w, moving, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
+    _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
                   wc, wv, wn, lo, hi, reach)
     fat_margin = params[_FAT]
     fat = fat.copy()  # (the step's inputs stay as they were: a failed step is undone by keeping them)
@@ -460,14 +462,14 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         turning[r] = moving[r] and (ii[r] > 0.0 or w[r] != 0.0)
     for _sub in range(nsub):
         for r in range(n):  # integrate velocities
-            if moving[r] and body[r] == _DYNAMIC:
+            if moving[r] and body[r] == _DYNAMIC and not driven[r]:
                 vx[r] += h * gx
                 vy[r] += h * gy
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
         _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, True, rotation, softness,
                inv_h, push)
         for r in range(n):  # integrate positions
-            if moving[r]:
+            if moving[r] and not driven[r]:
                 x[r] += h * vx[r]
                 y[r] += h * vy[r]
                 if turning[r]:
@@ -529,9 +531,13 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         for q in range(5):
             end_f[q, i] = ended_f[i, q]
     woken = np.flatnonzero(wake)
-    info = np.empty(2 + woken.size, dtype=np.int64)
-    info[0], info[1] = 1 if rebuilt else 0, nc
-    info[2:] = woken
+    sleepers = 0
+    for r in range(n):
+        if asleep[r] and body[r] != _STATIC:
+            sleepers += 1
+    info = np.empty(3 + woken.size, dtype=np.int64)
+    info[0], info[1], info[2] = 1 if rebuilt else 0, nc, sleepers
+    info[3:] = woken
     return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info
 
 

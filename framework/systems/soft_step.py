@@ -19,8 +19,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import esper
 import numpy as np
 
+from ..character import CharacterController
 from ..events import StepContacts
 from ..frame import StepFrame
 from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
@@ -97,6 +99,7 @@ class SoftStep(Stage):
         self._settings_key: tuple[Any, ...] | None = None
         self._columns_key: tuple[int, int] | None = None
         self._cols: tuple[np.ndarray, ...] = ()
+        self._no_driven = np.zeros(0, dtype=np.bool_)
         self.reset()
 
     def reset(self) -> None:
@@ -141,6 +144,18 @@ class SoftStep(Stage):
             self._columns_key = key
         return self._cols
 
+    def _driven(self, frame: StepFrame) -> np.ndarray:
+        """Rows the character stage moved this step (the soft step moves them no further)."""
+        n = self.bodies.store.n
+        if self._no_driven.size != n:
+            self._no_driven = np.zeros(n, dtype=np.bool_)
+        if not frame.counters.get("characters"):
+            return self._no_driven
+        rows = self.bodies.rows_of([e for e, _c in esper.get_component(CharacterController)])
+        driven = np.zeros(n, dtype=np.bool_)
+        driven[rows[rows >= 0]] = True
+        return driven
+
     def _settings(self, frame: StepFrame) -> np.ndarray:
         """The kernel's ``params`` for this step (rebuilt only when a setting changed)."""
         pipe, store = self.pipeline, self.bodies.store
@@ -160,8 +175,9 @@ class SoftStep(Stage):
     def run(self, frame: StepFrame) -> bool:
         store = self.bodies.store
         effects = self.pipeline.effects
-        x, y = store.cols["x"][: store.n], store.cols["y"][: store.n]
-        frame.start_x, frame.start_y = x.copy(), y.copy()
+        if "sleeping" in effects:  # (where the step began: what the sleeping stage measures rest by)
+            c, n = store.cols, store.n
+            frame.start_x, frame.start_y = c["x"][:n].copy(), c["y"][:n].copy()
         off, lv, ln, cnt, rr, spin = self._shape_tables()
         if "detection" not in effects:
             cnt = np.zeros(store.n, dtype=np.int64)
@@ -170,8 +186,8 @@ class SoftStep(Stage):
         if rebuild:
             self.fat = np.zeros((store.n, 4))
             self._pairs_key = key
-        out = soft_step(self._settings(frame), *self._columns(), off, lv, ln, cnt, rr, spin, self.fat, self.pairs,
-                        self.slots, rebuild)
+        out = soft_step(self._settings(frame), *self._columns(), off, lv, ln, cnt, rr, spin, self._driven(frame),
+                        self.fat, self.pairs, self.slots, rebuild)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info = out
         if "movement" in effects:
             store.motion += 1
@@ -180,8 +196,8 @@ class SoftStep(Stage):
         frame.contact_rows, frame.started = (ra, rb), started.astype(bool)
         frame.ended = StepContacts(end_i[0], end_i[1], *end_f)
         frame._events = None
-        if info.size > 2:
-            store.wake(info[2:])
+        if info.size > 3:
+            store.wake(info[3:])
         counters = frame.counters
         counters["integrated"] = int(store.active()[0].size)
         counters["candidate_pairs"] = int(self.pairs.shape[0])
@@ -189,5 +205,5 @@ class SoftStep(Stage):
         counters["contacts"] = int(ea.size)
         counters["events"] = int(ea.size + end_i.shape[1])
         counters["resolved"] = int(info[1])
-        counters["asleep"] = frame.n_asleep = int(np.count_nonzero(store.asleep[store.active_sel()[2]]))
+        counters["asleep"] = frame.n_asleep = int(info[2])
         return True
