@@ -454,7 +454,6 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     push = params[_PUSH]
     x0 = x.copy()
     y0 = y.copy()
-    r0 = rot.copy()
     qc = np.ones(n)
     qs = np.zeros(n)
     turning = np.zeros(n, dtype=np.bool_)
@@ -473,9 +472,13 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
                 x[r] += h * vx[r]
                 y[r] += h * vy[r]
                 if turning[r]:
-                    rot[r] += h * w[r]
-                    qc[r] = math.cos(rot[r] - r0[r])
-                    qs[r] = math.sin(rot[r] - r0[r])
+                    # the turn since the step began, as Box2D's b2IntegrateRotation: (c, s) advanced
+                    # along its tangent and normalised (no cos or sin; within (h w)^3 of the angle)
+                    hw = h * w[r]
+                    rot[r] += hw
+                    c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
+                    mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
+                    qc[r], qs[r] = c2 * mag, s2 * mag
         _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, False, rotation, softness,
                inv_h, push)
     _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
