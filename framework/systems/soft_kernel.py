@@ -465,22 +465,22 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
                 vx[r] += h * gx
                 vy[r] += h * gy
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
-        _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, True, rotation, softness,
-               inv_h, push)
-        for r in range(n):  # integrate positions
-            if moving[r] and not driven[r]:
-                x[r] += h * vx[r]
-                y[r] += h * vy[r]
-                if turning[r]:
-                    # the turn since the step began, as Box2D's b2IntegrateRotation: (c, s) advanced
-                    # along its tangent and normalised (no cos or sin; within (h w)^3 of the angle)
-                    hw = h * w[r]
-                    rot[r] += hw
-                    c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
-                    mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
-                    qc[r], qs[r] = c2 * mag, s2 * mag
-        _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, False, rotation, softness,
-               inv_h, push)
+        for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
+            if relax:
+                for r in range(n):
+                    if moving[r] and not driven[r]:
+                        x[r] += h * vx[r]
+                        y[r] += h * vy[r]
+                        if turning[r]:
+                            # the turn since the step began, as Box2D's b2IntegrateRotation: (c, s)
+                            # advanced along its tangent and normalised (no cos or sin)
+                            hw = h * w[r]
+                            rot[r] += hw
+                            c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
+                            mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
+                            qc[r], qs[r] = c2 * mag, s2 * mag
+            _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
+                   inv_h, push)
     _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
 
     # --- store the impulses in the slots; which pairs are in contact ----------------------------
