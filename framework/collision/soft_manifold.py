@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["box_box", "circle_circle", "polygon_circle", "polygon_polygon"]
+__all__ = ["box_box", "capsule_capsule", "circle_circle", "polygon_circle", "polygon_polygon"]
 
 _EPS = 1.1920929e-07  # Box2D's FLT_EPSILON, the scale of "safely outside"
 
@@ -215,6 +215,48 @@ def _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out):
     out[0, 0], out[0, 1], out[0, 2], out[0, 3] = upx, upy, sup - radius, float((i21 << 8) | i12)
     out[1, 0], out[1, 1], out[1, 2], out[1, 3] = lox, loy, slo - radius, float((i22 << 8) | i11)
     return 2, -nx, -ny
+
+
+@njit(cache=True, inline="always")
+def _segments_cross(V, a, b):
+    """Whether the segments of rows ``a`` and ``b`` cross (each one's ends on either side of the
+    other's line, by the signs of the orientations: closest points then lie at no distance, up
+    to rounding)."""
+    px, py, qx, qy = V[a, 0, 0], V[a, 0, 1], V[a, 1, 0], V[a, 1, 1]
+    rx, ry, sx, sy = V[b, 0, 0], V[b, 0, 1], V[b, 1, 0], V[b, 1, 1]
+    o1 = (qx - px) * (ry - py) - (qy - py) * (rx - px)
+    o2 = (qx - px) * (sy - py) - (qy - py) * (sx - px)
+    o3 = (sx - rx) * (py - ry) - (sy - ry) * (px - rx)
+    o4 = (sx - rx) * (qy - ry) - (sy - ry) * (qx - rx)
+    return o1 * o2 < 0.0 and o3 * o4 < 0.0
+
+
+@njit(cache=True, inline="always")
+def capsule_capsule(V, a, ra, b, rb, speculative, out):
+    """Two capsules (rows ``a``, ``b`` of ``V``: their segments' ends; radii): one point, between
+    the closest points of the two segments (as Box2D's ``b2CollideCapsules`` where the segments are
+    not parallel; our capsules never turn, so one point holds them). Two capsules end to end are
+    not a face against a face: the polygon clipper finds nothing there. Where the segments cross
+    (closest points at no distance), returns a count of -1: the separating-axis measure of
+    :func:`polygon_polygon` is the one that knows how deep they are then."""
+    f1, f2 = _segment_fractions(V[a, 0, 0], V[a, 0, 1], V[a, 1, 0], V[a, 1, 1],
+                                V[b, 0, 0], V[b, 0, 1], V[b, 1, 0], V[b, 1, 1])
+    c1x = V[a, 0, 0] + f1 * (V[a, 1, 0] - V[a, 0, 0])
+    c1y = V[a, 0, 1] + f1 * (V[a, 1, 1] - V[a, 0, 1])
+    c2x = V[b, 0, 0] + f2 * (V[b, 1, 0] - V[b, 0, 0])
+    c2y = V[b, 0, 1] + f2 * (V[b, 1, 1] - V[b, 0, 1])
+    dx, dy = c2x - c1x, c2y - c1y
+    d = math.sqrt(dx * dx + dy * dy)
+    if d - ra - rb > speculative:
+        return 0, 0.0, 0.0
+    if d == 0.0 or _segments_cross(V, a, b):  # the caller measures them as rounded polygons instead
+        return -1, 0.0, 0.0
+    nx, ny = dx / d, dy / d
+    cax, cay = c1x + ra * nx, c1y + ra * ny
+    cbx, cby = c2x - rb * nx, c2y - rb * ny
+    out[0, 0], out[0, 1] = 0.5 * (cax + cbx), 0.5 * (cay + cby)
+    out[0, 2], out[0, 3] = d - ra - rb, 0.0
+    return 1, nx, ny
 
 
 @njit(cache=True, inline="always")

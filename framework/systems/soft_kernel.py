@@ -4,24 +4,32 @@ Read top to bottom, one step is:
 
 1. **shapes**: every hitbox as a rounded polygon in world coordinates, and its bounds swept by
    this step's motion (:func:`_world_shapes`);
-2. **broad phase**: sort the bounds along x and sweep (:func:`_candidate_pairs`); pairs of two
-   idle bodies (static, asleep, without velocity) and pairs whose layers do not meet are skipped;
+2. **broad phase**: candidate pairs kept between steps on fat bounds (a moving body's bounds, a
+   margin wider): a body that leaves its fat bounds gets new ones and only its pairs change
+   (:func:`_moved_pairs`); after a structural change, or when many bodies left theirs, all of them
+   again by sort and sweep (:func:`_candidate_pairs`). Never two idle bodies (static, or without a
+   velocity); never layers that do not meet;
 3. **narrow phase**: a manifold per pair (:mod:`framework.collision.soft_manifold`), reported up
    to a speculative distance that grows with the pair's motion this step, so a fast body meets a
    wall it would otherwise pass in one step (no tunnelling, without a separate sweep);
 4. **prepare**: anchors relative to each body's origin, effective masses, the impulses of last
-   step's matching points (by pair and feature id) to warm start with;
+   step's matching points (by pair slot and feature id) to warm start with; where nothing turns, a
+   face's two points are one row;
 5. **sub-steps** (Box2D's ``b2SolverStage``): integrate velocities (gravity), warm start, solve
    with soft constraints (the bias pushes overlap out at most ``push_speed``), integrate
    positions, relax (solve again without the bias);
-6. **restitution**, then **store** the impulses and report the touching pairs sorted by entity
-   ids (started ones flagged, ended ones as indices into last step's), and the sleepers an awake
-   body touched (to wake).
+6. **restitution**, then **store** the impulses in the pairs' slots and report the pairs in
+   contact sorted by entity ids (started ones flagged), the ones no longer in contact, and the
+   sleepers an awake body touched (to wake).
 
 The separation of a point during the sub-steps is measured from the anchors and the bodies'
 motion since the step began (Box2D's ``contact_solver.c`` derivation), so nothing is re-measured
 geometrically inside the solve. Sequential impulses over contacts in a fixed order: bit-identical
 results for identical inputs.
+
+Numba's cache of this module does not see through the functions it inlines from
+:mod:`framework.collision.soft_manifold`: after editing that module, delete the ``soft_kernel*``
+cache files in ``__pycache__`` (an installed release replaces both files at once).
 """
 
 from __future__ import annotations
@@ -31,7 +39,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..collision.soft_manifold import box_box, circle_circle, polygon_circle, polygon_polygon
+from ..collision.soft_manifold import box_box, capsule_capsule, circle_circle, polygon_circle, polygon_polygon
 
 __all__ = ["PARAMS", "SLOT", "soft_step"]
 
@@ -41,7 +49,7 @@ PARAMS = ("dt", "substeps", "gx", "gy", "slop", "speculative", "hertz", "damping
 _DT, _SUB, _GX, _GY, _SLOP, _SPEC, _HZ, _ZETA, _PUSH, _REST, _LAYERS, _RESPONSE, _ROT, _FRIC, _FAT = range(len(PARAMS))
 
 _DYNAMIC, _STATIC = 0, 2
-_AABB, _CIRCLE = 0, 1
+_AABB, _CIRCLE, _CAPSULE = 0, 1, 3
 
 
 @njit(cache=True)
@@ -157,6 +165,10 @@ def _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, spec, out):
     if kind[a] == _CIRCLE:
         k, nx, ny = polygon_circle(wv, wn, b, cnt[b], rr[b], wv[a, 0, 0], wv[a, 0, 1], rr[a], spec, out)
         return k, -nx, -ny
+    if kind[a] == _CAPSULE and kind[b] == _CAPSULE:
+        k, nx, ny = capsule_capsule(wv, a, rr[a], b, rr[b], spec, out)
+        if k >= 0:
+            return k, nx, ny
     return polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, spec, out)
 
 
