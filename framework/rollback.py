@@ -22,6 +22,7 @@ from typing import Any
 
 import esper
 import numpy as np
+from numba import njit
 
 from .character import CharacterController
 
@@ -34,15 +35,32 @@ _CONTROLLER_STATE = ("drop_through", "on_floor", "floor_normal", "floor_entity",
                      "on_ceiling", "crushed")
 
 
+_KEPT = _STRUCTURE + _COLUMNS
+
+
+@njit(cache=True)
+def _keep(entity, kind, body, has_vel, x, y, rot, vx, vy, w, still, asleep):
+    """The columns (of one length, in :data:`_KEPT`'s order) as the rows of a new float array."""
+    n = x.size
+    out = np.empty((12, n))
+    for r in range(n):
+        out[0, r], out[1, r], out[2, r], out[3, r] = entity[r], kind[r], body[r], has_vel[r]
+        out[4, r], out[5, r], out[6, r], out[7, r], out[8, r], out[9, r] = x[r], y[r], rot[r], vx[r], vy[r], w[r]
+        out[10, r], out[11, r] = still[r], asleep[r]
+    return out
+
+
 class StepRollback:
     """The state of ``scene`` before a step (:meth:`restore` puts it back)."""
 
     def __init__(self, scene: Any) -> None:
         store = scene.bodies.store
-        self.n = store.n
-        # the rows' structure: which entity, shape kind, body kind and whether it has a Velocity
-        self.structure = {name: store.cols[name][: self.n].copy() for name in _STRUCTURE}
-        self.columns = {name: store.cols[name][: self.n].copy() for name in _COLUMNS}
+        n = self.n = store.n
+        # the rows' structure (which entity, shape kind, body kind, whether it has a Velocity) and
+        # the columns a step changes, as the rows of one float array (every value of them is exact
+        # in a float), copied in one compiled pass
+        c = store.cols
+        self.kept = _keep(*(c[name][:n] for name in _KEPT))
         self.frame = scene._pipeline.frame
         tracker = scene.tracker
         self.tracker = (tracker.active, tracker.keys)
@@ -61,11 +79,11 @@ class StepRollback:
         for e in [e for e in esper._entities if e >= self.next_entity]:
             scene._remove(e)  # spawned during the failed step
         store = scene.bodies.store
-        if store.n != self.n or not all(np.array_equal(store.cols[name][: self.n], values)
-                                        for name, values in self.structure.items()):
+        n, kept = self.n, self.kept
+        if store.n != n or not all(np.array_equal(store.cols[name][:n], kept[i]) for i, name in enumerate(_STRUCTURE)):
             return False
-        for name, values in self.columns.items():
-            store.cols[name][: self.n] = values
+        for i, name in enumerate(_COLUMNS, len(_STRUCTURE)):
+            store.cols[name][:n] = kept[i]
         store.motion += 1  # (caches keyed on motion look again)
         store.sleep_dirty = True
         store.written.clear()
