@@ -485,3 +485,26 @@ def test_a_character_rides_a_moving_platform_and_is_not_moved_twice():
         # carried along from the second step on (the first finds the floor), and no faster
         assert hx == pytest.approx(px - 2.0 / 60, abs=1e-6), solver
         assert s.get(hero, Transform).y == pytest.approx(0.75, abs=1e-3), solver
+
+
+def test_a_first_step_that_compiles_says_so_once_and_a_quick_one_says_nothing(monkeypatch, capsys):
+    import time
+
+    import framework.systems.soft_step as ss
+
+    calls = []
+
+    def slow(*args):
+        calls.append(args)
+        time.sleep(1.3)  # as numba compiling it would
+        return "out"
+
+    monkeypatch.setattr(ss, "soft_step", slow)
+    monkeypatch.setattr(ss, "_COMPILED", False)
+    assert ss._first_call((1, 2)) == "out"
+    assert ss.COMPILE_NOTICE in capsys.readouterr().err
+    assert ss._COMPILED
+    monkeypatch.setattr(ss, "_COMPILED", False)
+    monkeypatch.setattr(ss, "soft_step", lambda *args: "quick")
+    assert ss._first_call((1, 2)) == "quick"
+    assert capsys.readouterr().err == ""

@@ -17,6 +17,8 @@ response does: a game processor placed between the exact pipeline's physics stag
 from __future__ import annotations
 
 import math
+import sys
+import threading
 from typing import Any
 
 import esper
@@ -29,7 +31,7 @@ from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 from .soft_kernel import PARAMS, SLOT, soft_step
 from .stage import PRIORITY, Stage
 
-__all__ = ["SOFT_SETTINGS", "SoftStep", "shape_tables"]
+__all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "shape_tables"]
 
 #: Box2D v3's defaults, in metres (scaled by ``Scene(length_unit=...)``): linear slop, contact
 #: stiffness (hertz) and damping ratio, the fastest push out of an overlap, the slowest approach
@@ -81,6 +83,24 @@ def shape_tables(store) -> tuple[np.ndarray, ...]:
                 ln[r, i] = (ey / d, -ex / d)
             cnt[r] = m
     return off, lv, ln, cnt, rr, spin
+
+
+_COMPILED = False
+COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about half a minute; later runs load "
+                  "it from numba's cache)")
+
+
+def _first_call(args: tuple[Any, ...]) -> tuple[Any, ...]:
+    """The kernel's first call in this process: if it has not returned within a second (numba is
+    compiling it, not loading it from its cache), say so on stderr, once."""
+    global _COMPILED
+    timer = threading.Timer(1.0, lambda: print(COMPILE_NOTICE, file=sys.stderr, flush=True))
+    timer.start()
+    try:
+        return soft_step(*args)
+    finally:
+        timer.cancel()
+        _COMPILED = True
 
 
 class SoftStep(Stage):
@@ -186,8 +206,9 @@ class SoftStep(Stage):
         if rebuild:
             self.fat = np.zeros((store.n, 4))
             self._pairs_key = key
-        out = soft_step(self._settings(frame), *self._columns(), off, lv, ln, cnt, rr, spin, self._driven(frame),
-                        self.fat, self.pairs, self.slots, rebuild)
+        args = (self._settings(frame), *self._columns(), off, lv, ln, cnt, rr, spin, self._driven(frame), self.fat,
+                self.pairs, self.slots, rebuild)
+        out = soft_step(*args) if _COMPILED else _first_call(args)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info = out
         if "movement" in effects:
             store.motion += 1
