@@ -153,26 +153,6 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
 
 
 @njit(cache=True, inline="always")
-def _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, spec, out):
-    """The manifold of rows ``a``, ``b`` (normal from a to b)."""
-    if kind[a] == _AABB and kind[b] == _AABB:  # (an AABB's local corner 2 is its half extents)
-        return box_box(wc[a, 0], wc[a, 1], lv[a, 2, 0], lv[a, 2, 1], wc[b, 0], wc[b, 1], lv[b, 2, 0], lv[b, 2, 1],
-                       spec, out)
-    if kind[a] == _CIRCLE and kind[b] == _CIRCLE:
-        return circle_circle(wv[a, 0, 0], wv[a, 0, 1], rr[a], wv[b, 0, 0], wv[b, 0, 1], rr[b], spec, out)
-    if kind[b] == _CIRCLE:
-        return polygon_circle(wv, wn, a, cnt[a], rr[a], wv[b, 0, 0], wv[b, 0, 1], rr[b], spec, out)
-    if kind[a] == _CIRCLE:
-        k, nx, ny = polygon_circle(wv, wn, b, cnt[b], rr[b], wv[a, 0, 0], wv[a, 0, 1], rr[a], spec, out)
-        return k, -nx, -ny
-    if kind[a] == _CAPSULE and kind[b] == _CAPSULE:
-        k, nx, ny = capsule_capsule(wv, a, rr[a], b, rr[b], spec, out)
-        if k >= 0:
-            return k, nx, ny
-    return polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, spec, out)
-
-
-@njit(cache=True, inline="always")
 def _fat_overlap(fat, i, j):
     return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
 
@@ -378,8 +358,19 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
         if kind[a] == _AABB and kind[b] == _AABB:  # the common case, inline (an AABB's corner 2: its half extents)
             k, nx, ny = box_box(wc[a, 0], wc[a, 1], lv[a, 2, 0], lv[a, 2, 1], wc[b, 0], wc[b, 1], lv[b, 2, 0],
                                 lv[b, 2, 1], s_pair, out)
+        elif kind[a] == _CIRCLE and kind[b] == _CIRCLE:
+            k, nx, ny = circle_circle(wv[a, 0, 0], wv[a, 0, 1], rr[a], wv[b, 0, 0], wv[b, 0, 1], rr[b], s_pair, out)
+        elif kind[a] == _CIRCLE or kind[b] == _CIRCLE:  # a polygon (box, capsule) and a circle
+            g, o = (b, a) if kind[a] == _CIRCLE else (a, b)
+            k, nx, ny = polygon_circle(wv, wn, g, cnt[g], rr[g], wv[o, 0, 0], wv[o, 0, 1], rr[o], s_pair, out)
+            if g == b:
+                nx, ny = -nx, -ny
         else:
-            k, nx, ny = _manifold(a, b, kind, wc, lv, wv, wn, cnt, rr, slop, s_pair, out)
+            k, nx, ny = -1, 0.0, 0.0
+            if kind[a] == _CAPSULE and kind[b] == _CAPSULE:
+                k, nx, ny = capsule_capsule(wv, a, rr[a], b, rr[b], s_pair, out)
+            if k < 0:
+                k, nx, ny = polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, s_pair, out)
         low = 0.0
         if k > 0:
             low = out[0, 2]
