@@ -240,7 +240,7 @@ def physics_toy() -> Regime:
     (10 rows), a heavy ball (mass 20) thrown at it, three crates and a barrel on a slope."""
     pieces = [Piece(AABB(60.0, 1.0), 0.0, -0.5, kind="static"),
               Piece(Polygon([(0.0, 0.0), (8.0, 0.0), (0.0, 4.0)]), 14.0, 0.0, kind="static")]  # the slope
-    top = None
+    top = 0
     for r in range(10):
         k = 10 - r
         for i in range(k):

@@ -127,7 +127,7 @@ class SoftStep(Stage):
         self.pairs = np.zeros((0, 3), dtype=np.int64)  # rows a, b and key (entity a << 32 | entity b)
         self.slots = np.zeros((0, len(SLOT)))
         self.fat = np.zeros((0, 4))
-        self._pairs_key: tuple[int, int] | None = None
+        self._pairs_key: tuple[int, int, bool] | None = None
 
     def state(self) -> tuple[Any, ...]:
         """What the next step starts from (the kernel never modifies these arrays in place: a
