@@ -396,7 +396,7 @@ def test_candidate_pairs_kept_between_steps_are_those_a_full_sweep_finds():
     before = stage.pairs
     for _ in range(240):
         s.step(1 / 60)
-        cnt = stage._shape_tables()[3]
+        cnt = stage._kernel_tables[1][8]  # (iprops: the vertex counts)
         fixed = (store.body == 2) | ~store.has_vel
         full = _candidate_pairs(stage.fat, cnt, fixed, store.layer, store.mask, True, store.entity)
         assert np.array_equal(full, stage.pairs)

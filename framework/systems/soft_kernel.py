@@ -256,10 +256,15 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 
 
 @njit(cache=True)
-def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, friction, restitution, layer, mask,
-              sensor, one_way, asleep, has_vel, entity, bound, off, lv, ln, cnt, rr, spin,
-              driven, fat, pairs, slots, rebuild):
-    """One step of ``params[_DT]`` over the rows (the body columns modified in place).
+def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, driven, fat, pairs, slots, rebuild):
+    """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
+
+    What changes only with the rows comes packed, as rows of three tables (see
+    :func:`framework.systems.soft_step.kernel_tables`; an array argument costs about 0.3 us to pass):
+    ``fprops`` (inverse mass, inverse inertia, friction, restitution, bounding radius, rounding
+    radius), ``iprops`` (body kind, shape kind, layer, mask, entity, sensor, one-way, has a
+    velocity, vertex count, turns with the body), ``off`` (hitbox offsets) and ``verts`` (each
+    row's local vertices, then normals).
     ``driven``: rows a character controller moved this step (they are not moved again, and take
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
@@ -272,6 +277,11 @@ def soft_step(params, x, y, rot, vx, vy, w, body, kind, inv_mass, inv_inertia, f
     (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
     were found again, how many contacts the solver used, how many bodies sleep (before this step's
     wakes), then the rows of the sleepers to wake."""
+    inv_mass, inv_inertia, friction, restitution, bound, rr = fprops[0], fprops[1], fprops[2], fprops[3], fprops[4], \
+        fprops[5]
+    body, kind, layer, mask, entity = iprops[0], iprops[1], iprops[2], iprops[3], iprops[4]
+    sensor, one_way, has_vel, cnt, spin = iprops[5], iprops[6], iprops[7], iprops[8], iprops[9]
+    lv, ln = verts[:, :, 0:2], verts[:, :, 2:4]
     dt = params[_DT]
     nsub = int(params[_SUB])
     gx, gy = params[_GX], params[_GY]

@@ -31,7 +31,7 @@ from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 from .soft_kernel import PARAMS, SLOT, soft_step
 from .stage import PRIORITY, Stage
 
-__all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "shape_tables"]
+__all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "kernel_tables"]
 
 #: Box2D v3's defaults, in metres (scaled by ``Scene(length_unit=...)``): linear slop, contact
 #: stiffness (hertz) and damping ratio, the fastest push out of an overlap, the slowest approach
@@ -40,37 +40,38 @@ __all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "shape_tables"]
 SOFT_SETTINGS = {"slop": 0.005, "hertz": 30.0, "damping": 10.0, "push_speed": 3.0, "restitution_threshold": 1.0,
                  "substeps": 4, "fat_margin": 0.1}
 # the store's columns the kernel reads (and writes: the pose and velocity), in its argument order
-_KERNEL_COLUMNS = ("x", "y", "rot", "vx", "vy", "w", "body", "kind", "inv_mass", "inv_inertia", "friction",
-                   "restitution", "layer", "mask", "sensor", "one_way", "asleep", "has_vel", "entity", "bound")
+_KERNEL_COLUMNS = ("x", "y", "rot", "vx", "vy", "w", "asleep")
 
 
-def shape_tables(store) -> tuple[np.ndarray, ...]:
-    """Every row's hitbox as a rounded polygon about its hitbox origin: ``(offset, vertices,
-    normals, count, radius, spins)``; count 0 for a row without a hitbox. AABBs do not turn with
-    the transform (their offset does); circles are one vertex, capsules their segment."""
+def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
+    """What the kernel reads of each row that changes only with the rows (a hitbox's fields and
+    shape, its body kind, its entity): ``(fprops, iprops, off, verts)``, see
+    :func:`~framework.systems.soft_kernel.soft_step`. Every hitbox is a rounded polygon about its
+    hitbox origin (vertex count 0: no hitbox, or ``detection`` off): AABBs do not turn with the
+    transform (their offset does); circles are one vertex, capsules their segment."""
     n = store.n
     polys = [store.shapes[r] for r in range(n)]
-    K = max([4] + [len(s.points) for s, k in zip(polys, store.kind[:n].tolist()) if k == KIND_POLYGON])
+    kinds = store.kind[:n].tolist()
+    K = max([4] + [len(s.points) for s, k in zip(polys, kinds) if k == KIND_POLYGON])
     off = np.zeros((n, 2))
     off[:, 0], off[:, 1] = store.ox, store.oy
-    lv = np.zeros((n, K, 2))
-    ln = np.zeros((n, K, 2))
+    verts = np.zeros((n, K, 4))  # local vertices (x, y), then the edges' outward normals
     cnt = np.zeros(n, dtype=np.int64)
     rr = np.zeros(n)
-    spin = np.ones(n, dtype=np.bool_)
+    spin = np.ones(n, dtype=np.int64)
     box_n = ((0.0, -1.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0))
-    for r, k in enumerate(store.kind[:n].tolist()):
+    for r, k in enumerate(kinds):
         if k == KIND_AABB:
             hw, hh = float(store.hw[r]), float(store.hh[r])
-            lv[r, :4] = ((-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh))
-            ln[r, :4] = box_n
-            cnt[r], spin[r] = 4, False
+            verts[r, :4, 0:2] = ((-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh))
+            verts[r, :4, 2:4] = box_n
+            cnt[r], spin[r] = 4, 0
         elif k == KIND_CIRCLE:
             cnt[r], rr[r] = 1, float(store.radius[r])
         elif k == KIND_CAPSULE:
             h = polys[r].half_length
-            lv[r, :2] = ((0.0, -h), (0.0, h))
-            ln[r, :2] = ((1.0, 0.0), (-1.0, 0.0))
+            verts[r, :2, 0:2] = ((0.0, -h), (0.0, h))
+            verts[r, :2, 2:4] = ((1.0, 0.0), (-1.0, 0.0))
             cnt[r], rr[r] = 2, float(store.radius[r])
         elif k == KIND_POLYGON:
             pts = polys[r].points
@@ -79,10 +80,15 @@ def shape_tables(store) -> tuple[np.ndarray, ...]:
                 (x1, y1), (x2, y2) = pts[i], pts[(i + 1) % m]
                 ex, ey = x2 - x1, y2 - y1
                 d = math.hypot(ex, ey)
-                lv[r, i] = (x1, y1)
-                ln[r, i] = (ey / d, -ex / d)
+                verts[r, i] = (x1, y1, ey / d, -ex / d)
             cnt[r] = m
-    return off, lv, ln, cnt, rr, spin
+    if not detection:
+        cnt[:] = 0
+    fprops = np.stack([store.inv_mass, store.inv_inertia, store.friction, store.restitution, store.bound, rr])
+    iprops = np.stack([store.body.astype(np.int64), store.kind.astype(np.int64), store.layer, store.mask,
+                       store.entity, store.sensor.astype(np.int64), store.one_way.astype(np.int64),
+                       store.has_vel.astype(np.int64), cnt, spin])
+    return fprops, iprops, off, verts
 
 
 _COMPILED = False
@@ -113,12 +119,11 @@ class SoftStep(Stage):
     def __init__(self, pipeline) -> None:
         super().__init__(pipeline)
         self.priority = PRIORITY["response"] + 1  # where the response runs (see the module docstring)
-        self._tables_key: tuple[int, int] | None = None
-        self._tables: tuple[np.ndarray, ...] = ()
+        self._tables_key: tuple[int, int, bool] | None = None
         self._params = np.zeros(len(PARAMS))
         self._settings_key: tuple[Any, ...] | None = None
-        self._columns_key: tuple[int, int] | None = None
         self._cols: tuple[np.ndarray, ...] = ()
+        self._kernel_tables: tuple[np.ndarray, ...] = ()
         self._no_driven = np.zeros(0, dtype=np.bool_)
         self.reset()
 
@@ -142,27 +147,20 @@ class SoftStep(Stage):
         effects = self.pipeline.effects
         return self.pipeline.solver == "soft" and bool(effects & {"movement", "detection"})
 
-    def _shape_tables(self) -> tuple[np.ndarray, ...]:
-        store = self.bodies.store
-        key = (store.version, store.n)
-        if key != self._tables_key:
-            self._tables = shape_tables(store)
-            self._tables_key = key
-        return self._tables
-
-    def _columns(self) -> tuple[np.ndarray, ...]:
-        """The store's columns as the kernel takes them (views of the live rows), kept until the rows
-        or the columns' storage change."""
+    def _tables(self) -> tuple[np.ndarray, ...]:
+        """:func:`kernel_tables` and the pose and velocity columns (views of the live rows), kept
+        until the rows, the columns' storage or the detection effect change."""
         store = self.bodies.store
         c = store.cols
-        key = (store.version, store.n)
+        key = (store.version, store.n, "detection" in self.pipeline.effects)
         # (views of these very columns: a restored scene's copies are views of nothing, and an
         # unpickled copy of a column is not the column)
-        if key != self._columns_key or not self._cols or self._cols[0].base is not c["x"]:
+        if key != self._tables_key or not self._cols or self._cols[0].base is not c["x"]:
             n = store.n
             self._cols = tuple(c[name][:n] for name in _KERNEL_COLUMNS)
-            self._columns_key = key
-        return self._cols
+            self._kernel_tables = kernel_tables(store, key[-1])
+            self._tables_key = key
+        return self._cols + self._kernel_tables
 
     def _driven(self, frame: StepFrame) -> np.ndarray:
         """Rows the character stage moved this step (the soft step moves them no further)."""
@@ -198,16 +196,12 @@ class SoftStep(Stage):
         if "sleeping" in effects:  # (where the step began: what the sleeping stage measures rest by)
             c, n = store.cols, store.n
             frame.start_x, frame.start_y = c["x"][:n].copy(), c["y"][:n].copy()
-        off, lv, ln, cnt, rr, spin = self._shape_tables()
-        if "detection" not in effects:
-            cnt = np.zeros(store.n, dtype=np.int64)
         key = (store.version, store.n, "detection" in effects)
         rebuild = key != self._pairs_key
         if rebuild:
             self.fat = np.zeros((store.n, 4))
             self._pairs_key = key
-        args = (self._settings(frame), *self._columns(), off, lv, ln, cnt, rr, spin, self._driven(frame), self.fat,
-                self.pairs, self.slots, rebuild)
+        args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild)
         out = soft_step(*args) if _COMPILED else _first_call(args)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info = out
         if "movement" in effects:
