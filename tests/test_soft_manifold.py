@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from framework import AABB, Capsule, Circle, Hitbox, Polygon, Scene, Transform, Velocity, collide
@@ -53,6 +53,7 @@ def _shape(kind, size):
     return Capsule(size / 4, size)
 
 
+@example(ka="triangle", kb="triangle", sa=1.0, sb=1.0, bx=0.0, by=-1.5331679973654795e-230, ra=-2.5, rb=0.0)
 @settings(max_examples=300, deadline=None, derandomize=True)
 @given(ka=SHAPES, kb=SHAPES, sa=st.floats(0.5, 2.0), sb=st.floats(0.5, 2.0),
        bx=st.floats(-2.0, 2.0), by=st.floats(-2.0, 2.0), ra=st.floats(-3.2, 3.2), rb=st.floats(-3.2, 3.2))
@@ -65,7 +66,9 @@ def test_every_overlap_is_found_at_least_as_deep_as_the_oracle_says(ka, kb, sa, 
         # apart or touching: in contact only within rounding of touching
         assert soft is None or soft[1] < 1e-9
         return
-    assert soft is not None
+    if soft is None:  # decided in floats: an overlap within rounding of touching may be missed
+        assert exact.depth < 1e-9
+        return
     (nx, ny), depth = soft
     assert depth >= exact.depth - 1e-9
     assert math.hypot(nx, ny) == pytest.approx(1.0)
