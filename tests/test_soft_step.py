@@ -546,3 +546,41 @@ def test_events_tell_the_same_story_in_both_solvers():
     # resting contacts, a bullet a handler despawns on hitting a wall, a despawned resting body, a
     # shape changed in place, a body lifted by game code
     assert _event_story("soft") == _event_story("exact")
+
+
+@pytest.mark.parametrize("field,value", [("x", math.nan), ("vy", math.inf), ("x", 1e16)])
+def test_a_bad_value_is_refused_before_the_soft_step_changes_anything(field, value):
+    s, ents = _mixed_pile(19)
+    for _ in range(10):
+        s.step(1 / 60)
+    before = _state(s, ents)
+    target = s.get(ents[3], Transform if field == "x" else Velocity)
+    setattr(target, "x" if field == "x" else "y", value)
+    with pytest.raises(ValueError, match=f"entity {ents[3]}"):
+        s.step(1 / 60)
+    setattr(target, "x" if field == "x" else "y", 0.0 if field == "vy" else 0.25)
+    after = _state(s, ents)
+    # only the mended field differs: nothing else moved
+    differs = np.frombuffer(before, dtype=float) != np.frombuffer(after, dtype=float)
+    assert differs.sum() <= 1
+
+
+def test_the_soft_step_gives_the_same_bytes_in_another_process():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    here_dir = str(Path(__file__).resolve().parent)
+    code = (f"import sys; sys.path.insert(0, {here_dir!r}); import hashlib\n"
+            "from test_soft_step import _mixed_pile, _state\n"
+            "s, e = _mixed_pile(23)\n"
+            "for _ in range(120): s.step(1 / 60)\n"
+            "print(hashlib.sha256(_state(s, e)).hexdigest())")
+    here = _mixed_pile(23)
+    for _ in range(120):
+        here[0].step(1 / 60)
+    import hashlib
+
+    mine = hashlib.sha256(_state(*here)).hexdigest()
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == mine
