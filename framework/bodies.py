@@ -14,8 +14,8 @@ from numpy.typing import NDArray
 
 from .collision.broad_phase import SpatialHash
 from .collision.grid import auto_cell_size
+from .geometry import Geometry
 from .store import STATIC, BodyStore
-from .systems.geometry import Geometry
 
 __all__ = ["Bodies"]
 

@@ -30,6 +30,7 @@ from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import MissingComponent, check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
 from .frame import StepFrame, add_counters
+from .geometry import Geometry
 from .input import Input
 from .limits import MAX_COORD, check_motion, motion_within
 from .queries import ALL_LAYERS, SceneHit, ShapeHit, SpatialQueries
@@ -41,7 +42,6 @@ from .snapshot import take as take_snapshot
 from .store import BodyStore
 from .systems import pipeline_stages
 from .systems.character import CharacterStage
-from .systems.geometry import Geometry
 from .systems.narrow_phase import NarrowPhase
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
 from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister

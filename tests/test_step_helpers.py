@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from framework import AABB, Hitbox, Scene, Transform, Velocity
 from framework.arrays import distinct
 from framework.events import sorted_members
+from framework.geometry import widen_down, widen_up
 from framework.store import as_selector
-from framework.systems.geometry import widen_down, widen_up
 
 ints = st.lists(st.integers(-(2**40), 2**40), max_size=200)
 

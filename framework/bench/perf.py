@@ -34,8 +34,8 @@ from ..collision.batch import aabb_aabb
 from ..collision.broad_phase import SpatialHash, brute_force_pairs
 from ..collision.grid import Bounds
 from ..components import Hitbox, Transform, Velocity
+from ..geometry import widen_down, widen_up
 from ..shapes import AABB
-from ..systems.geometry import widen_down, widen_up
 from .progress import Progress
 from .report import (
     Column,
@@ -252,7 +252,7 @@ def check_pairs(wl: Workload, steps: int = 3) -> dict[str, Any]:
             ex, ey = np.concatenate([hw, np.full(n_tiles, 0.5)]), np.concatenate([hh, np.full(n_tiles, 0.5)])
             ids = np.concatenate([ents, tile_ids])
             static = np.concatenate([np.zeros(ents.size, bool), np.ones(n_tiles, bool)])
-            # The pipeline widens every bound by an ulp or two (see systems.geometry), so its
+            # The pipeline widens every bound by an ulp or two (see framework.geometry), so its
             # candidates are the brute-force overlaps of the widened bounds; its contacts, those of
             # the exact ones.
             wide = [(widen_down if k_ < 2 else widen_up)(v) for k_, v in enumerate(allb)]

@@ -18,8 +18,8 @@ import numpy as np
 from ..arrays import F64Array, IntpArray
 from ..collision.sweep import time_of_impact
 from ..frame import StepFrame
+from ..geometry import Geometry
 from ..store import STATIC, BodyStore
-from .geometry import Geometry
 from .stage import Stage
 
 __all__ = ["ContinuousDetection", "sweep_ccd_bodies"]

@@ -24,8 +24,8 @@ from numpy.typing import NDArray
 
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision.broad_phase import SpatialHash
+from ..geometry import Geometry
 from ..store import KIND_AABB, STATIC, BodyStore
-from .geometry import Geometry
 
 __all__ = ["InternalFaces"]
 

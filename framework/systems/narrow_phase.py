@@ -25,8 +25,8 @@ from ..collision.kinds import (
 )
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
+from ..geometry import Geometry
 from ..store import STATIC, BodyStore
-from .geometry import Geometry
 from .movement import integrate_rows
 from .stage import Stage
 

@@ -21,8 +21,8 @@ from ..collision import batch
 from ..collision.kinds import KIND_AABB, KIND_CIRCLE
 from ..events import pair_keys, sorted_find, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
+from ..geometry import Geometry
 from ..store import STATIC
-from .geometry import Geometry
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Pairs, Solve

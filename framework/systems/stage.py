@@ -11,15 +11,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar
 
 import esper
 
+from ..bodies import Bodies
 from ..frame import StepFrame
 from ..validation import InvalidValue
-
-if TYPE_CHECKING:  # (bodies imports the geometry of this package)
-    from ..bodies import Bodies
 
 __all__ = ["PRIORITY", "STAGES", "Pipeline", "Stage", "SystemProcessor", "place", "unregister"]
 

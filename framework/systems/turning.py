@@ -31,8 +31,8 @@ from ..collision.batch_manifold import pair_manifolds
 from ..collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys
 from ..frame import Points
+from ..geometry import Geometry
 from ..store import BodyStore
-from .geometry import Geometry
 
 if TYPE_CHECKING:  # (solve imports this module)
     from .solve import Contacts

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arrays import F64Array, I64Array, IntpArray
-from ..shapes import Capsule, Polygon
-from ..store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, BodyStore
+from .arrays import F64Array, I64Array, IntpArray
+from .shapes import Capsule, Polygon
+from .store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, BodyStore
 
 __all__ = ["Geometry", "widen_down", "widen_up"]
 
