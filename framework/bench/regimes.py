@@ -14,6 +14,8 @@ bodies. Scenes (``dt = 1/60`` s, gravity (0, -10), unless said):
   (the classic Box2D pyramid; stable without friction, every contact being flat).
 - **scattered-N**: :func:`framework.bench.perf.make_boxes` (boxes of side 4-16 moving through each
   other, no gravity, ``dt = 1`` as in the perf benchmark, about one overlapping pair per box).
+- **platformer-crates**: the same with 20 dynamic crates of a tile in stacks of four along the
+  player's way.
 - **platformer-1**: ours is the platformer's :class:`Game` playing its first level with the
   scripted demo input; the peers get the same level's bodies (read from our game scene at spawn, in
   tile units), their enemies patrolling and the platform moving back and forth (:func:`platformer`).
@@ -148,6 +150,7 @@ class Regime:
     game: Any = None  # platformer only: the ours-side game, already built ...
     entities: list[int] = field(default_factory=list)  # ... the entity of each piece ...
     scale: float = 1.0  # ... and the game's units per piece unit
+    remake: Any = None  # platformer only: the regime again, its game in the named solver (``remake("soft")``)
 
     @property
     def bodies(self) -> int:
@@ -331,20 +334,29 @@ def _scaled(shape: Shape, s: float) -> Shape:
     return Polygon([(x * s, y * s) for x, y in cast(Polygon, shape).points])
 
 
-def platformer() -> Regime | None:
+def platformer(crates: int = 0, solver: str = "exact") -> Regime | None:
     """The platformer's first level: ours is its :class:`Game` with the level's scripted demo input
-    (``Regime.game``); the pieces, for the peers and the oracle, are the game scene's bodies at
-    spawn read through the public API, in tile units (the peers' defaults are tuned for bodies
-    about 1 unit big; the game's tiles are 32 units). One-way slabs become solid slabs in the peers
-    and are not judged (bodies jump through them); sensors (coins, spikes, goal) stay sensors.
-    ``None`` when the example is not importable."""
+    (``Regime.game``, its scene in ``solver``; ``Regime.remake`` builds it in the other); the
+    pieces, for the peers and the oracle, are the game scene's bodies at spawn read through the
+    public API, in tile units (the peers' defaults are tuned for bodies about 1 unit big; the
+    game's tiles are 32 units). One-way slabs become solid slabs in the peers and are not judged
+    (bodies jump through them); sensors (coins, spikes, goal) stay sensors. ``crates``: that many
+    dynamic crates of a tile, in stacks of four on the ground along the player's way
+    (``platformer-crates``). ``None`` when the example is not importable."""
     mods = _platformer_modules()
     if mods is None:
         return None
+    from ..scene import Scene
+
     game_mod, demo, levels, comps = mods
     level = levels.load_level(levels.builtin_levels()[0])
-    game = game_mod.Game([level], autoplay=demo.Autoplay(demo.level1))
-    scene, s = game.scene, 1.0 / level.tile
+    tile = level.tile
+    game = game_mod.Game([level], autoplay=demo.Autoplay(demo.level1), scene=Scene(solver=solver, length_unit=tile))
+    scene, s = game.scene, 1.0 / tile
+    for k in range(crates):  # stacks of four, three tiles apart, from the tenth column on
+        col, high = 9 + 3 * (k // 4), k % 4
+        scene.spawn(Transform((col + 0.5) * tile, 2 * tile + (high + 0.5) * tile + (high + 1) * tile / 16),
+                    Velocity(), Hitbox(AABB(tile, tile)))
     pieces, ents = [], []
     for e, (t, hb) in scene.query(Transform, Hitbox):
         v = scene.try_get(e, Velocity)
@@ -360,8 +372,10 @@ def platformer() -> Regime | None:
                             v.x * s if v else 0.0, v.y * s if v else 0.0, body, hb.sensor,
                             judged=not (hb.sensor or hb.one_way), role=role, params=params))
         ents.append(e)
-    return Regime("platformer-1", "platformer", pieces, gravity=tuple(g * s for g in scene.gravity),
-                  sleeping=True, dynamic_pairs=False, game=game, entities=ents, scale=level.tile)
+    name = "platformer-crates" if crates else "platformer-1"
+    return Regime(name, "platformer", pieces, gravity=tuple(g * s for g in scene.gravity), sleeping=True,
+                  dynamic_pairs=False, game=game, entities=ents, scale=tile,
+                  remake=lambda other: platformer(crates, other))
 
 
 # --- the three engines --------------------------------------------------------------------------------
@@ -413,7 +427,8 @@ class Ours(Engine):
         from ..scene import DEFAULT_EFFECTS, Scene
 
         if regime.game is not None:
-            self.scene, self.entities, self._step = regime.game.scene, regime.entities, regime.game.step
+            mine = regime if self.solver == "exact" else regime.remake(self.solver)
+            self.scene, self.entities, self._step = mine.game.scene, mine.entities, mine.game.step
             return
         effects = regime.effects or (DEFAULT_EFFECTS if regime.sleeping else DEFAULT_EFFECTS - {"sleeping"})
         scene = self.scene = Scene(gravity=regime.gravity, effects=effects, solver=self.solver)
@@ -457,8 +472,8 @@ class Ours(Engine):
 
 
 class OursSoft(Ours):
-    """:class:`Ours` with the soft-step solver (``Scene(solver="soft")``); not for the platformer,
-    whose game builds its own scene."""
+    """:class:`Ours` with the soft-step solver (``Scene(solver="soft")``; the platformer's game in a
+    soft scene of ``length_unit`` one tile)."""
 
     name = "soft"
     solver = "soft"
@@ -656,7 +671,7 @@ def make_engines(regime: Regime, peers: dict[str, Any] | None = None) -> list[En
     """Ours and every installed peer, each with the regime built."""
     peers = peer_modules() if peers is None else peers
     out: list[Engine] = [Ours(regime)]
-    if regime.game is None:
+    if regime.game is None or regime.remake is not None:
         out.append(OursSoft(regime))
     if peers.get("pymunk") is not None:
         out.append(PymunkEngine(regime, peers["pymunk"]))
@@ -840,6 +855,7 @@ SCENES: dict[str, Callable[[], Regime | None]] = {
     "scattered-1000": lambda: scattered(1_000),
     "scattered-10000": lambda: scattered(10_000),
     "platformer-1": platformer,
+    "platformer-crates": lambda: platformer(crates=20),
 }
 
 
