@@ -5,26 +5,31 @@ Importing it (and running scenes without a renderer) never imports pyglet's GL m
 
 from typing import TYPE_CHECKING, Any
 
-from .components import Body, Hitbox, Transform, Velocity
+from .components import Body, Hitbox, Transform, Velocity, Visual
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .validation import InvalidValue
 
 if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type checkers see them
+    from .character import CharacterController
     from .collision import Contact, Impact, RayHit, Vec2, collide
     from .events import CollisionEvent
+    from .input import Input
+    from .render import Camera, Renderer, run, screenshot
     from .scene import STAGES, Scene, SceneClosed, SceneHit
 
 __all__ = [
-    "AABB", "Body", "Capsule", "Circle", "CollisionEvent", "Contact", "Hitbox", "Impact", "InvalidValue", "Polygon",
-    "RayHit", "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Transform", "Vec2", "Velocity",
-    "collide",
+    "AABB", "Body", "Camera", "Capsule", "CharacterController", "Circle", "CollisionEvent", "Contact", "Hitbox",
+    "Impact", "Input", "InvalidValue", "Polygon", "RayHit", "Renderer", "STAGES", "Scene", "SceneClosed", "SceneHit",
+    "Shape", "Transform", "Vec2", "Velocity", "Visual", "collide", "run", "screenshot",
 ]
 __version__ = "0.1.0"
 
 _LAZY = {
     "Contact": "collision", "Impact": "collision", "RayHit": "collision", "Vec2": "collision",
     "collide": "collision", "CollisionEvent": "events", "STAGES": "scene", "Scene": "scene",
-    "SceneClosed": "scene", "SceneHit": "scene",
+    "SceneClosed": "scene", "SceneHit": "scene", "CharacterController": "character", "Input": "input",
+    # the render entry points (pyglet loads with them, on first use)
+    "Camera": "render", "Renderer": "render", "run": "render", "screenshot": "render",
 }
 
 

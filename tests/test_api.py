@@ -43,3 +43,20 @@ def test_every_module_declares_its_public_names(path):
     missing = [n for n in declared if n not in _top_level_names(tree)]
     assert not missing, f"{path.relative_to(ROOT)}: __all__ names {missing}, which it does not define"
     assert len(set(declared)) == len(declared), f"{path.relative_to(ROOT)}: a name is in __all__ twice"
+
+
+def test_the_names_a_game_maker_reaches_for_are_at_the_top():
+    # (issue 36: the controller, Visual, Input and the render entry points, as `from arcade import ...`)
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from framework import CharacterController, Input, Visual, Scene, Hitbox, Transform, Velocity\n"
+            "assert not any(m.startswith('pyglet') for m in sys.modules), 'pyglet loaded before it was asked for'\n"
+            "from framework import Camera, Renderer, run, screenshot\n"
+            "import framework.render as r, framework.character as c, framework.input as i\n"
+            "assert (run, Renderer, Camera, screenshot) == (r.run, r.Renderer, r.Camera, r.screenshot)\n"
+            "assert (CharacterController, Input) == (c.CharacterController, i.Input)\n"
+            "print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
