@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 __all__ = ["box_box", "capsule_capsule", "circle_circle", "polygon_circle", "polygon_polygon"]
@@ -96,9 +95,9 @@ def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out):
     v1x, v1y, v2x, v2y = V[a, i1, 0], V[a, i1, 1], V[a, i2, 0], V[a, i2, 1]
     u1 = (cx - v1x) * (v2x - v1x) + (cy - v1y) * (v2y - v1y)
     u2 = (cx - v2x) * (v1x - v2x) + (cy - v2y) * (v1y - v2y)
-    if (u1 < 0.0 or u2 < 0.0 or count == 1) and sep > _EPS:
+    if (u1 < 0.0 or u2 < 0.0) and sep > _EPS:
         # the centre is nearest a vertex, safely outside: the normal runs from the vertex
-        px, py = (v1x, v1y) if (u1 < 0.0 or count == 1) else (v2x, v2y)
+        px, py = (v1x, v1y) if u1 < 0.0 else (v2x, v2y)
         dx, dy = cx - px, cy - py
         d = math.sqrt(dx * dx + dy * dy)
         if d - radius > speculative:
@@ -308,15 +307,3 @@ def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out):
         if not keep1:
             return 1, nx, ny
     return k, nx, ny
-
-
-def _warm_up() -> None:  # (a tiny call of each, for tests that time nothing but want them compiled)
-    out = np.zeros((2, 4))
-    sq = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
-    nm = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
-    circle_circle(0.0, 0.0, 1.0, 1.5, 0.0, 1.0, 0.02, out)
-    box_box(0.0, 0.0, 1.0, 1.0, 0.5, 1.9, 1.0, 1.0, 0.02, out)
-    V = np.stack([sq, sq + np.array([0.0, 1.9])])
-    N = np.stack([nm, nm])
-    polygon_circle(V, N, 0, 4, 0.0, 0.0, 1.9, 1.0, 0.02, out)
-    polygon_polygon(V, N, 0, 4, 0.0, 1, 4, 0.0, 0.005, 0.02, out)

@@ -234,24 +234,16 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
     """The slots of the new (sorted) candidate pairs, carried over from the old ones by key; the
     old pairs that touched and are no longer candidates are written to ``ended_*`` (how many)."""
     slots = np.zeros((new_keys.size, len(SLOT)))
-    i, n_end = 0, 0
-    for k in range(new_keys.size):
-        key = new_keys[k]
-        while i < old_keys.size and old_keys[i] < key:
-            if old_slots[i, _TOUCH] != 0.0:
-                ended_keys[n_end] = old_keys[i]
-                ended_f[n_end, :] = old_slots[i, _NX:_PY + 1]
-                n_end += 1
-            i += 1
-        if i < old_keys.size and old_keys[i] == key:
+    k, n_end = 0, 0
+    for i in range(old_keys.size):
+        while k < new_keys.size and new_keys[k] < old_keys[i]:
+            k += 1
+        if k < new_keys.size and new_keys[k] == old_keys[i]:
             slots[k, :] = old_slots[i, :]
-            i += 1
-    while i < old_keys.size:
-        if old_slots[i, _TOUCH] != 0.0:
+        elif old_slots[i, _TOUCH] != 0.0:
             ended_keys[n_end] = old_keys[i]
             ended_f[n_end, :] = old_slots[i, _NX:_PY + 1]
             n_end += 1
-        i += 1
     return slots, n_end
 
 
@@ -295,9 +287,12 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     fixed = np.zeros(n, dtype=np.bool_)  # never moves by itself: static, or without a velocity
     im = np.zeros(n)
     ii = np.zeros(n)
+    sleepers = 0
     for r in range(n):
         fixed[r] = body[r] == _STATIC or not has_vel[r]
         moving[r] = not fixed[r] and not asleep[r]
+        if asleep[r] and body[r] != _STATIC:
+            sleepers += 1
         if moving[r] and body[r] == _DYNAMIC and response:
             im[r] = inv_mass[r]
             if rotation:
@@ -547,14 +542,24 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
         for q in range(5):
             end_f[q, i] = ended_f[i, q]
     woken = np.flatnonzero(wake)
-    sleepers = 0
-    for r in range(n):
-        if asleep[r] and body[r] != _STATIC:
-            sleepers += 1
     info = np.empty(3 + woken.size, dtype=np.int64)
     info[0], info[1], info[2] = 1 if rebuilt else 0, nc, sleepers
     info[3:] = woken
     return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info
+
+
+@njit(cache=True, inline="always")
+def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, turning):
+    """The velocities of A and B after the impulse ``(px, py)`` at their anchors (B takes it, A
+    its opposite); ``turning``: the angular parts too."""
+    vax -= ma * px
+    vay -= ma * py
+    vbx += mb * px
+    vby += mb * py
+    if turning:
+        wa -= ia * (ax * py - ay * px)
+        wb += ib * (bx * py - by * px)
+    return vax, vay, wa, vbx, vby, wb
 
 
 @njit(cache=True, inline="always")
@@ -565,16 +570,14 @@ def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
         a, b = pairs[p, 0], pairs[p, 1]
         nx, ny = cf[c, 0], cf[c, 1]
         tx, ty = ny, -nx
+        vax, vay, wa, vbx, vby, wb = vx[a], vy[a], w[a], vx[b], vy[b], w[b]
         for j in range(ci[c, 1]):
             Px = cp[c, j, _PNI] * nx + cp[c, j, _PTI] * tx
             Py = cp[c, j, _PNI] * ny + cp[c, j, _PTI] * ty
             cp[c, j, _TOTAL] += cp[c, j, _PNI]
-            vx[a] -= im[a] * Px
-            vy[a] -= im[a] * Py
-            w[a] -= ii[a] * (cp[c, j, _RAX] * Py - cp[c, j, _RAY] * Px)
-            vx[b] += im[b] * Px
-            vy[b] += im[b] * Py
-            w[b] += ii[b] * (cp[c, j, _RBX] * Py - cp[c, j, _RBY] * Px)
+            vax, vay, wa, vbx, vby, wb = _push(Px, Py, im[a], ii[a], im[b], ii[b], cp[c, j, _RAX], cp[c, j, _RAY],
+                                               cp[c, j, _RBX], cp[c, j, _RBY], vax, vay, wa, vbx, vby, wb, True)
+        vx[a], vy[a], w[a], vx[b], vy[b], w[b] = vax, vay, wa, vbx, vby, wb
 
 
 @njit(cache=True, inline="always")
@@ -617,14 +620,8 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
             cp[c, j, _TOTAL] += imp
             if new > cp[c, j, _PEAK]:  # (the largest impulse a solve left: did the bodies meet?)
                 cp[c, j, _PEAK] = new
-            Px, Py = imp * nx, imp * ny
-            vax -= mA * Px
-            vay -= mA * Py
-            vbx += mB * Px
-            vby += mB * Py
-            if rotation:
-                wa -= iA * (ax_ * Py - ay_ * Px)
-                wb += iB * (bx_ * Py - by_ * Px)
+            vax, vay, wa, vbx, vby, wb = _push(imp * nx, imp * ny, mA, iA, mB, iB, ax_, ay_, bx_, by_,
+                                               vax, vay, wa, vbx, vby, wb, rotation)
         f = cf[c, 2]
         if f > 0.0:
             tx, ty = ny, -nx
@@ -639,14 +636,8 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
                 new = min(max(old - cp[c, j, _TMASS] * vt, -lim), lim)
                 imp = new - old
                 cp[c, j, _PTI] = new
-                Px, Py = imp * tx, imp * ty
-                vax -= mA * Px
-                vay -= mA * Py
-                vbx += mB * Px
-                vby += mB * Py
-                if rotation:
-                    wa -= iA * (ax_ * Py - ay_ * Px)
-                    wb += iB * (bx_ * Py - by_ * Px)
+                vax, vay, wa, vbx, vby, wb = _push(imp * tx, imp * ty, mA, iA, mB, iB, ax_, ay_, bx_, by_,
+                                                   vax, vay, wa, vbx, vby, wb, rotation)
         if mA > 0.0 or iA > 0.0:
             vx[a], vy[a], w[a] = vax, vay, wa
         if mB > 0.0 or iB > 0.0:
@@ -664,20 +655,16 @@ def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
         p = ci[c, 0]
         a, b = pairs[p, 0], pairs[p, 1]
         nx, ny = cf[c, 0], cf[c, 1]
+        vax, vay, wa, vbx, vby, wb = vx[a], vy[a], w[a], vx[b], vy[b], w[b]
         for j in range(ci[c, 1]):
             if cp[c, j, _RELV] > -threshold or cp[c, j, _TOTAL] == 0.0:
                 continue
             ax_, ay_, bx_, by_ = cp[c, j, _RAX], cp[c, j, _RAY], cp[c, j, _RBX], cp[c, j, _RBY]
-            vn = ((vx[b] - w[b] * by_ - vx[a] + w[a] * ay_) * nx
-                  + (vy[b] + w[b] * bx_ - vy[a] - w[a] * ax_) * ny)
+            vn = (vbx - wb * by_ - vax + wa * ay_) * nx + (vby + wb * bx_ - vay - wa * ax_) * ny
             old = cp[c, j, _PNI]
             new = max(old - cp[c, j, _NMASS] * (vn + e * cp[c, j, _RELV]), 0.0)
             imp = new - old
             cp[c, j, _PNI] = new
-            Px, Py = imp * nx, imp * ny
-            vx[a] -= im[a] * Px
-            vy[a] -= im[a] * Py
-            w[a] -= ii[a] * (ax_ * Py - ay_ * Px)
-            vx[b] += im[b] * Px
-            vy[b] += im[b] * Py
-            w[b] += ii[b] * (bx_ * Py - by_ * Px)
+            vax, vay, wa, vbx, vby, wb = _push(imp * nx, imp * ny, im[a], ii[a], im[b], ii[b], ax_, ay_, bx_, by_,
+                                               vax, vay, wa, vbx, vby, wb, True)
+        vx[a], vy[a], w[a], vx[b], vy[b], w[b] = vax, vay, wa, vbx, vby, wb
