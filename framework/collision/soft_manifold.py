@@ -27,7 +27,7 @@ __all__ = ["box_box", "capsule_capsule", "circle_circle", "polygon_circle", "pol
 _EPS = 1.1920929e-07  # Box2D's FLT_EPSILON, the scale of "safely outside"
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def circle_circle(ax, ay, ra, bx, by, rb, speculative, out):
     """Two circles (centres, radii)."""
     dx, dy = bx - ax, by - ay
@@ -46,7 +46,7 @@ def circle_circle(ax, ay, ra, bx, by, rb, speculative, out):
     return 1, nx, ny
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out):
     """Two axis-aligned boxes (centres, half extents): what :func:`polygon_polygon` gives them, in a
     few operations (the common case of boxes that never turn). The axis of least overlap (y on a
@@ -78,7 +78,7 @@ def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out):
     return 2, 0.0, sgn
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out):
     """Polygon A (world vertices ``V[a, :count]``, normals ``N[a]``, rounding ``ra``) and circle B."""
     sep = -1e300
@@ -117,7 +117,7 @@ def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out):
     return 1, nx, ny
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _max_separation(V, N, p1, c1, p2, c2):
     """The edge of polygon 1 whose normal separates the two the most, and that separation."""
     best, best_sep = 0, -1e300
@@ -132,7 +132,7 @@ def _max_separation(V, N, p1, c1, p2, c2):
     return best, best_sep
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _incident_edge(nx, ny, N, p2, c2):
     """The edge of polygon 2 most anti-parallel to the reference normal."""
     best, low = 0, 1e300
@@ -143,7 +143,7 @@ def _incident_edge(nx, ny, N, p2, c2):
     return best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _segment_fractions(p1x, p1y, q1x, q1y, p2x, p2y, q2x, q2y):
     """Box2D's ``b2SegmentDistance``: the fractions along segments 1 and 2 of their closest points."""
     d1x, d1y, d2x, d2y = q1x - p1x, q1y - p1y, q2x - p2x, q2y - p2y
@@ -174,7 +174,7 @@ def _segment_fractions(p1x, p1y, q1x, q1y, p2x, p2y, q2x, q2y):
     return f1, f2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out):
     """Box2D's ``b2ClipPolygons``: reference edge ``e1`` of polygon 1, incident edge ``e2`` of
     polygon 2; ``flip``: polygon 1 is B (the normal is turned to point from A to B)."""
@@ -216,7 +216,7 @@ def _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out):
     return 2, -nx, -ny
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _segments_cross(V, a, b):
     """Whether the segments of rows ``a`` and ``b`` cross (each one's ends on either side of the
     other's line, by the signs of the orientations: closest points then lie at no distance, up
@@ -230,7 +230,7 @@ def _segments_cross(V, a, b):
     return o1 * o2 < 0.0 and o3 * o4 < 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def capsule_capsule(V, a, ra, b, rb, speculative, out):
     """Two capsules (rows ``a``, ``b`` of ``V``: their segments' ends; radii): one point, between
     the closest points of the two segments (as Box2D's ``b2CollideCapsules`` where the segments are
@@ -258,7 +258,7 @@ def capsule_capsule(V, a, ra, b, rb, speculative, out):
     return 1, nx, ny
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out):
     """Two rounded polygons (world vertices, normals, counts, radii), ``slop``: Box2D's linear slop.
     Returns ``(count, nx, ny)``; points beyond ``speculative`` apart are dropped."""
@@ -292,10 +292,9 @@ def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out):
                 out[0, 0], out[0, 1] = 0.5 * (cax + cbx), 0.5 * (cay + cby)
                 out[0, 2], out[0, 3] = d - radius, float((ia << 8) | ib)
                 return 1, nx, ny
-    if flip:
-        k, nx, ny = _clip(V, N, b, cb, rb, eb, a, ca, ra, ea, True, out)
-    else:
-        k, nx, ny = _clip(V, N, a, ca, ra, ea, b, cb, rb, eb, False, out)
+    # one call site (a literal flip would compile the clip twice)
+    p1, c1, r1, e1, p2, c2, r2, e2 = (b, cb, rb, eb, a, ca, ra, ea) if flip else (a, ca, ra, ea, b, cb, rb, eb)
+    k, nx, ny = _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out)
     if k == 2:  # drop a point beyond the speculative distance (keep the order of the rest)
         keep0 = out[0, 2] <= speculative
         keep1 = out[1, 2] <= speculative

@@ -27,7 +27,7 @@ motion since the step began (Box2D's ``contact_solver.c`` derivation), so nothin
 geometrically inside the solve. Sequential impulses over contacts in a fixed order: bit-identical
 results for identical inputs.
 
-Numba's cache of this module does not see through the functions it inlines from
+Numba's cache of this module does not see through the functions it calls from
 :mod:`framework.collision.soft_manifold`: after editing that module, delete the ``soft_kernel*``
 cache files in ``__pycache__`` (an installed release replaces both files at once).
 """
@@ -106,12 +106,60 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, sp
 
 
 @njit(cache=True)
+def _stable_order(keys):
+    """The indices that sort ``keys`` ascending, equal keys in their order (a bottom-up merge sort:
+    what ``np.argsort(kind="mergesort")`` returns, at a tenth of its compile time)."""
+    n = keys.size
+    order = np.arange(n)
+    tmp = np.empty(n, dtype=np.int64)
+    width = 1
+    while width < n:
+        for lo in range(0, n, 2 * width):
+            mid = min(lo + width, n)
+            hi = min(lo + 2 * width, n)
+            i, j, o = lo, mid, lo
+            while i < mid and j < hi:
+                if keys[order[j]] < keys[order[i]]:
+                    tmp[o] = order[j]
+                    j += 1
+                else:
+                    tmp[o] = order[i]
+                    i += 1
+                o += 1
+            while i < mid:
+                tmp[o] = order[i]
+                i += 1
+                o += 1
+            while j < hi:
+                tmp[o] = order[j]
+                j += 1
+                o += 1
+        order, tmp = tmp, order
+        width *= 2
+    return order
+
+
+@njit(cache=True)
+def _float_keys(v):
+    """Integers in the order of the floats ``v`` (their bits, the negatives' flipped): one sort
+    (:func:`_stable_order` on integers) serves both."""
+    k = (v + 0.0).view(np.int64)  # (+ 0.0: -0.0 becomes 0.0, its equal)
+    for i in range(k.size):
+        if k[i] < 0:
+            k[i] ^= 0x7FFFFFFFFFFFFFFF
+    return k
+
+
+@njit(cache=True)
 def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
     """Sort-and-sweep along x over the fat bounds: the pairs of rows whose fat bounds overlap
     (never two fixed ones; layers that meet), as rows ``(a, b, key)`` with ``entity[a] < entity[b]``
     and ``key = entity[a] << 32 | entity[b]``, sorted by key."""
     n = fat.shape[0]
-    order = np.argsort(fat[:, 0], kind="mergesort")
+    xs = np.empty(n)
+    for i in range(n):
+        xs[i] = fat[i, 0]
+    order = _stable_order(_float_keys(xs))
     cap = 4 * n + 16
     pa = np.empty(cap, dtype=np.int64)
     pb = np.empty(cap, dtype=np.int64)
@@ -135,7 +183,8 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
                 cap *= 2
                 na = np.empty(cap, dtype=np.int64)
                 nb = np.empty(cap, dtype=np.int64)
-                na[:m], nb[:m] = pa[:m], pb[:m]
+                for q in range(m):
+                    na[q], nb[q] = pa[q], pb[q]
                 pa, pb = na, nb
             if entity[j] < entity[i]:
                 pa[m], pb[m] = j, i
@@ -145,14 +194,14 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
     keys = np.empty(m, dtype=np.int64)
     for k in range(m):
         keys[k] = (entity[pa[k]] << 32) | entity[pb[k]]
-    srt = np.argsort(keys, kind="mergesort")
+    srt = _stable_order(keys)
     pairs = np.empty((m, 3), dtype=np.int64)
     for k in range(m):
         pairs[k, 0], pairs[k, 1], pairs[k, 2] = pa[srt[k]], pb[srt[k]], keys[srt[k]]
     return pairs
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _fat_overlap(fat, i, j):
     return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
 
@@ -199,11 +248,15 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
             if n_add == cap:
                 cap *= 2
                 grown = np.empty((cap, 3), dtype=np.int64)
-                grown[:n_add] = add[:n_add]
+                for q in range(n_add):
+                    grown[q, 0], grown[q, 1], grown[q, 2] = add[q, 0], add[q, 1], add[q, 2]
                 add = grown
             add[n_add, 0], add[n_add, 1], add[n_add, 2] = a, b, key
             n_add += 1
-    order = np.argsort(add[:n_add, 2], kind="mergesort")
+    add_keys = np.empty(n_add, dtype=np.int64)
+    for q in range(n_add):
+        add_keys[q] = add[q, 2]
+    order = _stable_order(add_keys)
     out = np.empty((n_keep + n_add, 3), dtype=np.int64)
     i, k, o = 0, 0, 0
     while i < m or k < n_add:
@@ -211,10 +264,11 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
             i += 1
             continue
         if k < n_add and (i >= m or add[order[k], 2] < pairs[i, 2]):
-            out[o, :] = add[order[k], :]
+            q = order[k]
+            out[o, 0], out[o, 1], out[o, 2] = add[q, 0], add[q, 1], add[q, 2]
             k += 1
         else:
-            out[o, :] = pairs[i, :]
+            out[o, 0], out[o, 1], out[o, 2] = pairs[i, 0], pairs[i, 1], pairs[i, 2]
             i += 1
         o += 1
     return out
@@ -239,119 +293,30 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
         while k < new_keys.size and new_keys[k] < old_keys[i]:
             k += 1
         if k < new_keys.size and new_keys[k] == old_keys[i]:
-            slots[k, :] = old_slots[i, :]
+            for q in range(old_slots.shape[1]):
+                slots[k, q] = old_slots[i, q]
         elif old_slots[i, _TOUCH] != 0.0:
             ended_keys[n_end] = old_keys[i]
-            ended_f[n_end, :] = old_slots[i, _NX:_PY + 1]
+            for q in range(5):
+                ended_f[n_end, q] = old_slots[i, _NX + q]
             n_end += 1
     return slots, n_end
 
 
 @njit(cache=True)
-def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, driven, fat, pairs, slots, rebuild):
-    """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
-
-    What changes only with the rows comes packed, as rows of three tables (see
-    :func:`framework.systems.soft_step.kernel_tables`; an array argument costs about 0.3 us to pass):
-    ``fprops`` (inverse mass, inverse inertia, friction, restitution, bounding radius, rounding
-    radius), ``iprops`` (body kind, shape kind, layer, mask, entity, sensor, one-way, has a
-    velocity, vertex count, turns with the body), ``off`` (hitbox offsets) and ``verts`` (each
-    row's local vertices, then normals).
-    ``driven``: rows a character controller moved this step (they are not moved again, and take
-    no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
-    (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
-    not modified: new ones are returned. See the module docstring for the stages.
-
-    Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info)`` (few objects: each
-    array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
-    slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
-    entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
-    (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
-    were found again, how many contacts the solver used, how many bodies sleep (before this step's
-    wakes), then the rows of the sleepers to wake."""
-    inv_mass, inv_inertia, friction, restitution, bound, rr = fprops[0], fprops[1], fprops[2], fprops[3], fprops[4], \
-        fprops[5]
-    body, kind, layer, mask, entity = iprops[0], iprops[1], iprops[2], iprops[3], iprops[4]
-    sensor, one_way, has_vel, cnt, spin = iprops[5], iprops[6], iprops[7], iprops[8], iprops[9]
-    lv, ln = verts[:, :, 0:2], verts[:, :, 2:4]
-    dt = params[_DT]
-    nsub = int(params[_SUB])
-    gx, gy = params[_GX], params[_GY]
-    slop, spec = params[_SLOP], params[_SPEC]
-    response, rotation, use_friction = params[_RESPONSE] != 0.0, params[_ROT] != 0.0, params[_FRIC] != 0.0
-    n = x.size
-    K = lv.shape[1]
-
-    # --- bodies: who moves, who takes impulses ----------------------------------------------
-    moving = np.zeros(n, dtype=np.bool_)
-    fixed = np.zeros(n, dtype=np.bool_)  # never moves by itself: static, or without a velocity
-    im = np.zeros(n)
-    ii = np.zeros(n)
-    sleepers = 0
-    for r in range(n):
-        fixed[r] = body[r] == _STATIC or not has_vel[r]
-        moving[r] = not fixed[r] and not asleep[r]
-        if asleep[r] and body[r] != _STATIC:
-            sleepers += 1
-        if moving[r] and body[r] == _DYNAMIC and response:
-            im[r] = inv_mass[r]
-            if rotation:
-                ii[r] = inv_inertia[r]
-    # A scene where nothing turns runs the translation-only solve (no angular terms).
-    turns = False
-    for r in range(n):
-        if ii[r] > 0.0 or (moving[r] and w[r] != 0.0):
-            turns = True
-            break
-    rotation = rotation and turns
-
-    # --- shapes, fat bounds and the broad phase ----------------------------------------------------
-    wc = np.empty((n, 2))
-    wv = np.empty((n, K, 2))
-    wn = np.empty((n, K, 2))
-    lo = np.empty((n, 2))
-    hi = np.empty((n, 2))
-    reach = np.zeros(n)
-    margin0 = 0.5 * spec if response else 0.0
-    _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
-                  wc, wv, wn, lo, hi, reach)
-    fat_margin = params[_FAT]
-    fat = fat.copy()  # (the step's inputs stay as they were: a failed step is undone by keeping them)
-    slots = slots.copy()
-    moved = np.zeros(n, dtype=np.bool_)  # left its fat bounds (or the rows changed): new fat bounds
-    n_moved = 0
-    for r in range(n):
-        if cnt[r] == 0:
-            continue
-        inside = (lo[r, 0] >= fat[r, 0] and lo[r, 1] >= fat[r, 1] and hi[r, 0] <= fat[r, 2]
-                  and hi[r, 1] <= fat[r, 3])
-        if rebuild or not inside:
-            e = 0.0 if fixed[r] else fat_margin
-            fat[r, 0], fat[r, 1], fat[r, 2], fat[r, 3] = lo[r, 0] - e, lo[r, 1] - e, hi[r, 0] + e, hi[r, 1] + e
-            moved[r] = True
-            n_moved += 1
-    n_end = 0
-    ended_keys = np.empty(pairs.shape[0], dtype=np.int64)
-    ended_f = np.empty((pairs.shape[0], 5))
-    rebuilt = rebuild or 8 * n_moved > n
-    if rebuilt or n_moved:
-        if rebuilt:  # everything again: sort and sweep
-            new = _candidate_pairs(fat, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity)
-        else:  # a few bodies left their fat bounds: only their pairs change
-            new = _moved_pairs(fat, moved, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity, pairs)
-        slots, n_end = _merge_slots(pairs[:, 2], slots, new[:, 2], ended_keys, ended_f)
-        pairs = new
+def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction, kind, cnt, rr, sensor,
+                  one_way, friction, restitution, wc, lv, wv, wn, x, y, vx, vy, w, im, ii):
+    """The manifold of every candidate pair, and the contacts the solver uses, prepared (anchors, effective
+    masses, warm starts from the pair's slot by feature id): ``(nc, ci, cf, cp, tnow, evd)``, see
+    :func:`soft_step`; a pair whose bodies both rest keeps its state (``tnow`` -1)."""
     m = pairs.shape[0]
-
-    # --- narrow phase: manifolds -> contacts ---------------------------------------------------
     ci = np.empty((m, 2), dtype=np.int64)  # the contact's pair slot, points the solver uses
     cf = np.empty((m, 5))  # nx, ny, friction, restitution, stiff (against an idle body)
     cp = np.empty((m, 2, 13))
     tnow = np.zeros(m, dtype=np.int8)  # in contact now: 1 yes, 0 no, -1 not measured (keeps its state)
     evd = np.empty((m, 5))  # the contact measured now: nx, ny, depth, px, py
-    wake = np.zeros(n, dtype=np.bool_)
     out = np.empty((2, 4))
-    nc = 0
+    nc = np.int64(0)  # (not the literal 0: the solver's functions would compile twice, for it and for int64)
     for p in range(m):
         a, b = pairs[p, 0], pairs[p, 1]
         was = slots[p, _TOUCH] != 0.0
@@ -451,47 +416,17 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
                     cp[nc, j, _PNI], cp[nc, j, _PTI] = slots[p, _NI + o], slots[p, _TI + o]
         nc += 1
 
-    # --- sub-steps ------------------------------------------------------------------------------
-    h = dt / nsub if nsub > 0 else 0.0
-    inv_h = 1.0 / h if h > 0.0 else 0.0
-    hertz = min(params[_HZ], 0.125 * inv_h)
-    zeta = params[_ZETA]
-    r2 = math.sqrt(2.0)
-    softness = np.array([_soft(hertz, zeta, h), _soft(2.0 * hertz, zeta, h),
-                         _soft(r2 * hertz, r2 * zeta, h), _soft(2.0 * r2 * hertz, r2 * zeta, h)])
-    push = params[_PUSH]
-    x0 = x.copy()
-    y0 = y.copy()
-    qc = np.ones(n)
-    qs = np.zeros(n)
-    turning = np.zeros(n, dtype=np.bool_)
-    for r in range(n):
-        turning[r] = moving[r] and (ii[r] > 0.0 or w[r] != 0.0)
-    for _sub in range(nsub):
-        for r in range(n):  # integrate velocities
-            if moving[r] and body[r] == _DYNAMIC and not driven[r]:
-                vx[r] += h * gx
-                vy[r] += h * gy
-        _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
-        for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
-            if relax:
-                for r in range(n):
-                    if moving[r] and not driven[r]:
-                        x[r] += h * vx[r]
-                        y[r] += h * vy[r]
-                        if turning[r]:
-                            # the turn since the step began, as Box2D's b2IntegrateRotation: (c, s)
-                            # advanced along its tangent and normalised (no cos or sin)
-                            hw = h * w[r]
-                            rot[r] += hw
-                            c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
-                            mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
-                            qc[r], qs[r] = c2 * mag, s2 * mag
-            _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
-                   inv_h, push)
-    _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
+    return nc, ci, cf, cp, tnow, evd
 
-    # --- store the impulses in the slots; which pairs are in contact ----------------------------
+
+@njit(cache=True)
+def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving, ended_keys, ended_f, n_end,
+            rebuilt, sleepers):
+    """Store the impulses in the pairs' slots and report which pairs are in contact: ``(touch_i,
+    touch_f, end_i, end_f, info)``, see :func:`soft_step`."""
+    m = pairs.shape[0]
+    n = moving.size
+    wake = np.zeros(n, dtype=np.bool_)
     for c in range(nc):
         p = ci[c, 0]
         k = ci[c, 1]
@@ -541,14 +476,170 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
         end_i[0, i], end_i[1, i] = ended_keys[i] >> 32, ended_keys[i] & 0xFFFFFFFF
         for q in range(5):
             end_f[q, i] = ended_f[i, q]
-    woken = np.flatnonzero(wake)
-    info = np.empty(3 + woken.size, dtype=np.int64)
+    n_wake = 0
+    for r in range(n):
+        if wake[r]:
+            n_wake += 1
+    info = np.empty(3 + n_wake, dtype=np.int64)
     info[0], info[1], info[2] = 1 if rebuilt else 0, nc, sleepers
-    info[3:] = woken
+    n_wake = 3
+    for r in range(n):
+        if wake[r]:
+            info[n_wake] = r
+            n_wake += 1
+    return touch_i, touch_f, end_i, end_f, info
+
+
+@njit(cache=True)
+def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, driven, fat, pairs, slots, rebuild):
+    """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
+
+    What changes only with the rows comes packed, as rows of three tables (see
+    :func:`framework.systems.soft_step.kernel_tables`; an array argument costs about 0.3 us to pass):
+    ``fprops`` (inverse mass, inverse inertia, friction, restitution, bounding radius, rounding
+    radius), ``iprops`` (body kind, shape kind, layer, mask, entity, sensor, one-way, has a
+    velocity, vertex count, turns with the body), ``off`` (hitbox offsets) and ``verts`` (each
+    row's local vertices, then normals).
+    ``driven``: rows a character controller moved this step (they are not moved again, and take
+    no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
+    (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
+    not modified: new ones are returned. See the module docstring for the stages.
+
+    Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info)`` (few objects: each
+    array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
+    slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
+    entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
+    (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
+    were found again, how many contacts the solver used, how many bodies sleep (before this step's
+    wakes), then the rows of the sleepers to wake."""
+    inv_mass, inv_inertia, friction, restitution, bound, rr = fprops[0], fprops[1], fprops[2], fprops[3], fprops[4], \
+        fprops[5]
+    body, kind, layer, mask, entity = iprops[0], iprops[1], iprops[2], iprops[3], iprops[4]
+    sensor, one_way, has_vel, cnt, spin = iprops[5], iprops[6], iprops[7], iprops[8], iprops[9]
+    lv, ln = verts[:, :, 0:2], verts[:, :, 2:4]
+    dt = params[_DT]
+    nsub = int(params[_SUB])
+    gx, gy = params[_GX], params[_GY]
+    slop, spec = params[_SLOP], params[_SPEC]
+    response, rotation, use_friction = params[_RESPONSE] != 0.0, params[_ROT] != 0.0, params[_FRIC] != 0.0
+    n = x.size
+    K = lv.shape[1]
+
+    # --- bodies: who moves, who takes impulses ----------------------------------------------
+    moving = np.zeros(n, dtype=np.bool_)
+    fixed = np.zeros(n, dtype=np.bool_)  # never moves by itself: static, or without a velocity
+    im = np.zeros(n)
+    ii = np.zeros(n)
+    sleepers = np.int64(0)  # (np.int64: a literal 0 would compile _report twice)
+    for r in range(n):
+        fixed[r] = body[r] == _STATIC or not has_vel[r]
+        moving[r] = not fixed[r] and not asleep[r]
+        if asleep[r] and body[r] != _STATIC:
+            sleepers += 1
+        if moving[r] and body[r] == _DYNAMIC and response:
+            im[r] = inv_mass[r]
+            if rotation:
+                ii[r] = inv_inertia[r]
+    # A scene where nothing turns runs the translation-only solve (no angular terms).
+    turns = False
+    for r in range(n):
+        if ii[r] > 0.0 or (moving[r] and w[r] != 0.0):
+            turns = True
+            break
+    rotation = rotation and turns
+
+    # --- shapes, fat bounds and the broad phase ----------------------------------------------------
+    wc = np.empty((n, 2))
+    wv = np.empty((n, K, 2))
+    wn = np.empty((n, K, 2))
+    lo = np.empty((n, 2))
+    hi = np.empty((n, 2))
+    reach = np.zeros(n)
+    margin0 = 0.5 * spec if response else 0.0
+    _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
+                  wc, wv, wn, lo, hi, reach)
+    fat_margin = params[_FAT]
+    fat = fat.copy()  # (the step's inputs stay as they were: a failed step is undone by keeping them)
+    slots = slots.copy()
+    moved = np.zeros(n, dtype=np.bool_)  # left its fat bounds (or the rows changed): new fat bounds
+    n_moved = 0
+    for r in range(n):
+        if cnt[r] == 0:
+            continue
+        inside = (lo[r, 0] >= fat[r, 0] and lo[r, 1] >= fat[r, 1] and hi[r, 0] <= fat[r, 2]
+                  and hi[r, 1] <= fat[r, 3])
+        if rebuild or not inside:
+            e = 0.0 if fixed[r] else fat_margin
+            fat[r, 0], fat[r, 1], fat[r, 2], fat[r, 3] = lo[r, 0] - e, lo[r, 1] - e, hi[r, 0] + e, hi[r, 1] + e
+            moved[r] = True
+            n_moved += 1
+    n_end = np.int64(0)
+    ended_keys = np.empty(pairs.shape[0], dtype=np.int64)
+    ended_f = np.empty((pairs.shape[0], 5))
+    rebuilt = rebuild or 8 * n_moved > n
+    if rebuilt or n_moved:
+        if rebuilt:  # everything again: sort and sweep
+            new = _candidate_pairs(fat, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity)
+        else:  # a few bodies left their fat bounds: only their pairs change
+            new = _moved_pairs(fat, moved, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity, pairs)
+        slots, n_end = _merge_slots(pairs[:, 2], slots, new[:, 2], ended_keys, ended_f)
+        pairs = new
+
+    # --- narrow phase: manifolds -> contacts, prepared ---------------------------------------------
+    nc, ci, cf, cp, tnow, evd = _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction,
+                                              kind, cnt, rr, sensor, one_way, friction, restitution, wc, lv, wv, wn,
+                                              x, y, vx, vy, w, im, ii)
+
+    # --- sub-steps ------------------------------------------------------------------------------
+    h = dt / nsub if nsub > 0 else 0.0
+    inv_h = 1.0 / h if h > 0.0 else 0.0
+    hertz = min(params[_HZ], 0.125 * inv_h)
+    zeta = params[_ZETA]
+    r2 = math.sqrt(2.0)
+    softness = np.empty((4, 3))  # rows: between moving bodies, against an idle one; then each for a paired row
+    for q in range(4):
+        scale = r2 if q >= 2 else 1.0
+        softness[q, 0], softness[q, 1], softness[q, 2] = _soft((2.0 if q & 1 else 1.0) * scale * hertz,
+                                                               scale * zeta, h)
+    push = params[_PUSH]
+    x0 = x.copy()
+    y0 = y.copy()
+    qc = np.ones(n)
+    qs = np.zeros(n)
+    turning = np.zeros(n, dtype=np.bool_)
+    for r in range(n):
+        turning[r] = moving[r] and (ii[r] > 0.0 or w[r] != 0.0)
+    for _sub in range(nsub):
+        for r in range(n):  # integrate velocities
+            if moving[r] and body[r] == _DYNAMIC and not driven[r]:
+                vx[r] += h * gx
+                vy[r] += h * gy
+        _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
+        for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
+            if relax:
+                for r in range(n):
+                    if moving[r] and not driven[r]:
+                        x[r] += h * vx[r]
+                        y[r] += h * vy[r]
+                        if turning[r]:
+                            # the turn since the step began, as Box2D's b2IntegrateRotation: (c, s)
+                            # advanced along its tangent and normalised (no cos or sin)
+                            hw = h * w[r]
+                            rot[r] += hw
+                            c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
+                            mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
+                            qc[r], qs[r] = c2 * mag, s2 * mag
+            _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
+                   inv_h, push)
+    _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
+
+    # --- store the impulses in the slots; which pairs are in contact ----------------------------
+    touch_i, touch_f, end_i, end_f, info = _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
+                                                   ended_keys, ended_f, n_end, rebuilt, sleepers)
     return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, turning):
     """The velocities of A and B after the impulse ``(px, py)`` at their anchors (B takes it, A
     its opposite); ``turning``: the angular parts too."""
@@ -562,7 +653,7 @@ def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, tu
     return vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
     """Apply each point's accumulated impulses (Box2D's ``b2WarmStartContacts``)."""
     for c in range(nc):
@@ -580,7 +671,7 @@ def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
         vx[a], vy[a], w[a], vx[b], vy[b], w[b] = vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_bias, rotation, softness,
            inv_h, push):
     """One pass over the contacts (Box2D's ``b2SolveContact``): the normal impulses with soft
@@ -644,7 +735,7 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
             vx[b], vy[b], w[b] = vbx, vby, wb
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
     """Bounce the points that approached faster than ``threshold`` and took an impulse (Box2D's
     ``b2ApplyRestitution``): the relative normal velocity becomes ``-e`` times the approach."""
