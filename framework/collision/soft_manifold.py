@@ -14,6 +14,18 @@ lets them close, no further). Polygons are given as rows of the world vertex and
 Each function writes into ``out`` (rows: point 0, point 1; columns: x, y, separation, id) and
 returns ``(count, nx, ny)``. Floats only: these are the soft step's measurements, not the
 contract's exact decisions.
+
+**Internal faces.** A static box's face that another static box covers (a floor of tiles, a wall of
+tiles) is *internal*: nothing can be outside it. The ``faces`` bits of such a box (``LEFT``,
+``RIGHT``, ``DOWN``, ``UP``: the direction a body leaves the box through the face) keep the
+manifolds from pushing a body out through one: such an axis is not chosen as the contact's normal,
+and a corner where an internal face meets an open one is part of the open face (a body sliding
+or rolling over the seam between two tiles meets a flat floor, as on Box2D's chain shapes). Where
+the least overlap leaves through an internal face, the next open way out is taken only if it is
+within the pair's speculative distance (the body came that way this step); deeper, the contact
+belongs to the neighbour that covers the face (a box in the corner of a tiled floor and a wall is
+held by the floor and the wall, not lifted by the tile under the wall), and none is reported. A
+separation along a banned axis still proves the shapes apart.
 """
 
 from __future__ import annotations
@@ -22,9 +34,19 @@ import math
 
 from numba import njit
 
-__all__ = ["box_box", "capsule_capsule", "circle_circle", "polygon_circle", "polygon_polygon"]
+__all__ = ["DOWN", "LEFT", "RIGHT", "UP", "box_box", "capsule_capsule", "circle_circle", "face_bit", "polygon_circle",
+           "polygon_polygon"]
 
 _EPS = 1.1920929e-07  # Box2D's FLT_EPSILON, the scale of "safely outside"
+LEFT, RIGHT, DOWN, UP = 1, 2, 4, 8  # a static box's faces, by the direction a body leaves it through them
+
+
+@njit(cache=True)
+def face_bit(vx, vy):
+    """The face of a box that the direction ``(vx, vy)`` leaves it through (its dominant axis)."""
+    if abs(vx) >= abs(vy):
+        return RIGHT if vx > 0.0 else LEFT
+    return UP if vy > 0.0 else DOWN
 
 
 @njit(cache=True)
@@ -47,17 +69,28 @@ def circle_circle(ax, ay, ra, bx, by, rb, speculative, out):
 
 
 @njit(cache=True)
-def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out):
-    """Two axis-aligned boxes (centres, half extents): what :func:`polygon_polygon` gives them, in a
-    few operations (the common case of boxes that never turn). The axis of least overlap (y on a
-    tie: a resting stack's normal is vertical); two points at the ends of the faces' common run,
-    one where the runs do not meet (boxes apart across a corner). Ids: 0, 1 along y, 2, 3 along x."""
+def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out, fa=0, fb=0):
+    """Two axis-aligned boxes (centres, half extents; internal ``faces`` bits ``fa``, ``fb``): what
+    :func:`polygon_polygon` gives them, in a few operations (the common case of boxes that never
+    turn). The axis of least overlap (y on a tie: a resting stack's normal is vertical) unless it
+    leaves a box through an internal face; two points at the ends of the faces' common run, one
+    where the runs do not meet (boxes apart across a corner). Ids: 0, 1 along y, 2, 3 along x."""
     dx, dy = bx - ax, by - ay
     sx = abs(dx) - (aw + bw)
     sy = abs(dy) - (ah + bh)
     if sx > speculative or sy > speculative:
         return 0, 0.0, 0.0
-    if sx > sy:  # normal along x; the run is along y
+    along_x = sx > sy
+    if fa | fb:  # B leaves A along the normal, A leaves B against it
+        gx = 1.0 if dx >= 0.0 else -1.0
+        gy = 1.0 if dy >= 0.0 else -1.0
+        x_ok = (fa & face_bit(gx, 0.0)) == 0 and (fb & face_bit(-gx, 0.0)) == 0
+        y_ok = (fa & face_bit(0.0, gy)) == 0 and (fb & face_bit(0.0, -gy)) == 0
+        if x_ok != y_ok and along_x != x_ok:  # the least overlap leaves through an internal face
+            if (sy if along_x else sx) < -speculative:
+                return 0, 0.0, 0.0
+            along_x = x_ok
+    if along_x:  # normal along x; the run is along y
         sgn = 1.0 if dx >= 0.0 else -1.0
         lo, hi = max(ay - ah, by - bh), min(ay + ah, by + bh)
         face = 0.5 * (ax + sgn * aw + bx - sgn * bw)
@@ -79,22 +112,37 @@ def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out):
 
 
 @njit(cache=True)
-def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out):
-    """Polygon A (world vertices ``V[a, :count]``, normals ``N[a]``, rounding ``ra``) and circle B."""
-    sep = -1e300
-    best = 0
+def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out, fa=0):
+    """Polygon A (world vertices ``V[a, :count]``, normals ``N[a]``, rounding ``ra``, internal
+    ``faces`` bits ``fa``) and circle B."""
+    sep, sep_all = -1e300, -1e300
+    best = -1
     for i in range(count):
         s = N[a, i, 0] * (cx - V[a, i, 0]) + N[a, i, 1] * (cy - V[a, i, 1])
-        if s > sep:
+        sep_all = max(sep_all, s)
+        if s > sep and (fa & face_bit(N[a, i, 0], N[a, i, 1])) == 0:
             sep, best = s, i
     radius = ra + rb
-    if sep - radius > speculative:
+    if sep_all - radius > speculative:
+        return 0, 0.0, 0.0
+    if best < 0:  # every face internal: the deepest way out after all
+        for i in range(count):
+            s = N[a, i, 0] * (cx - V[a, i, 0]) + N[a, i, 1] * (cy - V[a, i, 1])
+            if s > sep:
+                sep, best = s, i
+    elif sep < sep_all and sep - radius < -speculative:  # the way out is through a neighbour
         return 0, 0.0, 0.0
     i1 = best
     i2 = i1 + 1 if i1 + 1 < count else 0
     v1x, v1y, v2x, v2y = V[a, i1, 0], V[a, i1, 1], V[a, i2, 0], V[a, i2, 1]
     u1 = (cx - v1x) * (v2x - v1x) + (cy - v1y) * (v2y - v1y)
     u2 = (cx - v2x) * (v1x - v2x) + (cy - v2y) * (v1y - v2y)
+    if fa:  # a corner where an internal face meets this one belongs to this face
+        i0 = i1 - 1 if i1 > 0 else count - 1
+        if u1 < 0.0 and (fa & face_bit(N[a, i0, 0], N[a, i0, 1])) != 0:
+            u1 = 0.0
+        if u2 < 0.0 and (fa & face_bit(N[a, i2, 0], N[a, i2, 1])) != 0:
+            u2 = 0.0
     if (u1 < 0.0 or u2 < 0.0) and sep > _EPS:
         # the centre is nearest a vertex, safely outside: the normal runs from the vertex
         px, py = (v1x, v1y) if u1 < 0.0 else (v2x, v2y)
@@ -118,18 +166,31 @@ def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out):
 
 
 @njit(cache=True)
-def _max_separation(V, N, p1, c1, p2, c2):
-    """The edge of polygon 1 whose normal separates the two the most, and that separation."""
-    best, best_sep = 0, -1e300
+def _max_separation(V, N, p1, c1, p2, c2, f1, f2):
+    """The edge of polygon 1 whose normal separates the two the most and that separation, among the
+    edges that leave no box through an internal face (``f1``, ``f2``: the polygons' ``faces`` bits;
+    -1 and -1e300 if none does); then the most separating of all edges' separations."""
+    best, best_sep, sep_all = -1, -1e300, -1e300
     for i in range(c1):
         si = 1e300
         for j in range(c2):
             s = N[p1, i, 0] * (V[p2, j, 0] - V[p1, i, 0]) + N[p1, i, 1] * (V[p2, j, 1] - V[p1, i, 1])
             if s < si:
                 si = s
-        if si > best_sep:
+        sep_all = max(sep_all, si)
+        if si > best_sep and ((f1 | f2) == 0 or ((f1 & face_bit(N[p1, i, 0], N[p1, i, 1])) == 0
+                                                 and (f2 & face_bit(-N[p1, i, 0], -N[p1, i, 1])) == 0)):
             best_sep, best = si, i
-    return best, best_sep
+    return best, best_sep, sep_all
+
+
+@njit(cache=True)
+def _internal_corner(N, p, c, i, f):
+    """Whether vertex ``i`` of polygon ``p`` (``c`` vertices, ``faces`` bits ``f``) ends an internal face."""
+    if f == 0:
+        return False
+    i0 = i - 1 if i > 0 else c - 1
+    return (f & face_bit(N[p, i0, 0], N[p, i0, 1])) != 0 or (f & face_bit(N[p, i, 0], N[p, i, 1])) != 0
 
 
 @njit(cache=True)
@@ -259,13 +320,19 @@ def capsule_capsule(V, a, ra, b, rb, speculative, out):
 
 
 @njit(cache=True)
-def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out):
-    """Two rounded polygons (world vertices, normals, counts, radii), ``slop``: Box2D's linear slop.
-    Returns ``(count, nx, ny)``; points beyond ``speculative`` apart are dropped."""
-    ea, sa = _max_separation(V, N, a, ca, b, cb)
-    eb, sb = _max_separation(V, N, b, cb, a, ca)
+def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out, fa=0, fb=0):
+    """Two rounded polygons (world vertices, normals, counts, radii, internal ``faces`` bits),
+    ``slop``: Box2D's linear slop. Returns ``(count, nx, ny)``; points beyond ``speculative`` apart
+    are dropped."""
+    ea, sa, all_a = _max_separation(V, N, a, ca, b, cb, fa, fb)
+    eb, sb, all_b = _max_separation(V, N, b, cb, a, ca, fb, fa)
     radius = ra + rb
-    if sa > speculative + radius or sb > speculative + radius:
+    if all_a > speculative + radius or all_b > speculative + radius:
+        return 0, 0.0, 0.0
+    if ea < 0 and eb < 0:  # every axis leaves through an internal face: the least deep after all
+        ea, sa, _ = _max_separation(V, N, a, ca, b, cb, 0, 0)
+        eb, sb, _ = _max_separation(V, N, b, cb, a, ca, 0, 0)
+    elif max(sa, sb) < max(all_a, all_b) and max(sa, sb) - radius < -speculative:  # through a neighbour
         return 0, 0.0, 0.0
     flip = not (sa >= sb)
     if flip:
@@ -278,9 +345,10 @@ def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out):
         i21, i22 = eb, (eb + 1 if eb + 1 < cb else 0)
         f1, f2 = _segment_fractions(V[a, i11, 0], V[a, i11, 1], V[a, i12, 0], V[a, i12, 1],
                                     V[b, i21, 0], V[b, i21, 1], V[b, i22, 0], V[b, i22, 1])
-        if (f1 == 0.0 or f1 == 1.0) and (f2 == 0.0 or f2 == 1.0):
-            ia = i11 if f1 == 0.0 else i12
-            ib = i21 if f2 == 0.0 else i22
+        ia = i11 if f1 == 0.0 else i12
+        ib = i21 if f2 == 0.0 else i22
+        if ((f1 == 0.0 or f1 == 1.0) and (f2 == 0.0 or f2 == 1.0) and not _internal_corner(N, a, ca, ia, fa)
+                and not _internal_corner(N, b, cb, ib, fb)):
             dx, dy = V[b, ib, 0] - V[a, ia, 0], V[b, ib, 1] - V[a, ia, 1]
             d = math.sqrt(dx * dx + dy * dy)
             if d - radius > speculative:

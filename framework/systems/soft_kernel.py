@@ -39,9 +39,19 @@ import math
 import numpy as np
 from numba import njit
 
-from ..collision.soft_manifold import box_box, capsule_capsule, circle_circle, polygon_circle, polygon_polygon
+from ..collision.soft_manifold import (
+    DOWN,
+    LEFT,
+    RIGHT,
+    UP,
+    box_box,
+    capsule_capsule,
+    circle_circle,
+    polygon_circle,
+    polygon_polygon,
+)
 
-__all__ = ["PARAMS", "SLOT", "soft_step"]
+__all__ = ["PARAMS", "SLOT", "internal_faces", "soft_step"]
 
 # The layout of the ``params`` float array (one argument instead of fourteen scalars).
 PARAMS = ("dt", "substeps", "gx", "gy", "slop", "speculative", "hertz", "damping", "push_speed",
@@ -62,6 +72,58 @@ def _soft(hertz, zeta, h):
     a2 = h * omega * a1
     a3 = 1.0 / (1.0 + a2)
     return omega / a1, a2 * a3, a3
+
+
+@njit(cache=True)
+def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
+    """Each row's internal faces (bits :data:`~framework.collision.soft_manifold.LEFT`, ``RIGHT``,
+    ``DOWN``, ``UP``; 0 for rows not ``eligible``: static boxes that take part in the response). A
+    face of box ``T`` is internal when another eligible box of the same layer and mask spans the
+    whole face and reaches past it, to within the rounding of the coordinates: a floor or a wall of
+    tiles. ``half``: each row's half extents. One sort and sweep along x, when the statics change."""
+    n = x.size
+    faces = np.zeros(n, dtype=np.int64)
+    rows = np.empty(n, dtype=np.int64)
+    m = 0
+    for r in range(n):
+        if eligible[r] and cnt[r] > 0:
+            rows[m] = r
+            m += 1
+    box = np.empty((n, 4))  # xmin, ymin, xmax, ymax
+    tol = np.empty(n)
+    xs = np.empty(m)
+    for k in range(m):
+        r = rows[k]
+        c, s = math.cos(rot[r]), math.sin(rot[r])
+        hx, hy = x[r] + c * off[r, 0] - s * off[r, 1], y[r] + s * off[r, 0] + c * off[r, 1]
+        box[r, 0], box[r, 1], box[r, 2], box[r, 3] = hx - half[r, 0], hy - half[r, 1], hx + half[r, 0], hy + half[r, 1]
+        tol[r] = 1e-9 * (1.0 + abs(hx) + abs(hy) + half[r, 0] + half[r, 1])
+        xs[k] = box[r, 0]
+    order = _stable_order(_float_keys(xs))
+    for ii in range(m):
+        i = rows[order[ii]]
+        for jj in range(ii + 1, m):
+            j = rows[order[jj]]
+            t = max(tol[i], tol[j])
+            if box[j, 0] > box[i, 2] + t:
+                break
+            if box[j, 1] > box[i, 3] + t or box[i, 1] > box[j, 3] + t:
+                continue
+            if layer[i] != layer[j] or mask[i] != mask[j]:
+                continue
+            for q in range(2):
+                T, M = (i, j) if q == 0 else (j, i)  # does M cover a face of T?
+                spans_y = box[M, 1] <= box[T, 1] + t and box[M, 3] >= box[T, 3] - t
+                spans_x = box[M, 0] <= box[T, 0] + t and box[M, 2] >= box[T, 2] - t
+                if spans_y and box[M, 0] <= box[T, 2] + t and box[M, 2] > box[T, 2] + t:
+                    faces[T] |= RIGHT
+                if spans_y and box[M, 2] >= box[T, 0] - t and box[M, 0] < box[T, 0] - t:
+                    faces[T] |= LEFT
+                if spans_x and box[M, 1] <= box[T, 3] + t and box[M, 3] > box[T, 3] + t:
+                    faces[T] |= UP
+                if spans_x and box[M, 3] >= box[T, 1] - t and box[M, 1] < box[T, 1] - t:
+                    faces[T] |= DOWN
+    return faces
 
 
 @njit(cache=True)
@@ -305,7 +367,7 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 
 @njit(cache=True)
 def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction, kind, cnt, rr, sensor,
-                  one_way, friction, restitution, wc, lv, wv, wn, x, y, vx, vy, w, im, ii):
+                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii):
     """The manifold of every candidate pair, and the contacts the solver uses, prepared (anchors, effective
     masses, warm starts from the pair's slot by feature id): ``(nc, ci, cf, cp, tnow, evd)``, see
     :func:`soft_step`; a pair whose bodies both rest keeps its state (``tnow`` -1)."""
@@ -327,12 +389,13 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
         s_pair = spec + reach[a] + reach[b] if response else 0.0
         if kind[a] == _AABB and kind[b] == _AABB:  # the common case, inline (an AABB's corner 2: its half extents)
             k, nx, ny = box_box(wc[a, 0], wc[a, 1], lv[a, 2, 0], lv[a, 2, 1], wc[b, 0], wc[b, 1], lv[b, 2, 0],
-                                lv[b, 2, 1], s_pair, out)
+                                lv[b, 2, 1], s_pair, out, faces[a], faces[b])
         elif kind[a] == _CIRCLE and kind[b] == _CIRCLE:
             k, nx, ny = circle_circle(wv[a, 0, 0], wv[a, 0, 1], rr[a], wv[b, 0, 0], wv[b, 0, 1], rr[b], s_pair, out)
         elif kind[a] == _CIRCLE or kind[b] == _CIRCLE:  # a polygon (box, capsule) and a circle
             g, o = (b, a) if kind[a] == _CIRCLE else (a, b)
-            k, nx, ny = polygon_circle(wv, wn, g, cnt[g], rr[g], wv[o, 0, 0], wv[o, 0, 1], rr[o], s_pair, out)
+            k, nx, ny = polygon_circle(wv, wn, g, cnt[g], rr[g], wv[o, 0, 0], wv[o, 0, 1], rr[o], s_pair, out,
+                                       faces[g])
             if g == b:
                 nx, ny = -nx, -ny
         else:
@@ -340,7 +403,8 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
             if kind[a] == _CAPSULE and kind[b] == _CAPSULE:
                 k, nx, ny = capsule_capsule(wv, a, rr[a], b, rr[b], s_pair, out)
             if k < 0:
-                k, nx, ny = polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, s_pair, out)
+                k, nx, ny = polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, s_pair, out, faces[a],
+                                            faces[b])
         low = 0.0
         if k > 0:
             low = out[0, 2]
@@ -491,7 +555,8 @@ def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
 
 
 @njit(cache=True)
-def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, driven, fat, pairs, slots, rebuild):
+def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, faces, driven, fat, pairs, slots,
+              rebuild):
     """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
 
     What changes only with the rows comes packed, as rows of three tables (see
@@ -499,7 +564,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     ``fprops`` (inverse mass, inverse inertia, friction, restitution, bounding radius, rounding
     radius), ``iprops`` (body kind, shape kind, layer, mask, entity, sensor, one-way, has a
     velocity, vertex count, turns with the body), ``off`` (hitbox offsets) and ``verts`` (each
-    row's local vertices, then normals).
+    row's local vertices, then normals); ``faces``: each row's internal faces (:func:`internal_faces`).
     ``driven``: rows a character controller moved this step (they are not moved again, and take
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
@@ -587,8 +652,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
 
     # --- narrow phase: manifolds -> contacts, prepared ---------------------------------------------
     nc, ci, cf, cp, tnow, evd = _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction,
-                                              kind, cnt, rr, sensor, one_way, friction, restitution, wc, lv, wv, wn,
-                                              x, y, vx, vy, w, im, ii)
+                                              kind, cnt, rr, sensor, one_way, friction, restitution, faces, wc, lv,
+                                              wv, wn, x, y, vx, vy, w, im, ii)
 
     # --- sub-steps ------------------------------------------------------------------------------
     h = dt / nsub if nsub > 0 else 0.0

@@ -27,8 +27,8 @@ import numpy as np
 from ..character import CharacterController
 from ..events import StepContacts
 from ..frame import StepFrame
-from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
-from .soft_kernel import PARAMS, SLOT, soft_step
+from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
+from .soft_kernel import PARAMS, SLOT, internal_faces, soft_step
 from .stage import PRIORITY, Stage
 
 __all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "kernel_tables"]
@@ -124,6 +124,8 @@ class SoftStep(Stage):
         self._settings_key: tuple[Any, ...] | None = None
         self._cols: tuple[np.ndarray, ...] = ()
         self._kernel_tables: tuple[np.ndarray, ...] = ()
+        self._faces_key: tuple[int, int, int, bool] | None = None
+        self._faces = np.zeros(0, dtype=np.int64)
         self._no_driven = np.zeros(0, dtype=np.bool_)
         self.reset()
 
@@ -160,7 +162,24 @@ class SoftStep(Stage):
             self._cols = tuple(c[name][:n] for name in _KERNEL_COLUMNS)
             self._kernel_tables = kernel_tables(store, key[-1])
             self._tables_key = key
-        return self._cols + self._kernel_tables
+        return self._cols + self._kernel_tables + (self._internal_faces(),)
+
+    def _internal_faces(self) -> np.ndarray:
+        """Each row's internal faces (:func:`~framework.systems.soft_kernel.internal_faces`): the
+        faces of static boxes that other static boxes cover, found again when the statics change."""
+        store = self.bodies.store
+        key = (store.version, store.static_epoch, store.n, "detection" in self.pipeline.effects)
+        if key != self._faces_key:
+            n = store.n
+            fprops, iprops, off, verts = self._kernel_tables
+            eligible = ((store.kind[:n] == KIND_AABB) & (store.body[:n] == STATIC) & ~store.sensor[:n]
+                        & ~store.one_way[:n])
+            c = store.cols
+            half = np.ascontiguousarray(verts[:, 2, 0:2])  # an AABB's corner 2: its half extents
+            self._faces = internal_faces(c["x"][:n], c["y"][:n], c["rot"][:n], off, half, iprops[8], eligible,
+                                         iprops[2], iprops[3])
+            self._faces_key = key
+        return self._faces
 
     def _driven(self, frame: StepFrame) -> np.ndarray:
         """Rows the character stage moved this step (the soft step moves them no further)."""
