@@ -461,6 +461,81 @@ def test_overlay_draws_each_moving_body_s_velocity(render):
         assert sorted(lit[:, 1].tolist()) == list(range(40, 40 + reach))  # from x = 40, 20 px long
 
 
+def _all_stages_scene(solver: str) -> Scene:
+    """A scene whose step runs every stage its solver has (a character, a swept body, a pile)."""
+    from framework import CharacterController
+
+    s = Scene(gravity=(0.0, -200.0), solver=solver)
+    s.spawn(Transform(400.0, 10.0), Hitbox(AABB(800.0, 20.0), body="static"), Visual((90, 70, 50)))
+    for i in range(6):
+        s.spawn(Transform(300.0 + 22.0 * i, 40.0), Velocity(), Hitbox(AABB(20.0, 20.0)), Visual(RED))
+    s.spawn(Transform(100.0, 200.0), Velocity(300.0, 0.0), Hitbox(Circle(4.0), ccd=True), Visual(GREEN))
+    if solver == "exact":
+        s.spawn(Transform(600.0, 40.0), Velocity(), Hitbox(AABB(16.0, 30.0), body="kinematic"), CharacterController(),
+                Visual(BLUE))
+    return s
+
+
+@pytest.mark.parametrize("solver", ["exact", "soft"])
+def test_overlay_shows_every_stage_timing_within_an_800_pixel_window(render, solver):
+    """Issue 36: the stage timings ran off the right edge of an 800 x 600 window. Each figure is
+    shown whole, every line fits the width, and the screenshot has text on each line's row and
+    none past the widest line."""
+    from framework.render.overlay import HUD_LINE_PX
+
+    text = render.OVERLAY_COLORS["text"][:3]
+    with _all_stages_scene(solver) as s:
+        r = render.Renderer(width=800, height=600, debug=True, background=BG)
+        s.renderer = r
+        for _ in range(3):
+            s.step(1 / 60)
+        stages = set(s.stage_ms)
+        expected = {"soft_step", "sleeping", "render"} if solver == "soft" else {
+            "movement", "ccd", "broad_phase", "narrow_phase", "response", "character", "sleeping", "render"}
+        assert stages == expected
+        for name in s.stage_ms:  # the widest figures a stage can plausibly show
+            s.stage_ms[name] = 888.88
+        r.fps = 888.0
+        r.draw(s)  # the overlay's text is built by the render stage
+        img = r.capture()
+        overlay = r._overlay
+        lines = overlay.lines(r.width, r.height)
+        shown = "  ".join(lines)
+        for name in stages:
+            assert f"{name} 888.88" in shown, (name, lines)  # whole: the name and its figure together
+        assert f"total {888.88 * len(stages):.2f}" in shown and "FPS 888" in shown
+        widths = overlay.label_widths()
+        assert len(widths) == len(lines) >= 2
+        assert max(widths) <= 800 - 2 * 6, widths
+        hud = np.all(img[:, :, :3] == text, axis=-1)
+        cols = np.flatnonzero(hud.any(axis=0))
+        assert cols.max() < 6 + max(widths) < 800 - 1, cols.max()  # nothing cut at the right edge
+        for i in range(len(lines)):  # each line's row of text is drawn
+            top = 4 + HUD_LINE_PX * i
+            assert hud[top: top + HUD_LINE_PX].sum() > 20, i
+        assert not hud[4 + HUD_LINE_PX * len(lines) + 4:].any()  # and nothing below the last
+        if solver == "exact":
+            assert len(lines) >= 3  # the stage line needed wrapping at this width
+        r.close()
+
+
+def test_wrap_figures_breaks_between_figures_only():
+    from framework.render.overlay import wrap_figures
+
+    def measure(t):
+        return 10.0 * len(t)
+
+    text = "head 1  two 2\nms/step: aaa 1.00  bbb 2.00  ccc 3.00"
+    assert wrap_figures(text, 1000, measure) == ["head 1  two 2", "ms/step: aaa 1.00  bbb 2.00  ccc 3.00"]
+    assert wrap_figures(text, 200, measure) == ["head 1  two 2", "ms/step: aaa 1.00", "  bbb 2.00  ccc 3.00"]
+    assert wrap_figures("a-very-long-figure 1  b 2", 50, measure) == ["a-very-long-figure 1", "  b 2"]
+    # At most two lines: each source line keeps one, its overflow running on past the width.
+    assert wrap_figures(text, 200, measure, max_lines=2) == text.split("\n")
+    assert wrap_figures(text, 200, measure, max_lines=0) == text.split("\n")  # never fewer than it has
+    assert wrap_figures(text, 100, measure, max_lines=3) == [
+        "head 1", "  two 2", "ms/step: aaa 1.00  bbb 2.00  ccc 3.00"]
+
+
 def test_scene_effect_debug_overlay_turns_the_overlay_on(render):
     with Scene(effects=["movement", "detection", "debug_overlay"]) as s:
         r = render.Renderer(width=32, height=32)
