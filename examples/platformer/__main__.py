@@ -25,6 +25,7 @@ from typing import Any
 
 from .demo import Autoplay, level1, play_all
 from .game import DT, Game
+from .hud import install_hud
 from .levels import LevelError, builtin_levels
 
 __all__ = ["BACKGROUND", "camera_for", "hud", "main", "make_game", "parse_args", "run_headless", "run_window"]
@@ -96,7 +97,8 @@ def run_window(game: Game, args: argparse.Namespace) -> dict[str, Any]:
     camera = camera_for(game, args.zoom)
 
     def window_hud(scene: Any, dt: float) -> None:
-        # The camera follows whichever player entity the current level has; the title is the HUD.
+        # The camera follows whichever player entity the current level has; the title says what the
+        # on-screen HUD (hud.py) does, for the task bar.
         renderer = scene.renderer
         if renderer is None:
             return
@@ -137,6 +139,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     with game:
+        if not args.headless or args.screenshot:  # coins, deaths and the level on screen
+            install_hud(game)
         if args.headless:
             result = run_headless(game, args)
         else:
