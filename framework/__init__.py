@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from .components import Body, Hitbox, Transform, Velocity, Visual
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
+from .text import Text
 from .validation import InvalidValue
 
 if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type checkers see them
@@ -20,7 +21,7 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
 __all__ = [
     "AABB", "Body", "Camera", "Capsule", "CharacterController", "Circle", "CollisionEvent", "Contact", "Hitbox",
     "Impact", "Input", "InvalidValue", "Polygon", "RayHit", "Renderer", "STAGES", "Scene", "SceneClosed", "SceneHit",
-    "Shape", "Transform", "Vec2", "Velocity", "Visual", "collide", "run", "screenshot",
+    "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual", "collide", "run", "screenshot",
 ]
 __version__ = "0.1.0"
 

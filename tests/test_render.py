@@ -11,6 +11,7 @@ Skipped, with the reason, only where no OpenGL library can make a context.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 import textwrap
@@ -18,7 +19,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
+from framework import AABB, Circle, Hitbox, Polygon, Scene, Text, Transform, Velocity
 from framework.components import Visual
 from framework.effects import DEFAULT_EFFECTS
 from framework.input import Input
@@ -293,12 +294,14 @@ def test_the_renderer_reads_the_scene_only_through_its_surface(render, scene, tm
     gone = scene.spawn(Transform(80.0, 40.0, 0.3), Velocity(0.0, 0.0), Hitbox(Polygon.box(12.0, 8.0)), Visual(BLUE))
     scene.spawn(Transform(10.0, 70.0), Velocity(900.0, 0.0), Hitbox(Circle(2.0), ccd=True))
     scene.spawn(Transform(100.0, 70.0), Visual(image=str(sprite)))
+    scene.spawn(Transform(60.0, 20.0), Text("world", size=8.0))
+    scene.spawn(Text("hud", size=8.0, screen=True, corner="top_right", anchor_x="right", anchor_y="top"))
     scene.add_system(lambda s, dt: s.raycast((0.0, 60.0), (1.0, -0.5), 150.0), after="response")
     scene.step(1 / 30)
     assert scene.bodies.static_hash_current
     bodies = _Only(scene.bodies, {"store", "ensure_geometry", "rows_of", "static_hash_current", "static_rows_in_box",
                                   "hash"})
-    view = _Only(scene, {"step_frame", "try_get", "exists", "frame", "renderer"}, bodies=bodies)
+    view = _Only(scene, {"step_frame", "try_get", "exists", "frame", "renderer", "query"}, bodies=bodies)
     for debug in (False, True):
         expected = render.screenshot(scene, width=128, height=96, background=BG, debug=debug)
         seen = render.screenshot(view, width=128, height=96, background=BG, debug=debug)
@@ -309,7 +312,7 @@ def test_the_renderer_reads_the_scene_only_through_its_surface(render, scene, tm
         assert renderer.stats["drawables"] == 11
         scene.despawn(gone)
         renderer.draw(view)  # the drawable of a despawned entity goes (found through bodies.rows_of)
-        assert renderer.stats["drawables"] == 10 and renderer.scene_entities == 11
+        assert renderer.stats["drawables"] == 10 and renderer.scene_entities == 12  # (the world text's)
     finally:
         renderer.close()
 
@@ -373,6 +376,152 @@ def test_camera_target_and_bounds_in_pixels(render, scene):
     # The view's right edge is the level's (x = 200): the player (193..197) is 3 px from it.
     expect = rect(canvas(64, 48, BLUE), 64 - 7, 22, 64 - 3, 26, RED)
     assert np.array_equal(img[..., :3], expect)
+
+
+# --- text ------------------------------------------------------------------------------------------
+
+# Glyphs are antialiased: a text pixel is a blend of its colour and the background. The world texts
+# below are green and the screen texts yellow, so on the blue background a pixel with green and no
+# red is a world text's, one with red and green a screen text's.
+WORLD_TEXT, SCREEN_TEXT = (0, 255, 0), (255, 255, 0)
+
+
+def _inked(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Masks (top row first) of the world texts' pixels and the screen texts' pixels."""
+    r, g = img[..., 0].astype(int), img[..., 1].astype(int)
+    return (r == 0) & (g > 0), (r > 0) & (g > 0)
+
+
+def _box(mask: np.ndarray) -> tuple[int, int, int, int]:
+    """x0, y0, x1, y1 (screen pixels, y up, inclusive) of the lit pixels of a top-row-first mask."""
+    ys, xs = np.nonzero(mask)
+    h = mask.shape[0]
+    return int(xs.min()), int(h - 1 - ys.max()), int(xs.max()), int(h - 1 - ys.min())
+
+
+def _text_scene(s: Scene) -> tuple[int, int]:
+    world = s.spawn(Transform(40.0, 60.0), Text("Hi there", size=10.0, color=WORLD_TEXT))
+    hud = s.spawn(Text("coins 3", size=10.0, color=SCREEN_TEXT, screen=True, corner="top_left",
+                       offset=(4.0, -4.0), anchor_y="top"))
+    return world, hud
+
+
+def test_text_is_drawn_where_its_label_is_and_nowhere_else(render, scene):
+    _text_scene(scene)
+    img = render.screenshot(scene, width=160, height=100, background=BG)
+    world, hud = _inked(img)
+    assert world.sum() > 30 and hud.sum() > 30
+    x0, y0, x1, y1 = _box(world)  # its layout's bottom left at the entity (40, 60): ink just above
+    assert 40 <= x0 <= 42 and 60 <= y0 <= 66 and 60 < x1 < 100 and 66 < y1 < 80, (x0, y0, x1, y1)
+    x0, y0, x1, y1 = _box(hud)  # top left at (4, 100 - 4), below and right of it
+    assert 4 <= x0 <= 6 and 86 <= y1 <= 96 and 30 < x1 < 70 and y0 > 70, (x0, y0, x1, y1)
+    rest = ~(img[..., :3] == BG).all(axis=2) & ~world & ~hud
+    assert not rest.any()  # nothing but the two texts on the background
+    without = render.screenshot(Scene(), width=160, height=100, background=BG)
+    assert (without[..., :3] == BG).all()
+
+
+def test_a_world_text_moves_with_the_camera_and_a_screen_text_does_not(render, scene):
+    _text_scene(scene)
+    a = render.screenshot(scene, width=160, height=100, background=BG)
+    # The camera 11 right of and 7 above the default centre (80, 50): the world shifts 11 left, 7 down.
+    b = render.screenshot(scene, width=160, height=100, camera=render.Camera(80.0 + 11.0, 50.0 + 7.0),
+                          background=BG)
+    (world_a, hud_a), (world_b, hud_b) = _inked(a), _inked(b)
+    assert np.array_equal(hud_a, hud_b)  # the HUD stays put, pixel for pixel
+    assert np.array_equal(a[hud_a], b[hud_b])
+    assert world_a.sum() == world_b.sum() > 30
+    assert np.array_equal(world_b[7:, :-11], world_a[:-7, 11:])  # rows are top first: down is +7
+    # Zoomed 2x, centred on (70, 60): the text's anchor (40, 60) lands at (80 - 2 x 30, 50) = (20, 50).
+    zoomed = render.screenshot(scene, width=160, height=100, camera=render.Camera(70.0, 60.0, zoom=2.0),
+                               background=BG)
+    world_z, hud_z = _inked(zoomed)
+    assert np.array_equal(hud_z, hud_a)  # zoom leaves the HUD alone
+    assert world_z.sum() > 2 * world_a.sum()  # and scales the world's text (about 4 times the ink)
+    x0, y0, x1, _y1 = _box(world_z)
+    ax0, _ay0, ax1, _ay1 = _box(world_a)
+    assert 20 <= x0 <= 24 and 50 <= y0 <= 62 and x1 - x0 >= 2 * (ax1 - ax0) - 2, (x0, y0, x1)
+
+
+def test_text_changes_show_in_an_attached_renderer(render, scene):
+    world, hud = _text_scene(scene)
+    r = render.Renderer(width=160, height=100, background=BG)
+    scene.renderer = r
+    try:
+        scene.step(1 / 60)
+        first = r.capture()
+        text = scene.get(hud, Text)
+        text.text = "coins 3"  # the same: no change
+        assert np.array_equal(r.capture(), first)
+        text.text = "coins 12345"  # longer: more ink, further right, shown without a step
+        longer = _inked(r.capture())[1]
+        assert _box(longer)[2] > _box(_inked(first)[1])[2]
+        scene.get(world, Transform).x += 20.0  # the world text follows its entity
+        scene.step(1 / 60)
+        moved = _inked(r.capture())[0]
+        assert np.array_equal(moved[:, 20:], _inked(first)[0][:, :-20])
+        scene.get(world, Text).visible = False
+        text.text = ""
+        img = r.capture()
+        assert (img[..., :3] == BG).all()
+        scene.despawn(hud)
+        scene.get(world, Text).visible = True
+        scene.step(1 / 60)
+        world_ink, hud_ink = _inked(r.capture())
+        assert world_ink.any() and not hud_ink.any()
+    finally:
+        r.close()
+
+
+def test_a_world_text_without_a_transform_is_not_drawn(render, scene):
+    scene.spawn(Text("lost", color=WORLD_TEXT))
+    img = render.screenshot(scene, width=64, height=48, background=BG)
+    assert (img[..., :3] == BG).all()
+
+
+@pytest.mark.parametrize("field, value, says", [
+    ("size", 0, "size must be finite and > 0"), ("size", -3.0, "size must be finite and > 0"),
+    ("size", float("nan"), "size must be finite and > 0"), ("offset", (float("nan"), 0.0), "offset[0] must be finite"),
+    ("offset", (1.0, float("inf")), "offset[1] must be finite"), ("offset", 3.0, "offset must be a pair"),
+    ("color", (300, 0, 0), "color must be 3 or 4 ints"), ("color", (1.5, 0, 0), "color must be 3 or 4 ints"),
+    ("color", 7, "color must be (r, g, b)"), ("corner", "middle", "corner must be one of"),
+    ("anchor_x", "top", "anchor_x must be one of"), ("anchor_y", None, "anchor_y must be one of"),
+    ("text", 12, "text must be a str"), ("text", "two\nlines", "one line"), ("z", 1.0, "z must be an int"),
+    ("z", True, "z must be an int"), ("screen", 1, "screen must be True or False"),
+    ("visible", "no", "visible must be True or False"), ("font", "", "font must be a font family name"),
+])
+def test_bad_text_values_raise_value_error_naming_them(field, value, says):
+    with pytest.raises(ValueError, match=re.escape(says)) as info:
+        if field == "text":
+            Text(value)
+        else:
+            Text("ok", **{field: value})
+    assert str(info.value).startswith("Text ") and "got" in str(info.value)  # which field, what it got
+    text = Text("ok")
+    before = text.version
+    with pytest.raises(ValueError, match=re.escape(says)):
+        setattr(text, field, value)  # the same when set later; the text keeps its value
+    assert text.version == before and text.text == "ok"
+
+
+def test_text_is_light_data_and_round_trips_through_a_snapshot_file(tmp_path):
+    import pickle
+
+    from framework.snapshot_file import load_snapshot, save_snapshot
+
+    code = "import sys, framework; framework.Text('a'); print(any(m.startswith('pyglet') for m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.strip() == "False", out.stderr
+    with Scene() as s:
+        e = s.spawn(Text("score 1", size=12.0, screen=True, corner="top_right", offset=(-4.0, -4.0)))
+        path = tmp_path / "snap.npz"
+        save_snapshot(s, path)
+        s.get(e, Text).text = "score 2"
+        load_snapshot(s, path)
+        back = s.get(e, Text)
+        assert (back.text, back.size, back.corner, back.offset) == ("score 1", 12.0, "top_right", (-4.0, -4.0))
+    copy = pickle.loads(pickle.dumps(back))
+    assert copy.text == "score 1" and copy.color == (255, 255, 255, 255)
 
 
 # --- the debug overlay ------------------------------------------------------------------------------
@@ -459,6 +608,81 @@ def test_overlay_draws_each_moving_body_s_velocity(render):
         lit = np.argwhere(np.all(img[..., :3] == colors["velocity"][:3], axis=-1))
         assert sorted(set((96 - 1 - lit[:, 0]).tolist())) == [40]  # one row, y = 40
         assert sorted(lit[:, 1].tolist()) == list(range(40, 40 + reach))  # from x = 40, 20 px long
+
+
+def _all_stages_scene(solver: str) -> Scene:
+    """A scene whose step runs every stage its solver has (a character, a swept body, a pile)."""
+    from framework import CharacterController
+
+    s = Scene(gravity=(0.0, -200.0), solver=solver)
+    s.spawn(Transform(400.0, 10.0), Hitbox(AABB(800.0, 20.0), body="static"), Visual((90, 70, 50)))
+    for i in range(6):
+        s.spawn(Transform(300.0 + 22.0 * i, 40.0), Velocity(), Hitbox(AABB(20.0, 20.0)), Visual(RED))
+    s.spawn(Transform(100.0, 200.0), Velocity(300.0, 0.0), Hitbox(Circle(4.0), ccd=True), Visual(GREEN))
+    if solver == "exact":
+        s.spawn(Transform(600.0, 40.0), Velocity(), Hitbox(AABB(16.0, 30.0), body="kinematic"), CharacterController(),
+                Visual(BLUE))
+    return s
+
+
+@pytest.mark.parametrize("solver", ["exact", "soft"])
+def test_overlay_shows_every_stage_timing_within_an_800_pixel_window(render, solver):
+    """Issue 36: the stage timings ran off the right edge of an 800 x 600 window. Each figure is
+    shown whole, every line fits the width, and the screenshot has text on each line's row and
+    none past the widest line."""
+    from framework.render.overlay import HUD_LINE_PX
+
+    text = render.OVERLAY_COLORS["text"][:3]
+    with _all_stages_scene(solver) as s:
+        r = render.Renderer(width=800, height=600, debug=True, background=BG)
+        s.renderer = r
+        for _ in range(3):
+            s.step(1 / 60)
+        stages = set(s.stage_ms)
+        expected = {"soft_step", "sleeping", "render"} if solver == "soft" else {
+            "movement", "ccd", "broad_phase", "narrow_phase", "response", "character", "sleeping", "render"}
+        assert stages == expected
+        for name in s.stage_ms:  # the widest figures a stage can plausibly show
+            s.stage_ms[name] = 888.88
+        r.fps = 888.0
+        r.draw(s)  # the overlay's text is built by the render stage
+        img = r.capture()
+        overlay = r._overlay
+        lines = overlay.lines(r.width, r.height)
+        shown = "  ".join(lines)
+        for name in stages:
+            assert f"{name} 888.88" in shown, (name, lines)  # whole: the name and its figure together
+        assert f"total {888.88 * len(stages):.2f}" in shown and "FPS 888" in shown
+        widths = overlay.label_widths()
+        assert len(widths) == len(lines) >= 2
+        assert max(widths) <= 800 - 2 * 6, widths
+        hud = np.all(img[:, :, :3] == text, axis=-1)
+        cols = np.flatnonzero(hud.any(axis=0))
+        assert cols.max() < 6 + max(widths) < 800 - 1, cols.max()  # nothing cut at the right edge
+        for i in range(len(lines)):  # each line's row of text is drawn
+            top = 4 + HUD_LINE_PX * i
+            assert hud[top: top + HUD_LINE_PX].sum() > 20, i
+        assert not hud[4 + HUD_LINE_PX * len(lines) + 4:].any()  # and nothing below the last
+        if solver == "exact":
+            assert len(lines) >= 3  # the stage line needed wrapping at this width
+        r.close()
+
+
+def test_wrap_figures_breaks_between_figures_only():
+    from framework.render.overlay import wrap_figures
+
+    def measure(t):
+        return 10.0 * len(t)
+
+    text = "head 1  two 2\nms/step: aaa 1.00  bbb 2.00  ccc 3.00"
+    assert wrap_figures(text, 1000, measure) == ["head 1  two 2", "ms/step: aaa 1.00  bbb 2.00  ccc 3.00"]
+    assert wrap_figures(text, 200, measure) == ["head 1  two 2", "ms/step: aaa 1.00", "  bbb 2.00  ccc 3.00"]
+    assert wrap_figures("a-very-long-figure 1  b 2", 50, measure) == ["a-very-long-figure 1", "  b 2"]
+    # At most two lines: each source line keeps one, its overflow running on past the width.
+    assert wrap_figures(text, 200, measure, max_lines=2) == text.split("\n")
+    assert wrap_figures(text, 200, measure, max_lines=0) == text.split("\n")  # never fewer than it has
+    assert wrap_figures(text, 100, measure, max_lines=3) == [
+        "head 1", "  two 2", "ms/step: aaa 1.00  bbb 2.00  ccc 3.00"]
 
 
 def test_scene_effect_debug_overlay_turns_the_overlay_on(render):

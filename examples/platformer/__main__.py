@@ -10,6 +10,9 @@ one-way platform, R to restart the level, F1 for the debug overlay, Esc to quit)
 --screenshot PATH  after the run, write a PNG of the last frame (headless rendering)
 --debug            start with the debug overlay (and draw it in the screenshot)
 --zoom Z           camera zoom (screen pixels per world unit)
+
+Without a display (and without --headless), it says so in one line on stderr, with how to play
+instead, and exits with status 1: it never runs an invisible window.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from typing import Any
 
 from .demo import Autoplay, level1, play_all
 from .game import DT, Game
+from .hud import install_hud
 from .levels import LevelError, builtin_levels
 
 __all__ = ["BACKGROUND", "camera_for", "hud", "main", "make_game", "parse_args", "run_headless", "run_window"]
@@ -93,7 +97,8 @@ def run_window(game: Game, args: argparse.Namespace) -> dict[str, Any]:
     camera = camera_for(game, args.zoom)
 
     def window_hud(scene: Any, dt: float) -> None:
-        # The camera follows whichever player entity the current level has; the title is the HUD.
+        # The camera follows whichever player entity the current level has; the title says what the
+        # on-screen HUD (hud.py) does, for the task bar.
         renderer = scene.renderer
         if renderer is None:
             return
@@ -113,15 +118,39 @@ def run_window(game: Game, args: argparse.Namespace) -> dict[str, Any]:
     return {"frames": scene.frame, "ms_per_frame": round(ms, 4)}
 
 
+def no_window(reason: object) -> str:
+    """The one line said where no window can be shown: why, and how to play instead."""
+    return (f"error: {reason}. Play with a display (set DISPLAY), or without a window: "
+            f"python -m {__package__} --headless --demo")
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    if not args.headless:  # before loading the levels: say at once that no window can be shown
+        from framework.render.display import no_display_reason
+
+        reason = no_display_reason()
+        if reason is not None:
+            print(no_window(reason), file=sys.stderr)
+            return 1
     try:
         game = make_game(args)
     except LevelError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     with game:
-        result = run_headless(game, args) if args.headless else run_window(game, args)
+        if not args.headless or args.screenshot:  # coins, deaths and the level on screen
+            install_hud(game)
+        if args.headless:
+            result = run_headless(game, args)
+        else:
+            from framework.render import NoDisplayError
+
+            try:
+                result = run_window(game, args)
+            except NoDisplayError as exc:  # the display is there but fails to open
+                print(no_window(exc), file=sys.stderr)
+                return 1
         if args.screenshot:
             from framework.render import screenshot
 

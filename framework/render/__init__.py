@@ -7,22 +7,15 @@ imports it: ``import framework`` and scenes without a renderer never load pyglet
 Without a display (Linux with neither ``DISPLAY`` nor ``WAYLAND_DISPLAY``), importing this package
 switches pyglet to headless EGL rendering, unless ``PYGLET_HEADLESS`` is set or pyglet's window
 module was already imported. pyglet's shadow window is turned off the same way (the renderer makes
-the contexts it needs), unless ``PYGLET_SHADOW_WINDOW`` is set.
+the contexts it needs), unless ``PYGLET_SHADOW_WINDOW`` is set. A window is never opened
+invisibly for want of a display: :func:`run` raises :class:`NoDisplayError` (see :mod:`.display`).
 """
 
 from __future__ import annotations
 
-import os
-import sys
+from .display import NoDisplayError, choose_headless
 
-import pyglet as _pyglet
-
-if "pyglet.window" not in sys.modules and "pyglet.gl" not in sys.modules:
-    if "PYGLET_HEADLESS" not in os.environ and sys.platform.startswith("linux") \
-            and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
-        _pyglet.options["headless"] = True
-    if "PYGLET_SHADOW_WINDOW" not in os.environ:
-        _pyglet.options["shadow_window"] = False
+choose_headless()  # before pyglet's window and GL modules load (imported below)
 
 from .camera import Camera  # noqa: E402
 from .headless import screenshot  # noqa: E402
@@ -32,6 +25,6 @@ from .renderer import Renderer  # noqa: E402
 from .window import Runner, key_name, run  # noqa: E402
 
 __all__ = [
-    "OVERLAY_COLORS", "Camera", "DebugOverlay", "Renderer", "Runner", "key_name", "offscreen_window", "run",
-    "screenshot", "write_png",
+    "OVERLAY_COLORS", "Camera", "DebugOverlay", "NoDisplayError", "Renderer", "Runner", "key_name",
+    "offscreen_window", "run", "screenshot", "write_png",
 ]

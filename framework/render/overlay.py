@@ -16,8 +16,10 @@
   (``scene.bodies.hash.cells_in_use()``);
 - this step's rays (``scene.step_frame.ray_log``): to the hit, the rest of the ray dimmer, the hit
   normal;
-- a text line with FPS, entity count and milliseconds per pipeline stage
-  (``scene.step_frame.stage_ms``).
+- text lines with FPS, entity count and milliseconds per pipeline stage
+  (``scene.step_frame.stage_ms``), wrapped between figures to the view's width, so every figure is
+  seen in a narrow window (an 800 x 600 one shows every stage of a scene with all of them), onto at
+  most a quarter of the view's height (two lines at least: a tiny view shows the start of each).
 
 All lines go into one vertex buffer, rebuilt from numpy arrays each step and drawn with one
 ``GL_LINES`` call; marks whose size is in pixels (crosses, normals) keep it at any zoom. Lines
@@ -28,6 +30,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -38,7 +41,7 @@ from pyglet.graphics import Batch, Group
 from ..events import pair_keys, sorted_find
 from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 
-__all__ = ["OVERLAY_COLORS", "DebugOverlay"]
+__all__ = ["HUD_FONT_SIZE", "HUD_LINE_PX", "OVERLAY_COLORS", "DebugOverlay", "wrap_figures"]
 
 #: RGBA colours of the overlay's marks.
 OVERLAY_COLORS: dict[str, tuple[int, int, int, int]] = {
@@ -64,6 +67,10 @@ CIRCLE_SEGMENTS = 24
 CROSS_PX = 4.0    # half size of a contact cross, in screen pixels
 NORMAL_PX = 16.0  # length of a drawn normal, in screen pixels
 VELOCITY_SECONDS = 0.25  # a velocity is drawn as the way its body would go in this time
+HUD_FONT_SIZE = 10  # the text's size in points
+HUD_LINE_PX = 16  # from one text line to the next, in pixels
+HUD_MARGIN_PX = 6  # the text's distance from the view's left and right edges
+HUD_MAX_SHARE = 0.25  # the text wraps onto at most this share of the view's height (two lines at least)
 
 _VERTEX = """#version 150 core
 in vec2 position;
@@ -275,7 +282,8 @@ def _friction_segments(store: Any, rows_of: Any, contacts: Any, support: tuple, 
 
 
 def _hud_text(scene: Any, renderer: Any) -> str:
-    """The overlay's two text lines: FPS, entities, drawn, contacts, frame; ms per stage."""
+    """The overlay's text: FPS, entities, drawn, contacts, frame; then ms per stage and their total.
+    Figures are separated by two spaces, each name and its figure by one (see :func:`wrap_figures`)."""
     frame = scene.step_frame
     fps = f"{renderer.fps:.0f}" if renderer.fps > 0 else "-"
     head = (f"FPS {fps}  entities {scene.bodies.store.n}  drawn {renderer.stats.get('drawn', 0)}  "
@@ -287,6 +295,42 @@ def _hud_text(scene: Any, renderer: Any) -> str:
         ms["render"] = renderer.draw_ms
     stages = "  ".join(f"{k} {v:.2f}" for k, v in ms.items())
     return f"{head}\nms/step: {stages}  total {sum(ms.values()):.2f}"
+
+
+def _wrap_line(line: str, max_width: float, measure: Callable[[str], float]) -> list[str]:
+    out: list[str] = []
+    current = ""
+    for figure in line.split("  "):
+        joined = f"{current}  {figure}" if current else figure
+        if current and measure(joined) > max_width:
+            out.append(current)
+            joined = f"  {figure}"
+        current = joined
+    out.append(current)
+    return out
+
+
+def wrap_figures(text: str, max_width: float, measure: Callable[[str], float],
+                 max_lines: int | None = None) -> list[str]:
+    """``text``'s lines, each broken into as few lines as keep every one within ``max_width`` (as
+    ``measure`` gives a string's width): breaks fall only between figures (the two-space gaps),
+    never between a name and its figure. A continued line is indented by two spaces; a figure
+    wider than ``max_width`` on its own stays whole.
+
+    ``max_lines``: at most this many lines (never fewer than ``text`` has): each of ``text``'s
+    lines keeps at least one, and what does not fit stays on a line's last one, running past
+    ``max_width`` (a view too small to show it all shows the start of each line)."""
+    source = text.split("\n")
+    limit = None if max_lines is None else max(max_lines, len(source))
+    out: list[str] = []
+    for i, line in enumerate(source):
+        wrapped = _wrap_line(line, max_width, measure)
+        if limit is not None:
+            room = limit - len(out) - (len(source) - 1 - i)
+            if len(wrapped) > room:  # continuations start with their gap: joining them restores it
+                wrapped = [*wrapped[:room - 1], "".join(wrapped[room - 1:])]
+        out += wrapped
+    return out
 
 
 class DebugOverlay:
@@ -316,11 +360,9 @@ class DebugOverlay:
         self._hud_batch = Batch()
         self._hud_back = pyglet.shapes.Rectangle(0, 0, 1, 1, color=(0, 0, 0, 160), batch=self._hud_batch,
                                                  group=Group(order=0))
-        self._labels = [
-            pyglet.text.Label("", x=6, y=0, anchor_y="top", font_size=10, color=OVERLAY_COLORS["text"],
-                              batch=self._hud_batch, group=Group(order=1))
-            for _ in range(2)
-        ]
+        self._text_group = Group(order=1)
+        self._labels: list[Any] = []  # one per text line shown, made as lines are needed
+        self._font: Any = None
 
     # --- building ---------------------------------------------------------------------------
 
@@ -376,20 +418,42 @@ class DebugOverlay:
         gl.glDisable(gl.GL_BLEND)
         self._program.stop()
 
+    def lines(self, width: int, height: int) -> list[str]:
+        """The text as shown in a ``width`` x ``height`` view: wrapped between figures so that every
+        line fits the width (:func:`wrap_figures`, measured in the overlay's font), onto at most
+        :data:`HUD_MAX_SHARE` of the height, so that the text never hides most of a small view."""
+        if self._font is None:
+            self._font = pyglet.font.load(None, HUD_FONT_SIZE)
+        font = self._font
+
+        def measure(text: str) -> float:
+            return float(sum(glyph.advance for glyph in font.get_glyphs(text)[0]))
+
+        max_lines = int(height * HUD_MAX_SHARE) // HUD_LINE_PX
+        return wrap_figures(self.text, width - 2 * HUD_MARGIN_PX, measure, max_lines=max_lines)
+
     def draw_hud(self, renderer: Any) -> None:
-        """Draw the text line at the top left (the identity view must be set)."""
-        lines = self.text.split("\n")
+        """Draw the text at the top left, wrapped to the view's width (the identity view must be set)."""
+        lines = self.lines(renderer.width, renderer.height)
+        while len(self._labels) < len(lines):
+            self._labels.append(pyglet.text.Label(
+                "", x=HUD_MARGIN_PX, y=0, anchor_y="top", font_size=HUD_FONT_SIZE, color=OVERLAY_COLORS["text"],
+                batch=self._hud_batch, group=self._text_group))
         top = renderer.height - 4
         width = 0.0
         for i, label in enumerate(self._labels):
             text = lines[i] if i < len(lines) else ""
             if label.text != text:
                 label.text = text
-            label.y = top - 16 * i
+            label.y = top - HUD_LINE_PX * i
             width = max(width, label.content_width)
-        self._hud_back.position = (0, top - 16 * len(self._labels) - 2)
-        self._hud_back.width, self._hud_back.height = width + 12, 16 * len(self._labels) + 6
+        self._hud_back.position = (0, top - HUD_LINE_PX * len(lines) - 2)
+        self._hud_back.width, self._hud_back.height = width + 2 * HUD_MARGIN_PX, HUD_LINE_PX * len(lines) + 6
         self._hud_batch.draw()
+
+    def label_widths(self) -> list[int]:
+        """The laid-out width in pixels of each text line the last :meth:`draw_hud` showed."""
+        return [label.content_width for label in self._labels if label.text]
 
     def delete(self) -> None:
         self._vbo.delete()

@@ -29,6 +29,10 @@ multi-draw call, whatever the number of entities, images and animations.
 
 Animations: a sprite's frame is chosen when the frame is shown (:meth:`render`), from the scene's
 clock then (``scene.time``), so what is drawn is what ``Visual.frame_at(scene.time)`` says.
+
+Text: entities' :class:`~framework.text.Text` components are pyglet labels (:mod:`.texts`), brought
+up to date when the frame is shown: world texts over the sprites with the camera's view, screen
+texts (a HUD) over everything but the debug overlay's text.
 """
 
 from __future__ import annotations
@@ -45,12 +49,14 @@ from ..components import Visual
 from ..shapes import Circle
 from ..sprites import Animation, Frame
 from ..store import KIND_CAPSULE, KIND_POLYGON, STATIC
+from ..text import Text
 from .atlas import Atlas
 from .camera import Camera
 from .drawables import fill_outline
 from .instances import DISC, DISC_QUAD, FILL, SPRITE, SPRITE_QUAD, InstanceTable, LayerGroup, vertex_list
 from .offscreen import OffscreenTarget, offscreen_window, write_png
 from .overlay import DebugOverlay
+from .texts import TextLabels
 
 __all__ = ["Renderer"]
 
@@ -98,6 +104,7 @@ class Renderer:
         self._atlas = Atlas()
         self._table = InstanceTable()
         self._overlay: DebugOverlay | None = None
+        self._texts: TextLabels | None = None  # the labels of the scene's Text components, made on first use
         self._target = OffscreenTarget()  # what capture() draws into
         self._draws = 0  # render stages run (a drawable's last_seen counts in these)
         self._store_version_seen = -1  # the store's version when despawned entities were last looked for
@@ -551,13 +558,31 @@ class Renderer:
             win.view = Mat4(*self.camera.matrix())
             assert self._batch is not None
             self._batch.draw()
+            texts = self._sync_texts()
+            if texts is not None:
+                texts.draw_world()
             if self.debug and self._overlay is not None:
                 self._overlay.draw_world()
-                win.view = Mat4()
-                self._overlay.draw_hud(self)
             win.view = Mat4()
+            if texts is not None:
+                texts.draw_screen()
+            if self.debug and self._overlay is not None:
+                self._overlay.draw_hud(self)
         finally:
             self._restore(previous)
+
+    def _sync_texts(self) -> TextLabels | None:
+        """The labels of the last drawn scene's Text components, brought up to date now (what a
+        game wrote since the last step shows too); ``None`` while the scene has none."""
+        scene = self._scene
+        if scene is None:
+            return self._texts
+        if self._texts is None:
+            if not scene.query(Text):
+                return None
+            self._texts = TextLabels()
+        self._texts.sync(scene, self.width, self.height)
+        return self._texts
 
     def capture(self, path: str | None = None) -> np.ndarray:
         """Render the last :meth:`draw` offscreen into an RGBA8 texture (pixel-exact) and return
@@ -576,13 +601,15 @@ class Renderer:
 
     def reset(self) -> None:
         """Forget every drawable (e.g. before drawing another scene, whose entity ids differ)."""
-        if self._slots_used or self._overlay is not None:
+        if self._slots_used or self._overlay is not None or self._texts is not None:
             previous = self._make_current()
             try:
                 for vlist in self._s_vlist:
                     if vlist is not None:
                         vlist.delete()
                 self._table.delete()
+                if self._texts is not None:
+                    self._texts.delete()
             finally:
                 self._restore(previous)
         self._forget_entities()

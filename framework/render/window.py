@@ -12,6 +12,9 @@ Keys go into ``scene.resources[Input]`` as lower-case names (``"left"``, ``"spac
 ``"f1"``, ``"escape"``, digits as ``"1"``): game systems read them in the next step, no globals.
 F1 toggles the debug overlay, Escape closes the window; ``on_key(scene, key)`` is called on every
 key press (after the Input update) and may return a new scene to switch to (e.g. a restart).
+
+Where no window can be seen (no display, or one that fails to open), :class:`~.display.NoDisplayError`
+is raised before anything runs: never an invisible window running on with nobody to close it.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from pyglet.window import key as _key
 
 from ..input import Input
 from .camera import Camera
+from .display import NoDisplayError, no_display_reason, open_failure
 from .renderer import Renderer
 
 __all__ = ["MAX_FRAME_TIME", "MAX_STEPS_PER_FRAME", "Runner", "key_name", "run"]
@@ -39,6 +43,21 @@ def key_name(symbol: int) -> str:
     ``key._1`` -> ``"1"``, ``key.NUM_1`` -> ``"num_1"``)."""
     name = _key.symbol_string(symbol).lower()
     return name[1:] if name.startswith("_") and len(name) > 1 else name
+
+
+def _open_window(width: int, height: int, title: str) -> Any:
+    """A visible, resizable window; :class:`NoDisplayError` where none can be seen (no display, or
+    the display fails to open), never an invisible one."""
+    reason = no_display_reason()
+    if reason is None:
+        try:
+            return pyglet.window.Window(width, height, caption=title, resizable=True, visible=True)
+        except Exception as exc:
+            reason = open_failure(exc)
+            if reason is None:
+                raise
+            raise NoDisplayError(f"{reason}; no window can be shown") from exc
+    raise NoDisplayError(f"{reason}; no window can be shown")
 
 
 class Runner:
@@ -67,7 +86,7 @@ class Runner:
         self.frames = 0
         self.steps = 0
         self.accumulator = 0.0
-        self.window = pyglet.window.Window(width, height, caption=title, resizable=True, visible=True)
+        self.window = _open_window(width, height, title)
         self.renderer = Renderer(width=width, height=height, camera=camera, debug=debug,
                                  background=background, window=self.window)
         self.scene = scene
@@ -215,6 +234,8 @@ def run(
     ``camera``: the view (see :class:`~framework.render.camera.Camera`; e.g. ``Camera(target=player,
     bounds=level, zoom=2)``); ``debug``: start with the overlay on (F1 toggles it); ``on_key(scene,
     key)``: called on every key press with the key's name; return a new scene to switch to it;
-    ``background``: the clear colour (r, g, b), 0-255."""
+    ``background``: the clear colour (r, g, b), 0-255.
+
+    Raises :class:`~.display.NoDisplayError` (one line: why) where no window can be seen."""
     Runner(scene, width=width, height=height, title=title, fps=fps, camera=camera, debug=debug,
            on_key=on_key, max_frames=max_frames, background=background).run()
