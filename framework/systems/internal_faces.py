@@ -33,6 +33,7 @@ RowsOf = Callable[[I64Array], I64Array]  # entity ids -> store rows
 
 # Face bits, by the direction a body leaves the box through them.
 LEFT, RIGHT, DOWN, UP = 1, 2, 4, 8
+AXIS_TOLERANCE = 1e-9  # a unit normal's other component below this: the normal is along an axis
 _UNKNOWN = 255
 
 
@@ -107,24 +108,10 @@ class InternalFaces:
         depth: its body also overlaps the box that covers the face, and that contact goes first
         (a box that slid into a wall's lowest tile leaves it sideways, and the floor tile under the
         wall, whose top is covered, is then not touched at all)."""
-        static_a = store.body[ra] == STATIC
-        static_b = store.body[rb] == STATIC
-        axis = (nx == 0.0) | (ny == 0.0)
-        cand = np.flatnonzero(hit & (static_a != static_b) & axis
-                              & (store.kind[np.where(static_a, ra, rb)] == KIND_AABB))
-        if cand.size == 0:
+        found = self._through_covered(store, geom, hash_, rows_of, ra, rb, nx, ny, hit)
+        if found is None:
             return 0
-        t = np.where(static_a[cand], ra[cand], rb[cand])  # the static box
-        m = np.where(static_a[cand], rb[cand], ra[cand])  # the body pushed out of it
-        sgn = np.where(static_a[cand], 1.0, -1.0)  # the body moves along sgn * n
-        px, py = nx[cand] * sgn, ny[cand] * sgn
-        leave = np.where(px < 0, LEFT, np.where(px > 0, RIGHT, np.where(py < 0, DOWN, UP))).astype(np.uint8)
-        faces = self.masks(store, geom, hash_, rows_of, t)
-        bad = (faces & leave) != 0
-        if not bad.any():
-            return 0
-        cand, t, m, sgn, faces = cand[bad], t[bad], m[bad], sgn[bad], faces[bad]
-        px, py = px[bad], py[bad]
+        cand, t, m, sgn, faces, px, py = found
         # The body's extent along the box's axes (exact for any convex shape: its bounds).
         lo_x, hi_x, lo_y, hi_y = _extent(store, geom, m)
         tx, ty = geom.hx[t], geom.hy[t]
@@ -160,6 +147,42 @@ class InternalFaces:
         depth[cand] = dd
         rank[cand] = -1.0 / (1.0 + rank[cand])  # in (-1, 0): below every plain depth, same order
         return int(cand.size + beyond.sum())
+
+
+    def _through_covered(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
+                         ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, among: BoolArray):
+        """The contacts ``among`` these whose push-out leaves a static box through an internal face:
+        ``(index, box row, body row, sign, the box's faces, push x, push y)``, or None; the push
+        ``(px, py)`` is along the covered face's normal.
+
+        A normal along an axis (to the rounding of a turning polygon's: a box turned by -0.0 has
+        normals like (-1, 4e-11)) leaves through the face it is the normal of; a corner's (a circle
+        or a polygon's corner off the box's corner) through the two faces that meet there: if one
+        of them is covered, the corner is that face's end (a ball rolling over the seam of two tiles
+        is on the floor, not on a bump)."""
+        static_a = store.body[ra] == STATIC
+        static_b = store.body[rb] == STATIC
+        cand = np.flatnonzero(among & (static_a != static_b) & (store.kind[np.where(static_a, ra, rb)] == KIND_AABB))
+        if cand.size == 0:
+            return None
+        t = np.where(static_a[cand], ra[cand], rb[cand])  # the static box
+        m = np.where(static_a[cand], rb[cand], ra[cand])  # the body pushed out of it
+        sgn = np.where(static_a[cand], 1.0, -1.0)  # the body moves along sgn * n
+        px, py = nx[cand] * sgn, ny[cand] * sgn
+        faces = self.masks(store, geom, hash_, rows_of, t)
+        cov_x = (faces & np.where(px < 0, LEFT, RIGHT).astype(np.uint8)) != 0
+        cov_y = (faces & np.where(py < 0, DOWN, UP).astype(np.uint8)) != 0
+        along_x = np.abs(py) <= AXIS_TOLERANCE
+        along_y = ~along_x & (np.abs(px) <= AXIS_TOLERANCE)
+        corner = ~(along_x | along_y)
+        # the covered face it leaves through: its axis's; at a corner, the covered one of the two
+        # (both covered: the one nearer the normal)
+        use_x = along_x | (corner & np.where(cov_x != cov_y, cov_x, np.abs(px) >= np.abs(py)))
+        bad = np.where(use_x, cov_x, cov_y)
+        if not bad.any():
+            return None
+        px, py = np.where(use_x, np.sign(px), 0.0), np.where(use_x, 0.0, np.sign(py))
+        return cand[bad], t[bad], m[bad], sgn[bad], faces[bad], px[bad], py[bad]
 
 
 def _extent(store: BodyStore, geom: Geometry, rows: IntpArray) -> tuple[F64Array, F64Array, F64Array, F64Array]:
