@@ -204,3 +204,30 @@ def test_site_builds_strict(tmp_path):
         shown = {i[len(name) + 1:] for i in ids if i.startswith(name + ".") and "." not in i[len(name) + 1:]}
         extra = shown - set(module.__all__)
         assert not extra, f"the API page shows {sorted(extra)} of {name}, which are not in its __all__"
+
+
+def test_the_pythonpath_setting_on_the_testing_page_makes_a_games_modules_importable(tmp_path):
+    """docs/testing.md's layout, as the page says: a game's test imports the game's own module;
+    under the plain ``pytest`` command (which puts no current folder on ``sys.path``: ``python -P``)
+    that fails without the page's ``pythonpath`` setting and passes with it."""
+    page = (DOCS / "testing.md").read_text()
+    (settings,) = re.findall(r"```toml\n(.*?)```", page, flags=re.S)
+    assert 'pythonpath = ["."]' in settings
+    (tmp_path / "mygame").mkdir()
+    (tmp_path / "mygame" / "__init__.py").write_text("SPEED = 5.0\n")
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "test_mygame.py").write_text("import mygame\n\n\ndef test_speed():\n"
+                                                       "    assert mygame.SPEED == 5.0\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}  # this checkout's framework, whatever is installed
+
+    def pytest_there() -> str:
+        command = [sys.executable, "-P", "-m", "pytest", "-p", "no:cacheprovider", "--no-framework-pictures"]
+        out = subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+        return out.stdout + out.stderr
+
+    (tmp_path / "pyproject.toml").write_text("[project]\nname = 'mygame'\n")
+    out = pytest_there()
+    assert "ModuleNotFoundError: No module named 'mygame'" in out, out[-4000:]
+    (tmp_path / "pyproject.toml").write_text("[project]\nname = 'mygame'\n\n" + settings)
+    out = pytest_there()
+    assert "1 passed" in out and "error" not in out.lower(), out[-4000:]

@@ -14,6 +14,7 @@ from typing import Any
 
 from ..input import Input
 from ..validation import InvalidValue
+from .tracebacks import hide_on_failure
 
 __all__ = ["DT", "KeyScript", "run", "step_until", "describe"]
 
@@ -114,6 +115,7 @@ def step_until(scene: Any, predicate: Callable[[Any], bool], *, within: int | No
     A bound is required: ``within`` steps or ``seconds``. When it runs out, ``AssertionError`` says
     what was awaited (``what``, else the predicate's name) and what was last seen
     (``describe_with(scene)``, else :func:`describe`)."""
+    __tracebackhide__ = hide_on_failure
     n = _steps(within, seconds, dt, "step_until")
     if predicate(scene):
         return 0
