@@ -130,6 +130,7 @@ def test_substeps_reduce_the_elastic_balls_energy_drift():
     assert abs(four["energy_drift"]) < abs(one["energy_drift"])
 
 
+@pytest.mark.slow
 def test_friction_rows_meet_the_analytic_answers():
     # The crate stops v dt / 2 short of v^2 / (2 mu g) (semi-implicit Euler: 1/60 of 2.5 at one
     # sub-step, a quarter of that at four); the rest is exact to rounding.
@@ -209,6 +210,7 @@ def test_perf_without_pymunk_has_null_columns(monkeypatch, tmp_path):
     assert plot_perf(report, tmp_path / "p.png") is False and not (tmp_path / "p.png").exists()
 
 
+@pytest.mark.slow
 def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
     plot = tmp_path / "perf.png"
     code = main(["perf", "--quick", "--json", "--sizes", "40,80", "--tiles", "200", "--rounds", "2",
@@ -225,6 +227,7 @@ def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
         assert plot.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_accuracy_report_of_a_tiny_configuration(tmp_path):
     cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1}
     report = acc.run_accuracy(cfg, progress=False, speeds=(1.0, 64.0))
@@ -435,6 +438,7 @@ def test_progress_bar_writes_to_its_stream_only_when_enabled():
 # --- the render benchmark -----------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_render_cli_of_a_tiny_configuration(render, capsys, tmp_path):
     """Every kind at a tiny size, through the command line: a row per (kind, size) with all three
     in-process contenders timed, ratios that are what they say, goals stated; JSON and CSV written."""

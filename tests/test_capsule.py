@@ -110,6 +110,7 @@ def both_orders(a, ta, b, tb):
     return c
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("other", [Circle(0.25), AABB(1, 0.5), Polygon.box(1, 0.5), CAP, Capsule(0.25, 1),
                                    Polygon([(-0.5, -0.25), (0.5, -0.25), (0, 0.25)])])
 def test_touching_is_not_a_collision_and_one_ulp_of_overlap_is(other) -> None:

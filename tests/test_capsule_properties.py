@@ -97,6 +97,7 @@ def _push_out(a, ta, b, tb, ux, uy):
     return hi
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(capsules, poses, others, poses)

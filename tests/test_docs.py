@@ -129,6 +129,7 @@ def _pytest_in_a_process(pytester, *args):
     return result.parseoutcomes(), result.stdout.str()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("page,number,code", [b for b in PYTEST_BLOCKS if b not in GOLDEN_BLOCKS],
                          ids=[f"{p}#{n}" for p, n, c in PYTEST_BLOCKS if (p, n, c) not in GOLDEN_BLOCKS])
 def test_test_file_blocks_in_docs_pass_under_pytest(page, number, code, pytester):
@@ -139,6 +140,7 @@ def test_test_file_blocks_in_docs_pass_under_pytest(page, number, code, pytester
     assert outcomes == {"passed": len(tests)}, f"docs/{page} test file {number}:\n{out[-4000:]}"
 
 
+@pytest.mark.slow
 def test_the_golden_sample_records_once_and_then_can_fail(pytester, monkeypatch):
     """The page's golden sample, as its text says: the first run fails for want of a golden file,
     ``--update-golden`` records it next to the test, the same run then passes, and a change of
@@ -191,6 +193,7 @@ def test_site_navigation_lists_every_page_and_only_pages_that_exist():
     assert sorted(set(nav) - set(pages)) == [], "mkdocs.yml lists pages that do not exist"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(importlib.util.find_spec("mkdocs") is None or importlib.util.find_spec("mkdocstrings") is None,
                     reason="the docs extra is not installed (pip install -e '.[docs]')")
 def test_site_builds_strict(tmp_path):
@@ -217,6 +220,7 @@ def test_site_builds_strict(tmp_path):
         assert not extra, f"the API page shows {sorted(extra)} of {name}, which are not in its __all__"
 
 
+@pytest.mark.slow
 def test_the_pythonpath_setting_on_the_testing_page_makes_a_games_modules_importable(tmp_path):
     """docs/testing.md's layout, as the page says: a game's test imports the game's own module;
     under the plain ``pytest`` command (which puts no current folder on ``sys.path``: ``python -P``)
@@ -368,6 +372,7 @@ def test_the_docs_show_runs_with_their_output():
     assert ("platformer.md", "python -m examples.platformer --headless --demo") in {(p, c) for p, c, _ in SHOWN_RUNS}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("page,command,shown", SHOWN_RUNS, ids=[f"{p}:{c}" for p, c, _ in SHOWN_RUNS])
 def test_a_run_shown_in_the_docs_prints_what_it_shows(page, command, shown):
     words = shlex.split(command)
@@ -396,3 +401,13 @@ def test_the_replay_file_shown_is_what_the_sample_writes(tmp_path):
     replay = eval(made, {"Replay": Replay})
     replay.save(tmp_path / "run.replay")
     assert (tmp_path / "run.replay").read_text() == shown
+
+
+def test_the_quick_run_the_docs_show_uses_a_registered_marker_and_the_default_runs_everything():
+    import tomllib
+
+    pytest_settings = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]
+    assert any(m.startswith("slow:") for m in pytest_settings["markers"])
+    assert "-m" not in pytest_settings["addopts"].split(), "the default run (CI's) must select every test"
+    for page in ("README.md", "CONTRIBUTING.md"):
+        assert 'pytest -m "not slow"' in (ROOT / page).read_text(), page

@@ -417,6 +417,7 @@ def mutated_description(draw) -> bytes:
     return buf.getvalue()
 
 
+@pytest.mark.slow
 @FUZZ
 @given(mutated_description())
 def test_snapshot_file_descriptions(tmp_path_factory, blob):
@@ -555,6 +556,7 @@ def test_golden_traces_with_hostile_values(tmp_path_factory, data):
     _write_report()
 
 
+@pytest.mark.slow
 @HOSTILE_FUZZ_SNAPSHOTS
 @given(st.data())
 def test_snapshot_file_descriptions_with_hostile_values(tmp_path_factory, data):
@@ -740,6 +742,7 @@ def test_found_a_replay_of_deeply_nested_brackets(tmp_path):
         Replay.load(path)
 
 
+@pytest.mark.slow
 def test_found_a_zlib_bomb_in_tile_data(tmp_path):
     """Compressed tile data that inflates far beyond what the map declares is refused while it
     inflates, not after."""

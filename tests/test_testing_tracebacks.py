@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 pytest_plugins = ["pytester"]
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -98,6 +100,7 @@ def _sections(out: str) -> dict[str, str]:
     return parts
 
 
+@pytest.mark.slow
 def test_failing_toolkit_assertions_show_the_test_and_not_the_framework(pytester, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))  # this checkout's framework, whatever is installed
     pytester.makepyfile(test_game=GAME_TEST)
