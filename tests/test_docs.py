@@ -17,8 +17,9 @@
   method and attribute of ``Input``, is in docs/api.md's tables ("At a glance"), with its true
   default; docs/concepts.md's component table names every constructor parameter.
 - Output the docs show is what the code prints today: a ``$ python -m ...`` line in a ```sh block
-  is run and its output compared (JSON lines field by field, wall-clock timings excepted), and the
-  replay file docs/reliability.md shows is what its sample writes.
+  is run and its output compared (JSON lines field by field, wall-clock timings excepted), so are
+  the examples' summary lines on docs/examples.md, and the replay file docs/reliability.md shows
+  is what its sample writes.
 """
 
 from __future__ import annotations
@@ -345,8 +346,16 @@ def test_the_concepts_component_table_names_every_constructor_parameter():
 # --- output shown in the docs is what the code prints ------------------------------------------------
 
 # The fields of a shown JSON line that are measured wall-clock time, different on every run: the
-# only ones allowed to differ (the platformer's summary: ms_per_frame, time per simulated frame).
-TIMINGS = {"ms_per_frame"}
+# only ones allowed to differ (the platformer's summary: ms_per_frame, time per simulated frame;
+# bullet_hell's: stage_ms, each stage's milliseconds).
+TIMINGS = {"ms_per_frame", "stage_ms"}
+
+
+def _same_but_timings(want: str, got: str) -> set[str]:
+    """The fields, timings aside, in which two JSON lines differ (both must have the same fields)."""
+    want_fields, got_fields = json.loads(want), json.loads(got)
+    assert set(want_fields) == set(got_fields), f"shown: {want}\nprinted: {got}"
+    return {k for k in want_fields if want_fields[k] != got_fields[k]} - TIMINGS
 
 
 def _shown_runs() -> list[tuple[str, str, list[str]]]:
@@ -384,12 +393,26 @@ def test_a_run_shown_in_the_docs_prints_what_it_shows(page, command, shown):
     assert len(printed) == len(shown), f"docs/{page}: {command} printed\n{out.stdout}"
     for want, got in zip(shown, printed):
         if want.startswith("{"):
-            want_fields, got_fields = json.loads(want), json.loads(got)
-            assert set(want_fields) == set(got_fields), f"docs/{page}: {command} printed\n{got}"
-            differ = {k for k in want_fields if want_fields[k] != got_fields[k]} - TIMINGS
+            differ = _same_but_timings(want, got)
             assert not differ, f"docs/{page}: {command} now prints {got} (differs in {sorted(differ)})"
         else:
             assert got == want, f"docs/{page}: {command} printed\n{out.stdout}"
+
+
+@pytest.mark.slow
+def test_the_examples_summaries_shown_are_what_they_print():
+    """docs/examples.md shows each example's summary line, as the page says, of
+    ``python -m examples.NAME --headless --frames 60``; every field but the timings is checked
+    (tests/test_examples.py checks the rest of what they print)."""
+    shown = re.findall(r'^(\{"example": "(\w+)".*\})$', (DOCS / "examples.md").read_text(), flags=re.M)
+    assert len(shown) == 4
+    for line, name in shown:
+        out = subprocess.run([sys.executable, "-m", f"examples.{name}", "--headless", "--frames", "60"], cwd=ROOT,
+                             capture_output=True, text=True, timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
+        assert out.returncode == 0, out.stderr[-4000:]
+        printed = out.stdout.splitlines()[-1]
+        differ = _same_but_timings(line, printed)
+        assert not differ, f"docs/examples.md: {name} now prints {printed} (differs in {sorted(differ)})"
 
 
 def test_the_replay_file_shown_is_what_the_sample_writes(tmp_path):
