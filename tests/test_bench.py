@@ -124,6 +124,7 @@ def test_more_response_iterations_leave_less_overlap_in_a_crowd():
     assert eight["residual"] < one["residual"]
 
 
+@pytest.mark.slow
 def test_substeps_reduce_the_elastic_balls_energy_drift():
     one = acc.run_ball("substeps-1", steps=300)
     four = acc.run_ball("substeps-4", steps=300)
@@ -186,6 +187,7 @@ def test_perf_workload_density_and_tiles():
     assert (t.tile_y + 0.5).max() < (wl.y - wl.h / 2).min() - 0.5 * 100
 
 
+@pytest.mark.slow
 def test_perf_report_has_the_documented_columns_and_json():
     report = tiny_perf()
     rows = report["rows"]
@@ -347,6 +349,7 @@ def test_friction_regimes_give_every_engine_the_same_friction(shape):
             eng.close()
 
 
+@pytest.mark.slow
 def test_regimes_report_of_a_tiny_configuration(tmp_path):
     report = reg.run_regimes(TINY_REGIMES, scenes=("stack-20", "scattered-10", "platformer-1"), crowds=("boxes",),
                              progress=False)
@@ -383,6 +386,7 @@ def test_regimes_without_peers_has_null_columns(monkeypatch, tmp_path):
     assert plot_regimes(report, tmp_path / "r.png") is False and not (tmp_path / "r.png").exists()
 
 
+@pytest.mark.slow
 def test_cli_regimes_quick_json_of_a_tiny_configuration(capsys, tmp_path):
     plot = tmp_path / "regimes.png"
     code = main(["regimes", "--quick", "--json", "--rounds", "2", "--crowd-steps", "3", "--scenes",

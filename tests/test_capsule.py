@@ -564,6 +564,7 @@ def test_manifold_of_a_pair_with_a_capsule_is_collides_point() -> None:
         assert m.points[0].point == c.point and m.points[0].depth == c.depth
 
 
+@pytest.mark.slow
 def test_a_capsule_slides_over_tile_seams_without_snagging() -> None:
     with Scene(gravity=(0.0, -10.0)) as s:
         tiles(s, 40, x0=0.0)

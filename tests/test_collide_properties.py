@@ -200,6 +200,7 @@ def test_depth_and_overlap_agree_with_independent_references(sa, pa, sb, pb):
             assert SPolygon(world_outline(shape, pose)).distance(Point(*c.point)) <= 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(hull_polygons(), poses, hull_polygons(), poses)

@@ -275,6 +275,7 @@ def _load_or_refuse(tmp_path_factory, blob: bytes, label: str) -> None:
         scene.close()
 
 
+@pytest.mark.slow
 @FUZZ
 @given(mutated_snapshot())
 def test_snapshot_files(tmp_path_factory, blob):
@@ -491,6 +492,7 @@ def hostile(draw, data: bytes) -> bytes:
     return b"".join(out) + data[last:]
 
 
+@pytest.mark.slow
 @HOSTILE_FUZZ
 @given(st.data())
 def test_tiled_maps_with_hostile_values(tmp_path_factory, data):
@@ -540,6 +542,7 @@ def _golden_short() -> bytes:
     return GOLDEN_SHORT
 
 
+@pytest.mark.slow
 @HOSTILE_FUZZ
 @given(st.data())
 def test_golden_traces_with_hostile_values(tmp_path_factory, data):

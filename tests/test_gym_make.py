@@ -56,6 +56,7 @@ def test_the_documented_id_names_the_installed_module():
     assert _documented_id() == f"framework.examples.platformer.env:{ENV_ID}"
 
 
+@pytest.mark.slow
 def test_gym_make_from_the_installed_package_needs_no_other_import(wheel, tmp_path):  # noqa: F811
     site = tmp_path / "site"
     with zipfile.ZipFile(wheel) as z:
@@ -66,6 +67,7 @@ def test_gym_make_from_the_installed_package_needs_no_other_import(wheel, tmp_pa
     assert Path(where).is_relative_to(site)  # the wheel's module, not a checkout's
 
 
+@pytest.mark.slow
 def test_gym_make_from_the_checkout_needs_no_other_import():
     checkout_id = _documented_id().replace("framework.examples.", "examples.")
     printed = _make_in_a_fresh_process(checkout_id, cwd=ROOT, path=ROOT)

@@ -312,6 +312,7 @@ ONE_WAY_LEVEL = """
 """
 
 
+@pytest.mark.slow
 def test_one_way_platform_jump_up_through_land_stay_drop_down():
     g = Game([parse_text(ONE_WAY_LEVEL)])
     top = 4 * T  # the slab is the top quarter of row 4 of 8: 3 tiles above the floor
@@ -495,6 +496,7 @@ def test_enemies_turn_at_walls_and_spikes():
     assert g.state.deaths == 0
 
 
+@pytest.mark.slow
 def test_enemy_turns_at_a_ledge():
     g = Game([parse_text("""
 #.............#

@@ -221,6 +221,7 @@ def _golden_scene(speed: float = 3.0) -> Scene:
     return level.scene
 
 
+@pytest.mark.slow
 def test_golden_runs_record_then_compare_and_name_the_first_difference(tmp_path, monkeypatch):
     monkeypatch.delenv("FRAMEWORK_UPDATE_GOLDEN", raising=False)
     path = tmp_path / "golden" / "roll.json"

@@ -75,6 +75,7 @@ def test_a_stack_of_ten_rotating_boxes_with_friction_stands_and_sleeps():
         assert s.store.asleep[[s.store.row_of[b] for b in boxes]].all()
 
 
+@pytest.mark.slow
 def test_a_pyramid_of_twenty_rows_of_rotating_boxes_with_friction_stands():
     with Scene(gravity=(0.0, -G)) as s:
         _floor(s, 80.0)
