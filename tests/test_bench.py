@@ -124,12 +124,14 @@ def test_more_response_iterations_leave_less_overlap_in_a_crowd():
     assert eight["residual"] < one["residual"]
 
 
+@pytest.mark.slow
 def test_substeps_reduce_the_elastic_balls_energy_drift():
     one = acc.run_ball("substeps-1", steps=300)
     four = acc.run_ball("substeps-4", steps=300)
     assert abs(four["energy_drift"]) < abs(one["energy_drift"])
 
 
+@pytest.mark.slow
 def test_friction_rows_meet_the_analytic_answers():
     # The crate stops v dt / 2 short of v^2 / (2 mu g) (semi-implicit Euler: 1/60 of 2.5 at one
     # sub-step, a quarter of that at four); the rest is exact to rounding.
@@ -185,6 +187,7 @@ def test_perf_workload_density_and_tiles():
     assert (t.tile_y + 0.5).max() < (wl.y - wl.h / 2).min() - 0.5 * 100
 
 
+@pytest.mark.slow
 def test_perf_report_has_the_documented_columns_and_json():
     report = tiny_perf()
     rows = report["rows"]
@@ -209,6 +212,7 @@ def test_perf_without_pymunk_has_null_columns(monkeypatch, tmp_path):
     assert plot_perf(report, tmp_path / "p.png") is False and not (tmp_path / "p.png").exists()
 
 
+@pytest.mark.slow
 def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
     plot = tmp_path / "perf.png"
     code = main(["perf", "--quick", "--json", "--sizes", "40,80", "--tiles", "200", "--rounds", "2",
@@ -225,6 +229,7 @@ def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
         assert plot.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_accuracy_report_of_a_tiny_configuration(tmp_path):
     cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1}
     report = acc.run_accuracy(cfg, progress=False, speeds=(1.0, 64.0))
@@ -344,6 +349,7 @@ def test_friction_regimes_give_every_engine_the_same_friction(shape):
             eng.close()
 
 
+@pytest.mark.slow
 def test_regimes_report_of_a_tiny_configuration(tmp_path):
     report = reg.run_regimes(TINY_REGIMES, scenes=("stack-20", "scattered-10", "platformer-1"), crowds=("boxes",),
                              progress=False)
@@ -380,6 +386,7 @@ def test_regimes_without_peers_has_null_columns(monkeypatch, tmp_path):
     assert plot_regimes(report, tmp_path / "r.png") is False and not (tmp_path / "r.png").exists()
 
 
+@pytest.mark.slow
 def test_cli_regimes_quick_json_of_a_tiny_configuration(capsys, tmp_path):
     plot = tmp_path / "regimes.png"
     code = main(["regimes", "--quick", "--json", "--rounds", "2", "--crowd-steps", "3", "--scenes",
@@ -435,6 +442,7 @@ def test_progress_bar_writes_to_its_stream_only_when_enabled():
 # --- the render benchmark -----------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_render_cli_of_a_tiny_configuration(render, capsys, tmp_path):
     """Every kind at a tiny size, through the command line: a row per (kind, size) with all three
     in-process contenders timed, ratios that are what they say, goals stated; JSON and CSV written."""

@@ -531,6 +531,7 @@ def scenes(draw):
     return b, static
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(scenes(), cells, st.integers(0, 2**40))
 def test_random_scenes_match_brute_force(scene, cell, id_base):
@@ -545,6 +546,7 @@ def test_random_scenes_match_brute_force(scene, cell, id_base):
     assert h.rehashed_last == int((~static).sum())
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None)
 @given(scenes(), cells, quarter, quarter, size, size, st.integers(1, 6))
 def test_random_query_box_matches_brute_force(scene, cell, x, y, w, hh, repeat):

@@ -110,6 +110,7 @@ def both_orders(a, ta, b, tb):
     return c
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("other", [Circle(0.25), AABB(1, 0.5), Polygon.box(1, 0.5), CAP, Capsule(0.25, 1),
                                    Polygon([(-0.5, -0.25), (0.5, -0.25), (0, 0.25)])])
 def test_touching_is_not_a_collision_and_one_ulp_of_overlap_is(other) -> None:
@@ -563,6 +564,7 @@ def test_manifold_of_a_pair_with_a_capsule_is_collides_point() -> None:
         assert m.points[0].point == c.point and m.points[0].depth == c.depth
 
 
+@pytest.mark.slow
 def test_a_capsule_slides_over_tile_seams_without_snagging() -> None:
     with Scene(gravity=(0.0, -10.0)) as s:
         tiles(s, 40, x0=0.0)

@@ -97,6 +97,7 @@ def _push_out(a, ta, b, tb, ux, uy):
     return hi
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(capsules, poses, others, poses)
@@ -141,6 +142,7 @@ def test_scaling_by_a_power_of_two_scales_the_answer(cap, pa, other, pb, k):
         assert m.normal == c.normal and m.depth == c.depth * s
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(capsules, poses, others, poses)
@@ -163,6 +165,7 @@ def test_shapely_agrees_on_overlap_distance_and_the_point(cap, pa, other, pb):
         assert ga.intersection(after).area < 1e-3
 
 
+@pytest.mark.slow
 @FAST
 @given(st.lists(st.tuples(capsules, poses, others, poses, st.booleans()), min_size=1, max_size=12))
 def test_the_batch_kernel_gives_collides_answers(rows):
@@ -230,6 +233,7 @@ def _from_core(cap, pose, p):
     return math.hypot(p[0] - cx, p[1] - cy), (cx, cy)
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(capsules, poses, ray_origins, st.tuples(eighths, eighths), ray_aims, st.one_of(st.just(math.inf),

@@ -144,6 +144,7 @@ def test_walks_up_and_down_a_2_to_1_slope():
             assert -1e-9 <= feet(s, e) - under <= 3 * SKIN, (x, feet(s, e) - under)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("slope", ["45", "2:1"])
 def test_stands_still_on_a_slope(slope):
     tiles = hill_level() if slope == "45" else gentle_level()
@@ -196,6 +197,7 @@ V_LEVEL = floor_row(8) + floor_row(3, 48.0) + floor_row(3, 48.0, start=5) + [
 """Ground at 64 on both sides of a V: a 45-degree slope down from x = 96 to 128, up to 160."""
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("drop_x, rest", [(128.0, 44.0), (125.0, 47.0), (134.0, 50.0)])
 def test_stands_in_a_v(drop_x, rest):
     """Dropped into a V of two 45-degree slopes, it stays where it lands: centred, its corners on
@@ -338,6 +340,7 @@ def test_pushes_a_crate_it_walks_into():
     assert s.get(e, Transform).x + W / 2 <= s.get(crate, Transform).x - 16.0 + 1e-9
 
 
+@pytest.mark.slow
 def test_random_input_on_the_hill_never_enters_a_tile():
     tiles = hill_level() + [(-16.0, 16.0 + T * k, AABB(T, T)) for k in range(8)] + \
         [(400.0, 16.0 + T * k, AABB(T, T)) for k in range(8)]
@@ -465,6 +468,7 @@ terrain_kinds = st.sampled_from([None, None, None, "solid", "solid", "slope_up",
                                  "slope_up_high", "slope_down_high", "slope_down_low", "step"])
 
 
+@pytest.mark.slow
 @settings(max_examples=int(os.environ.get("CHARACTER_EXAMPLES", "40")), deadline=None)
 @given(st.lists(st.lists(terrain_kinds, min_size=10, max_size=10), min_size=3, max_size=3),
        st.lists(st.tuples(st.sampled_from([-256.0, -128.0, 0.0, 128.0, 256.0]), st.booleans()), min_size=5,

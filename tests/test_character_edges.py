@@ -490,6 +490,7 @@ def check_not_held_by_a_step(s: Scene, e: int, walked: float) -> None:
     assert down is None or down.normal.y < COS_F, (s.frame, t.x, feet(s, e), c.wall_normal, down)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["box", "capsule"])
 def test_a_long_random_walk_keeps_floor_and_velocity_honest(kind):
     """3000 steps of random input (walking at slow, fast and odd speeds, jumps, dropping through),

@@ -175,6 +175,7 @@ def test_translation_by_a_power_of_two_changes_nothing_but_the_point(sa, pa, sb,
 
 # --- agreement with independent references ------------------------------------------------------
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(shapes, poses, shapes, poses)
@@ -199,6 +200,7 @@ def test_depth_and_overlap_agree_with_independent_references(sa, pa, sb, pb):
             assert SPolygon(world_outline(shape, pose)).distance(Point(*c.point)) <= 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(hull_polygons(), poses, hull_polygons(), poses)
@@ -385,6 +387,7 @@ def near_touching(draw):
     return sa, pa, sb, pb
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(near_touching())

@@ -83,6 +83,7 @@ def _thrown_crowd(seed: int, speed: float) -> tuple[Scene, list[int]]:
     return s, ents
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("seed", "speed"), [(6, 5.0), (2, 10.0), (12, 5.0)])
 def test_a_thrown_crowd_of_boxes_ends_apart(seed, speed):
     """Seeds where the crowd ended (measured 2026-11-26, before this fix) asleep with rows wedged

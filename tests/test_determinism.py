@@ -15,6 +15,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 GAME = textwrap.dedent('''
     import hashlib, sys
     import numpy as np
@@ -89,6 +91,7 @@ def run_game(tmp_path: Path, hash_seed: str, replay_file: Path | None = None) ->
     return out.stdout
 
 
+@pytest.mark.slow
 def test_same_replay_same_bytes_across_hash_seeds(tmp_path):
     a = run_game(tmp_path, "0")
     b = run_game(tmp_path, "12345")
@@ -98,6 +101,7 @@ def test_same_replay_same_bytes_across_hash_seeds(tmp_path):
     assert "'started': 0" not in summary and "'ended': 0" not in summary, summary
 
 
+@pytest.mark.slow
 def test_replay_file_reproduces_the_recorded_run(tmp_path):
     from framework.replay import Replay
 

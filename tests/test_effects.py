@@ -65,6 +65,7 @@ def test_enabling_an_effect_turns_the_work_on():
     assert "response" in c["systems"] and c["resolved"] == 1 and y == pytest.approx(1.0, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_100k_static_tiles_add_no_per_step_rehashing():
     with Scene(cell_size=4.0) as s:
         side = 317

@@ -47,6 +47,7 @@ def test_registered_and_made_by_id():
         made.close()
 
 
+@pytest.mark.slow
 def test_reset_with_a_seed_is_deterministic_and_restores_the_start(env):
     rng = np.random.default_rng(5)
     actions = rng.integers(0, 7, size=120).tolist()
@@ -67,6 +68,7 @@ def test_reset_with_a_seed_is_deterministic_and_restores_the_start(env):
     assert env.game.scene.frame > 0
 
 
+@pytest.mark.slow
 def test_resets_restore_the_snapshot_and_never_read_the_level_again(monkeypatch):
     """The level file is loaded and parsed, and its entities spawned, once, when the environment
     is made; every reset restores the start's snapshot instead."""
@@ -267,6 +269,7 @@ def _reference_rays(env, player):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("level", [0, 1, 2])
 def test_the_vectorised_rays_agree_with_one_raycast_per_ray(level):
     e = PlatformerEnv(level)

@@ -48,6 +48,7 @@ def _hashes(s: Scene, steps: int) -> list[str]:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stage", ["movement", "broad_phase", "narrow_phase", "response", "sleeping"])
 def test_a_system_that_raises_mid_step_leaves_the_scene_as_it_was(stage):
     s, twin = _busy(), _busy()
@@ -231,6 +232,7 @@ def _shape(kind: str, size: float):
     return Capsule(size / 4, size / 2)
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None, derandomize=True)
 @given(ka=st.sampled_from(["aabb", "circle", "polygon", "capsule"]),
        kb=st.sampled_from(["aabb", "circle", "polygon", "capsule"]),

@@ -194,6 +194,7 @@ def test_a_kinematic_platform_carries_a_box_with_friction():
         assert s.get(box, Transform).y == 0.5
 
 
+@pytest.mark.slow
 def test_friction_makes_no_energy_in_a_closed_box_of_bodies():
     # Boxes and balls thrown about a closed room with friction everywhere: the total energy
     # (kinetic, of rolling too, + potential) never rises above its start (rounding: 1e-9 of it).
@@ -380,6 +381,7 @@ def test_mass_and_density_together_are_refused_and_a_later_edit_names_the_entity
 # --- any slope, any friction (hypothesis) --------------------------------------------------------------
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, derandomize=True)
 @given(theta=st.floats(math.radians(5.0), math.radians(60.0)), ratio=st.floats(0.0, 2.0))
 def test_a_box_on_any_slope_holds_or_slides_as_coulomb_says(theta, ratio):
@@ -394,6 +396,7 @@ def test_a_box_on_any_slope_holds_or_slides_as_coulomb_says(theta, ratio):
         assert speed == pytest.approx(expected, rel=1e-9, abs=1e-12)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, derandomize=True)
 @given(theta=st.floats(math.radians(5.0), math.radians(60.0)), ratio=st.floats(0.0, 3.0))
 def test_a_disk_on_any_slope_rolls_or_slips_as_coulomb_says(theta, ratio):
@@ -409,6 +412,7 @@ def test_a_disk_on_any_slope_rolls_or_slips_as_coulomb_says(theta, ratio):
         assert w == pytest.approx(2.0 * mu * 10.0 * math.cos(theta) / 0.5, rel=1e-9, abs=1e-12)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 2**31 - 1), n=st.integers(2, 8), gravity=st.sampled_from([0.0, 10.0]))
 def test_friction_never_adds_energy_to_random_bodies(seed, n, gravity):

@@ -174,6 +174,7 @@ def test_a_crate_on_a_platform_slips_the_analytic_distance(shape):
         assert s.get(crate, Transform).y == pytest.approx(0.5, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_a_row_of_widely_spaced_dominoes_falls_to_the_last():
     # Dominoes 1/8 x 1 spaced 3/4 apart (less than their height), friction 1/2 on them and the
     # floor: each one falling reaches the next. With friction several times too strong the row

@@ -275,6 +275,7 @@ def _load_or_refuse(tmp_path_factory, blob: bytes, label: str) -> None:
         scene.close()
 
 
+@pytest.mark.slow
 @FUZZ
 @given(mutated_snapshot())
 def test_snapshot_files(tmp_path_factory, blob):
@@ -417,6 +418,7 @@ def mutated_description(draw) -> bytes:
     return buf.getvalue()
 
 
+@pytest.mark.slow
 @FUZZ
 @given(mutated_description())
 def test_snapshot_file_descriptions(tmp_path_factory, blob):
@@ -490,6 +492,7 @@ def hostile(draw, data: bytes) -> bytes:
     return b"".join(out) + data[last:]
 
 
+@pytest.mark.slow
 @HOSTILE_FUZZ
 @given(st.data())
 def test_tiled_maps_with_hostile_values(tmp_path_factory, data):
@@ -539,6 +542,7 @@ def _golden_short() -> bytes:
     return GOLDEN_SHORT
 
 
+@pytest.mark.slow
 @HOSTILE_FUZZ
 @given(st.data())
 def test_golden_traces_with_hostile_values(tmp_path_factory, data):
@@ -555,6 +559,7 @@ def test_golden_traces_with_hostile_values(tmp_path_factory, data):
     _write_report()
 
 
+@pytest.mark.slow
 @HOSTILE_FUZZ_SNAPSHOTS
 @given(st.data())
 def test_snapshot_file_descriptions_with_hostile_values(tmp_path_factory, data):
@@ -740,6 +745,7 @@ def test_found_a_replay_of_deeply_nested_brackets(tmp_path):
         Replay.load(path)
 
 
+@pytest.mark.slow
 def test_found_a_zlib_bomb_in_tile_data(tmp_path):
     """Compressed tile data that inflates far beyond what the map declares is refused while it
     inflates, not after."""

@@ -542,3 +542,4 @@ class HandlerMachine(RuleBasedStateMachine):
 HandlerMachine.TestCase.settings = settings(max_examples=60, stateful_step_count=25, deadline=None,
                                             suppress_health_check=[HealthCheck.too_slow])
 test_handlers_keep_the_scene_consistent = HandlerMachine.TestCase
+test_handlers_keep_the_scene_consistent.pytestmark = [pytest.mark.slow]

@@ -121,6 +121,7 @@ def test_a_box_sliding_over_a_seam_is_not_pushed_back():
         assert all(b > a for a, b in zip(xs, xs[1:])) and xs[-1] == 1.0 + 64 * 4.0 * DT
 
 
+@pytest.mark.slow
 def test_a_triangle_touching_a_tiled_corner_at_any_angle_stays_inside():
     # A triangle resting in the corner of a floor and a wall, its tip touching both: at some angles
     # its tip pokes a sliver into the corner tile, whose top and left faces the wall and the floor

@@ -19,6 +19,7 @@ def test_tasks_play_the_scripted_agent_once_and_the_random_one_per_seed():
                      (2, "scripted", 0), (2, "random", 0), (2, "random", 1), (2, "random", 2)]
 
 
+@pytest.mark.slow
 def test_in_process_sweep_writes_a_summary(tmp_path, capsys):
     out, png = tmp_path / "s.json", tmp_path / "s.png"
     assert sweep.main(["--workers", "0", "--episodes", "2", "--levels", "2", "--out", str(out),
@@ -39,6 +40,7 @@ def test_in_process_sweep_writes_a_summary(tmp_path, capsys):
         assert (int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")) == (600, 320)
 
 
+@pytest.mark.slow
 def test_the_random_agent_is_deterministic_per_seed():
     a = sweep.run_episode((0, "random", 5), max_frames=600)
     b = sweep.run_episode((0, "random", 5), max_frames=600)
@@ -63,6 +65,7 @@ def test_workers_without_ray_is_a_clear_error(monkeypatch, capsys, tmp_path):
     assert "--workers 2 needs Ray" in err and "--workers 0" in err
 
 
+@pytest.mark.slow
 def test_a_sweep_on_ray_gives_the_in_process_results(tmp_path):
     pytest.importorskip("ray", reason="the rl extra (ray) is not installed: pip install -e '.[rl]'")
     tasks = sweep.tasks_for([2], 2)

@@ -65,6 +65,7 @@ def _region(shape, pose):
     return SPolygon(world_outline(shape, pose))
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, derandomize=True)
 @given(sa=shapes, pa=poses, sb=shapes, pb=poses)
 def test_every_point_lies_in_the_overlap_no_deeper_than_collide(sa, pa, sb, pb):

@@ -375,6 +375,7 @@ _SETTINGS = settings(max_examples=120, deadline=None, derandomize=True,
                      suppress_health_check=[HealthCheck.too_slow])
 
 
+@pytest.mark.slow
 @_SETTINGS
 @given(value=BUILTIN_VALUES, first=st.booleans())
 def test_any_builtin_value_is_refused_by_spawn_and_add_component_and_changes_nothing(value, first):
@@ -391,6 +392,7 @@ def test_any_builtin_value_is_refused_by_spawn_and_add_component_and_changes_not
         s.close()
 
 
+@pytest.mark.slow
 @_SETTINGS
 @given(cls=st.sampled_from(USER_COMPONENTS), x=st.floats(-5, 5), first=st.booleans())
 def test_any_instance_of_a_games_own_class_is_accepted(cls, x, first):

@@ -103,6 +103,7 @@ def test_the_examples_ship_as_framework_examples_with_levels_and_images(names):
     assert len(images) >= 9 and all(n.endswith(".png") for n in images)
 
 
+@pytest.mark.slow
 def test_the_platformer_plays_from_the_unpacked_wheel(wheel, tmp_path):
     # What a non-editable install runs: the unpacked wheel first on the path, run from elsewhere.
     site = tmp_path / "site"

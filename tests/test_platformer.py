@@ -49,6 +49,7 @@ def vel(g: Game) -> Velocity:
 # --- the demo and the command line ---------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_demo_plays_the_first_level_to_its_goal():
     g = Game(autoplay=Autoplay(level1))
     while not g.state.reached_goal and g.scene.frame < 2400:
@@ -58,6 +59,7 @@ def test_demo_plays_the_first_level_to_its_goal():
     assert not g.scene.query(Enemy)  # it stomped both walkers on the way
 
 
+@pytest.mark.slow
 def test_second_level_can_be_played_through():
     g = Game([builtin_levels()[1]], autoplay=Autoplay(level2))
     while not g.state.reached_goal and g.scene.frame < 2600:
@@ -65,6 +67,7 @@ def test_second_level_can_be_played_through():
     assert g.state.reached_goal and g.state.deaths == 0
 
 
+@pytest.mark.slow
 def test_cli_headless_demo_prints_a_json_summary_last():
     out = subprocess.run([sys.executable, "-m", "examples.platformer", "--headless", "--demo"], cwd=ROOT,
                          capture_output=True, text=True, timeout=120)
@@ -116,6 +119,7 @@ def test_cli_screenshot(tmp_path):
 # --- standing, running, walls --------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_lands_and_stands_still_for_thousands_of_frames():
     g = Game([parse_text("""
 #..........#
@@ -308,6 +312,7 @@ ONE_WAY_LEVEL = """
 """
 
 
+@pytest.mark.slow
 def test_one_way_platform_jump_up_through_land_stay_drop_down():
     g = Game([parse_text(ONE_WAY_LEVEL)])
     top = 4 * T  # the slab is the top quarter of row 4 of 8: 3 tiles above the floor
@@ -354,6 +359,7 @@ def test_walks_off_a_one_way_platform_edge_and_lands_on_the_floor():
 # --- moving platforms ------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", ["horizontal", "vertical"])
 def test_rides_the_moving_platform(path):
     if path == "horizontal":
@@ -466,6 +472,7 @@ def test_spikes_and_falling_out_kill():
     assert_on_floor(g.scene, g.player)
 
 
+@pytest.mark.slow
 def test_enemies_turn_at_walls_and_spikes():
     g = Game([parse_text("""
 #.......................#
@@ -489,6 +496,7 @@ def test_enemies_turn_at_walls_and_spikes():
     assert g.state.deaths == 0
 
 
+@pytest.mark.slow
 def test_enemy_turns_at_a_ledge():
     g = Game([parse_text("""
 #.............#

@@ -6,6 +6,7 @@ import math
 import random
 
 import numpy as np
+import pytest
 
 from examples.platformer import Game, builtin_levels, parse_text
 from examples.platformer.components import Enemy, LevelPiece, Tuning
@@ -27,6 +28,7 @@ def test_the_hills_level_has_slopes_a_step_a_v_and_a_lift_over_a_pit():
     assert slopes and all(isinstance(g.scene.get(e, Hitbox).shape, Polygon) for e in slopes)
 
 
+@pytest.mark.slow
 def test_demo_plays_the_hills_to_the_goal():
     g = Game([builtin_levels()[2]], autoplay=Autoplay(level3))
     step_until(g.scene, lambda s: g.state.reached_goal, within=2000, what="the goal")
@@ -73,6 +75,7 @@ def test_player_runs_up_and_over_the_hill_with_its_feet_on_the_ground():
     assert g.player_transform.x > 18 * T  # 150 steps at up to 7 tiles/s, never held up
 
 
+@pytest.mark.slow
 def test_walker_walks_up_and_down_slopes_and_turns_at_walls():
     g = Game([parse_text("""
 #...............................#
@@ -93,6 +96,7 @@ def test_walker_walks_up_and_down_slopes_and_turns_at_walls():
     assert g.state.deaths == 0
 
 
+@pytest.mark.slow
 def test_random_input_on_the_hills_for_10000_frames_never_enters_terrain_or_leaves_the_level():
     g = Game([builtin_levels()[2]])
     scene = g.scene

@@ -382,6 +382,7 @@ aims = st.one_of(st.none(), st.tuples(st.floats(-4, 4), st.floats(-4, 4)),
                  st.tuples(st.integers(-8, 8), st.integers(-8, 8)).map(lambda p: (p[0] / 2, p[1] / 2)))
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(shapes_poly, coord, coord, angles, st.tuples(coord, coord), st.tuples(coord, coord), aims,
        st.one_of(st.just(math.inf), st.floats(0, 60)))

@@ -571,6 +571,7 @@ def _shapely(shape, pose):
     return SPolygon([(c * px - s * py + x, s * px + c * py + y) for px, py in shape.points])
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(placed_shapes(), st.floats(0, 2 * math.pi), st.floats(8, 60), st.tuples(st.floats(-3, 3), st.floats(-3, 3)),
        st.floats(1e-3, 1e3))

@@ -574,6 +574,7 @@ SceneMachine.TestCase.settings = settings(
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 TestSceneMachine = SceneMachine.TestCase
+TestSceneMachine.pytestmark = [pytest.mark.slow]
 
 
 # --- part 2: bad input from game code -------------------------------------------------------------

@@ -92,6 +92,7 @@ def _pyramid(s: Scene, rows: int, mu: float) -> list[int]:
             for r in range(rows) for k in [rows - r] for i in range(k)]
 
 
+@pytest.mark.slow
 def test_a_heavy_ball_thrown_into_a_pyramid_is_not_turned_up_off_it():
     """The issue's scene: a ball of radius 1 and density 5 thrown at (22, 4) into a pyramid of 10
     rows of unit boxes that tip (friction 0.5), dt 1/60, 4 s. Measured 2026-11-26: pymunk 7.3's
@@ -115,6 +116,7 @@ def test_a_heavy_ball_thrown_into_a_pyramid_is_not_turned_up_off_it():
 # --- rolling ------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_disk_rolling_on_a_flat_floor_keeps_its_speed():
     """Rolling without slipping (``v = -w r``) on a level floor with friction: no force acts
     along the floor, so without rolling resistance the disk rolls on at its speed (to rounding)."""
@@ -201,6 +203,7 @@ def test_a_disk_rolled_over_the_top_of_another_falls_off_its_side(v0):
         assert s.get(top, Transform).y == pytest.approx(0.5, abs=1e-3)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_a_pile_of_rolling_circles_comes_to_rest_about_when_the_peers_pile_does(seed):
     """80 rolling circles (radius 0.3-0.5, friction 0.5) dropped into a pit 10 wide: every speed

@@ -155,6 +155,7 @@ def test_layers_and_masks_filter_pairs_before_geometry(scene):
 # --- response -------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_box_rests_on_ground_for_10000_steps_without_jitter_or_sinking():
     with Scene(gravity=(0.0, -10.0)) as s:
         floor_tiles(s, 8, x0=-3.5)  # top surface at y = 0.5
@@ -216,6 +217,7 @@ def test_stack_of_boxes_settles_and_stays():
         assert all(abs(s.get(b, Transform).x) < 1e-9 for b in boxes)
 
 
+@pytest.mark.slow
 def test_elastic_ball_never_bounces_higher_than_it_started():
     with Scene(gravity=(0.0, -10.0)) as s:
         floor_tiles(s, 3, x0=-1.0)
@@ -345,6 +347,7 @@ def _busy_run(seed: int) -> bytes:
         return b"".join(out)
 
 
+@pytest.mark.slow
 def test_same_inputs_same_bytes():
     assert _busy_run(3) == _busy_run(3)
 

@@ -72,6 +72,7 @@ def run(scene: Scene, steps: int) -> list[str]:
     return out
 
 
+@pytest.mark.slow
 def test_a_restored_scene_steps_bit_identically():
     s = build(1)
     run(s, 40)
@@ -85,6 +86,7 @@ def test_a_restored_scene_steps_bit_identically():
     assert run(s, 120) == first
 
 
+@pytest.mark.slow
 def test_a_snapshot_pickles_and_restores_into_a_scene_built_the_same_way():
     s = build(2)
     run(s, 30)
@@ -95,6 +97,7 @@ def test_a_snapshot_pickles_and_restores_into_a_scene_built_the_same_way():
     assert run(fresh, 100) == first
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None)
 @given(st.integers(0, 10_000), st.integers(0, 60), st.integers(1, 60))
 def test_random_scenes_and_random_points_of_snapshot(seed, before, after):
@@ -258,6 +261,7 @@ def test_rollback_rewinds_eight_frames_and_replays_with_corrected_input():
     assert math.isfinite(s.time)
 
 
+@pytest.mark.slow
 def test_the_platformer_restores_bit_identically_in_place_and_in_a_new_game():
     from examples.platformer import Game
     from examples.platformer.components import GameState

@@ -27,6 +27,7 @@ def test_a_saved_file_restores_bit_identically_into_a_scene_built_the_same_way(t
     assert run(other, 90) == first
 
 
+@pytest.mark.slow
 @settings(max_examples=10, deadline=None)
 @given(st.integers(0, 10_000), st.integers(0, 40))
 def test_random_scenes_round_trip_through_files(tmp_path_factory, seed, before):
@@ -40,6 +41,7 @@ def test_random_scenes_round_trip_through_files(tmp_path_factory, seed, before):
     assert run(other, 30) == first
 
 
+@pytest.mark.slow
 def test_the_platformer_saves_and_loads(tmp_path):
     from examples.platformer import Game
     from examples.platformer.components import GameState

@@ -235,6 +235,7 @@ def check(out: dict) -> None:
     assert out["block_growth"] <= BLOCK_BOUND and out["rss_growth_bytes"] <= RSS_BOUND, out
 
 
+@pytest.mark.slow
 def test_short_soak():
     out = soak(SHORT_STEPS, SHORT_BODIES, seed=1, memory_from=200, trace_from=600, trace_steps=100)
     check(out)

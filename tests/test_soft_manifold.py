@@ -53,6 +53,7 @@ def _shape(kind, size):
     return Capsule(size / 4, size)
 
 
+@pytest.mark.slow
 @example(ka="triangle", kb="triangle", sa=1.0, sb=1.0, bx=0.0, by=-1.5331679973654795e-230, ra=-2.5, rb=0.0)
 @settings(max_examples=300, deadline=None, derandomize=True)
 @given(ka=SHAPES, kb=SHAPES, sa=st.floats(0.5, 2.0), sb=st.floats(0.5, 2.0),

@@ -453,6 +453,7 @@ def test_a_soft_snapshot_does_not_restore_into_an_exact_scene():
 # --- the platformer and its characters -------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_the_platformers_demo_plays_the_same_in_the_soft_step():
     from examples.platformer import Game
     from examples.platformer.demo import Autoplay, level1
@@ -487,6 +488,7 @@ def test_a_character_rides_a_moving_platform_and_is_not_moved_twice():
         assert s.get(hero, Transform).y == pytest.approx(0.75, abs=1e-3), solver
 
 
+@pytest.mark.slow
 def test_a_first_step_that_compiles_says_so_once_and_a_quick_one_says_nothing(monkeypatch, capsys):
     import time
 
@@ -565,6 +567,7 @@ def test_a_bad_value_is_refused_before_the_soft_step_changes_anything(field, val
     assert differs.sum() <= 1
 
 
+@pytest.mark.slow
 def test_the_soft_step_gives_the_same_bytes_in_another_process():
     import subprocess
     import sys

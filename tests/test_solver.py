@@ -146,6 +146,7 @@ MIXED_NOT_YET = pytest.mark.xfail(
     "lighter one, since a 20-row pyramid of turning boxes fell apart without it, it is back to 33 s.)")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("kind", "seconds", "friction"), [
     ("balls", 30, None), ("boxes", 30, None), pytest.param("mixed", 30, None, marks=MIXED_NOT_YET),
     ("mixed", 60, None), ("mixed", 30, 0.5)])
@@ -181,6 +182,7 @@ def test_a_pile_of_boxes_rests_at_its_exact_height():
         assert ys == pytest.approx([r + 0.5 for r in range(10) for _ in range(10)], abs=1e-12)
 
 
+@pytest.mark.slow
 def test_a_tall_pile_of_balls_pushes_none_through_its_walls():
     # Was (during the solver's development): the pile's pressure pushed a ball at the bottom corner
     # 2 units sideways out through the wall in one step.

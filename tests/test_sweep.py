@@ -372,6 +372,7 @@ def _aimed(xa, ya, xb, yb, ma, mb, aim):
     return (ma[0] + (xa + aim[0] - xb) * aim[2], ma[1] + (ya + aim[1] - yb) * aim[2])
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(shapes, coord, coord, angles, motions, shapes, coord, coord, angles, motions, aims)
 def test_consistent_with_collide(a, xa, ya, ra, ma, b, xb, yb, rb, mb, aim):
@@ -415,6 +416,7 @@ def test_consistent_with_collide(a, xa, ya, ra, ma, b, xb, yb, rb, mb, aim):
             assert tuple(c.normal) == pytest.approx(tuple(imp.normal), abs=1e-4)
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(shapes, coord, coord, angles, motions, shapes, coord, coord, angles, motions, aims)
 def test_swap_symmetry(a, xa, ya, ra, ma, b, xb, yb, rb, mb, aim):

@@ -379,6 +379,7 @@ def support(shape, axis, sign):
     return ext, min(other), max(other)
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(shapes, shapes, st.integers(0, 3), pos, st.integers(-8, 8), st.integers(-64, 64),
        st.sampled_from([0, 1, -1]), st.booleans())

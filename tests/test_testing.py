@@ -221,6 +221,7 @@ def _golden_scene(speed: float = 3.0) -> Scene:
     return level.scene
 
 
+@pytest.mark.slow
 def test_golden_runs_record_then_compare_and_name_the_first_difference(tmp_path, monkeypatch):
     monkeypatch.delenv("FRAMEWORK_UPDATE_GOLDEN", raising=False)
     path = tmp_path / "golden" / "roll.json"
@@ -250,6 +251,7 @@ def test_golden_runs_record_then_compare_and_name_the_first_difference(tmp_path,
 # --- strategies ----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @settings(max_examples=10, deadline=None)
 @given(small_scenes(max_bodies=6))
 def test_small_scenes_settle_without_sinking(scene):
@@ -284,6 +286,7 @@ def test_passes(scene):
 """
 
 
+@pytest.mark.slow
 def test_the_plugin_pictures_a_failing_tests_scene(pytester):
     pytester.makepyfile(test_game=GAME_TEST)
     result = pytester.runpytest_subprocess("-p", "no:cacheprovider", "--framework-pictures", "pics")
@@ -299,6 +302,7 @@ def test_the_plugin_pictures_a_failing_tests_scene(pytester):
         assert "no picture of scene 1 (step 60)" in out
 
 
+@pytest.mark.slow
 def test_the_plugin_can_be_told_not_to_picture(pytester):
     pytester.makepyfile(test_game=GAME_TEST)
     result = pytester.runpytest_subprocess("-p", "no:cacheprovider", "--no-framework-pictures",
@@ -350,6 +354,7 @@ def test_roll(golden_dir):
 """
 
 
+@pytest.mark.slow
 def test_the_update_golden_option_records_and_golden_dir_is_next_to_the_test(pytester, monkeypatch):
     monkeypatch.delenv("FRAMEWORK_UPDATE_GOLDEN", raising=False)
 

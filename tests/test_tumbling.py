@@ -75,6 +75,7 @@ def test_a_stack_of_ten_rotating_boxes_with_friction_stands_and_sleeps():
         assert s.store.asleep[[s.store.row_of[b] for b in boxes]].all()
 
 
+@pytest.mark.slow
 def test_a_pyramid_of_twenty_rows_of_rotating_boxes_with_friction_stands():
     with Scene(gravity=(0.0, -G)) as s:
         _floor(s, 80.0)
@@ -90,6 +91,7 @@ def test_a_pyramid_of_twenty_rows_of_rotating_boxes_with_friction_stands():
         assert int(s.store.asleep.sum()) == len(placed)
 
 
+@pytest.mark.slow
 def test_a_row_of_dominoes_falls():
     with Scene(gravity=(0.0, -G)) as s:
         _floor(s)
@@ -115,6 +117,7 @@ def _energy(s: Scene, ents) -> float:
     return total
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("friction", [None, 0.7])
 def test_tumbling_bodies_never_gain_energy(friction):
     """A closed scene (a box of static walls) of tilted boxes and triangles dropped on each other:
@@ -224,6 +227,7 @@ def test_scene_contact_points_are_the_two_corners_a_box_rests_on():
         assert s.resolved[0].size == 1  # one pair applied
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("x0, rot", [(0.3, 0.1), (1.0, 0.0)])
 def test_a_box_resting_on_a_static_circle_is_measured_again_and_does_not_sink(x0, rot):
     """A turning box against an immovable circle: its contact is measured again between rounds
@@ -244,6 +248,7 @@ def test_a_box_resting_on_a_static_circle_is_measured_again_and_does_not_sink(x0
     s.close()
 
 
+@pytest.mark.slow
 def test_a_pyramid_of_turning_boxes_dropped_onto_its_rows_settles_and_stands():
     """The regimes bench's pyramid (20 rows of unit boxes that turn, friction 0.6, each row spawned
     a hair above the one below): its rows land on each other and it stands, the top box at 19.5.

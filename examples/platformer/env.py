@@ -300,7 +300,11 @@ def _level(level: int | str | Path | Level) -> Level:
 
 
 def register() -> None:
-    """Register ``framework/Platformer-v0`` with Gymnasium (done when this module is imported)."""
+    """Register ``framework/Platformer-v0`` with Gymnasium (done when this module is imported).
+
+    ``gym.make("framework.examples.platformer.env:framework/Platformer-v0")`` imports this module
+    by itself, so a script needs no import but Gymnasium's (Gymnasium 1.x has no plugin entry
+    points that could register it on Gymnasium's import; see docs/headless.md)."""
     if ENV_ID not in gym.registry:
         gym.register(ENV_ID, entry_point=f"{__name__}:PlatformerEnv")
 

@@ -9,6 +9,8 @@
 - :mod:`.golden`: golden runs (:func:`check_golden`);
 - :mod:`.strategies`: hypothesis strategies for shapes, transforms and small scenes (import it
   yourself: it needs hypothesis);
+- :mod:`.tracebacks`: the helpers' frames are left out of pytest's tracebacks when they fail a
+  test, so a failure points at the test's line;
 - :mod:`.plugin`: the pytest plugin (a ``scene`` fixture, a ``golden_dir`` fixture, pictures of
   failing tests' scenes, ``--update-golden``), active wherever the framework is installed.
 

@@ -15,11 +15,13 @@ import numpy as np
 from ..collision import collide
 from ..components import Hitbox, Transform, Velocity
 from ..validation import InvalidValue
+from .tracebacks import hide_on_failure
 
 __all__ = ["assert_at_rest", "assert_inside", "assert_no_overlap", "assert_on_floor", "bounds", "feet", "overlaps"]
 
 
 def _row(scene: Any, entity: int) -> int:
+    __tracebackhide__ = hide_on_failure
     if not scene.exists(entity):
         raise AssertionError(f"entity {entity} does not exist at step {scene.frame}")
     row = scene.bodies.store.row_of.get(entity)
@@ -32,6 +34,7 @@ def bounds(scene: Any, entity: int) -> tuple[float, float, float, float]:
     """``(minx, miny, maxx, maxy)`` of ``entity``'s hitbox where it is now, exactly as its shape
     and pose give it (a box's bottom is ``y - height / 2`` to the bit; the broad phase's bounds are
     wider by an ulp or two); its position, as a point, without a hitbox."""
+    __tracebackhide__ = hide_on_failure
     from ..casting import shape_bounds
 
     row = _row(scene, entity)
@@ -46,11 +49,13 @@ def bounds(scene: Any, entity: int) -> tuple[float, float, float, float]:
 
 def feet(scene: Any, entity: int) -> float:
     """The lowest point of ``entity``'s hitbox now: where it stands (``bounds(...)[1]``)."""
+    __tracebackhide__ = hide_on_failure
     return bounds(scene, entity)[1]
 
 
 def assert_at_rest(scene: Any, entity: int, *, speed: float = 1e-6) -> None:
     """``entity`` moves no faster than ``speed`` (units/s), and does not turn faster either."""
+    __tracebackhide__ = hide_on_failure
     _row(scene, entity)
     v = scene.try_get(entity, Velocity)
     if v is None:
@@ -88,6 +93,7 @@ def overlaps(scene: Any, deeper_than: float = 0.0, among: set[int] | None = None
 
 def assert_no_overlap(scene: Any, *, deeper_than: float = 0.0, among: set[int] | None = None) -> None:
     """No two solid hitboxes overlap deeper than ``deeper_than`` (see :func:`overlaps`)."""
+    __tracebackhide__ = hide_on_failure
     found = overlaps(scene, deeper_than, among)
     if found:
         a, b, depth = found[0]
@@ -98,6 +104,7 @@ def assert_no_overlap(scene: Any, *, deeper_than: float = 0.0, among: set[int] |
 def assert_inside(scene: Any, entity: int, box: tuple[float, float, float, float]) -> None:
     """``entity``'s hitbox (or its position, without one) lies inside ``box`` = (minx, miny,
     maxx, maxy)."""
+    __tracebackhide__ = hide_on_failure
     x0, y0, x1, y1 = box
     if not (x1 > x0 and y1 > y0):
         raise InvalidValue(f"box must be (minx, miny, maxx, maxy) with max > min, got {box!r}")
@@ -110,6 +117,7 @@ def assert_inside(scene: Any, entity: int, box: tuple[float, float, float, float
 def assert_on_floor(scene: Any, entity: int, *, gap: float = 1e-6) -> None:
     """``entity`` stands on something: its character controller says so, or a solid hitbox lies
     right under it (a shape cast ``gap`` down meets one with an upward normal)."""
+    __tracebackhide__ = hide_on_failure
     row = _row(scene, entity)
     from ..character import CharacterController
 

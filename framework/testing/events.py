@@ -16,6 +16,7 @@ from typing import Any, NamedTuple
 import esper
 
 from ..validation import InvalidValue
+from .tracebacks import hide_on_failure
 
 __all__ = ["EventLog", "Recorded"]
 
@@ -66,6 +67,7 @@ class EventLog:
     def assert_started(self, a: Who, b: Who, *, within: int | None = None) -> Recorded:
         """A ``started`` event between ``a`` and ``b`` happened (within the first ``within`` steps
         since the log began); return the first."""
+        __tracebackhide__ = hide_on_failure
         hits = self.between(a, b, "started")
         if within is not None:
             hits = [r for r in hits if r.frame - self._start <= within]
@@ -77,6 +79,7 @@ class EventLog:
 
     def assert_never(self, a: Who, b: Who, kind: str = "started") -> None:
         """No ``kind`` event between ``a`` and ``b`` was recorded."""
+        __tracebackhide__ = hide_on_failure
         hits = self.between(a, b, kind)
         if hits:
             raise AssertionError(f"{len(hits)} '{kind}' event(s) between {_name(a)} and {_name(b)}, the first at "

@@ -31,6 +31,7 @@ from typing import Any
 
 from ..validation import InvalidValue
 from .running import DT, Keys, _hold, _steps
+from .tracebacks import hide_on_failure
 
 __all__ = ["GOLDEN_FORMAT", "MAX_BYTES", "GoldenMismatch", "check_golden", "trace_step"]
 
@@ -66,6 +67,7 @@ def check_golden(scene: Any, path: str | Path, steps: int, *, keys: Keys = None,
     """Run ``scene`` ``steps`` steps (holding ``keys``, at ``dt``) and compare each step with the
     golden file at ``path``, or write it (see the module docstring); a file over ``max_bytes`` is
     refused before it is read."""
+    __tracebackhide__ = hide_on_failure
     from .. import __version__
 
     n = _steps(steps, None, dt, "check_golden")

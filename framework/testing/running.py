@@ -14,6 +14,7 @@ from typing import Any
 
 from ..input import Input
 from ..validation import InvalidValue
+from .tracebacks import hide_on_failure
 
 __all__ = ["DT", "KeyScript", "run", "step_until", "describe"]
 
@@ -111,9 +112,12 @@ def step_until(scene: Any, predicate: Callable[[Any], bool], *, within: int | No
                describe_with: Callable[[Any], str] | None = None, what: str | None = None) -> int:
     """Step until ``predicate(scene)`` holds; return how many steps that took (0: it held already).
 
-    A bound is required: ``within`` steps or ``seconds``. When it runs out, ``AssertionError`` says
-    what was awaited (``what``, else the predicate's name) and what was last seen
-    (``describe_with(scene)``, else :func:`describe`)."""
+    A bound is required: ``within`` steps or ``seconds``. ``keys`` are held while it steps, as in
+    :func:`run`: a :class:`KeyScript` (its frame 0 is this call's first step) or a set of keys held
+    throughout (``keys={"left"}``). When the bound runs out, ``AssertionError`` says what was
+    awaited (``what``, else the predicate's name) and what was last seen (``describe_with(scene)``,
+    else :func:`describe`); the traceback shows the test's call, not this function."""
+    __tracebackhide__ = hide_on_failure
     n = _steps(within, seconds, dt, "step_until")
     if predicate(scene):
         return 0
