@@ -15,6 +15,7 @@ import itertools
 import math
 import re
 from collections.abc import Callable, Iterable
+from contextlib import nullcontext
 from numbers import Integral
 from typing import Any, cast
 
@@ -25,6 +26,7 @@ from numpy.typing import NDArray
 from .bodies import Bodies
 from .character import CharacterController
 from .collision.broad_phase import SpatialHash
+from .compile_notice import FIRST_STEP_NOTICE, notice_if_slow
 from .components import Hitbox, Transform, Velocity, Visual
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import MissingComponent, check_added_component, spawn_components
@@ -51,6 +53,7 @@ __all__ = ["DEFAULT_EFFECTS", "EFFECTS", "SLEEP_SPEED", "SLEEP_STEPS", "SOLVERS"
            "SceneClosed", "SceneHit", "ShapeHit", "resolve_effects"]
 
 _scene_ids = itertools.count(1)
+_STEPPED = False  # whether a scene in this process has stepped (the first step compiles: see step())
 # Called with each new scene (the test plugin, framework.testing.plugin, follows the scenes a test
 # makes, to picture them when it fails).
 SCENE_CREATED: list[Callable[[Scene], None]] = []
@@ -494,26 +497,31 @@ class Scene:
         before = StepRollback(self)
         n = self.substeps
         errors: list[Exception] = []  # raised by collision handlers, raised once the step is complete
-        try:
-            self._totals = None
-            if n == 1:
-                self._substep(dt, render=True, checked=True, errors=errors, where=f", in step {self.frame + 1}")
-            else:
-                events: list[CollisionEvent] = []
-                total: dict[str, Any] = {}
-                for k in range(n):
-                    self._substep(dt / n, render=k == n - 1, checked=k == 0, errors=errors,
-                                  where=f", in step {self.frame + 1} (sub-step {k + 1} of {n})")
-                    events.extend(self.events)
-                    add_counters(total, self.counters)
-                self._totals = (events, total)
-        except Exception as exc:
-            if before.restore(self):
-                exc.add_note(f"step {self.frame + 1} failed and was undone: the scene is as it was before it")
-            else:
-                exc.add_note(f"step {self.frame + 1} failed after a system changed the scene's structure (a Hitbox "
-                             "or Velocity added or removed): the scene is left as the failure found it")
-            raise
+        # The process's first step compiles the kernels it uses (after installing): say so if slow.
+        # (A soft scene's kernel says its own.)
+        global _STEPPED
+        first, _STEPPED = not _STEPPED and self._pipeline.solver == "exact", True
+        with notice_if_slow(FIRST_STEP_NOTICE) if first else nullcontext():
+            try:
+                self._totals = None
+                if n == 1:
+                    self._substep(dt, render=True, checked=True, errors=errors, where=f", in step {self.frame + 1}")
+                else:
+                    events: list[CollisionEvent] = []
+                    total: dict[str, Any] = {}
+                    for k in range(n):
+                        self._substep(dt / n, render=k == n - 1, checked=k == 0, errors=errors,
+                                      where=f", in step {self.frame + 1} (sub-step {k + 1} of {n})")
+                        events.extend(self.events)
+                        add_counters(total, self.counters)
+                    self._totals = (events, total)
+            except Exception as exc:
+                if before.restore(self):
+                    exc.add_note(f"step {self.frame + 1} failed and was undone: the scene is as it was before it")
+                else:
+                    exc.add_note(f"step {self.frame + 1} failed after a system changed the scene's structure (a Hitbox "
+                                 "or Velocity added or removed): the scene is left as the failure found it")
+                raise
         self.frame += 1
         self.time += dt
         inp = self.resources.get(Input)

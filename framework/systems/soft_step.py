@@ -17,14 +17,13 @@ response does: a game processor placed between the exact pipeline's physics stag
 from __future__ import annotations
 
 import math
-import sys
-import threading
 from typing import Any
 
 import esper
 import numpy as np
 
 from ..character import CharacterController
+from ..compile_notice import notice_if_slow
 from ..events import StepContacts
 from ..frame import StepFrame
 from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
@@ -92,7 +91,7 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
 
 
 _COMPILED = False
-COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about half a minute; later runs load "
+COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 20 seconds; later runs load "
                   "it from numba's cache)")
 
 
@@ -100,12 +99,10 @@ def _first_call(args: tuple[Any, ...]) -> tuple[Any, ...]:
     """The kernel's first call in this process: if it has not returned within a second (numba is
     compiling it, not loading it from its cache), say so on stderr, once."""
     global _COMPILED
-    timer = threading.Timer(1.0, lambda: print(COMPILE_NOTICE, file=sys.stderr, flush=True))
-    timer.start()
     try:
-        return soft_step(*args)
+        with notice_if_slow(COMPILE_NOTICE):
+            return soft_step(*args)
     finally:
-        timer.cancel()
         _COMPILED = True
 
 
