@@ -14,8 +14,10 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from .casting import ShapeHit, cast_rows, touch_point
+from .casting import ShapeHit, cast_rows, shape_bounds, touch_point
 from .collision import batch, collide
+from .collision.distance import Distance, point_distance
+from .collision.distance import distance as shape_distance
 from .collision.placement import check_shape
 from .collision.ray import closest_on_segment
 from .collision.ray import raycast as _raycast
@@ -25,7 +27,7 @@ from .store import STATIC
 from .systems.stage import Pipeline
 from .validation import InvalidValue, finite, vector2
 
-__all__ = ["ALL_LAYERS", "SceneHit", "ShapeHit", "SpatialQueries"]
+__all__ = ["ALL_LAYERS", "Nearest", "SceneHit", "ShapeHit", "SpatialQueries"]
 
 ALL_LAYERS = 0xFFFFFFFF
 
@@ -37,6 +39,15 @@ class SceneHit(NamedTuple):
     distance: float
     point: Vec2
     normal: Vec2
+
+
+class Nearest(NamedTuple):
+    """The hitbox nearest a point: its entity, how far it is (0: the point is inside or on it) and
+    its point nearest the given one."""
+
+    entity: int
+    distance: float
+    point: Vec2
 
 
 class SpatialQueries:
@@ -147,6 +158,55 @@ class SpatialQueries:
         rows = self._mask_ok(self._candidate_rows(px - 1e-9, py - 1e-9, px + 1e-9, py + 1e-9), mask)
         return sorted(int(self.bodies.store.entity[r]) for r in rows.tolist() if self._contains(r, px, py))
 
+    def query_shape(self, shape: Any, position: tuple[float, float], rotation: float = 0.0,
+                    mask: int = ALL_LAYERS) -> list[int]:
+        """Entities whose hitbox interiors overlap ``shape``'s at ``position`` (its hitbox origin),
+        turned by ``rotation``, sorted (touching does not count, as in the collision contract)."""
+        check_shape("shape", shape)
+        x, y = vector2("position", position)
+        rot = finite("rotation", rotation)
+        return self._overlapping(shape, (x, y, rot), mask, shape_bounds(shape, x, y, rot))
+
+    def nearest(self, point: tuple[float, float], max_distance: float = math.inf,
+                mask: int = ALL_LAYERS) -> Nearest | None:
+        """The hitbox nearest ``point`` within ``max_distance`` (0 if the point is inside one), or
+        None; ties go to the lower entity id."""
+        px, py = vector2("point", point)
+        md = float(max_distance) if not isinstance(max_distance, bool) else math.nan
+        if not md >= 0.0:
+            raise InvalidValue(f"max_distance must be >= 0, got {max_distance!r}")
+        store = self.bodies.store
+        geom = self.bodies.ensure_geometry()
+        if math.isfinite(md):
+            rows = self._candidate_rows(px - md - 1e-9, py - md - 1e-9, px + md + 1e-9, py + md + 1e-9)
+        else:
+            self.bodies.sync_static()
+            rows = np.flatnonzero(store.kind >= 0)
+        best: Nearest | None = None
+        for r in self._mask_ok(rows, mask).tolist():
+            hb = store.hitboxes[r]
+            assert hb is not None  # (rows with a kind have a hitbox)
+            d, at = point_distance(hb.shape, float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]), px, py)
+            e = int(store.entity[r])
+            if d <= md and (best is None or (d, e) < (best.distance, best.entity)):
+                best = Nearest(e, d, at)
+        return best
+
+    def distance(self, entity_a: int, entity_b: int) -> Distance:
+        """How far entity B's hitbox is from entity A's, and their closest points
+        (:func:`~framework.collision.distance.distance`)."""
+        store = self.bodies.store
+        geom = self.bodies.ensure_geometry()
+        poses = []
+        for name, e in (("entity_a", entity_a), ("entity_b", entity_b)):
+            r = store.row_of.get(e) if isinstance(e, int) and not isinstance(e, bool) else None
+            hb = store.hitboxes[r] if r is not None else None
+            if hb is None:
+                raise InvalidValue(f"{name} must be an entity with a Hitbox, got {e!r}")
+            poses.append((hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))))
+        (sa, pa), (sb, pb) = poses
+        return shape_distance(sa, pa, sb, pb)
+
     def _contains(self, r: int, px: float, py: float) -> bool:
         store, geom = self.bodies.store, self.bodies.geometry
         hb = store.hitboxes[r]
@@ -168,7 +228,7 @@ class SpatialQueries:
                 return False
         return True
 
-    def _overlapping(self, shape: Any, center: tuple[float, float], mask: int,
+    def _overlapping(self, shape: Any, center: tuple[float, float] | tuple[float, float, float], mask: int,
                      box: tuple[float, float, float, float]) -> list[int]:
         rows = self._mask_ok(self._candidate_rows(*box), mask)
         store, geom = self.bodies.store, self.bodies.geometry

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from .bodies import Bodies
 from .character import CharacterController
 from .collision.broad_phase import SpatialHash
+from .collision.distance import Distance
 from .compile_notice import FIRST_STEP_NOTICE, notice_if_slow
 from .components import Hitbox, Transform, Velocity, Visual
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
@@ -35,7 +36,7 @@ from .frame import StepFrame, add_counters
 from .geometry import Geometry
 from .input import Input
 from .limits import MAX_COORD, check_motion, motion_within
-from .queries import ALL_LAYERS, SceneHit, ShapeHit, SpatialQueries
+from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
 from .shapes import Shape
 from .snapshot import Snapshot
@@ -500,8 +501,8 @@ class Scene:
         # The process's first step compiles the kernels it uses (after installing): say so if slow.
         # (A soft scene's kernel says its own.)
         global _STEPPED
-        first, _STEPPED = not _STEPPED and self._pipeline.solver == "exact", True
-        with notice_if_slow(FIRST_STEP_NOTICE) if first else nullcontext():
+        compiling, _STEPPED = not _STEPPED and self._pipeline.solver == "exact", True
+        with notice_if_slow(FIRST_STEP_NOTICE) if compiling else nullcontext():
             try:
                 self._totals = None
                 if n == 1:
@@ -622,6 +623,28 @@ class Scene:
         """Entities whose hitbox contains the point (closed: a point on the boundary counts)."""
         self._activate()
         return self._queries.query_point(x, y, mask)
+
+    def query_shape(self, shape: Shape, position: tuple[float, float], *, rotation: float = 0.0,
+                    mask: int = ALL_LAYERS) -> list[int]:
+        """Entities whose hitbox interiors overlap ``shape``'s placed at ``position`` (its hitbox
+        origin) and turned by ``rotation``, sorted: an explosion's reach, a sword's swing, whether a
+        spawn point is free. Touching does not count."""
+        self._activate()
+        return self._queries.query_shape(shape, position, rotation, mask)
+
+    def nearest(self, point: tuple[float, float], *, max_distance: float = math.inf,
+                mask: int = ALL_LAYERS) -> Nearest | None:
+        """The hitbox nearest ``point`` within ``max_distance``: a :class:`~framework.queries.Nearest`
+        (entity, distance, its nearest point; distance 0 if the point is inside), or None. Ties go to
+        the lower entity id."""
+        self._activate()
+        return self._queries.nearest(point, max_distance, mask)
+
+    def distance(self, entity_a: int, entity_b: int) -> Distance:
+        """How far apart two entities' hitboxes are (0 where they overlap or touch) and their
+        closest points: a :class:`~framework.collision.distance.Distance`."""
+        self._activate()
+        return self._queries.distance(entity_a, entity_b)
 
     # --- snapshots ---------------------------------------------------------------------------
 

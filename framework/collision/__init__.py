@@ -5,10 +5,11 @@ touching is not a collision; normals point from A toward B; grazing rays and swe
 """
 
 from .collide import collide
+from .distance import Distance, distance
 from .manifold import manifold
 from .ray import raycast
 from .results import Contact, Impact, Manifold, ManifoldPoint, RayHit, Vec2
 from .sweep import time_of_impact
 
-__all__ = ["Contact", "Impact", "Manifold", "ManifoldPoint", "RayHit", "Vec2", "collide", "manifold", "raycast",
-           "time_of_impact"]
+__all__ = ["Contact", "Distance", "Impact", "Manifold", "ManifoldPoint", "RayHit", "Vec2", "collide", "distance",
+           "manifold", "raycast", "time_of_impact"]
