@@ -482,6 +482,16 @@ def test_queries_over_many_moving_bodies():
     assert h._moving_cells is None
 
 
+@pytest.mark.parametrize("direct", [0, 10**9], ids=["through the cell index", "bounds tested directly"])
+def test_box_queries_answer_the_same_with_and_without_the_cell_index(monkeypatch, direct):
+    # up to DIRECT_QUERY bodies a box query tests every bound without the index: both ways are brute force's
+    import framework.collision.broad_phase as bp
+
+    monkeypatch.setattr(bp, "DIRECT_QUERY", direct)
+    test_query_box_hand_cases()
+    test_queries_over_many_moving_bodies()
+
+
 def test_the_caller_may_overwrite_its_arrays():
     b = [np.array(v) for v in boxes((0, 0, 1, 1), (5, 5, 6, 6), (-1e9, 3, 1e9, 4))]
     h = SpatialHash(1.0)
