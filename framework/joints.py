@@ -304,11 +304,15 @@ class MouseJoint(Joint):
 
 
 JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint)
+_JOINT_SET = frozenset(JOINT_TYPES)
 
 
 def joint_components() -> list[tuple[int, Joint]]:
-    """Every joint of the current esper world as ``(entity, joint)``, by entity then kind (esper's
-    cached queries: a few microseconds in a scene without joints)."""
+    """Every joint of the current esper world as ``(entity, joint)``, by entity then kind. A world
+    without joints answers from esper's table of component types (which drops a type when its last
+    component goes): four set look-ups, a fraction of a microsecond a step."""
+    if esper._components.keys().isdisjoint(_JOINT_SET):
+        return []
     out: list[tuple[int, Joint]] = []
     for cls in JOINT_TYPES:
         out.extend(esper.get_component(cls))

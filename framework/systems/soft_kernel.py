@@ -682,10 +682,14 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
         softness[q, 0], softness[q, 1], softness[q, 2] = _soft((2.0 if q & 1 else 1.0) * scale * hertz,
                                                                scale * zeta, h)
     push = params[_PUSH]
-    jp = prepare_joints(jint, jf, x, y, rot, moving, im, ii, h)
-    jimp = jimp.copy()
-    jsoft = np.empty(3)  # the joints' stiffness (Box2D's b2PrepareJoint: at most a quarter of the sub-step rate)
-    jsoft[0], jsoft[1], jsoft[2] = _soft(min(params[_JHZ], 0.25 * inv_h), params[_JZETA], h)
+    nj = jint.shape[0]  # (no joints: no calls and no copies, as before there were joints)
+    jp = jf
+    jsoft = softness[0]
+    if nj:
+        jp = prepare_joints(jint, jf, x, y, rot, moving, im, ii, h)
+        jimp = jimp.copy()
+        jsoft = np.empty(3)  # the joints' stiffness (Box2D's b2PrepareJoint: at most a quarter of the sub-step rate)
+        jsoft[0], jsoft[1], jsoft[2] = _soft(min(params[_JHZ], 0.25 * inv_h), params[_JZETA], h)
     x0 = x.copy()
     y0 = y.copy()
     qc = np.ones(n)
@@ -698,7 +702,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             if moving[r] and body[r] == _DYNAMIC and not driven[r]:
                 vx[r] += h * gx
                 vy[r] += h * gy
-        warm_start_joints(jint, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
+        if nj:
+            warm_start_joints(jint, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
         for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
             if relax:
@@ -714,7 +719,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
                             c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
                             mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
                             qc[r], qs[r] = c2 * mag, s2 * mag
-            solve_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w, relax == 0, jsoft, h, inv_h)
+            if nj:
+                solve_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w, relax == 0, jsoft, h, inv_h)
             _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
                    inv_h, push)
     _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
