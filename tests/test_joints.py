@@ -27,6 +27,7 @@ from framework import (
     Velocity,
     WeldJoint,
 )
+from framework.snapshot_file import load_snapshot, save_snapshot
 from framework.systems.soft_step import SOFT_SETTINGS
 
 SLOP = SOFT_SETTINGS["slop"]
@@ -386,6 +387,20 @@ def test_a_restored_snapshot_continues_bit_for_bit():
     assert state(s, es) == expected
 
 
+def test_a_snapshot_file_continues_bit_for_bit(tmp_path):
+    s, es = machine()
+    for _ in range(40):
+        s.step(DT)
+    save_snapshot(s, tmp_path / "machine.snap")
+    for _ in range(40):
+        s.step(DT)
+    expected = state(s, es)
+    load_snapshot(s, tmp_path / "machine.snap")
+    for _ in range(40):
+        s.step(DT)
+    assert state(s, es) == expected
+
+
 def test_a_failed_step_leaves_the_joints_as_they_were():
     s, es = machine()
     twin, _ = machine()
@@ -413,3 +428,35 @@ def test_the_exact_solver_refuses_joints():
     with pytest.raises(InvalidValue, match='joints need Scene\\(solver="soft"\\)'):
         s.step(DT)
     assert s.frame == 0 and pose(s, a) == (0.0, 0.0, 0.0)
+
+
+def test_a_sleeping_body_wakes_when_its_joint_changes():
+    s = soft()
+    wheel = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.5)))
+    axle = s.spawn(RevoluteJoint(wheel, None, (0.0, 0.0), max_motor_torque=64.0))
+    grabbed = s.spawn(Transform(4.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
+    mouse = s.spawn(MouseJoint(grabbed, (4.0, 0.0), max_force=64.0))
+    for _ in range(128):
+        s.step(DT)
+    assert s.store.asleep[s.store.row_of[wheel]] and s.store.asleep[s.store.row_of[grabbed]]
+    s.get(axle, RevoluteJoint).motor_speed = 2.0
+    s.get(mouse, MouseJoint).target = (4.0, 1.0)
+    for _ in range(128):
+        s.step(DT)
+    assert s.get(wheel, Velocity).angular == pytest.approx(2.0, abs=1e-6)
+    assert math.dist(pose(s, grabbed)[:2], (4.0, 1.0)) < 0.01
+
+
+def test_a_body_asleep_wakes_when_the_other_body_of_its_joint_moves():
+    s = soft()
+    hook = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.125), body="kinematic"))
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125)))
+    s.spawn(DistanceJoint(ball, hook))
+    for _ in range(128):
+        s.step(DT)
+    assert s.store.asleep[s.store.row_of[ball]]
+    s.get(hook, Velocity).x = 1.0  # the hook moves off: the ball follows
+    for _ in range(64):
+        s.step(DT)
+    assert pose(s, ball)[0] > 0.5
+    assert math.dist(pose(s, ball)[:2], pose(s, hook)[:2]) == pytest.approx(1.0, abs=SLOP)

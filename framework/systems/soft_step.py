@@ -39,7 +39,7 @@ from ..joints import (
     check_joints,
     joint_components,
 )
-from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
+from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
 from .soft_joints import JOINT_F, JOINT_IMP
 from .soft_kernel import PARAMS, SLOT, internal_faces, soft_step
 from .stage import PRIORITY, Stage
@@ -313,13 +313,18 @@ class SoftStep(Stage):
         return jint, jf, imp, apart
 
     def _wake_joined(self, jint: np.ndarray, changed: np.ndarray) -> None:
-        """Wake the sleeping bodies of joints that are new or changed, or whose other body moves."""
+        """Wake the sleeping bodies of joints that are new or changed, or whose other body is an
+        awake dynamic body or moves (a kinematic one with a velocity). (Joined dynamic bodies fall
+        asleep together: the sleeping stage reads the joints' rows, ``frame.joined``.)"""
         store = self.bodies.store
         n = store.n
         asleep = store.cols["asleep"][:n]
         if not asleep.any():
             return
-        moves = np.append(~asleep & store.has_vel[:n] & (store.body[:n] != STATIC), False)  # (row -1: the world)
+        c = store.cols
+        going = (c["vx"][:n] != 0.0) | (c["vy"][:n] != 0.0) | (c["w"][:n] != 0.0)
+        awake = ~asleep & store.has_vel[:n] & ((store.body[:n] == DYNAMIC) | ((store.body[:n] != STATIC) & going))
+        moves = np.append(awake, False)  # (row -1: the world)
         ra, rb = jint[:, 1], jint[:, 2]
         wake = np.concatenate([ra[changed | moves[rb]], rb[changed | moves[ra]]])
         wake = wake[wake >= 0]
@@ -343,6 +348,9 @@ class SoftStep(Stage):
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info, jimp = out
         if jimp.size:
             self.joints = (self.joints[0], jimp, self.joints[2])
+            ja, jb = args[-4][:, 1], args[-4][:, 2]
+            both = (ja >= 0) & (jb >= 0)
+            frame.joined = (ja[both], jb[both])
         if "movement" in effects:
             store.motion += 1
         ra, rb, ea, eb, started = touch_i
