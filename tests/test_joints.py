@@ -280,14 +280,17 @@ def test_a_mouse_joint_pulls_with_at_most_its_force():
 
 
 def bodies(s: Scene) -> tuple[int, int, int]:
+    """Two bodies, an entity without a Hitbox, and entity 4 despawned."""
     a = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
     b = s.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
     plain = s.spawn(Transform(3.0, 0.0))
+    s.despawn(s.spawn(Transform(4.0, 0.0), Velocity(), Hitbox(Circle(0.25))))
     return a, b, plain
 
 
 @pytest.mark.parametrize("make", [
     lambda a, b, p: DistanceJoint(a, 999),
+    lambda a, b, p: DistanceJoint(a, 4),  # despawned
     lambda a, b, p: DistanceJoint(a, p),
     lambda a, b, p: RevoluteJoint(999, b, (0.0, 0.0)),
     lambda a, b, p: WeldJoint(a, a, (0.0, 0.0)),
