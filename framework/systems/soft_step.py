@@ -342,13 +342,14 @@ class SoftStep(Stage):
         if rebuild:
             self.fat = np.zeros((store.n, 4))
             self._pairs_key = key
+        joints = self._joints()
         args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
-                *self._joints())
+                *joints)
         out = soft_step(*args) if _COMPILED else _first_call(args)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info, jimp = out
         if jimp.size:
             self.joints = (self.joints[0], jimp, self.joints[2])
-            ja, jb = args[-4][:, 1], args[-4][:, 2]
+            ja, jb = joints[0][:, 1], joints[0][:, 2]
             both = (ja >= 0) & (jb >= 0)
             frame.joined = (ja[both], jb[both])
         if "movement" in effects:
