@@ -90,6 +90,8 @@ class StepFrame:
     # and impulse (a, b, nx, ny, push, impulse, gap, tangent push, tangent impulse)
     resolved: Resolved = NO_RESOLVED
     support: Support = NO_SUPPORT
+    # the soft step's joints: the rows of each joint's two bodies (joined bodies sleep and wake together)
+    joined: tuple[_I, _I] = (_INTS, _INTS)
     # where bodies turn (see framework.systems.turning): each contact point acted on, by pair and
     # slot (pair key, slot, push, impulse, tangent push, tangent impulse, x, y), sorted by pair
     points: Points = NO_POINTS

@@ -35,6 +35,7 @@ from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
 from .frame import StepFrame, add_counters
 from .geometry import Geometry
 from .input import Input
+from .joints import Joint, check_joints, joint_components, remove_joints_of
 from .limits import MAX_COORD, check_motion, motion_within
 from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
@@ -267,9 +268,13 @@ class Scene:
     def spawn(self, *components: Any) -> int:
         """Create an entity with ``components``; return its id.
 
-        A Hitbox needs a Transform; a static body has no Velocity. Nothing changes on error."""
+        A Hitbox needs a Transform; a static body has no Velocity; a joint's bodies are bodies of
+        the scene (see :mod:`framework.joints`). Nothing changes on error."""
         self._activate()
         t, v, h = spawn_components(components)
+        for comp in components:
+            if isinstance(comp, Joint):
+                comp.attach(self.bodies.store)
         entity = esper.create_entity(*components)
         if t is not None:
             self.bodies.store.add(entity, t, v, h)
@@ -301,12 +306,15 @@ class Scene:
         comps: tuple[Any, ...] = esper.components_for_entity(entity)
         self.handlers.remember(entity, {type(c) for c in comps})
         store = self.bodies.store
-        if entity in store.row_of:
-            row = store.row_of[entity]
+        row = store.row_of.get(entity)
+        if row is not None:
             if store.asleep.any() and store.kind[row] >= 0:
                 self.bodies.wake_near(row)
             store.remove(entity, comps)
         esper.delete_entity(entity, immediate=True)
+        if row is not None:  # a body: its joints go with it (and the entities they leave empty)
+            for e in remove_joints_of(entity):
+                self._remove(e)
 
     def _was_entity(self, entity: Any) -> bool:
         """Whether ``entity`` is an id this scene gave out (esper never gives one out twice): one
@@ -334,6 +342,8 @@ class Scene:
             raise InvalidValue(f"entity {entity!r} does not exist")
         store = self.bodies.store
         check_added_component(store, entity, component)
+        if isinstance(component, Joint):
+            component.attach(store)
         old = esper.try_component(entity, type(component))
         esper.add_component(entity, component)
         if isinstance(component, CharacterController):
@@ -486,6 +496,9 @@ class Scene:
         dt = positive("dt", dt)
         store = self.bodies.store
         store.check()
+        joints = joint_components()
+        if joints:
+            check_joints(joints, store, self.solver)
         characters = self._stages["character"]
         if isinstance(characters, CharacterStage) and characters.wanted():
             characters.check()

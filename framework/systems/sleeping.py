@@ -3,8 +3,9 @@
 A dynamic body sleeps after :data:`SLEEP_STEPS` steps at rest: moving less than
 :data:`SLEEP_SPEED` (relative to 1 + its size, per second) with a speed below that. A stack sleeps
 as one: a body touching an awake, restless dynamic body stays awake, and so, in turn, does
-whatever touches it. Game code writing its Transform or Velocity, a contact with an awake body, a
-change to the static level or a despawn nearby wake it.
+whatever touches it (the two bodies of a joint count as touching). Game code writing its Transform
+or Velocity, a contact with an awake body, a change to the static level or a despawn nearby wake
+it.
 
 And a stack wakes as one: the bodies that fell asleep touching each other (contacts and resting
 pairs, as the response saw them then) are linked, and when one of them wakes, for whatever reason,
@@ -76,12 +77,13 @@ class Sleeping(Stage):
         return True
 
     def _touching(self, frame: StepFrame) -> tuple[I64Array, I64Array]:
-        """The rows of the pairs touching this step: its contacts and the response's resting pairs
-        (bodies that fell together merely touch), both still in the store."""
+        """The rows of the pairs touching this step: its contacts, the response's resting pairs
+        (bodies that fell together merely touch) and the bodies of joints, all still in the store."""
         store = self.bodies.store
         sa, sb = self.bodies.rows_of(frame.support[0]), self.bodies.rows_of(frame.support[1])
-        ra = np.concatenate([frame.contact_rows[0], sa])
-        rb = np.concatenate([frame.contact_rows[1], sb])
+        ja, jb = frame.joined
+        ra = np.concatenate([frame.contact_rows[0], sa, ja])
+        rb = np.concatenate([frame.contact_rows[1], sb, jb])
         ok = (ra >= 0) & (rb >= 0) & (ra < store.n) & (rb < store.n)
         return ra[ok], rb[ok]
 

@@ -14,10 +14,11 @@ Read top to bottom, one step is:
    wall it would otherwise pass in one step (no tunnelling, without a separate sweep);
 4. **prepare**: anchors relative to each body's origin, effective masses, the impulses of last
    step's matching points (by pair slot and feature id) to warm start with; where nothing turns, a
-   face's two points are one row;
+   face's two points are one row; the joints prepared likewise (:mod:`.soft_joints`), and the
+   pairs of a joint's bodies never touch (unless it says they collide);
 5. **sub-steps** (Box2D's ``b2SolverStage``): integrate velocities (gravity), warm start, solve
    with soft constraints (the bias pushes overlap out at most ``push_speed``), integrate
-   positions, relax (solve again without the bias);
+   positions, relax (solve again without the bias); joints before contacts in each;
 6. **restitution**, then **store** the impulses in the pairs' slots and report the pairs in
    contact sorted by entity ids (started ones flagged), the ones no longer in contact, and the
    sleepers an awake body touched (to wake).
@@ -28,7 +29,8 @@ geometrically inside the solve. Sequential impulses over contacts in a fixed ord
 results for identical inputs.
 
 Numba's cache of this module does not see through the functions it calls from
-:mod:`framework.collision.soft_manifold`: after editing that module, delete the ``soft_kernel*``
+:mod:`framework.collision.soft_manifold`, :mod:`.soft_joints` and :mod:`.softness`: after editing
+one of them, delete the ``soft_kernel*``
 cache files in ``__pycache__`` (an installed release replaces both files at once).
 """
 
@@ -50,28 +52,20 @@ from ..collision.soft_manifold import (
     polygon_circle,
     polygon_polygon,
 )
+from .soft_joints import prepare_joints, solve_joints, warm_start_joints
+from .softness import soft as _soft
 
 __all__ = ["PARAMS", "SLOT", "internal_faces", "soft_step"]
 
 # The layout of the ``params`` float array (one argument instead of fourteen scalars).
 PARAMS = ("dt", "substeps", "gx", "gy", "slop", "speculative", "hertz", "damping", "push_speed",
-          "restitution_threshold", "layers_open", "response", "rotation", "friction", "fat_margin")
-_DT, _SUB, _GX, _GY, _SLOP, _SPEC, _HZ, _ZETA, _PUSH, _REST, _LAYERS, _RESPONSE, _ROT, _FRIC, _FAT = range(len(PARAMS))
+          "restitution_threshold", "layers_open", "response", "rotation", "friction", "fat_margin", "joint_hertz",
+          "joint_damping")
+(_DT, _SUB, _GX, _GY, _SLOP, _SPEC, _HZ, _ZETA, _PUSH, _REST, _LAYERS, _RESPONSE, _ROT, _FRIC, _FAT, _JHZ,
+ _JZETA) = range(len(PARAMS))
 
 _DYNAMIC, _STATIC = 0, 2
 _AABB, _CIRCLE, _CAPSULE = 0, 1, 3
-
-
-@njit(cache=True)
-def _soft(hertz, zeta, h):
-    """Box2D's ``b2MakeSoft``: (bias rate, mass scale, impulse scale) of a soft constraint."""
-    if hertz == 0.0:
-        return 0.0, 1.0, 0.0
-    omega = 2.0 * math.pi * hertz
-    a1 = 2.0 * zeta + h * omega
-    a2 = h * omega * a1
-    a3 = 1.0 / (1.0 + a2)
-    return omega / a1, a2 * a3, a3
 
 
 @njit(cache=True)
@@ -367,10 +361,11 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 
 @njit(cache=True)
 def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction, kind, cnt, rr, sensor,
-                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii):
+                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii, apart):
     """The manifold of every candidate pair, and the contacts the solver uses, prepared (anchors, effective
     masses, warm starts from the pair's slot by feature id): ``(nc, ci, cf, cp, tnow, evd)``, see
-    :func:`soft_step`; a pair whose bodies both rest keeps its state (``tnow`` -1)."""
+    :func:`soft_step`; a pair whose bodies both rest keeps its state (``tnow`` -1); a pair whose key is
+    in ``apart`` (sorted: the bodies of a joint) never touches."""
     m = pairs.shape[0]
     ci = np.empty((m, 2), dtype=np.int64)  # the contact's pair slot, points the solver uses
     cf = np.empty((m, 5))  # nx, ny, friction, restitution, stiff (against an idle body)
@@ -384,6 +379,10 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
         was = slots[p, _TOUCH] != 0.0
         if not moving[a] and not moving[b]:  # asleep (or still): keeps what it had
             tnow[p] = -1
+            slots[p, _NP] = 0.0
+            continue
+        if apart.size and _holds(apart, pairs[p, 2]):  # joined, not colliding
+            tnow[p] = 0
             slots[p, _NP] = 0.0
             continue
         s_pair = spec + reach[a] + reach[b] if response else 0.0
@@ -484,6 +483,19 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
 
 
 @njit(cache=True)
+def _holds(keys, key):
+    """Whether the sorted ``keys`` hold ``key`` (a binary search)."""
+    lo, hi = 0, keys.size
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if keys[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo < keys.size and keys[lo] == key
+
+
+@njit(cache=True)
 def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving, ended_keys, ended_f, n_end,
             rebuilt, sleepers):
     """Store the impulses in the pairs' slots and report which pairs are in contact: ``(touch_i,
@@ -556,7 +568,7 @@ def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
 
 @njit(cache=True)
 def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, faces, driven, fat, pairs, slots,
-              rebuild):
+              rebuild, jint, jf, jimp, apart):
     """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
 
     What changes only with the rows comes packed, as rows of three tables (see
@@ -568,15 +580,18 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     ``driven``: rows a character controller moved this step (they are not moved again, and take
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
-    not modified: new ones are returned. See the module docstring for the stages.
+    not modified: new ones are returned. ``jint, jf, jimp``: the joints, their parameters and their
+    impulses from the last step (:mod:`framework.systems.soft_joints`; new impulses are returned);
+    ``apart``: the sorted keys of the pairs that do not collide (a joint's bodies). See the module
+    docstring for the stages.
 
-    Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info)`` (few objects: each
+    Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp)`` (few objects: each
     array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
     slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
     entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
     (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
     were found again, how many contacts the solver used, how many bodies sleep (before this step's
-    wakes), then the rows of the sleepers to wake."""
+    wakes), then the rows of the sleepers to wake; the joints' impulses."""
     inv_mass, inv_inertia, friction, restitution, bound, rr = fprops[0], fprops[1], fprops[2], fprops[3], fprops[4], \
         fprops[5]
     body, kind, layer, mask, entity = iprops[0], iprops[1], iprops[2], iprops[3], iprops[4]
@@ -653,7 +668,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     # --- narrow phase: manifolds -> contacts, prepared ---------------------------------------------
     nc, ci, cf, cp, tnow, evd = _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction,
                                               kind, cnt, rr, sensor, one_way, friction, restitution, faces, wc, lv,
-                                              wv, wn, x, y, vx, vy, w, im, ii)
+                                              wv, wn, x, y, vx, vy, w, im, ii, apart)
 
     # --- sub-steps ------------------------------------------------------------------------------
     h = dt / nsub if nsub > 0 else 0.0
@@ -667,6 +682,14 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
         softness[q, 0], softness[q, 1], softness[q, 2] = _soft((2.0 if q & 1 else 1.0) * scale * hertz,
                                                                scale * zeta, h)
     push = params[_PUSH]
+    nj = jint.shape[0]  # (no joints: no calls and no copies, as before there were joints)
+    jp = jf
+    jsoft = softness[0]
+    if nj:
+        jp = prepare_joints(jint, jf, x, y, rot, moving, im, ii, h)
+        jimp = jimp.copy()
+        jsoft = np.empty(3)  # the joints' stiffness (Box2D's b2PrepareJoint: at most a quarter of the sub-step rate)
+        jsoft[0], jsoft[1], jsoft[2] = _soft(min(params[_JHZ], 0.25 * inv_h), params[_JZETA], h)
     x0 = x.copy()
     y0 = y.copy()
     qc = np.ones(n)
@@ -679,6 +702,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             if moving[r] and body[r] == _DYNAMIC and not driven[r]:
                 vx[r] += h * gx
                 vy[r] += h * gy
+        if nj:
+            warm_start_joints(jint, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
         for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
             if relax:
@@ -694,6 +719,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
                             c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
                             mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
                             qc[r], qs[r] = c2 * mag, s2 * mag
+            if nj:
+                solve_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w, relax == 0, jsoft, h, inv_h)
             _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
                    inv_h, push)
     _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
@@ -701,7 +728,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     # --- store the impulses in the slots; which pairs are in contact ----------------------------
     touch_i, touch_f, end_i, end_f, info = _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
                                                    ended_keys, ended_f, n_end, rebuilt, sleepers)
-    return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info
+    return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp
 
 
 @njit(cache=True)

@@ -26,7 +26,20 @@ from ..character import CharacterController
 from ..compile_notice import notice_if_slow
 from ..events import StepContacts
 from ..frame import StepFrame
-from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
+from ..joints import (
+    DISTANCE,
+    MOUSE,
+    REVOLUTE,
+    WELD,
+    DistanceJoint,
+    Joint,
+    RevoluteJoint,
+    WeldJoint,
+    check_joints,
+    joint_components,
+)
+from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
+from .soft_joints import JOINT_F, JOINT_IMP
 from .soft_kernel import PARAMS, SLOT, internal_faces, soft_step
 from .stage import PRIORITY, Stage
 
@@ -34,12 +47,67 @@ __all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "kernel_tables"]
 
 #: Box2D v3's defaults, in metres (scaled by ``Scene(length_unit=...)``): linear slop, contact
 #: stiffness (hertz) and damping ratio, the fastest push out of an overlap, the slowest approach
-#: that bounces, sub-steps per step, and how far a moving body's fat bounds reach beyond it (its
-#: candidate pairs are found again only when it leaves them).
+#: that bounces, sub-steps per step, how far a moving body's fat bounds reach beyond it (its
+#: candidate pairs are found again only when it leaves them), and the joints' stiffness (hertz, at
+#: most a quarter of the sub-step rate) and damping ratio.
 SOFT_SETTINGS = {"slop": 0.005, "hertz": 30.0, "damping": 10.0, "push_speed": 3.0, "restitution_threshold": 1.0,
-                 "substeps": 4, "fat_margin": 0.1}
+                 "substeps": 4, "fat_margin": 0.1, "joint_hertz": 60.0, "joint_damping": 2.0}
 # the store's columns the kernel reads (and writes: the pose and velocity), in its argument order
 _KERNEL_COLUMNS = ("x", "y", "rot", "vx", "vy", "w", "asleep")
+# a scene without joints passes these
+_NO_JINT = np.zeros((0, 3), dtype=np.int64)
+_NO_JF = np.zeros((0, len(JOINT_F)))
+_NO_IMP = np.zeros((0, len(JOINT_IMP)))
+_NO_KEYS = np.zeros(0, dtype=np.int64)
+_JF = {name: i for i, name in enumerate(JOINT_F)}
+
+
+def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tuple[np.ndarray, ...]:
+    """The kernel's joint tables (:mod:`~framework.systems.soft_joints`) for ``joints`` (checked
+    and attached): ``(jint, jf, keys, apart)``; ``keys``: each joint's warm-start key (entity * 4 +
+    kind); ``apart``: the sorted pair keys of the bodies that must not collide."""
+    m = len(joints)
+    jint = np.empty((m, 3), dtype=np.int64)
+    jf = np.zeros((m, len(JOINT_F)))
+    keys = np.empty(m, dtype=np.int64)
+    apart = []
+    for i, (e, j) in enumerate(joints):
+        frame = j._frame
+        assert frame is not None
+        ra, rb = row_of[j.a], (-1 if j.b is None else row_of[j.b])
+        keys[i] = 4 * e + j.kind
+        jint[i] = (j.kind, ra, rb)
+        row = jf[i]
+        row[0:5] = frame
+        if j.kind == DISTANCE:
+            assert isinstance(j, DistanceJoint)
+            lo, hi = j.limits()
+            length = max(j.length or 0.0, lo)
+            if hi is not None:
+                length = min(length, hi)
+            row[_JF["length"]], row[_JF["lo"]] = length, lo
+            row[_JF["hi"]], row[_JF["has_hi"]] = (0.0, 0.0) if hi is None else (hi, 1.0)
+            row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
+        elif j.kind == REVOLUTE:  # the kernel's angle is its b's turn relative to its a: a and b swap
+            assert isinstance(j, RevoluteJoint)
+            jint[i] = (REVOLUTE, jint[i, 2], ra)
+            row[0:5] = (frame[2], frame[3], frame[0], frame[1], -frame[4])
+            if j.lower is not None:
+                row[_JF["lower"]], row[_JF["has_lower"]] = j.lower, 1.0
+            if j.upper is not None:
+                row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
+            row[_JF["speed"]], row[_JF["torque"]] = j.motor_speed, j.max_motor_torque
+        elif j.kind == WELD:
+            assert isinstance(j, WeldJoint)
+            row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
+        elif j.kind == MOUSE:  # the world's anchor is the target; the body is b to the kernel
+            jint[i] = (MOUSE, -1, ra)
+            row[0:5] = (*j.target, frame[0], frame[1], 0.0)  # type: ignore[attr-defined]
+            row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping  # type: ignore[attr-defined]
+            row[_JF["force"]] = j.max_force  # type: ignore[attr-defined]
+        if j.b is not None and not j.collide_connected:
+            apart.append((min(j.a, j.b) << 32) | max(j.a, j.b))
+    return jint, jf, keys, np.array(sorted(set(apart)), dtype=np.int64)
 
 
 def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
@@ -132,15 +200,16 @@ class SoftStep(Stage):
         self.slots = np.zeros((0, len(SLOT)))
         self.fat = np.zeros((0, 4))
         self._pairs_key: tuple[int, int, bool] | None = None
+        self.joints: tuple[np.ndarray, ...] = (_NO_KEYS, _NO_IMP, _NO_JF)  # keys, impulses, parameters
 
     def state(self) -> tuple[Any, ...]:
         """What the next step starts from (the kernel never modifies these arrays in place: a
         step replaces them, so keeping the references keeps the state)."""
-        return self.fat, self.pairs, self.slots, self._pairs_key
+        return self.fat, self.pairs, self.slots, self._pairs_key, self.joints
 
     def restore(self, state: tuple[Any, ...]) -> None:
         """Start the next step from ``state`` (of :meth:`state`)."""
-        self.fat, self.pairs, self.slots, self._pairs_key = state
+        self.fat, self.pairs, self.slots, self._pairs_key, self.joints = state
 
     def wanted(self) -> bool:
         effects = self.pipeline.effects
@@ -202,9 +271,62 @@ class SoftStep(Stage):
             self._params[:] = (frame.dt if moves else 0.0, s["substeps"] if moves else 0, gx, gy, s["slop"] * unit,
                                4.0 * s["slop"] * unit, s["hertz"], s["damping"], s["push_speed"] * unit,
                                s["restitution_threshold"] * unit, float(key[-1]), float("response" in effects),
-                               float("rotation" in effects), float("friction" in effects), s["fat_margin"] * unit)
+                               float("rotation" in effects), float("friction" in effects), s["fat_margin"] * unit,
+                               s["joint_hertz"], s["joint_damping"])
             self._settings_key = key
         return self._params
+
+    def _joints(self) -> tuple[np.ndarray, ...]:
+        """The kernel's joint arguments ``(jint, jf, jimp, apart)``: the joint components packed
+        (checked again: game code may have written to them), last step's impulses matched by joint.
+        A sleeping body is woken where its joint's other body moves, or the joint is new or changed
+        (a motor's speed, a mouse's target)."""
+        joints = joint_components()
+        old_keys, old_imp, old_jf = self.joints
+        if not joints:
+            if old_keys.size:
+                self.joints = (_NO_KEYS, _NO_IMP, _NO_JF)
+            return _NO_JINT, _NO_JF, _NO_IMP, _NO_KEYS
+        store = self.bodies.store
+        for _e, j in joints:
+            if j._frame is None:  # (added to the world by hand, not by the scene: measured now)
+                j.attach(store)
+        check_joints(joints, store, "soft")
+        jint, jf, keys, apart = joint_tables(joints, store.row_of)
+        if np.array_equal(keys, old_keys):
+            imp = old_imp
+            changed = np.any(jf != old_jf, axis=1)
+        else:
+            imp = np.zeros((keys.size, len(JOINT_IMP)))
+            where = {int(k): i for i, k in enumerate(old_keys)}
+            changed = np.ones(keys.size, dtype=bool)
+            for i, k in enumerate(keys.tolist()):
+                o = where.get(k)
+                if o is not None:
+                    imp[i] = old_imp[o]
+                    changed[i] = bool(np.any(jf[i] != old_jf[o]))
+        self._wake_joined(jint, changed)
+        self.joints = (keys, imp, jf)
+        return jint, jf, imp, apart
+
+    def _wake_joined(self, jint: np.ndarray, changed: np.ndarray) -> None:
+        """Wake the sleeping bodies of joints that are new or changed, or whose other body is an
+        awake dynamic body or moves (a kinematic one with a velocity). (Joined dynamic bodies fall
+        asleep together: the sleeping stage reads the joints' rows, ``frame.joined``.)"""
+        store = self.bodies.store
+        n = store.n
+        asleep = store.cols["asleep"][:n]
+        if not asleep.any():
+            return
+        c = store.cols
+        going = (c["vx"][:n] != 0.0) | (c["vy"][:n] != 0.0) | (c["w"][:n] != 0.0)
+        awake = ~asleep & store.has_vel[:n] & ((store.body[:n] == DYNAMIC) | ((store.body[:n] != STATIC) & going))
+        moves = np.append(awake, False)  # (row -1: the world)
+        ra, rb = jint[:, 1], jint[:, 2]
+        wake = np.concatenate([ra[changed | moves[rb]], rb[changed | moves[ra]]])
+        wake = wake[wake >= 0]
+        if wake.size:
+            store.wake(wake[asleep[wake]])
 
     def run(self, frame: StepFrame) -> bool:
         store = self.bodies.store
@@ -217,9 +339,16 @@ class SoftStep(Stage):
         if rebuild:
             self.fat = np.zeros((store.n, 4))
             self._pairs_key = key
-        args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild)
+        joints = self._joints()
+        args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
+                *joints)
         out = soft_step(*args) if _COMPILED else _first_call(args)
-        self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info = out
+        self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info, jimp = out
+        if jimp.size:
+            self.joints = (self.joints[0], jimp, self.joints[2])
+            ja, jb = joints[0][:, 1], joints[0][:, 2]
+            both = (ja >= 0) & (jb >= 0)
+            frame.joined = (ja[both], jb[both])
         if "movement" in effects:
             store.motion += 1
         ra, rb, ea, eb, started = touch_i

@@ -1,0 +1,348 @@
+"""Joints: components that hold two bodies together (Box2D v3's joints, in the soft step).
+
+A joint is a component on an entity of its own (``scene.spawn(DistanceJoint(a, b))``) naming two
+bodies by entity id: ``a`` and ``b`` (``b=None``: the world, a fixed point). Both must have a
+Hitbox; either may be static. It is read, changed (``joint.motor_speed = 2.0``, ``mouse.target =
+(x, y)``) and removed like any component; despawning one of its bodies removes it (and its entity,
+if the joint was all the entity held). The bodies of a joint do not collide with each other unless
+``collide_connected=True``.
+
+- :class:`DistanceJoint`: keeps two anchors at a distance: a rod (rigid), a rope (``min_length=0``
+  and a ``max_length``: only a most) or a spring (``hertz > 0``);
+- :class:`RevoluteJoint`: a hinge at a point both bodies share, with angle limits and a motor;
+- :class:`WeldJoint`: glues two bodies in their relative pose (stiff, or springy with ``hertz``);
+- :class:`MouseJoint`: drags a point of a body toward a target with a limited force.
+
+What a joint measures when it is spawned (a :class:`DistanceJoint`'s ``length`` if not given, a
+revolute or weld joint's anchor in each body's frame and the bodies' relative angle) is fixed
+then: the anchors are each body's own points, they turn with the body. Only ``Scene(solver="soft")``
+solves joints; stepping an exact-solver scene that holds one raises :class:`InvalidValue`. The
+solver is :mod:`framework.systems.soft_joints`; see docs/physics.md ("Joints").
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from numbers import Integral
+from typing import ClassVar
+
+import esper
+
+from .store import KIND_NONE, BodyStore
+from .validation import InvalidValue, finite, positive, vector2
+
+__all__ = ["DistanceJoint", "Joint", "MouseJoint", "RevoluteJoint", "WeldJoint"]
+
+# The kernel's joint kinds (framework.systems.soft_joints reads them by number).
+DISTANCE, REVOLUTE, WELD, MOUSE = 0, 1, 2, 3
+
+
+def _entity(name: str, value: object, optional: bool) -> int | None:
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, Integral):
+        what = "an entity id (an int) or None (the world)" if optional else "an entity id (an int)"
+        raise InvalidValue(f"{name} must be {what}, got {value!r}")
+    return int(value)
+
+
+def _at_least_zero(name: str, value: object) -> float:
+    v = finite(name, value)
+    if v < 0.0:
+        raise InvalidValue(f"{name} must be >= 0, got {value!r}")
+    return v
+
+
+def _optional(name: str, value: object) -> float | None:
+    return None if value is None else _at_least_zero(name, value)
+
+
+def _pose(store: BodyStore, entity: int) -> tuple[float, float, float]:
+    """A body's (x, y, rotation) now."""
+    row = store.row_of[entity]
+    c = store.cols
+    return float(c["x"][row]), float(c["y"][row]), float(c["rot"][row])
+
+
+def _to_local(pose: tuple[float, float, float], px: float, py: float) -> tuple[float, float]:
+    """The world point ``(px, py)`` in the frame of a body at ``pose`` (about its Transform origin)."""
+    x, y, r = pose
+    c, s = math.cos(r), math.sin(r)
+    dx, dy = px - x, py - y
+    return c * dx + s * dy, -s * dx + c * dy
+
+
+def _to_world(pose: tuple[float, float, float], lx: float, ly: float) -> tuple[float, float]:
+    x, y, r = pose
+    c, s = math.cos(r), math.sin(r)
+    return x + c * lx - s * ly, y + s * lx + c * ly
+
+
+class Joint(ABC):
+    """What every joint has: its bodies ``a`` and ``b`` (``None``: the world) and whether they
+    collide with each other. Subclasses add their parameters and :meth:`check` them."""
+
+    kind: ClassVar[int]
+    a: int
+    b: int | None
+    collide_connected: bool
+
+    def _init_bodies(self, a: object, b: object, collide_connected: object) -> None:
+        name = type(self).__name__
+        self.a = _entity(f"{name} a", a, optional=False)  # type: ignore[assignment]  # (never None)
+        self.b = _entity(f"{name} b", b, optional=True)
+        if self.a == self.b:
+            raise InvalidValue(f"{name} joins body {self.a} to itself: a and b must be two bodies")
+        if not isinstance(collide_connected, bool):
+            raise InvalidValue(f"{name} collide_connected must be True or False, got {collide_connected!r}")
+        self.collide_connected = collide_connected
+        # each body's anchor in its own frame (b None: a world point) and their relative angle at
+        # creation; fixed by attach()
+        self._frame: tuple[float, float, float, float, float] | None = None
+
+    def bodies(self) -> tuple[int, ...]:
+        """The entity ids of the joint's bodies (one for a joint to the world)."""
+        return (self.a,) if self.b is None else (self.a, self.b)
+
+    @abstractmethod
+    def check(self) -> None:
+        """:class:`InvalidValue` naming the field if a parameter is bad (as the constructor checks;
+        a value written later is checked again at each step)."""
+
+    def check_bodies(self, store: BodyStore) -> None:
+        """:class:`InvalidValue` unless the joint's bodies are bodies of the scene with a Hitbox."""
+        name = type(self).__name__
+        if self.a == self.b:
+            raise InvalidValue(f"{name} joins body {self.a} to itself: a and b must be two bodies")
+        for label, e in (("a", self.a), ("b", self.b)):
+            if e is None and label == "b":
+                continue
+            row = store.row_of.get(e) if isinstance(e, int) and not isinstance(e, bool) else None
+            if row is None:
+                raise InvalidValue(f"{name} {label} = {e!r} is not a body of this scene (no such entity, despawned, "
+                                   "or without a Transform)")
+            if store.kind[row] == KIND_NONE:
+                raise InvalidValue(f"{name} {label} = {e!r} has no Hitbox: a joint holds bodies with a Hitbox")
+
+    def attach(self, store: BodyStore) -> None:
+        """Check the joint against the scene's bodies and fix what it measures at creation (changes
+        nothing on error)."""
+        self.check()
+        self.check_bodies(store)
+        self._measure(store)
+
+    @abstractmethod
+    def _measure(self, store: BodyStore) -> None:
+        """Fix what the joint measures when it is made (``_frame``; a distance joint's length)."""
+
+    def _anchors_at(self, store: BodyStore, point: tuple[float, float]) -> None:
+        """Fix the anchor frame from one world point both bodies share (revolute, weld)."""
+        pa = _pose(store, self.a)
+        ax, ay = _to_local(pa, *point)
+        if self.b is None:
+            bx, by, rb = point[0], point[1], 0.0
+        else:
+            pb = _pose(store, self.b)
+            (bx, by), rb = _to_local(pb, *point), pb[2]
+        self._frame = (ax, ay, bx, by, rb - pa[2])
+
+
+class DistanceJoint(Joint):
+    """Keeps ``anchor_a`` (a point of body ``a``, in its frame) and ``anchor_b`` (of ``b``; with
+    ``b=None`` a world point) ``length`` apart (``None``: their distance when spawned).
+
+    ``hertz == 0``: rigid between ``min_length`` and ``max_length`` (both default to ``length``: a
+    rod; ``min_length=0`` and a ``max_length``: a rope, which goes slack). ``hertz > 0``: a spring
+    of that frequency and damping ratio ``damping`` toward ``length``, free to stretch unless
+    ``min_length`` or ``max_length`` say otherwise."""
+
+    kind = DISTANCE
+
+    def __init__(self, a: int, b: int | None, anchor_a: tuple[float, float] = (0.0, 0.0),
+                 anchor_b: tuple[float, float] = (0.0, 0.0), length: float | None = None,
+                 min_length: float | None = None, max_length: float | None = None, hertz: float = 0.0,
+                 damping: float = 0.0, collide_connected: bool = False) -> None:
+        self._init_bodies(a, b, collide_connected)
+        self.anchor_a = anchor_a
+        self.anchor_b = anchor_b
+        self.length = length
+        self.min_length = min_length
+        self.max_length = max_length
+        self.hertz = hertz
+        self.damping = damping
+        self.check()
+
+    def limits(self) -> tuple[float, float | None]:
+        """The least and the most length allowed (``None``: no most), defaults resolved."""
+        return _limits(self.hertz, self.length or 0.0, self.min_length, self.max_length)
+
+    def check(self) -> None:
+        self.anchor_a = vector2("DistanceJoint anchor_a", self.anchor_a)
+        self.anchor_b = vector2("DistanceJoint anchor_b", self.anchor_b)
+        self.length = _optional("DistanceJoint length", self.length)
+        self.min_length = _optional("DistanceJoint min_length", self.min_length)
+        self.max_length = _optional("DistanceJoint max_length", self.max_length)
+        self.hertz = _at_least_zero("DistanceJoint hertz", self.hertz)
+        self.damping = _at_least_zero("DistanceJoint damping", self.damping)
+        if self.min_length is not None and self.max_length is not None and self.min_length > self.max_length:
+            raise InvalidValue(f"DistanceJoint min_length ({self.min_length}) is more than max_length "
+                               f"({self.max_length})")
+
+    def _measure(self, store: BodyStore) -> None:
+        pa = _pose(store, self.a)
+        wa = _to_world(pa, *self.anchor_a)
+        wb = self.anchor_b if self.b is None else _to_world(_pose(store, self.b), *self.anchor_b)
+        length = math.hypot(wb[0] - wa[0], wb[1] - wa[1]) if self.length is None else self.length
+        lo, hi = _limits(self.hertz, length, self.min_length, self.max_length)
+        if hi is not None and lo > hi:
+            raise InvalidValue(f"DistanceJoint length {length} with min_length {self.min_length} and max_length "
+                               f"{self.max_length}: the least length allowed ({lo}) is more than the most ({hi})")
+        self.length = length
+        self._frame = (*self.anchor_a, *self.anchor_b, 0.0)
+
+
+def _limits(hertz: float, length: float, lo: float | None, hi: float | None) -> tuple[float, float | None]:
+    """A distance joint's least and most length: as given, else a rod's (``length``, with ``hertz``
+    0) or a spring's (0 and none)."""
+    rigid = hertz == 0.0
+    least = lo if lo is not None else (length if rigid else 0.0)
+    return least, (hi if hi is not None else (length if rigid else None))
+
+
+class RevoluteJoint(Joint):
+    """A hinge: bodies ``a`` and ``b`` share the world point ``anchor`` (where it is when spawned;
+    each body's point there turns with it) and turn freely about it, within ``lower`` and
+    ``upper`` (radians of ``a``'s turn relative to ``b`` since the joint was made, counter-clockwise;
+    with ``b=None``, ``a``'s own turn; ``None``: no limit). A motor (``max_motor_torque > 0``)
+    drives that turn at ``motor_speed`` radians a second with at most that torque."""
+
+    kind = REVOLUTE
+
+    def __init__(self, a: int, b: int | None, anchor: tuple[float, float], lower: float | None = None,
+                 upper: float | None = None, motor_speed: float = 0.0, max_motor_torque: float = 0.0,
+                 collide_connected: bool = False) -> None:
+        self._init_bodies(a, b, collide_connected)
+        self.anchor = anchor
+        self.lower = lower
+        self.upper = upper
+        self.motor_speed = motor_speed
+        self.max_motor_torque = max_motor_torque
+        self.check()
+
+    def check(self) -> None:
+        self.anchor = vector2("RevoluteJoint anchor", self.anchor)
+        self.lower = None if self.lower is None else finite("RevoluteJoint lower", self.lower)
+        self.upper = None if self.upper is None else finite("RevoluteJoint upper", self.upper)
+        self.motor_speed = finite("RevoluteJoint motor_speed", self.motor_speed)
+        self.max_motor_torque = _at_least_zero("RevoluteJoint max_motor_torque", self.max_motor_torque)
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise InvalidValue(f"RevoluteJoint lower ({self.lower}) is more than upper ({self.upper})")
+
+    def _measure(self, store: BodyStore) -> None:
+        self._anchors_at(store, self.anchor)
+
+
+class WeldJoint(Joint):
+    """Glues bodies ``a`` and ``b`` in their relative pose when spawned, about the world point
+    ``anchor``: rigid with ``hertz == 0``, else a spring of that frequency and damping ratio
+    ``damping`` (in both the offset and the angle)."""
+
+    kind = WELD
+
+    def __init__(self, a: int, b: int | None, anchor: tuple[float, float], hertz: float = 0.0,
+                 damping: float = 0.0, collide_connected: bool = False) -> None:
+        self._init_bodies(a, b, collide_connected)
+        self.anchor = anchor
+        self.hertz = hertz
+        self.damping = damping
+        self.check()
+
+    def check(self) -> None:
+        self.anchor = vector2("WeldJoint anchor", self.anchor)
+        self.hertz = _at_least_zero("WeldJoint hertz", self.hertz)
+        self.damping = _at_least_zero("WeldJoint damping", self.damping)
+
+    def _measure(self, store: BodyStore) -> None:
+        self._anchors_at(store, self.anchor)
+
+
+class MouseJoint(Joint):
+    """Drags ``body`` toward the world point ``target`` (change it at will: ``joint.target = (x,
+    y)``) as a spring of ``hertz`` and damping ratio ``damping``, with at most ``max_force``. The
+    point of the body dragged is the one under ``target`` when the joint is spawned (where the
+    mouse grabbed it); its turning is damped a little (Box2D's mouse joint)."""
+
+    kind = MOUSE
+
+    def __init__(self, body: int, target: tuple[float, float], max_force: float, hertz: float = 5.0,
+                 damping: float = 0.7) -> None:
+        self._init_bodies(body, None, False)
+        self.target = target
+        self.max_force = max_force
+        self.hertz = hertz
+        self.damping = damping
+        self.check()
+
+    @property
+    def body(self) -> int:
+        """The body dragged (``a``)."""
+        return self.a
+
+    def check(self) -> None:
+        self.target = vector2("MouseJoint target", self.target)
+        force = finite("MouseJoint max_force", self.max_force)
+        if force <= 0.0:
+            raise InvalidValue(f"MouseJoint max_force must be > 0, got {self.max_force!r}")
+        self.max_force = force
+        self.hertz = positive("MouseJoint hertz", self.hertz)
+        self.damping = _at_least_zero("MouseJoint damping", self.damping)
+
+    def _measure(self, store: BodyStore) -> None:
+        lx, ly = _to_local(_pose(store, self.a), *self.target)
+        self._frame = (lx, ly, 0.0, 0.0, 0.0)
+
+
+JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint)
+_JOINT_SET = frozenset(JOINT_TYPES)
+
+
+def joint_components() -> list[tuple[int, Joint]]:
+    """Every joint of the current esper world as ``(entity, joint)``, by entity then kind. A world
+    without joints answers from esper's table of component types (which drops a type when its last
+    component goes): four set look-ups, a fraction of a microsecond a step."""
+    if esper._components.keys().isdisjoint(_JOINT_SET):
+        return []
+    out: list[tuple[int, Joint]] = []
+    for cls in JOINT_TYPES:
+        out.extend(esper.get_component(cls))
+    if len(out) > 1:
+        out.sort(key=lambda ej: (ej[0], ej[1].kind))
+    return out
+
+
+def check_joints(joints: list[tuple[int, Joint]], store: BodyStore, solver: str) -> None:
+    """:class:`InvalidValue` naming the joint's entity if a joint is bad (a parameter written since,
+    a body gone or without a Hitbox), or if the scene's solver cannot solve joints."""
+    if joints and solver != "soft":
+        e, j = joints[0]
+        raise InvalidValue(f"entity {e} holds a {type(j).__name__}: joints need Scene(solver=\"soft\"); the exact "
+                           "solver does not solve joints yet")
+    for e, j in joints:
+        try:
+            j.check()
+            j.check_bodies(store)
+        except InvalidValue as exc:
+            raise InvalidValue(f"entity {e}: {exc}") from None
+
+
+def remove_joints_of(entity: int) -> list[int]:
+    """Remove the joints holding body ``entity`` (from the current esper world); return the joint
+    entities left with no component at all (for the caller to delete)."""
+    empty = []
+    for e, j in joint_components():
+        if entity == j.a or entity == j.b:
+            esper.remove_component(e, type(j))
+            if not esper.components_for_entity(e):
+                empty.append(e)
+    return empty

@@ -1,0 +1,341 @@
+"""Joints in the soft step: Box2D v3's distance, revolute, weld and mouse joints, compiled.
+
+The soft step (:mod:`framework.systems.soft_kernel`) calls these in its sub-steps, joints before
+contacts as Box2D does: :func:`prepare_joints` once a step (anchors relative to each body's origin
+at the step's start, effective masses, spring coefficients), then every sub-step
+:func:`warm_start_joints` (last step's impulses) and :func:`solve_joints`, once with the bias that
+pulls a joint back together (soft: Box2D's joint stiffness, 60 hertz at most a quarter of the
+sub-step rate, damping ratio 2) and once without (the relax). As for contacts, nothing is
+re-measured geometrically inside the solve: a joint's error is its separation at the step's start
+plus the bodies' motion since (``x - x0``) and their anchors turned by the bodies' turn since
+(``qc, qs``), Box2D's ``deltaPosition`` and ``deltaRotation``. A body's angle is its ``rot``.
+
+The tables (packed by :class:`~framework.systems.soft_step.SoftStep` from the joint components,
+:mod:`framework.joints`): ``jint`` rows ``(kind, row a, row b)`` (row -1: the world, where an
+anchor is a world point), ``jf`` rows of :data:`JOINT_F`, ``imp`` rows of :data:`JOINT_IMP` (the
+accumulated impulses, kept between steps for warm starting; the kernel works on a copy).
+
+Numba's cache of :mod:`~framework.systems.soft_kernel` does not see edits of this module: after
+editing it, delete the ``soft_kernel*`` cache files in ``__pycache__``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .softness import soft
+
+__all__ = ["JOINT_F", "JOINT_IMP", "prepare_joints", "solve_joints", "warm_start_joints"]
+
+DISTANCE, REVOLUTE, WELD, MOUSE = 0, 1, 2, 3  # (as framework.joints)
+
+#: A joint's parameters: its anchors in each body's frame (a world point for the world), the
+#: bodies' relative angle at creation; a distance joint's length, least and most length (and
+#: whether it has a most), spring frequency and damping ratio (also the weld's and the mouse's);
+#: a revolute joint's limits (and whether each is on), motor speed and torque; the mouse's force.
+JOINT_F = ("ax", "ay", "bx", "by", "ref", "length", "lo", "hi", "has_hi", "hertz", "damping", "lower", "upper",
+           "has_lower", "has_upper", "speed", "torque", "force")
+(_AX, _AY, _BX, _BY, _REF, _LEN, _LO, _HI, _HAS_HI, _HZ, _ZETA, _LOWER, _UPPER, _HAS_LOWER, _HAS_UPPER, _SPEED,
+ _TORQUE, _FORCE) = range(len(JOINT_F))
+#: A joint's accumulated impulses: the linear impulse (x, y; a distance joint's along its axis in
+#: the first), the lower and upper limits', and the angular one (a motor's, a weld's or a mouse's).
+JOINT_IMP = ("px", "py", "lower", "upper", "angular")
+_PX, _PY, _ILO, _IUP, _IANG = range(len(JOINT_IMP))
+# Columns of a prepared joint: on; anchors from each origin at the step's start; the origins'
+# offset (b - a); inverse masses; the axial (or angular) effective mass; the joint's own softness
+# (a spring's, else the joints' stiffness); the mouse's linear effective mass (a symmetric 2x2)
+# and its angular softness.
+(_ON, _RAX, _RAY, _RBX, _RBY, _DCX, _DCY, _MA, _IA, _MB, _IB, _AXM, _SB, _SM, _SI, _K11, _K12, _K22, _AB, _AM,
+ _AI) = range(21)
+_NP = 21
+
+
+@njit(cache=True)
+def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
+    """Each joint prepared for this step (rows of the columns above; ``_ON`` 0: skipped, no body
+    of it moves or none takes impulses)."""
+    m = jint.shape[0]
+    jp = np.zeros((m, _NP))
+    for j in range(m):
+        kind, a, b = jint[j, 0], jint[j, 1], jint[j, 2]
+        if not ((a >= 0 and moving[a]) or (b >= 0 and moving[b])):
+            continue
+        ma, ia, mb, ib = 0.0, 0.0, 0.0, 0.0
+        rax, ray, cax, cay = jf[j, _AX], jf[j, _AY], 0.0, 0.0
+        rbx, rby, cbx, cby = jf[j, _BX], jf[j, _BY], 0.0, 0.0
+        if a >= 0:
+            ma, ia, cax, cay = im[a], ii[a], x[a], y[a]
+            c, s = math.cos(rot[a]), math.sin(rot[a])
+            rax, ray = c * jf[j, _AX] - s * jf[j, _AY], s * jf[j, _AX] + c * jf[j, _AY]
+        if b >= 0:
+            mb, ib, cbx, cby = im[b], ii[b], x[b], y[b]
+            c, s = math.cos(rot[b]), math.sin(rot[b])
+            rbx, rby = c * jf[j, _BX] - s * jf[j, _BY], s * jf[j, _BX] + c * jf[j, _BY]
+        if ma == 0.0 and ia == 0.0 and mb == 0.0 and ib == 0.0:
+            continue
+        jp[j, _ON] = 1.0
+        jp[j, _RAX], jp[j, _RAY], jp[j, _RBX], jp[j, _RBY] = rax, ray, rbx, rby
+        jp[j, _DCX], jp[j, _DCY] = cbx - cax, cby - cay
+        jp[j, _MA], jp[j, _IA], jp[j, _MB], jp[j, _IB] = ma, ia, mb, ib
+        jp[j, _SB], jp[j, _SM], jp[j, _SI] = soft(jf[j, _HZ], jf[j, _ZETA], h)
+        if kind == DISTANCE:
+            sx, sy = jp[j, _DCX] + rbx - rax, jp[j, _DCY] + rby - ray
+            ux, uy = _unit(sx, sy)
+            cra, crb = rax * uy - ray * ux, rbx * uy - rby * ux
+            k = ma + mb + ia * cra * cra + ib * crb * crb
+            jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
+        elif kind == MOUSE:  # (body b, held to a world point)
+            k11, k12, k22 = mb + ib * rby * rby, -ib * rbx * rby, mb + ib * rbx * rbx
+            det = k11 * k22 - k12 * k12
+            det = 1.0 / det if det != 0.0 else 0.0
+            jp[j, _K11], jp[j, _K12], jp[j, _K22] = det * k22, -det * k12, det * k11
+            jp[j, _AXM] = 1.0 / ib if ib > 0.0 else 0.0
+            jp[j, _AB], jp[j, _AM], jp[j, _AI] = soft(0.5, 0.1, h)  # (Box2D's: damps the turn a little)
+        else:
+            k = ia + ib
+            jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
+    return jp
+
+
+@njit(cache=True)
+def _unit(x, y):
+    """``(x, y)`` normalised; (0, 0) for a vector too short to have a direction (``b2Normalize``)."""
+    d = math.sqrt(x * x + y * y)
+    if d < 1e-300:
+        return 0.0, 0.0
+    return x / d, y / d
+
+
+@njit(cache=True)
+def _state(r, x, y, x0, y0, qc, qs, rot, vx, vy, w):
+    """A body's motion since the step began (dx, dy, turn cos, sin), angle and velocity; the
+    world's (row -1) is still."""
+    if r < 0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return x[r] - x0[r], y[r] - y0[r], qc[r], qs[r], rot[r], vx[r], vy[r], w[r]
+
+
+@njit(cache=True)
+def _store(r, m, i, vxr, vyr, wr, vx, vy, w):
+    """Write a body's new velocity (a body that takes no impulse keeps its own)."""
+    if r >= 0 and (m > 0.0 or i > 0.0):
+        vx[r], vy[r], w[r] = vxr, vyr, wr
+
+
+@njit(cache=True)
+def warm_start_joints(jint, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
+    """Apply each joint's accumulated impulses (Box2D's ``b2WarmStart*Joint``)."""
+    for j in range(jint.shape[0]):
+        if jp[j, _ON] == 0.0:
+            continue
+        kind, a, b = jint[j, 0], jint[j, 1], jint[j, 2]
+        dax, day, ca, sa, _ra, vax, vay, wa = _state(a, x, y, x0, y0, qc, qs, rot, vx, vy, w)
+        dbx, dby, cb, sb, _rb, vbx, vby, wb = _state(b, x, y, x0, y0, qc, qs, rot, vx, vy, w)
+        rax, ray = ca * jp[j, _RAX] - sa * jp[j, _RAY], sa * jp[j, _RAX] + ca * jp[j, _RAY]
+        rbx, rby = cb * jp[j, _RBX] - sb * jp[j, _RBY], sb * jp[j, _RBX] + cb * jp[j, _RBY]
+        if kind == DISTANCE:
+            ux, uy = _unit(jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray)
+            axial = imp[j, _PX] + imp[j, _ILO] - imp[j, _IUP]
+            px, py, ang = axial * ux, axial * uy, 0.0
+        else:
+            px, py = imp[j, _PX], imp[j, _PY]
+            ang = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
+        ma, ia, mb, ib = jp[j, _MA], jp[j, _IA], jp[j, _MB], jp[j, _IB]
+        _store(a, ma, ia, vax - ma * px, vay - ma * py, wa - ia * (rax * py - ray * px + ang), vx, vy, w)
+        _store(b, mb, ib, vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px + ang), vx, vy, w)
+
+
+@njit(cache=True)
+def solve_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w, use_bias, csoft, h, inv_h):
+    """One pass over the joints (Box2D's ``b2Solve*Joint``): with the bias that pulls them back
+    together (``use_bias``; ``csoft``: the joints' softness) or without it (the relax)."""
+    for j in range(jint.shape[0]):
+        if jp[j, _ON] == 0.0:
+            continue
+        kind, a, b = jint[j, 0], jint[j, 1], jint[j, 2]
+        dax, day, ca, sa, rota, vax, vay, wa = _state(a, x, y, x0, y0, qc, qs, rot, vx, vy, w)
+        dbx, dby, cb, sb, rotb, vbx, vby, wb = _state(b, x, y, x0, y0, qc, qs, rot, vx, vy, w)
+        # the anchors now: turned by each body's turn since the step began
+        rax, ray = ca * jp[j, _RAX] - sa * jp[j, _RAY], sa * jp[j, _RAX] + ca * jp[j, _RAY]
+        rbx, rby = cb * jp[j, _RBX] - sb * jp[j, _RBY], sb * jp[j, _RBX] + cb * jp[j, _RBY]
+        # the separation of the anchors (b's less a's) now
+        sx, sy = jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray
+        ma, ia, mb, ib = jp[j, _MA], jp[j, _IA], jp[j, _MB], jp[j, _IB]
+        if kind == DISTANCE:
+            vax, vay, wa, vbx, vby, wb = _distance(jf, jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
+                                                   vax, vay, wa, vbx, vby, wb, use_bias, csoft, h, inv_h)
+        elif kind == REVOLUTE:
+            angle = rotb - rota - jf[j, _REF]
+            vax, vay, wa, vbx, vby, wb = _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb,
+                                                   ib, vax, vay, wa, vbx, vby, wb, use_bias, csoft, h, inv_h)
+        elif kind == WELD:
+            angle = rotb - rota - jf[j, _REF]
+            vax, vay, wa, vbx, vby, wb = _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
+                                               vax, vay, wa, vbx, vby, wb, use_bias, csoft)
+        else:
+            vbx, vby, wb = _mouse(jf, jp, imp, j, sx, sy, rbx, rby, mb, ib, vbx, vby, wb, h)
+        _store(a, ma, ia, vax, vay, wa, vx, vy, w)
+        _store(b, mb, ib, vbx, vby, wb, vx, vy, w)
+
+
+@njit(cache=True)
+def _axial(s, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb):
+    """The velocities after the impulse ``s`` along the axis ``(ux, uy)`` at the anchors."""
+    px, py = s * ux, s * uy
+    return (vax - ma * px, vay - ma * py, wa - ia * (rax * py - ray * px),
+            vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px))
+
+
+@njit(cache=True)
+def _limit(c, cdot, mass, old, use_bias, csoft, inv_h):
+    """A one-sided limit's new accumulated impulse (>= 0), ``c >= 0`` where it is kept: ahead of
+    it, speculative (close the gap, no more); past it, soft (with the bias) or rigid."""
+    bias, ms, isc = 0.0, 1.0, 0.0
+    if c > 0.0:
+        bias = c * inv_h
+    elif use_bias:
+        bias, ms, isc = csoft[0] * c, csoft[1], csoft[2]
+    return max(old - ms * mass * (cdot + bias) - isc * old, 0.0)
+
+
+@njit(cache=True)
+def _distance(jf, jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias,
+              csoft, h, inv_h):
+    """Box2D's ``b2SolveDistanceJoint``: a spring toward the length (``hertz > 0``) and the
+    limits, or one rigid row where the least and the most length are one."""
+    length = math.sqrt(sx * sx + sy * sy)
+    ux, uy = _unit(sx, sy)
+    mass = jp[j, _AXM]
+    lo, hi, has_hi = jf[j, _LO], jf[j, _HI], jf[j, _HAS_HI] != 0.0
+    if jf[j, _HZ] > 0.0 or not has_hi or lo < hi:
+        if jf[j, _HZ] > 0.0:  # the spring: always soft, always biased
+            cdot = (vbx - wb * rby - vax + wa * ray) * ux + (vby + wb * rbx - vay - wa * rax) * uy
+            old = imp[j, _PX]
+            s = -jp[j, _SM] * mass * (cdot + jp[j, _SB] * (length - jf[j, _LEN])) - jp[j, _SI] * old
+            imp[j, _PX] = old + s
+            vax, vay, wa, vbx, vby, wb = _axial(s, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx,
+                                                vby, wb)
+        # the least length
+        cdot = (vbx - wb * rby - vax + wa * ray) * ux + (vby + wb * rbx - vay - wa * rax) * uy
+        old = imp[j, _ILO]
+        new = _limit(length - lo, cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _ILO] = new
+        vax, vay, wa, vbx, vby, wb = _axial(new - old, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa,
+                                            vbx, vby, wb)
+        if has_hi:  # the most (signs flipped: c and the impulse stay positive where it holds)
+            cdot = (vbx - wb * rby - vax + wa * ray) * ux + (vby + wb * rbx - vay - wa * rax) * uy
+            old = imp[j, _IUP]
+            new = _limit(hi - length, -cdot, mass, old, use_bias, csoft, inv_h)
+            imp[j, _IUP] = new
+            vax, vay, wa, vbx, vby, wb = _axial(old - new, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay,
+                                                wa, vbx, vby, wb)
+    else:  # rigid
+        cdot = (vbx - wb * rby - vax + wa * ray) * ux + (vby + wb * rbx - vay - wa * rax) * uy
+        bias, ms, isc = 0.0, 1.0, 0.0
+        if use_bias:
+            bias, ms, isc = csoft[0] * (length - jf[j, _LEN]), csoft[1], csoft[2]
+        s = -ms * mass * (cdot + bias) - isc * imp[j, _PX]
+        imp[j, _PX] += s
+        vax, vay, wa, vbx, vby, wb = _axial(s, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby,
+                                            wb)
+    return vax, vay, wa, vbx, vby, wb
+
+
+@njit(cache=True)
+def _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, bias_rate, ms, isc):
+    """The point-to-point row of the revolute and weld joints (Box2D's 2x2 block): the anchors'
+    relative velocity, plus ``bias_rate`` times their separation, to zero."""
+    cx = vbx - wb * rby - vax + wa * ray + bias_rate * sx
+    cy = vby + wb * rbx - vay - wa * rax + bias_rate * sy
+    k11 = ma + mb + ray * ray * ia + rby * rby * ib
+    k12 = -ray * rax * ia - rby * rbx * ib
+    k22 = ma + mb + rax * rax * ia + rbx * rbx * ib
+    det = k11 * k22 - k12 * k12
+    det = 1.0 / det if det != 0.0 else 0.0
+    bx, by = det * (k22 * cx - k12 * cy), det * (k11 * cy - k12 * cx)
+    px = -ms * bx - isc * imp[j, _PX]
+    py = -ms * by - isc * imp[j, _PY]
+    imp[j, _PX] += px
+    imp[j, _PY] += py
+    return (vax - ma * px, vay - ma * py, wa - ia * (rax * py - ray * px),
+            vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px))
+
+
+@njit(cache=True)
+def _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
+              use_bias, csoft, h, inv_h):
+    """Box2D's ``b2SolveRevoluteJoint``: the motor, the angle limits, then the shared point."""
+    mass = jp[j, _AXM]
+    if ia + ib > 0.0:
+        if jf[j, _TORQUE] > 0.0:  # the motor: the relative turn at its speed, with at most its torque
+            old = imp[j, _IANG]
+            most = h * jf[j, _TORQUE]
+            new = min(max(old - mass * (wb - wa - jf[j, _SPEED]), -most), most)
+            imp[j, _IANG] = new
+            wa -= ia * (new - old)
+            wb += ib * (new - old)
+        if jf[j, _HAS_LOWER] != 0.0:
+            old = imp[j, _ILO]
+            new = _limit(angle - jf[j, _LOWER], wb - wa, mass, old, use_bias, csoft, inv_h)
+            imp[j, _ILO] = new
+            wa -= ia * (new - old)
+            wb += ib * (new - old)
+        if jf[j, _HAS_UPPER] != 0.0:  # (signs flipped)
+            old = imp[j, _IUP]
+            new = _limit(jf[j, _UPPER] - angle, wa - wb, mass, old, use_bias, csoft, inv_h)
+            imp[j, _IUP] = new
+            wa += ia * (new - old)
+            wb -= ib * (new - old)
+    bias_rate, ms, isc = 0.0, 1.0, 0.0
+    if use_bias:
+        bias_rate, ms, isc = csoft[0], csoft[1], csoft[2]
+    return _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, bias_rate, ms,
+                  isc)
+
+
+@njit(cache=True)
+def _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias,
+          csoft):
+    """Box2D's ``b2SolveWeldJoint`` (not block solved): the relative angle, then the shared point;
+    a spring (``hertz > 0``) is always biased, a rigid weld only with ``use_bias``."""
+    spring = jf[j, _HZ] > 0.0
+    bias_rate, ms, isc = 0.0, 1.0, 0.0
+    if spring:
+        bias_rate, ms, isc = jp[j, _SB], jp[j, _SM], jp[j, _SI]
+    elif use_bias:
+        bias_rate, ms, isc = csoft[0], csoft[1], csoft[2]
+    old = imp[j, _IANG]
+    s = -ms * jp[j, _AXM] * (wb - wa + bias_rate * angle) - isc * old
+    imp[j, _IANG] = old + s
+    wa -= ia * s
+    wb += ib * s
+    return _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, bias_rate, ms,
+                  isc)
+
+
+@njit(cache=True)
+def _mouse(jf, jp, imp, j, sx, sy, rbx, rby, mb, ib, vbx, vby, wb, h):
+    """Box2D's ``b2SolveMouseJoint``: damp the body's turn a little, then pull its anchor toward the
+    target (a spring, always biased), the accumulated impulse at most ``max_force * h``."""
+    if ib > 0.0:
+        old = imp[j, _IANG]
+        s = -jp[j, _AM] * jp[j, _AXM] * wb - jp[j, _AI] * old
+        imp[j, _IANG] = old + s
+        wb += ib * s
+    cx = vbx - wb * rby + jp[j, _SB] * sx
+    cy = vby + wb * rbx + jp[j, _SB] * sy
+    bx = jp[j, _K11] * cx + jp[j, _K12] * cy
+    by = jp[j, _K12] * cx + jp[j, _K22] * cy
+    ox, oy = imp[j, _PX], imp[j, _PY]
+    nx = ox - jp[j, _SM] * bx - jp[j, _SI] * ox
+    ny = oy - jp[j, _SM] * by - jp[j, _SI] * oy
+    most = jf[j, _FORCE] * h
+    mag = math.sqrt(nx * nx + ny * ny)
+    if mag > most:
+        nx, ny = nx * most / mag, ny * most / mag
+    imp[j, _PX], imp[j, _PY] = nx, ny
+    px, py = nx - ox, ny - oy
+    return vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px)

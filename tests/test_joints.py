@@ -1,0 +1,465 @@
+"""Joints in the soft step (framework.joints, framework.systems.soft_joints).
+
+Analytic where the physics gives an answer (a pendulum's period, a spring's frequency, a motor's
+torque, the angular acceleration of a hinged bar), bounded by the solver's tolerance (the linear
+slop) where a constraint holds a length or an angle; dyadic values throughout.
+"""
+
+from __future__ import annotations
+
+import math
+
+import esper
+import numpy as np
+import pytest
+
+from framework import (
+    AABB,
+    Circle,
+    DistanceJoint,
+    Hitbox,
+    InvalidValue,
+    MouseJoint,
+    Polygon,
+    RevoluteJoint,
+    Scene,
+    Transform,
+    Velocity,
+    WeldJoint,
+)
+from framework.snapshot_file import load_snapshot, save_snapshot
+from framework.systems.soft_step import SOFT_SETTINGS
+
+SLOP = SOFT_SETTINGS["slop"]
+G = 8.0
+DT = 1 / 64
+
+
+def soft(gravity: float = G) -> Scene:
+    return Scene(gravity=(0.0, -gravity), solver="soft")
+
+
+def box(hw: float, hh: float) -> Polygon:
+    """A box that turns (an AABB never does)."""
+    return Polygon([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
+
+
+def pose(scene: Scene, e: int) -> tuple[float, float, float]:
+    t = scene.get(e, Transform)
+    return t.x, t.y, t.rotation
+
+
+def crossings(ts: list[float], xs: list[float]) -> list[float]:
+    """The times where ``xs`` changes sign, interpolated."""
+    out = []
+    for k in range(1, len(xs)):
+        if xs[k - 1] < 0.0 <= xs[k] or xs[k - 1] >= 0.0 > xs[k]:
+            f = xs[k - 1] / (xs[k - 1] - xs[k])
+            out.append(ts[k - 1] + f * (ts[k] - ts[k - 1]))
+    return out
+
+
+def period(ts: list[float], xs: list[float]) -> float:
+    c = crossings(ts, xs)
+    assert len(c) >= 5
+    return 2.0 * (c[-1] - c[0]) / (len(c) - 1)
+
+
+# --- distance joints: rod, rope, spring ----------------------------------------------------------
+
+
+@pytest.mark.parametrize("to_world", [False, True])
+def test_a_pendulum_keeps_its_length_swings_at_its_period_and_gains_no_energy(to_world):
+    s = soft()
+    L, th0 = 2.0, 0.125
+    pivot = None if to_world else s.spawn(Transform(0.0, 0.0), Hitbox(AABB(0.25, 0.25), body="static"))
+    ball = s.spawn(Transform(L * math.sin(th0), -L * math.cos(th0)), Velocity(), Hitbox(Circle(0.0625)))
+    joint = s.spawn(DistanceJoint(ball, pivot))
+    assert s.get(joint, DistanceJoint).length == pytest.approx(L, abs=1e-15)
+    ts, xs, angles, lengths = [], [], [], []
+    for k in range(64 * 12):
+        s.step(DT)
+        x, y, _r = pose(s, ball)
+        ts.append((k + 1) * DT)
+        xs.append(x)
+        angles.append(abs(math.atan2(x, -y)))
+        lengths.append(math.hypot(x, y))
+    assert max(abs(d - L) for d in lengths) < SLOP
+    # small-angle period 2 pi sqrt(L / g), lengthened by (1 + th0^2 / 16) at this amplitude
+    assert period(ts, xs) == pytest.approx(2 * math.pi * math.sqrt(L / G) * (1 + th0 * th0 / 16), rel=0.01)
+    assert max(angles) <= th0 * (1 + 1e-5)  # (sampled once a step: no swing higher than the start)
+
+
+def test_a_rope_lets_its_body_come_closer_but_never_farther():
+    s = soft()
+    anchor = s.spawn(Transform(0.0, 0.0), Hitbox(AABB(0.25, 0.25), body="static"))
+    ball = s.spawn(Transform(0.0, -2.0), Velocity(1.0, 6.0), Hitbox(Circle(0.125)))
+    s.spawn(DistanceJoint(ball, anchor, min_length=0.0, max_length=2.0))
+    ds = []
+    for _ in range(64 * 4):
+        s.step(DT)
+        x, y, _r = pose(s, ball)
+        ds.append(math.hypot(x, y))
+    assert min(ds) < 1.0  # thrown up: slack
+    assert max(ds) <= 2.0 + SLOP  # caught at its length, never past it
+
+
+@pytest.mark.parametrize("hertz", [0.5, 1.0])
+def test_a_spring_oscillates_at_its_frequency(hertz):
+    s = soft()
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125)))
+    s.spawn(DistanceJoint(ball, None, length=1.0, hertz=hertz))
+    # equilibrium: stretched by g / omega^2 below the rest length
+    rest = -1.0 - G / (2 * math.pi * hertz) ** 2
+    ts, ys = [], []
+    for k in range(int(64 * 6 / hertz)):
+        s.step(DT)
+        ts.append((k + 1) * DT)
+        ys.append(pose(s, ball)[1] - rest)
+    assert period(ts, ys) == pytest.approx(1.0 / hertz, rel=0.03)
+
+
+def test_a_damped_spring_settles_at_its_equilibrium():
+    s = soft()
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125)))
+    s.spawn(DistanceJoint(ball, None, length=1.0, hertz=1.0, damping=1.0))
+    for _ in range(64 * 8):
+        s.step(DT)
+    assert pose(s, ball)[1] == pytest.approx(-1.0 - G / (2 * math.pi) ** 2, abs=1e-3)
+
+
+def test_a_chain_of_twenty_links_between_two_statics_stays_within_its_length():
+    s = soft()
+    left = s.spawn(Transform(-2.0, 0.0), Hitbox(AABB(0.25, 0.25), body="static"))
+    right = s.spawn(Transform(2.0, 0.0), Hitbox(AABB(0.25, 0.25), body="static"))
+    link = 0.25  # 20 links of 0.25 and one more to the right: 5.25 across a gap of 4
+    links = [s.spawn(Transform(-2.0 + 0.1875 * (i + 1), 0.0), Velocity(), Hitbox(Circle(0.0625))) for i in range(20)]
+    ends = [left, *links, right]
+    for a, b in zip(ends, ends[1:]):
+        s.spawn(DistanceJoint(a, b, length=link))
+    for k in range(64 * 6):
+        s.step(DT)
+        xy = [pose(s, e)[:2] for e in ends]
+        gaps = [math.dist(p, q) for p, q in zip(xy, xy[1:])]
+        # soft joints give a little while the chain falls and swings (as Box2D's do), hardly once it hangs
+        assert max(gaps) <= link * (1 + 1 / 16) and sum(gaps) <= 21 * link * (1 + 1 / 32)
+        if k >= 64 * 5:
+            assert max(gaps) <= link + SLOP
+    assert min(y for _x, y in xy) < -1.0  # it hangs (a taut chain would be at y 0)
+
+
+# --- revolute joints: hinge, limits, motor --------------------------------------------------------
+
+
+def hinged_bar(s: Scene, **kw) -> tuple[int, int]:
+    """A bar 2 long (mass 1, inertia 1/4 about its middle) hinged to the world at its left end,
+    level to start: gravity's torque about the hinge is -m g L/2 = -8, its inertia there 5/4."""
+    bar = s.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(box(1.0, 0.125), inertia=0.25))
+    return bar, s.spawn(RevoluteJoint(bar, None, (0.0, 0.0), **kw))
+
+
+def test_a_hinged_bar_turns_about_its_hinge():
+    s = soft()
+    bar, _j = hinged_bar(s)
+    lowest = 0.0
+    for _ in range(64 * 3):
+        s.step(DT)
+        x, y, r = pose(s, bar)
+        assert math.hypot(x - math.cos(r), y - math.sin(r)) < SLOP  # its left end stays at the hinge
+        lowest = min(lowest, r)
+    assert lowest == pytest.approx(-math.pi, abs=0.01)  # it swings down and up to level on the other side
+
+
+def test_a_revolute_limit_holds_under_load():
+    s = soft()
+    bar, _j = hinged_bar(s, lower=-0.25, upper=0.25)
+    rs = []
+    for _ in range(64 * 3):
+        s.step(DT)
+        rs.append(pose(s, bar)[2])
+    assert min(rs) >= -0.25 - 0.01
+    assert rs[-1] == pytest.approx(-0.25, abs=0.01)  # it rests on the lower limit
+
+
+def test_a_motor_reaches_its_speed_against_a_load_it_can_carry():
+    s = soft()
+    bar, _j = hinged_bar(s, motor_speed=1.0, max_motor_torque=16.0)
+    for _ in range(32):
+        s.step(DT)
+    assert s.get(bar, Velocity).angular == pytest.approx(1.0, abs=1e-3)
+
+
+def test_a_motor_applies_no_more_than_its_torque():
+    s = soft()
+    bar, _j = hinged_bar(s, motor_speed=1.0, max_motor_torque=4.0)
+    for _ in range(16):
+        s.step(DT)
+    # the motor's 4 against gravity's -8 about the hinge: alpha = -4 / (5/4)
+    assert s.get(bar, Velocity).angular / (16 * DT) == pytest.approx(-3.2, rel=0.02)
+
+
+def test_a_motor_too_weak_for_its_load_holds_nothing():
+    s = soft()
+    bar, j = hinged_bar(s, motor_speed=0.0, max_motor_torque=12.0)  # more than gravity's 8: held still
+    for _ in range(64):
+        s.step(DT)
+    assert abs(pose(s, bar)[2]) < 1e-3
+    s.get(j, RevoluteJoint).max_motor_torque = 4.0  # now too weak: it falls
+    for _ in range(16):
+        s.step(DT)
+    assert pose(s, bar)[2] < -0.05
+
+
+def test_changing_the_motor_speed_takes_effect():
+    s = soft(gravity=0.0)
+    wheel = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.5)))
+    j = s.spawn(RevoluteJoint(wheel, None, (0.0, 0.0), motor_speed=2.0, max_motor_torque=64.0))
+    for _ in range(8):
+        s.step(DT)
+    assert s.get(wheel, Velocity).angular == pytest.approx(2.0, abs=1e-6)
+    s.get(j, RevoluteJoint).motor_speed = -1.0
+    for _ in range(8):
+        s.step(DT)
+    assert s.get(wheel, Velocity).angular == pytest.approx(-1.0, abs=1e-6)
+    assert math.hypot(*pose(s, wheel)[:2]) < 1e-9  # turning about its centre
+
+
+# --- weld and mouse joints ------------------------------------------------------------------------
+
+
+def relative(s: Scene, a: int, b: int) -> tuple[float, float, float]:
+    """b's pose in a's frame."""
+    xa, ya, ra = pose(s, a)
+    xb, yb, rb = pose(s, b)
+    c, sn = math.cos(ra), math.sin(ra)
+    return c * (xb - xa) + sn * (yb - ya), -sn * (xb - xa) + c * (yb - ya), rb - ra
+
+
+def test_a_weld_of_two_boxes_falls_and_lands_as_one():
+    s = soft()
+    s.spawn(Transform(0.0, -0.5), Hitbox(AABB(20.0, 1.0), body="static"))
+    a = s.spawn(Transform(0.0, 2.0, 0.25), Velocity(0.0, 0.0, 1.0), Hitbox(box(0.5, 0.25)))
+    b = s.spawn(Transform(0.0, 2.0, 0.25), Velocity(0.0, 0.0, 1.0), Hitbox(box(0.5, 0.25)))
+    x, y, r = pose(s, a)
+    t = s.get(b, Transform)
+    t.x, t.y = x + math.cos(r), y + math.sin(r)  # b one to a's right, in a's frame
+    s.spawn(WeldJoint(a, b, (x + 0.5 * math.cos(r), y + 0.5 * math.sin(r))))
+    start = relative(s, a, b)
+    for _ in range(64 * 3):
+        s.step(DT)
+        now = relative(s, a, b)
+        # (the corner's impact on landing strains the weld for a step or two)
+        assert math.dist(now[:2], start[:2]) < 2 * SLOP and abs(now[2] - start[2]) < 0.01
+    assert math.dist(now[:2], start[:2]) < 1e-3 and abs(now[2] - start[2]) < 1e-3
+    for e in (a, b):  # landed flat, side by side
+        assert pose(s, e)[1] == pytest.approx(0.25, abs=SLOP) and abs(pose(s, e)[2]) < 1e-3
+
+
+def test_a_mouse_joint_brings_a_body_to_its_target():
+    s = soft(gravity=0.0)
+    body = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
+    j = s.spawn(MouseJoint(body, (0.0, 0.0), max_force=64.0, hertz=4.0, damping=1.0))
+    s.get(j, MouseJoint).target = (3.0, 1.0)
+    for _ in range(64 * 3):
+        s.step(DT)
+    assert math.dist(pose(s, body)[:2], (3.0, 1.0)) < 1e-3
+
+
+def test_a_mouse_joint_pulls_with_at_most_its_force():
+    s = soft(gravity=0.0)
+    body = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    s.spawn(MouseJoint(body, (0.0, 0.0), max_force=2.0, hertz=4.0))
+    s.get(esper.get_component(MouseJoint)[0][0], MouseJoint).target = (100.0, 0.0)
+    for _ in range(16):
+        s.step(DT)
+    # a force of 2 on a mass of 1 for 1/4 s: a speed of 1/2 at most
+    assert s.get(body, Velocity).x == pytest.approx(0.5, rel=1e-6)
+
+
+# --- ECS: validation, removal, collisions ---------------------------------------------------------
+
+
+def bodies(s: Scene) -> tuple[int, int, int]:
+    """Two bodies, an entity without a Hitbox, and entity 4 despawned."""
+    a = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    b = s.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    plain = s.spawn(Transform(3.0, 0.0))
+    s.despawn(s.spawn(Transform(4.0, 0.0), Velocity(), Hitbox(Circle(0.25))))
+    return a, b, plain
+
+
+@pytest.mark.parametrize("make", [
+    lambda a, b, p: DistanceJoint(a, 999),
+    lambda a, b, p: DistanceJoint(a, 4),  # despawned
+    lambda a, b, p: DistanceJoint(a, p),
+    lambda a, b, p: RevoluteJoint(999, b, (0.0, 0.0)),
+    lambda a, b, p: WeldJoint(a, a, (0.0, 0.0)),
+    lambda a, b, p: DistanceJoint(a, b, length=math.nan),
+    lambda a, b, p: DistanceJoint(a, b, anchor_a=(math.inf, 0.0)),
+    lambda a, b, p: DistanceJoint(a, b, length=-1.0),
+    lambda a, b, p: DistanceJoint(a, b, hertz=-1.0),
+    lambda a, b, p: DistanceJoint(a, b, min_length=2.0, max_length=1.0),
+    lambda a, b, p: DistanceJoint(a, b, min_length=2.0),  # more than the length measured, 1
+    lambda a, b, p: RevoluteJoint(a, b, (0.5, 0.0), lower=0.5, upper=-0.5),
+    lambda a, b, p: RevoluteJoint(a, b, (0.5, 0.0), max_motor_torque=-1.0),
+    lambda a, b, p: MouseJoint(a, (0.0, 0.0), max_force=0.0),
+    lambda a, b, p: MouseJoint(a, (0.0, math.nan), max_force=1.0),
+    lambda a, b, p: DistanceJoint(True, b),
+])
+def test_a_bad_joint_is_refused_and_the_scene_is_unchanged(make):
+    s = soft()
+    a, b, plain = bodies(s)
+    before = s.entities
+    with pytest.raises(InvalidValue):
+        s.spawn(make(a, b, plain))
+    assert s.entities == before
+    with pytest.raises(InvalidValue):
+        s.add_component(plain, make(a, b, plain))
+    assert esper.components_for_entity(plain) == (s.get(plain, Transform),)
+
+
+def test_a_bad_value_written_later_is_refused_before_the_step_changes_anything():
+    s = soft()
+    a, b, _p = bodies(s)
+    j = s.spawn(RevoluteJoint(a, b, (0.5, 0.0)))
+    s.get(j, RevoluteJoint).motor_speed = math.nan
+    with pytest.raises(InvalidValue, match=f"entity {j}.*motor_speed"):
+        s.step(DT)
+    assert s.frame == 0 and pose(s, a) == (0.0, 0.0, 0.0)
+
+
+def test_despawning_a_body_removes_its_joints():
+    s = soft()
+    a, b, _p = bodies(s)
+    c = s.spawn(Transform(2.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    ab = s.spawn(DistanceJoint(a, b))
+    bc = s.spawn(DistanceJoint(b, c))
+    tagged = s.spawn(RevoluteJoint(a, None, (0.0, 0.0)), Tag())  # an entity holding more than the joint stays
+    s.despawn(b)
+    assert not s.exists(ab) and not s.exists(bc)
+    assert s.exists(tagged) and s.try_get(tagged, RevoluteJoint) is not None
+    s.despawn(a)
+    assert s.exists(tagged) and s.try_get(tagged, RevoluteJoint) is None
+    s.step(DT)
+
+
+class Tag:
+    """A game's own component."""
+
+
+def test_collide_connected_is_off_by_default():
+    def scene(collide: bool) -> Scene:
+        s = soft(gravity=0.0)
+        a = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.5)))
+        b = s.spawn(Transform(0.75, 0.0), Velocity(), Hitbox(Circle(0.5)))  # overlapping
+        s.spawn(DistanceJoint(a, b, collide_connected=collide))
+        s.step(DT)
+        return s
+
+    assert len(scene(False).events) == 0
+    assert len(scene(True).events) == 1
+
+
+# --- snapshots, rollback, the exact solver --------------------------------------------------------
+
+
+def machine() -> tuple[Scene, list[int]]:
+    s = soft()
+    s.spawn(Transform(0.0, -3.0), Hitbox(AABB(20.0, 1.0), body="static"))
+    bar, _j = hinged_bar(s, lower=-1.0, upper=0.5, motor_speed=0.5, max_motor_torque=2.0)
+    ball = s.spawn(Transform(2.0, -1.0), Velocity(), Hitbox(Circle(0.125)))
+    s.spawn(DistanceJoint(bar, ball, anchor_a=(1.0, 0.0), hertz=2.0, damping=0.25))
+    return s, [bar, ball]
+
+
+def state(s: Scene, es: list[int]) -> bytes:
+    return np.array([v for e in es for v in (*pose(s, e), *s.get(e, Velocity)._values())]).tobytes()
+
+
+def test_a_restored_snapshot_continues_bit_for_bit():
+    s, es = machine()
+    for _ in range(40):
+        s.step(DT)
+    snap = s.snapshot()
+    for _ in range(40):
+        s.step(DT)
+    expected = state(s, es)
+    s.restore(snap)
+    for _ in range(40):
+        s.step(DT)
+    assert state(s, es) == expected
+
+
+def test_a_snapshot_file_continues_bit_for_bit(tmp_path):
+    s, es = machine()
+    for _ in range(40):
+        s.step(DT)
+    save_snapshot(s, tmp_path / "machine.snap")
+    for _ in range(40):
+        s.step(DT)
+    expected = state(s, es)
+    load_snapshot(s, tmp_path / "machine.snap")
+    for _ in range(40):
+        s.step(DT)
+    assert state(s, es) == expected
+
+
+def test_a_failed_step_leaves_the_joints_as_they_were():
+    s, es = machine()
+    twin, _ = machine()
+    for _ in range(20):
+        s.step(DT)
+        twin.step(DT)
+
+    def fail(scene, dt):
+        raise RuntimeError("boom")
+
+    s.add_system(fail, after="response")
+    with pytest.raises(RuntimeError):
+        s.step(DT)
+    s.remove_system(fail)
+    for _ in range(20):
+        s.step(DT)
+        twin.step(DT)
+    assert state(s, es) == state(twin, es)
+
+
+def test_the_exact_solver_refuses_joints():
+    s = Scene(gravity=(0.0, -G))
+    a, b, _p = bodies(s)
+    s.spawn(DistanceJoint(a, b))
+    with pytest.raises(InvalidValue, match='joints need Scene\\(solver="soft"\\)'):
+        s.step(DT)
+    assert s.frame == 0 and pose(s, a) == (0.0, 0.0, 0.0)
+
+
+def test_a_sleeping_body_wakes_when_its_joint_changes():
+    s = soft()
+    wheel = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.5)))
+    axle = s.spawn(RevoluteJoint(wheel, None, (0.0, 0.0), max_motor_torque=64.0))
+    grabbed = s.spawn(Transform(4.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
+    mouse = s.spawn(MouseJoint(grabbed, (4.0, 0.0), max_force=64.0))
+    for _ in range(128):
+        s.step(DT)
+    assert s.store.asleep[s.store.row_of[wheel]] and s.store.asleep[s.store.row_of[grabbed]]
+    s.get(axle, RevoluteJoint).motor_speed = 2.0
+    s.get(mouse, MouseJoint).target = (4.0, 1.0)
+    for _ in range(128):
+        s.step(DT)
+    assert s.get(wheel, Velocity).angular == pytest.approx(2.0, abs=1e-6)
+    assert math.dist(pose(s, grabbed)[:2], (4.0, 1.0)) < 0.01
+
+
+def test_a_body_asleep_wakes_when_the_other_body_of_its_joint_moves():
+    s = soft()
+    hook = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.125), body="kinematic"))
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125)))
+    s.spawn(DistanceJoint(ball, hook))
+    for _ in range(128):
+        s.step(DT)
+    assert s.store.asleep[s.store.row_of[ball]]
+    s.get(hook, Velocity).x = 1.0  # the hook moves off: the ball follows
+    for _ in range(64):
+        s.step(DT)
+    assert pose(s, ball)[0] > 0.5
+    assert math.dist(pose(s, ball)[:2], pose(s, hook)[:2]) == pytest.approx(1.0, abs=SLOP)
