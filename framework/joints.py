@@ -25,14 +25,24 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from numbers import Integral
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import esper
 
+from .collision.results import Vec2
 from .store import KIND_NONE, BodyStore
 from .validation import InvalidValue, finite, positive, vector2
 
-__all__ = ["DistanceJoint", "Joint", "MouseJoint", "RevoluteJoint", "WeldJoint"]
+__all__ = ["DistanceJoint", "Joint", "JointReaction", "MouseJoint", "RevoluteJoint", "WeldJoint"]
+
+class JointReaction(NamedTuple):
+    """What a joint did to its body ``a`` in the last step (``Scene.joint_reaction``): the force
+    (world units of force: mass times length per second squared) and the torque of its angular
+    part (a motor's, a limit's, a weld's; not the moment of the force)."""
+
+    force: Vec2
+    torque: float
+
 
 # The kernel's joint kinds (framework.systems.soft_joints reads them by number).
 DISTANCE, REVOLUTE, WELD, MOUSE = 0, 1, 2, 3

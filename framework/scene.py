@@ -27,6 +27,7 @@ from .bodies import Bodies
 from .character import CharacterController
 from .collision.broad_phase import SpatialHash
 from .collision.distance import Distance
+from .collision.results import Vec2
 from .compile_notice import FIRST_STEP_NOTICE, notice_if_slow
 from .components import Hitbox, Transform, Velocity, Visual
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
@@ -35,7 +36,7 @@ from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
 from .frame import StepFrame, add_counters
 from .geometry import Geometry
 from .input import Input
-from .joints import Joint, check_joints, joint_components, remove_joints_of
+from .joints import Joint, JointReaction, check_joints, joint_components, remove_joints_of
 from .limits import MAX_COORD, check_motion, motion_within
 from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
@@ -48,6 +49,7 @@ from .systems import pipeline_stages
 from .systems.character import CharacterStage
 from .systems.narrow_phase import NarrowPhase
 from .systems.sleeping import SLEEP_SPEED, SLEEP_STEPS
+from .systems.soft_step import SoftStep
 from .systems.stage import STAGES, Pipeline, SystemProcessor, place, unregister
 from .validation import InvalidValue, positive, vector2
 
@@ -658,6 +660,22 @@ class Scene:
         closest points: a :class:`~framework.collision.distance.Distance`."""
         self._activate()
         return self._queries.distance(entity_a, entity_b)
+
+    def joint_reaction(self, joint: int) -> JointReaction:
+        """What the joint on entity ``joint`` did to its body ``a`` in the last step: a
+        :class:`~framework.joints.JointReaction` ``(force, torque)`` (Box2D's constraint force
+        and torque: the torque is the joint's angular part, a motor's, a limit's or a weld's).
+        Zeros before a step has solved it (and in the exact solver, which solves no joints)."""
+        self._activate()
+        found: list[Joint] = []
+        if isinstance(joint, int) and not isinstance(joint, bool) and esper.entity_exists(joint):
+            held: tuple[Any, ...] = esper.components_for_entity(joint)
+            found = [c for c in held if isinstance(c, Joint)]
+        if not found:
+            raise InvalidValue(f"joint must be an entity holding a joint component, got {joint!r}")
+        stage = self._stages.get("soft_step")
+        fx, fy, torque = stage.reaction(joint, found[0]) if isinstance(stage, SoftStep) else (0.0, 0.0, 0.0)
+        return JointReaction(Vec2(float(fx), float(fy)), float(torque))
 
     # --- snapshots ---------------------------------------------------------------------------
 

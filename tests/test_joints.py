@@ -463,3 +463,63 @@ def test_a_body_asleep_wakes_when_the_other_body_of_its_joint_moves():
         s.step(DT)
     assert pose(s, ball)[0] > 0.5
     assert math.dist(pose(s, ball)[:2], pose(s, hook)[:2]) == pytest.approx(1.0, abs=SLOP)
+
+
+# --- reactions: what a joint does to its body ---------------------------------------------------
+
+
+def test_a_hanging_ball_is_held_by_its_weight():
+    # a ball of mass 2 hanging at rest 1 below a fixed point: the rod pulls it up with m g = 16
+    s = soft()
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125), mass=2.0))
+    j = s.spawn(DistanceJoint(ball, None, anchor_b=(0.0, 0.0)))
+    assert s.joint_reaction(j) == ((0.0, 0.0), 0.0)  # not solved yet
+    for _ in range(64):
+        s.step(DT)
+    force, torque = s.joint_reaction(j)
+    assert force == pytest.approx((0.0, 2.0 * G), abs=1e-6)
+    assert torque == 0.0
+
+
+def test_a_motor_holding_a_bar_level_gives_the_torque_gravity_takes():
+    # the hinged bar (mass 1, 2 long) held level by a motor at speed 0: the hinge holds its weight
+    # (force (0, 8) on the bar) and the motor gravity's moment about the hinge (m g L/2 = 8, turning
+    # the bar up: counter-clockwise)
+    s = soft()
+    bar, j = hinged_bar(s, motor_speed=0.0, max_motor_torque=100.0)
+    for _ in range(64):
+        s.step(DT)
+    assert abs(pose(s, bar)[2]) < 0.01
+    force, torque = s.joint_reaction(j)
+    assert force == pytest.approx((0.0, G), rel=1e-3)
+    assert torque == pytest.approx(G * 1.0, rel=1e-3)
+
+
+def test_a_welded_cantilever_carries_its_weight_and_moment():
+    # a box 1 x 1/4 (mass 1) welded to the world at its left end: force (0, 8), torque 8 * 1/2
+    s = soft()
+    plank = s.spawn(Transform(0.5, 0.0), Velocity(), Hitbox(box(0.5, 0.125)))
+    j = s.spawn(WeldJoint(plank, None, (0.0, 0.0)))
+    for _ in range(64):
+        s.step(DT)
+    force, torque = s.joint_reaction(j)
+    assert force == pytest.approx((0.0, G), rel=1e-3)
+    assert torque == pytest.approx(G * 0.5, rel=1e-3)
+
+
+def test_a_mouse_joint_holding_a_body_against_gravity_pulls_up_with_its_weight():
+    s = soft()
+    body = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25), mass=0.5))
+    j = s.spawn(MouseJoint(body, (0.0, 0.0), max_force=64.0, hertz=4.0, damping=1.0))
+    for _ in range(64 * 4):
+        s.step(DT)
+    force, _torque = s.joint_reaction(j)
+    assert force == pytest.approx((0.0, 0.5 * G), rel=1e-3)
+
+
+def test_the_reaction_of_something_that_is_no_joint_is_refused():
+    s = soft()
+    ball = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    for bad in (ball, 999, "joint", True):
+        with pytest.raises(InvalidValue, match="joint"):
+            s.joint_reaction(bad)

@@ -211,6 +211,40 @@ class SoftStep(Stage):
         """Start the next step from ``state`` (of :meth:`state`)."""
         self.fat, self.pairs, self.slots, self._pairs_key, self.joints = state
 
+    def reaction(self, entity: int, joint: Joint) -> tuple[float, float, float]:
+        """The force ``(fx, fy)`` and torque the joint on ``entity`` applied to its body ``a`` in the
+        last step (Box2D's constraint force and torque: the impulse of the last sub-step over its
+        length; the torque is the joint's angular part: a motor's, a limit's, a weld's, not the
+        moment of the force). Zeros before a step has solved it."""
+        keys, imp, jf = self.joints
+        at = np.flatnonzero(keys == 4 * entity + joint.kind)
+        dt, nsub = self._params[PARAMS.index("dt")], self._params[PARAMS.index("substeps")]
+        if at.size == 0 or dt <= 0.0 or nsub <= 0:
+            return 0.0, 0.0, 0.0
+        i, inv_h = int(at[0]), nsub / dt
+        px, py, lower, upper, angular = (float(v) for v in imp[i])
+        if joint.kind == DISTANCE:  # along the line between the anchors (the kernel's b takes +impulse)
+            store = self.bodies.store
+            c = store.cols
+
+            def world(body: int | None, lx: float, ly: float) -> tuple[float, float]:
+                if body is None:
+                    return lx, ly
+                r = store.row_of[body]
+                co, si = math.cos(c["rot"][r]), math.sin(c["rot"][r])
+                return float(c["x"][r] + co * lx - si * ly), float(c["y"][r] + si * lx + co * ly)
+
+            (ax, ay), (bx, by) = world(joint.a, jf[i, 0], jf[i, 1]), world(joint.b, jf[i, 2], jf[i, 3])
+            d = math.hypot(bx - ax, by - ay)
+            axial = px + lower - upper
+            if d == 0.0:
+                return 0.0, 0.0, 0.0
+            return -axial * (bx - ax) / d * inv_h, -axial * (by - ay) / d * inv_h, 0.0
+        turn = (angular + lower - upper) * inv_h
+        if joint.kind in (REVOLUTE, MOUSE):  # the kernel's b is the joint's a (see joint_tables)
+            return px * inv_h, py * inv_h, turn
+        return -px * inv_h, -py * inv_h, -turn  # a weld: the kernel's a is the joint's a
+
     def wanted(self) -> bool:
         effects = self.pipeline.effects
         return self.pipeline.solver == "soft" and bool(effects & {"movement", "detection"})
