@@ -33,13 +33,25 @@ from .collision.results import Vec2
 from .store import KIND_NONE, BodyStore
 from .validation import InvalidValue, finite, positive, vector2
 
-__all__ = ["DistanceJoint", "Joint", "JointReaction", "MouseJoint", "RevoluteJoint", "WeldJoint"]
+__all__ = ["DistanceJoint", "Joint", "JointBroken", "JointReaction", "MouseJoint", "RevoluteJoint", "WeldJoint"]
 
 class JointReaction(NamedTuple):
     """What a joint did to its body ``a`` in the last step (``Scene.joint_reaction``): the force
     (world units of force: mass times length per second squared) and the torque of its angular
     part (a motor's, a limit's, a weld's; not the moment of the force)."""
 
+    force: Vec2
+    torque: float
+
+
+class JointBroken(NamedTuple):
+    """A joint that broke at the end of a step (``scene.broken_joints``): its entity, its bodies,
+    the joint itself (removed from the entity) and the force and torque that broke it."""
+
+    entity: int
+    a: int
+    b: int | None
+    joint: Joint
     force: Vec2
     torque: float
 
@@ -97,6 +109,20 @@ class Joint(ABC):
     a: int
     b: int | None
     collide_connected: bool
+    #: the joint breaks (is removed at the end of a step, and listed in ``scene.broken_joints``)
+    #: when the force or the torque it applied in the step is above these (> 0; inf: never)
+    break_force: float = math.inf
+    break_torque: float = math.inf
+
+    def check_breaking(self) -> None:
+        """:class:`InvalidValue` unless ``break_force`` and ``break_torque`` are > 0 (inf: never)."""
+        name = type(self).__name__
+        for field in ("break_force", "break_torque"):
+            value = getattr(self, field)
+            v = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
+            if not v > 0.0:
+                raise InvalidValue(f"{name} {field} must be > 0 (math.inf: never breaks), got {value!r}")
+            setattr(self, field, v)
 
     def _init_bodies(self, a: object, b: object, collide_connected: object) -> None:
         name = type(self).__name__
@@ -172,8 +198,10 @@ class DistanceJoint(Joint):
     def __init__(self, a: int, b: int | None, anchor_a: tuple[float, float] = (0.0, 0.0),
                  anchor_b: tuple[float, float] = (0.0, 0.0), length: float | None = None,
                  min_length: float | None = None, max_length: float | None = None, hertz: float = 0.0,
-                 damping: float = 0.0, collide_connected: bool = False) -> None:
+                 damping: float = 0.0, collide_connected: bool = False, break_force: float = math.inf,
+                 break_torque: float = math.inf) -> None:
         self._init_bodies(a, b, collide_connected)
+        self.break_force, self.break_torque = break_force, break_torque
         self.anchor_a = anchor_a
         self.anchor_b = anchor_b
         self.length = length
@@ -188,6 +216,7 @@ class DistanceJoint(Joint):
         return _limits(self.hertz, self.length or 0.0, self.min_length, self.max_length)
 
     def check(self) -> None:
+        self.check_breaking()
         self.anchor_a = vector2("DistanceJoint anchor_a", self.anchor_a)
         self.anchor_b = vector2("DistanceJoint anchor_b", self.anchor_b)
         self.length = _optional("DistanceJoint length", self.length)
@@ -231,8 +260,10 @@ class RevoluteJoint(Joint):
 
     def __init__(self, a: int, b: int | None, anchor: tuple[float, float], lower: float | None = None,
                  upper: float | None = None, motor_speed: float = 0.0, max_motor_torque: float = 0.0,
-                 collide_connected: bool = False) -> None:
+                 collide_connected: bool = False, break_force: float = math.inf,
+                 break_torque: float = math.inf) -> None:
         self._init_bodies(a, b, collide_connected)
+        self.break_force, self.break_torque = break_force, break_torque
         self.anchor = anchor
         self.lower = lower
         self.upper = upper
@@ -241,6 +272,7 @@ class RevoluteJoint(Joint):
         self.check()
 
     def check(self) -> None:
+        self.check_breaking()
         self.anchor = vector2("RevoluteJoint anchor", self.anchor)
         self.lower = None if self.lower is None else finite("RevoluteJoint lower", self.lower)
         self.upper = None if self.upper is None else finite("RevoluteJoint upper", self.upper)
@@ -261,14 +293,17 @@ class WeldJoint(Joint):
     kind = WELD
 
     def __init__(self, a: int, b: int | None, anchor: tuple[float, float], hertz: float = 0.0,
-                 damping: float = 0.0, collide_connected: bool = False) -> None:
+                 damping: float = 0.0, collide_connected: bool = False, break_force: float = math.inf,
+                 break_torque: float = math.inf) -> None:
         self._init_bodies(a, b, collide_connected)
+        self.break_force, self.break_torque = break_force, break_torque
         self.anchor = anchor
         self.hertz = hertz
         self.damping = damping
         self.check()
 
     def check(self) -> None:
+        self.check_breaking()
         self.anchor = vector2("WeldJoint anchor", self.anchor)
         self.hertz = _at_least_zero("WeldJoint hertz", self.hertz)
         self.damping = _at_least_zero("WeldJoint damping", self.damping)
@@ -286,8 +321,9 @@ class MouseJoint(Joint):
     kind = MOUSE
 
     def __init__(self, body: int, target: tuple[float, float], max_force: float, hertz: float = 5.0,
-                 damping: float = 0.7) -> None:
+                 damping: float = 0.7, break_force: float = math.inf, break_torque: float = math.inf) -> None:
         self._init_bodies(body, None, False)
+        self.break_force, self.break_torque = break_force, break_torque
         self.target = target
         self.max_force = max_force
         self.hertz = hertz
@@ -300,6 +336,7 @@ class MouseJoint(Joint):
         return self.a
 
     def check(self) -> None:
+        self.check_breaking()
         self.target = vector2("MouseJoint target", self.target)
         force = finite("MouseJoint max_force", self.max_force)
         if force <= 0.0:

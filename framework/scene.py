@@ -36,7 +36,7 @@ from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
 from .frame import StepFrame, add_counters
 from .geometry import Geometry
 from .input import Input
-from .joints import Joint, JointReaction, check_joints, joint_components, remove_joints_of
+from .joints import Joint, JointBroken, JointReaction, check_joints, joint_components, remove_joints_of
 from .limits import MAX_COORD, check_motion, motion_within
 from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
@@ -127,6 +127,8 @@ class Scene:
         self.closed = False
         self.frame = 0
         self.time = 0.0
+        #: the joints that broke at the end of the last step (see JointBroken, Joint.break_force)
+        self.broken_joints: list[JointBroken] = []
         self._totals: tuple[list[CollisionEvent], dict[str, Any]] | None = None  # a step of several sub-steps
         self._systems: list[SystemProcessor] = []
         self._stepping = False
@@ -538,6 +540,7 @@ class Scene:
                     exc.add_note(f"step {self.frame + 1} failed after a system changed the scene's structure (a Hitbox "
                                  "or Velocity added or removed): the scene is left as the failure found it")
                 raise
+        self.broken_joints = self._break_joints()
         self.frame += 1
         self.time += dt
         inp = self.resources.get(Input)
@@ -660,6 +663,25 @@ class Scene:
         closest points: a :class:`~framework.collision.distance.Distance`."""
         self._activate()
         return self._queries.distance(entity_a, entity_b)
+
+    def _break_joints(self) -> list[JointBroken]:
+        """Remove the joints whose force or torque this step was above their ``break_force`` or
+        ``break_torque`` (and their entities, if that was all they held); what broke, by entity."""
+        stage = self._stages.get("soft_step")
+        if not isinstance(stage, SoftStep):
+            return []
+        broken = []
+        for e, j in joint_components():
+            if j.break_force == math.inf and j.break_torque == math.inf:
+                continue
+            fx, fy, torque = stage.reaction(e, j)
+            if math.hypot(fx, fy) > j.break_force or abs(torque) > j.break_torque:
+                broken.append(JointBroken(e, j.a, j.b, j, Vec2(float(fx), float(fy)), float(torque)))
+        for b in broken:
+            esper.remove_component(b.entity, type(b.joint))
+            if not esper.components_for_entity(b.entity):
+                self._remove(b.entity)
+        return broken
 
     def joint_reaction(self, joint: int) -> JointReaction:
         """What the joint on entity ``joint`` did to its body ``a`` in the last step: a

@@ -523,3 +523,71 @@ def test_the_reaction_of_something_that_is_no_joint_is_refused():
     for bad in (ball, 999, "joint", True):
         with pytest.raises(InvalidValue, match="joint"):
             s.joint_reaction(bad)
+
+
+# --- breaking -------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("mass, breaks", [(2.0, False), (3.0, True)])
+def test_a_rope_breaks_above_its_force(mass, breaks):
+    # a ball hanging from a rod that breaks above a force of 20: its weight m g is 16 or 24
+    s = soft()
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125), mass=mass))
+    rod = s.spawn(DistanceJoint(ball, None, anchor_b=(0.0, 0.0), break_force=20.0))
+    s.step(DT)
+    if breaks:
+        (b,) = s.broken_joints
+        assert (b.entity, b.a, b.b, type(b.joint)) == (rod, ball, None, DistanceJoint)
+        assert b.force == pytest.approx((0.0, mass * G), rel=1e-3)
+        assert not s.exists(rod)  # the joint was all its entity held
+        for _ in range(31):
+            s.step(DT)
+        assert s.broken_joints == []
+        assert s.get(ball, Velocity).y == pytest.approx(-G * 31 * DT, rel=1e-6)  # falling freely since
+    else:
+        for _ in range(63):
+            s.step(DT)
+            assert s.broken_joints == []
+        assert pose(s, ball)[1] == pytest.approx(-1.0, abs=SLOP)
+
+
+@pytest.mark.parametrize("limit, breaks", [(6.0, True), (16.0, False)])
+def test_a_motor_hinge_breaks_above_its_torque(limit, breaks):
+    # the motor holding the bar level gives a torque of 8 (up to 11 in the first steps, as the bar settles)
+    s = soft()
+    bar, j = hinged_bar(s, motor_speed=0.0, max_motor_torque=100.0)
+    s.get(j, RevoluteJoint).break_torque = limit
+    broke = []
+    for _ in range(32):
+        s.step(DT)
+        broke += s.broken_joints
+    assert bool(broke) == breaks
+    if breaks:
+        assert broke[0].torque > limit and not s.exists(j)
+
+
+def test_a_joint_on_an_entity_with_other_components_leaves_the_entity():
+    s = soft()
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125), mass=4.0))
+    class Label:  # a game's own component on the joint's entity
+        pass
+
+    holder = s.spawn(DistanceJoint(ball, None, anchor_b=(0.0, 0.0), break_force=1.0), Label())
+    s.step(DT)
+    assert s.exists(holder) and s.try_get(holder, DistanceJoint) is None
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, "strong", True, None])
+def test_a_bad_break_force_or_torque_is_refused(bad):
+    s = soft()
+    ball = s.spawn(Transform(0.0, -1.0), Velocity(), Hitbox(Circle(0.125)))
+    with pytest.raises(InvalidValue, match="break_force"):
+        DistanceJoint(ball, None, break_force=bad)
+    with pytest.raises(InvalidValue, match="break_torque"):
+        RevoluteJoint(ball, None, (0.0, 0.0), break_torque=bad)
+    j = s.spawn(WeldJoint(ball, None, (0.0, 0.0)))
+    s.get(j, WeldJoint).break_force = bad
+    before = pose(s, ball)
+    with pytest.raises(InvalidValue, match="break_force"):
+        s.step(DT)
+    assert pose(s, ball) == before
