@@ -33,7 +33,8 @@ from .collision.results import Vec2
 from .store import KIND_NONE, BodyStore
 from .validation import InvalidValue, finite, positive, vector2
 
-__all__ = ["DistanceJoint", "Joint", "JointBroken", "JointReaction", "MouseJoint", "RevoluteJoint", "WeldJoint"]
+__all__ = ["DistanceJoint", "Joint", "JointBroken", "JointReaction", "MouseJoint", "PrismaticJoint", "RevoluteJoint",
+           "WeldJoint"]
 
 class JointReaction(NamedTuple):
     """What a joint did to its body ``a`` in the last step (``Scene.joint_reaction``): the force
@@ -57,7 +58,7 @@ class JointBroken(NamedTuple):
 
 
 # The kernel's joint kinds (framework.systems.soft_joints reads them by number).
-DISTANCE, REVOLUTE, WELD, MOUSE = 0, 1, 2, 3
+DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC = 0, 1, 2, 3, 4
 
 
 def _entity(name: str, value: object, optional: bool) -> int | None:
@@ -350,7 +351,54 @@ class MouseJoint(Joint):
         self._frame = (lx, ly, 0.0, 0.0, 0.0)
 
 
-JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint)
+class PrismaticJoint(Joint):
+    """A slider: body ``a`` slides along ``axis`` on ``b`` (the world with ``b=None``): they keep
+    their relative angle, and ``a``'s point ``anchor`` stays on the line along ``axis`` through
+    ``b``'s (``axis``: a world direction when spawned, turning with ``b`` after). ``lower`` and
+    ``upper`` limit ``a``'s slide (world units along the axis from where it was when spawned;
+    ``None``: no limit); a motor (``max_motor_force > 0``) drives it at ``motor_speed`` units a
+    second with at most that force."""
+
+    kind = PRISMATIC
+
+    def __init__(self, a: int, b: int | None, anchor: tuple[float, float], axis: tuple[float, float] = (1.0, 0.0),
+                 lower: float | None = None, upper: float | None = None, motor_speed: float = 0.0,
+                 max_motor_force: float = 0.0, collide_connected: bool = False, break_force: float = math.inf,
+                 break_torque: float = math.inf) -> None:
+        self._init_bodies(a, b, collide_connected)
+        self.break_force, self.break_torque = break_force, break_torque
+        self.anchor = anchor
+        self.axis = axis
+        self.lower = lower
+        self.upper = upper
+        self.motor_speed = motor_speed
+        self.max_motor_force = max_motor_force
+        self._axis_local: tuple[float, float] = (1.0, 0.0)
+        self.check()
+
+    def check(self) -> None:
+        self.check_breaking()
+        self.anchor = vector2("PrismaticJoint anchor", self.anchor)
+        ax, ay = vector2("PrismaticJoint axis", self.axis)
+        length = math.hypot(ax, ay)
+        if not length > 0.0 or not math.isfinite(length):
+            raise InvalidValue(f"PrismaticJoint axis must be a direction (not zero), got {self.axis!r}")
+        self.axis = (ax / length, ay / length)
+        self.lower = None if self.lower is None else finite("PrismaticJoint lower", self.lower)
+        self.upper = None if self.upper is None else finite("PrismaticJoint upper", self.upper)
+        self.motor_speed = finite("PrismaticJoint motor_speed", self.motor_speed)
+        self.max_motor_force = _at_least_zero("PrismaticJoint max_motor_force", self.max_motor_force)
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise InvalidValue(f"PrismaticJoint lower ({self.lower}) is more than upper ({self.upper})")
+
+    def _measure(self, store: BodyStore) -> None:
+        self._anchors_at(store, self.anchor)
+        rot = 0.0 if self.b is None else _pose(store, self.b)[2]
+        c, s = math.cos(rot), math.sin(rot)
+        self._axis_local = (c * self.axis[0] + s * self.axis[1], -s * self.axis[0] + c * self.axis[1])
+
+
+JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint, PrismaticJoint)
 _JOINT_SET = frozenset(JOINT_TYPES)
 
 

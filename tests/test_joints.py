@@ -21,6 +21,7 @@ from framework import (
     InvalidValue,
     MouseJoint,
     Polygon,
+    PrismaticJoint,
     RevoluteJoint,
     Scene,
     Transform,
@@ -591,3 +592,88 @@ def test_a_bad_break_force_or_torque_is_refused(bad):
     with pytest.raises(InvalidValue, match="break_force"):
         s.step(DT)
     assert pose(s, ball) == before
+
+
+# --- prismatic: a slider ------------------------------------------------------------------------------
+
+
+def slider(s: Scene, axis=(1.0, 1.0), **kw) -> tuple[int, int]:
+    """A box (mass 1, turns) on a slider to the world through its centre at the origin."""
+    body = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
+    return body, s.spawn(PrismaticJoint(body, None, (0.0, 0.0), axis=axis, **kw))
+
+
+def test_a_slider_slides_along_its_axis_as_gravity_along_it_says():
+    # a 45-degree axis: gravity along it is -8 / sqrt 2; the box keeps to the line and its angle
+    s = soft()
+    body, _j = slider(s)
+    for _ in range(64):
+        s.step(DT)
+        x, y, r = pose(s, body)
+        assert abs(x - y) / math.sqrt(2.0) < SLOP and abs(r) < 1e-3
+    along = (x + y) / math.sqrt(2.0)
+    assert along == pytest.approx(-0.5 * G / math.sqrt(2.0) * 1.0 ** 2, rel=0.02)
+
+
+def test_a_slider_stops_at_its_limits():
+    s = soft()
+    body, _j = slider(s, axis=(0.0, 1.0), lower=-0.5, upper=2.0)
+    for _ in range(64 * 2):
+        s.step(DT)
+        assert pose(s, body)[1] > -0.5 - 0.01
+    assert pose(s, body)[1] == pytest.approx(-0.5, abs=0.01)
+    s.get(body, Velocity).y = 20.0  # thrown up: stops at the upper limit
+    for _ in range(16):
+        s.step(DT)
+        assert pose(s, body)[1] < 2.0 + 0.01
+
+
+def test_a_slider_motor_reaches_its_speed_and_pushes_no_harder_than_its_force():
+    s = soft(gravity=0.0)
+    body, _j = slider(s, axis=(1.0, 0.0), motor_speed=2.0, max_motor_force=100.0)
+    for _ in range(16):
+        s.step(DT)
+    assert s.get(body, Velocity).x == pytest.approx(2.0, abs=1e-3)
+    # up a vertical slider against gravity's 8 with a force of 4: it falls at 4
+    s = soft()
+    body, _j = slider(s, axis=(0.0, 1.0), motor_speed=1.0, max_motor_force=4.0)
+    for _ in range(16):
+        s.step(DT)
+    assert s.get(body, Velocity).y / (16 * DT) == pytest.approx(-4.0, rel=0.02)
+
+
+def test_a_slider_motor_holding_a_body_carries_its_weight():
+    s = soft()
+    body, j = slider(s, axis=(0.0, 1.0), motor_speed=0.0, max_motor_force=100.0)
+    for _ in range(64):
+        s.step(DT)
+    assert abs(pose(s, body)[1]) < 0.01
+    force, torque = s.joint_reaction(j)
+    assert force == pytest.approx((0.0, G), rel=1e-3, abs=1e-6)
+    assert torque == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_slider_between_two_bodies_keeps_them_on_its_line():
+    # a box sliding on a turning beam pinned at its middle: it stays on the beam's axis as the beam turns
+    s = soft()
+    beam = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(2.0, 0.0625), inertia=1.0))
+    s.spawn(RevoluteJoint(beam, None, (0.0, 0.0)))
+    bead = s.spawn(Transform(1.0, 0.5), Velocity(), Hitbox(Circle(0.125)))
+    s.spawn(PrismaticJoint(bead, beam, (1.0, 0.5), axis=(1.0, 0.0), lower=-3.0, upper=1.0))
+    for _ in range(64 * 2):
+        s.step(DT)
+        bx, by, br = pose(s, beam)
+        x, y, _r = pose(s, bead)
+        # the bead's offset from the beam's line through (1, 0.5) when made: 0.5 across the beam
+        across = -(x - bx) * math.sin(br) + (y - by) * math.cos(br)
+        assert across == pytest.approx(0.5, abs=2 * SLOP)
+
+
+@pytest.mark.parametrize("kw, field", [({"axis": (0.0, 0.0)}, "axis"), ({"lower": 1.0, "upper": 0.0}, "lower"),
+                                       ({"max_motor_force": -1.0}, "max_motor_force"),
+                                       ({"motor_speed": math.nan}, "motor_speed")])
+def test_a_bad_slider_is_refused(kw, field):
+    s = soft()
+    body = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
+    with pytest.raises(InvalidValue, match=field):
+        PrismaticJoint(body, None, (0.0, 0.0), **kw)

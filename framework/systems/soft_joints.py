@@ -30,18 +30,19 @@ from .softness import soft
 
 __all__ = ["JOINT_F", "JOINT_IMP", "prepare_joints", "solve_joints", "warm_start_joints"]
 
-DISTANCE, REVOLUTE, WELD, MOUSE = 0, 1, 2, 3  # (as framework.joints)
+DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC = 0, 1, 2, 3, 4  # (as framework.joints)
 
 #: A joint's parameters: its anchors in each body's frame (a world point for the world), the
 #: bodies' relative angle at creation; a distance joint's length, least and most length (and
 #: whether it has a most), spring frequency and damping ratio (also the weld's and the mouse's);
 #: a revolute joint's limits (and whether each is on), motor speed and torque; the mouse's force.
 JOINT_F = ("ax", "ay", "bx", "by", "ref", "length", "lo", "hi", "has_hi", "hertz", "damping", "lower", "upper",
-           "has_lower", "has_upper", "speed", "torque", "force")
+           "has_lower", "has_upper", "speed", "torque", "force", "axis_x", "axis_y")
 (_AX, _AY, _BX, _BY, _REF, _LEN, _LO, _HI, _HAS_HI, _HZ, _ZETA, _LOWER, _UPPER, _HAS_LOWER, _HAS_UPPER, _SPEED,
- _TORQUE, _FORCE) = range(len(JOINT_F))
+ _TORQUE, _FORCE, _AXIS_X, _AXIS_Y) = range(len(JOINT_F))
 #: A joint's accumulated impulses: the linear impulse (x, y; a distance joint's along its axis in
-#: the first), the lower and upper limits', and the angular one (a motor's, a weld's or a mouse's).
+#: the first; a prismatic joint's across its axis, then its angular one), the lower and upper
+#: limits', and the angular one (a motor's, a weld's or a mouse's; a prismatic motor's, along its axis).
 JOINT_IMP = ("px", "py", "lower", "upper", "angular")
 _PX, _PY, _ILO, _IUP, _IANG = range(len(JOINT_IMP))
 # Columns of a prepared joint: on; anchors from each origin at the step's start; the origins'
@@ -49,8 +50,8 @@ _PX, _PY, _ILO, _IUP, _IANG = range(len(JOINT_IMP))
 # (a spring's, else the joints' stiffness); the mouse's linear effective mass (a symmetric 2x2)
 # and its angular softness.
 (_ON, _RAX, _RAY, _RBX, _RBY, _DCX, _DCY, _MA, _IA, _MB, _IB, _AXM, _SB, _SM, _SI, _K11, _K12, _K22, _AB, _AM,
- _AI) = range(21)
-_NP = 21
+ _AI, _WAX, _WAY) = range(23)  # (_WAX, _WAY: a prismatic joint's axis at the step's start)
+_NP = 23
 
 
 @njit(cache=True)
@@ -86,6 +87,15 @@ def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
             ux, uy = _unit(sx, sy)
             cra, crb = rax * uy - ray * ux, rbx * uy - rby * ux
             k = ma + mb + ia * cra * cra + ib * crb * crb
+            jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
+        elif kind == PRISMATIC:  # the axis turns with a (the world's: fixed); the axial effective mass
+            c, s = (math.cos(rot[a]), math.sin(rot[a])) if a >= 0 else (1.0, 0.0)
+            wax, way = c * jf[j, _AXIS_X] - s * jf[j, _AXIS_Y], s * jf[j, _AXIS_X] + c * jf[j, _AXIS_Y]
+            jp[j, _WAX], jp[j, _WAY] = wax, way
+            dx, dy = jp[j, _DCX] + rbx - rax, jp[j, _DCY] + rby - ray
+            a1 = (dx + rax) * way - (dy + ray) * wax
+            a2 = rbx * way - rby * wax
+            k = ma + mb + ia * a1 * a1 + ib * a2 * a2
             jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
         elif kind == MOUSE:  # (body b, held to a world point)
             k11, k12, k22 = mb + ib * rby * rby, -ib * rbx * rby, mb + ib * rbx * rbx
@@ -140,6 +150,19 @@ def warm_start_joints(jint, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
             ux, uy = _unit(jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray)
             axial = imp[j, _PX] + imp[j, _ILO] - imp[j, _IUP]
             px, py, ang = axial * ux, axial * uy, 0.0
+        elif kind == PRISMATIC:  # Box2D's b2WarmStartPrismaticJoint: along, across and about the axis
+            dx, dy = jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray
+            ux, uy = ca * jp[j, _WAX] - sa * jp[j, _WAY], sa * jp[j, _WAX] + ca * jp[j, _WAY]
+            axial = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
+            perp, turn = imp[j, _PX], imp[j, _PY]
+            a1, a2 = (dx + rax) * uy - (dy + ray) * ux, rbx * uy - rby * ux
+            s1, s2 = (dx + rax) * ux + (dy + ray) * uy, rbx * ux + rby * uy  # (crosses with the left perp)
+            px, py = axial * ux - perp * uy, axial * uy + perp * ux
+            la, lb = axial * a1 + perp * s1 + turn, axial * a2 + perp * s2 + turn
+            ma, ia, mb, ib = jp[j, _MA], jp[j, _IA], jp[j, _MB], jp[j, _IB]
+            _store(a, ma, ia, vax - ma * px, vay - ma * py, wa - ia * la, vx, vy, w)
+            _store(b, mb, ib, vbx + mb * px, vby + mb * py, wb + ib * lb, vx, vy, w)
+            continue
         else:
             px, py = imp[j, _PX], imp[j, _PY]
             ang = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
@@ -171,6 +194,11 @@ def solve_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w, use_bi
             angle = rotb - rota - jf[j, _REF]
             vax, vay, wa, vbx, vby, wb = _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb,
                                                    ib, vax, vay, wa, vbx, vby, wb, use_bias, csoft, h, inv_h)
+        elif kind == PRISMATIC:
+            angle = rotb - rota - jf[j, _REF]
+            ux, uy = ca * jp[j, _WAX] - sa * jp[j, _WAY], sa * jp[j, _WAX] + ca * jp[j, _WAY]
+            vax, vay, wa, vbx, vby, wb = _prismatic(jf, jp, imp, j, angle, ux, uy, sx, sy, rax, ray, rbx, rby, ma, ia,
+                                                    mb, ib, vax, vay, wa, vbx, vby, wb, use_bias, csoft, h, inv_h)
         elif kind == WELD:
             angle = rotb - rota - jf[j, _REF]
             vax, vay, wa, vbx, vby, wb = _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
@@ -294,6 +322,67 @@ def _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
         bias_rate, ms, isc = csoft[0], csoft[1], csoft[2]
     return _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, bias_rate, ms,
                   isc)
+
+
+@njit(cache=True)
+def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
+               use_bias, csoft, h, inv_h):
+    """Box2D's ``b2SolvePrismaticJoint``: the motor along the axis ``(ux, uy)``, the limits of the
+    slide, then the block that keeps the anchors on the axis's line and the angle (``dx, dy``: the
+    anchors' separation, b's less a's)."""
+    a1, a2 = (dx + rax) * uy - (dy + ray) * ux, rbx * uy - rby * ux
+    mass = jp[j, _AXM]
+    if jf[j, _FORCE] > 0.0:  # the motor: the slide at its speed, with at most its force
+        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
+        old = imp[j, _IANG]
+        most = h * jf[j, _FORCE]
+        new = min(max(old + mass * (jf[j, _SPEED] - cdot), -most), most)
+        imp[j, _IANG] = new
+        s = new - old
+        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
+        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
+    slide = ux * dx + uy * dy
+    if jf[j, _HAS_LOWER] != 0.0:
+        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
+        old = imp[j, _ILO]
+        new = _limit(slide - jf[j, _LOWER], cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _ILO] = new
+        s = new - old
+        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
+        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
+    if jf[j, _HAS_UPPER] != 0.0:  # (signs flipped)
+        cdot = ux * (vax - vbx) + uy * (vay - vby) + a1 * wa - a2 * wb
+        old = imp[j, _IUP]
+        new = _limit(jf[j, _UPPER] - slide, cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _IUP] = new
+        s = new - old
+        vax, vay, wa = vax + ma * s * ux, vay + ma * s * uy, wa + ia * s * a1
+        vbx, vby, wb = vbx - mb * s * ux, vby - mb * s * uy, wb - ib * s * a2
+    # across the axis (its left perpendicular) and the angle, as one 2x2 block
+    nx, ny = -uy, ux
+    s1, s2 = (dx + rax) * ny - (dy + ray) * nx, rbx * ny - rby * nx
+    c1 = nx * (vbx - vax) + ny * (vby - vay) + s2 * wb - s1 * wa
+    c2 = wb - wa
+    ms, isc = 1.0, 0.0
+    if use_bias:
+        c1 += csoft[0] * (nx * dx + ny * dy)
+        c2 += csoft[0] * angle
+        ms, isc = csoft[1], csoft[2]
+    k11 = ma + mb + ia * s1 * s1 + ib * s2 * s2
+    k12 = ia * s1 + ib * s2
+    k22 = ia + ib
+    if k22 == 0.0:  # (bodies that do not turn)
+        k22 = 1.0
+    det = k11 * k22 - k12 * k12
+    det = 1.0 / det if det != 0.0 else 0.0
+    b1, b2 = det * (k22 * c1 - k12 * c2), det * (k11 * c2 - k12 * c1)
+    p1 = -ms * b1 - isc * imp[j, _PX]
+    p2 = -ms * b2 - isc * imp[j, _PY]
+    imp[j, _PX] += p1
+    imp[j, _PY] += p2
+    la, lb = p1 * s1 + p2, p1 * s2 + p2
+    return (vax - ma * p1 * nx, vay - ma * p1 * ny, wa - ia * la,
+            vbx + mb * p1 * nx, vby + mb * p1 * ny, wb + ib * lb)
 
 
 @njit(cache=True)

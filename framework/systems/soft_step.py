@@ -29,10 +29,12 @@ from ..frame import StepFrame
 from ..joints import (
     DISTANCE,
     MOUSE,
+    PRISMATIC,
     REVOLUTE,
     WELD,
     DistanceJoint,
     Joint,
+    PrismaticJoint,
     RevoluteJoint,
     WeldJoint,
     check_joints,
@@ -64,7 +66,7 @@ _JF = {name: i for i, name in enumerate(JOINT_F)}
 
 def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tuple[np.ndarray, ...]:
     """The kernel's joint tables (:mod:`~framework.systems.soft_joints`) for ``joints`` (checked
-    and attached): ``(jint, jf, keys, apart)``; ``keys``: each joint's warm-start key (entity * 4 +
+    and attached): ``(jint, jf, keys, apart)``; ``keys``: each joint's warm-start key (entity * 8 +
     kind); ``apart``: the sorted pair keys of the bodies that must not collide."""
     m = len(joints)
     jint = np.empty((m, 3), dtype=np.int64)
@@ -75,7 +77,7 @@ def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tup
         frame = j._frame
         assert frame is not None
         ra, rb = row_of[j.a], (-1 if j.b is None else row_of[j.b])
-        keys[i] = 4 * e + j.kind
+        keys[i] = 8 * e + j.kind
         jint[i] = (j.kind, ra, rb)
         row = jf[i]
         row[0:5] = frame
@@ -100,6 +102,16 @@ def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tup
         elif j.kind == WELD:
             assert isinstance(j, WeldJoint)
             row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
+        elif j.kind == PRISMATIC:  # the kernel slides its b along its a's axis: a and b swap
+            assert isinstance(j, PrismaticJoint)
+            jint[i] = (PRISMATIC, jint[i, 2], ra)
+            row[0:5] = (frame[2], frame[3], frame[0], frame[1], -frame[4])
+            if j.lower is not None:
+                row[_JF["lower"]], row[_JF["has_lower"]] = j.lower, 1.0
+            if j.upper is not None:
+                row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
+            row[_JF["speed"]], row[_JF["force"]] = j.motor_speed, j.max_motor_force
+            row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
         elif j.kind == MOUSE:  # the world's anchor is the target; the body is b to the kernel
             jint[i] = (MOUSE, -1, ra)
             row[0:5] = (*j.target, frame[0], frame[1], 0.0)  # type: ignore[attr-defined]
@@ -217,7 +229,7 @@ class SoftStep(Stage):
         length; the torque is the joint's angular part: a motor's, a limit's, a weld's, not the
         moment of the force). Zeros before a step has solved it."""
         keys, imp, jf = self.joints
-        at = np.flatnonzero(keys == 4 * entity + joint.kind)
+        at = np.flatnonzero(keys == 8 * entity + joint.kind)
         dt, nsub = self._params[PARAMS.index("dt")], self._params[PARAMS.index("substeps")]
         if at.size == 0 or dt <= 0.0 or nsub <= 0:
             return 0.0, 0.0, 0.0
@@ -240,6 +252,14 @@ class SoftStep(Stage):
             if d == 0.0:
                 return 0.0, 0.0, 0.0
             return -axial * (bx - ax) / d * inv_h, -axial * (by - ay) / d * inv_h, 0.0
+        if joint.kind == PRISMATIC:  # along the axis (turned with b), across it, and the angle's torque
+            assert isinstance(joint, PrismaticJoint)
+            store = self.bodies.store
+            rot = 0.0 if joint.b is None else float(store.cols["rot"][store.row_of[joint.b]])
+            lx, ly = joint._axis_local
+            ux, uy = math.cos(rot) * lx - math.sin(rot) * ly, math.sin(rot) * lx + math.cos(rot) * ly
+            axial = angular + lower - upper  # (the kernel's b is the joint's a: it takes +impulse)
+            return (axial * ux - px * uy) * inv_h, (axial * uy + px * ux) * inv_h, py * inv_h
         turn = (angular + lower - upper) * inv_h
         if joint.kind in (REVOLUTE, MOUSE):  # the kernel's b is the joint's a (see joint_tables)
             return px * inv_h, py * inv_h, turn
