@@ -15,7 +15,7 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
     from .collision import Contact, Impact, RayHit, Vec2, collide
     from .events import CollisionEvent
     from .input import Input
-    from .joints import DistanceJoint, MouseJoint, PrismaticJoint, RevoluteJoint, WeldJoint
+    from .joints import DistanceJoint, MouseJoint, PrismaticJoint, RevoluteJoint, WeldJoint, WheelJoint
     from .render import Camera, Renderer, run, screenshot
     from .scene import STAGES, Scene, SceneClosed, SceneHit
 
@@ -24,7 +24,7 @@ __all__ = [
     "Hitbox", "Impact", "Input", "InvalidValue", "MouseJoint", "Polygon", "PrismaticJoint", "RayHit", "Renderer",
     "RevoluteJoint",
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",
-    "WeldJoint", "collide", "run", "screenshot",
+    "WeldJoint", "WheelJoint", "collide", "run", "screenshot",
 ]
 __version__ = "0.1.0"
 
@@ -33,7 +33,7 @@ _LAZY = {
     "collide": "collision", "CollisionEvent": "events", "STAGES": "scene", "Scene": "scene",
     "SceneClosed": "scene", "SceneHit": "scene", "CharacterController": "character", "Input": "input",
     "DistanceJoint": "joints", "MouseJoint": "joints", "PrismaticJoint": "joints", "RevoluteJoint": "joints",
-    "WeldJoint": "joints",
+    "WeldJoint": "joints", "WheelJoint": "joints",
     # the render entry points (pyglet loads with them, on first use)
     "Camera": "render", "Renderer": "render", "run": "render", "screenshot": "render",
 }

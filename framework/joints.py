@@ -34,7 +34,7 @@ from .store import KIND_NONE, BodyStore
 from .validation import InvalidValue, finite, positive, vector2
 
 __all__ = ["DistanceJoint", "Joint", "JointBroken", "JointReaction", "MouseJoint", "PrismaticJoint", "RevoluteJoint",
-           "WeldJoint"]
+           "WeldJoint", "WheelJoint"]
 
 class JointReaction(NamedTuple):
     """What a joint did to its body ``a`` in the last step (``Scene.joint_reaction``): the force
@@ -58,7 +58,7 @@ class JointBroken(NamedTuple):
 
 
 # The kernel's joint kinds (framework.systems.soft_joints reads them by number).
-DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC = 0, 1, 2, 3, 4
+DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC, WHEEL = 0, 1, 2, 3, 4, 5
 
 
 def _entity(name: str, value: object, optional: bool) -> int | None:
@@ -398,7 +398,59 @@ class PrismaticJoint(Joint):
         self._axis_local = (c * self.axis[0] + s * self.axis[1], -s * self.axis[0] + c * self.axis[1])
 
 
-JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint, PrismaticJoint)
+class WheelJoint(Joint):
+    """A wheel on a chassis: body ``a`` (the wheel) turns freely about its point ``anchor`` and
+    slides along ``axis`` on ``b`` (the chassis; the world with ``b=None``), held by a suspension
+    spring of ``hertz`` and damping ratio ``damping`` toward where it was spawned (``hertz`` 0: no
+    spring; ``axis``: a world direction when spawned, turning with ``b``); ``lower``, ``upper``
+    limit the slide; a motor (``max_motor_torque > 0``) turns the wheel relative to the chassis at
+    ``motor_speed`` radians a second with at most that torque (Box2D's wheel joint)."""
+
+    kind = WHEEL
+
+    def __init__(self, a: int, b: int | None, anchor: tuple[float, float], axis: tuple[float, float] = (0.0, 1.0),
+                 hertz: float = 1.0, damping: float = 0.7, lower: float | None = None, upper: float | None = None,
+                 motor_speed: float = 0.0, max_motor_torque: float = 0.0, collide_connected: bool = False,
+                 break_force: float = math.inf, break_torque: float = math.inf) -> None:
+        self._init_bodies(a, b, collide_connected)
+        self.break_force, self.break_torque = break_force, break_torque
+        self.anchor = anchor
+        self.axis = axis
+        self.hertz = hertz
+        self.damping = damping
+        self.lower = lower
+        self.upper = upper
+        self.motor_speed = motor_speed
+        self.max_motor_torque = max_motor_torque
+        self._axis_local: tuple[float, float] = (0.0, 1.0)
+        self.check()
+
+    def check(self) -> None:
+        self.check_breaking()
+        self.anchor = vector2("WheelJoint anchor", self.anchor)
+        ax, ay = vector2("WheelJoint axis", self.axis)
+        length = math.hypot(ax, ay)
+        if not length > 0.0 or not math.isfinite(length):
+            raise InvalidValue(f"WheelJoint axis must be a direction (not zero), got {self.axis!r}")
+        self.axis = (ax / length, ay / length)
+        self.hertz = _at_least_zero("WheelJoint hertz", self.hertz)
+        self.damping = _at_least_zero("WheelJoint damping", self.damping)
+        self.lower = None if self.lower is None else finite("WheelJoint lower", self.lower)
+        self.upper = None if self.upper is None else finite("WheelJoint upper", self.upper)
+        self.motor_speed = finite("WheelJoint motor_speed", self.motor_speed)
+        self.max_motor_torque = _at_least_zero("WheelJoint max_motor_torque", self.max_motor_torque)
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise InvalidValue(f"WheelJoint lower ({self.lower}) is more than upper ({self.upper})")
+
+    def _measure(self, store: BodyStore) -> None:
+        self._anchors_at(store, self.anchor)
+        rot = 0.0 if self.b is None else _pose(store, self.b)[2]
+        c, s = math.cos(rot), math.sin(rot)
+        self._axis_local = (c * self.axis[0] + s * self.axis[1], -s * self.axis[0] + c * self.axis[1])
+
+
+JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint, PrismaticJoint,
+                                        WheelJoint)
 _JOINT_SET = frozenset(JOINT_TYPES)
 
 

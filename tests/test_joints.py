@@ -27,6 +27,7 @@ from framework import (
     Transform,
     Velocity,
     WeldJoint,
+    WheelJoint,
 )
 from framework.snapshot_file import load_snapshot, save_snapshot
 from framework.systems.soft_step import SOFT_SETTINGS
@@ -677,3 +678,80 @@ def test_a_bad_slider_is_refused(kw, field):
     body = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
     with pytest.raises(InvalidValue, match=field):
         PrismaticJoint(body, None, (0.0, 0.0), **kw)
+
+
+# --- wheel: a suspension and a motor ------------------------------------------------------------------
+
+
+def test_a_wheel_hangs_on_its_suspension_and_bounces_at_its_frequency():
+    # a wheel (mass 1) on a vertical spring of 2 hertz to the world: it settles where the spring
+    # carries its weight, m g / k below, k = m (2 pi f)^2, and bounces about there at 2 hertz
+    s = soft()
+    wheel = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    s.spawn(WheelJoint(wheel, None, (0.0, 0.0), axis=(0.0, 1.0), hertz=2.0, damping=0.0))
+    ts, ys = [], []
+    for k in range(64 * 4):
+        s.step(DT)
+        x, y, _r = pose(s, wheel)
+        assert abs(x) < SLOP
+        ts.append((k + 1) * DT)
+        ys.append(y)
+    sag = G / (2.0 * math.pi * 2.0) ** 2
+    assert sum(ys) / len(ys) == pytest.approx(-sag, rel=0.05)
+    assert period(ts, [y + sag for y in ys]) == pytest.approx(0.5, rel=0.03)
+
+
+def test_a_wheel_motor_turns_the_wheel_at_its_speed():
+    s = soft(gravity=0.0)
+    wheel = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    s.spawn(WheelJoint(wheel, None, (0.0, 0.0), motor_speed=-5.0, max_motor_torque=10.0))
+    for _ in range(32):
+        s.step(DT)
+    assert s.get(wheel, Velocity).angular == pytest.approx(-5.0, abs=1e-3)
+
+
+def test_a_car_drives_on_its_wheels():
+    # a chassis on two wheels (radius 1/4) with motors at -8 rad/s, on a floor with friction: it
+    # drives right at about 8 * 1/4 = 2 (the wheels roll), level, on its suspension
+    s = soft()
+    s.spawn(Transform(20.0, -0.5), Hitbox(AABB(60.0, 1.0), body="static", friction=0.9))
+    chassis = s.spawn(Transform(0.0, 0.75), Velocity(), Hitbox(box(0.75, 0.125), mass=2.0, friction=0.9))
+    wheels = []
+    for x in (-0.5, 0.5):
+        w = s.spawn(Transform(x, 0.25), Velocity(), Hitbox(Circle(0.25), mass=0.5, friction=0.9))
+        s.spawn(WheelJoint(w, chassis, (x, 0.25), axis=(0.0, 1.0), hertz=4.0, damping=0.7, motor_speed=-8.0,
+                           max_motor_torque=20.0))
+        wheels.append(w)
+    for _ in range(64 * 3):
+        s.step(DT)
+    v = s.get(chassis, Velocity)
+    assert v.x == pytest.approx(2.0, rel=0.05)
+    assert abs(pose(s, chassis)[2]) < 0.05
+    for w in wheels:
+        assert s.get(w, Velocity).angular == pytest.approx(-8.0, rel=0.02)
+        assert pose(s, w)[1] == pytest.approx(0.25, abs=4 * SLOP)  # on the ground
+
+
+def test_a_wheel_motor_holding_still_reports_its_torque():
+    # the hinged-bar load on a wheel joint (no spring slide: limits at 0): the motor at speed 0
+    # holds the bar level with torque m g L/2 = 8 (joint_reaction, on the bar)
+    s = soft()
+    bar = s.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(box(1.0, 0.125), inertia=0.25))
+    j = s.spawn(WheelJoint(bar, None, (0.0, 0.0), axis=(0.0, 1.0), hertz=0.0, lower=0.0, upper=0.0,
+                           motor_speed=0.0, max_motor_torque=100.0))
+    for _ in range(64):
+        s.step(DT)
+    assert abs(pose(s, bar)[2]) < 0.01
+    force, torque = s.joint_reaction(j)
+    assert force == pytest.approx((0.0, G), rel=1e-2, abs=1e-3)
+    assert torque == pytest.approx(G, rel=1e-2)
+
+
+@pytest.mark.parametrize("kw, field", [({"axis": (0.0, 0.0)}, "axis"), ({"hertz": -1.0}, "hertz"),
+                                       ({"lower": 1.0, "upper": 0.0}, "lower"),
+                                       ({"max_motor_torque": math.inf}, "max_motor_torque")])
+def test_a_bad_wheel_is_refused(kw, field):
+    s = soft()
+    wheel = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(Circle(0.25)))
+    with pytest.raises(InvalidValue, match=field):
+        WheelJoint(wheel, None, (0.0, 0.0), **kw)

@@ -30,7 +30,7 @@ from .softness import soft
 
 __all__ = ["JOINT_F", "JOINT_IMP", "prepare_joints", "solve_joints", "warm_start_joints"]
 
-DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC = 0, 1, 2, 3, 4  # (as framework.joints)
+DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC, WHEEL = 0, 1, 2, 3, 4, 5  # (as framework.joints)
 
 #: A joint's parameters: its anchors in each body's frame (a world point for the world), the
 #: bodies' relative angle at creation; a distance joint's length, least and most length (and
@@ -41,8 +41,9 @@ JOINT_F = ("ax", "ay", "bx", "by", "ref", "length", "lo", "hi", "has_hi", "hertz
 (_AX, _AY, _BX, _BY, _REF, _LEN, _LO, _HI, _HAS_HI, _HZ, _ZETA, _LOWER, _UPPER, _HAS_LOWER, _HAS_UPPER, _SPEED,
  _TORQUE, _FORCE, _AXIS_X, _AXIS_Y) = range(len(JOINT_F))
 #: A joint's accumulated impulses: the linear impulse (x, y; a distance joint's along its axis in
-#: the first; a prismatic joint's across its axis, then its angular one), the lower and upper
-#: limits', and the angular one (a motor's, a weld's or a mouse's; a prismatic motor's, along its axis).
+#: the first; a prismatic joint's across its axis, then its angular one; a wheel's across its axis,
+#: then its spring's), the lower and upper limits', and the angular one (a motor's, a weld's or a
+#: mouse's; a prismatic motor's, along its axis).
 JOINT_IMP = ("px", "py", "lower", "upper", "angular")
 _PX, _PY, _ILO, _IUP, _IANG = range(len(JOINT_IMP))
 # Columns of a prepared joint: on; anchors from each origin at the step's start; the origins'
@@ -88,7 +89,7 @@ def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
             cra, crb = rax * uy - ray * ux, rbx * uy - rby * ux
             k = ma + mb + ia * cra * cra + ib * crb * crb
             jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
-        elif kind == PRISMATIC:  # the axis turns with a (the world's: fixed); the axial effective mass
+        elif kind == PRISMATIC or kind == WHEEL:  # the axis turns with a (the world's: fixed); effective masses
             c, s = (math.cos(rot[a]), math.sin(rot[a])) if a >= 0 else (1.0, 0.0)
             wax, way = c * jf[j, _AXIS_X] - s * jf[j, _AXIS_Y], s * jf[j, _AXIS_X] + c * jf[j, _AXIS_Y]
             jp[j, _WAX], jp[j, _WAY] = wax, way
@@ -97,6 +98,11 @@ def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
             a2 = rbx * way - rby * wax
             k = ma + mb + ia * a1 * a1 + ib * a2 * a2
             jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
+            if kind == WHEEL:  # across the axis (in _K11) and the motor's turn (in _K22)
+                s1, s2 = (dx + rax) * wax + (dy + ray) * way, rbx * wax + rby * way
+                k = ma + mb + ia * s1 * s1 + ib * s2 * s2
+                jp[j, _K11] = 1.0 / k if k > 0.0 else 0.0
+                jp[j, _K22] = 1.0 / (ia + ib) if ia + ib > 0.0 else 0.0
         elif kind == MOUSE:  # (body b, held to a world point)
             k11, k12, k22 = mb + ib * rby * rby, -ib * rbx * rby, mb + ib * rbx * rbx
             det = k11 * k22 - k12 * k12
@@ -150,11 +156,15 @@ def warm_start_joints(jint, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
             ux, uy = _unit(jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray)
             axial = imp[j, _PX] + imp[j, _ILO] - imp[j, _IUP]
             px, py, ang = axial * ux, axial * uy, 0.0
-        elif kind == PRISMATIC:  # Box2D's b2WarmStartPrismaticJoint: along, across and about the axis
+        elif kind == PRISMATIC or kind == WHEEL:  # Box2D's b2WarmStart{Prismatic,Wheel}Joint
             dx, dy = jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray
             ux, uy = ca * jp[j, _WAX] - sa * jp[j, _WAY], sa * jp[j, _WAX] + ca * jp[j, _WAY]
-            axial = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
-            perp, turn = imp[j, _PX], imp[j, _PY]
+            if kind == PRISMATIC:  # along (motor and limits), across, about
+                axial = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
+                perp, turn = imp[j, _PX], imp[j, _PY]
+            else:  # along (spring and limits), across; the motor's turn
+                axial = imp[j, _PY] + imp[j, _ILO] - imp[j, _IUP]
+                perp, turn = imp[j, _PX], imp[j, _IANG]
             a1, a2 = (dx + rax) * uy - (dy + ray) * ux, rbx * uy - rby * ux
             s1, s2 = (dx + rax) * ux + (dy + ray) * uy, rbx * ux + rby * uy  # (crosses with the left perp)
             px, py = axial * ux - perp * uy, axial * uy + perp * ux
@@ -199,6 +209,10 @@ def solve_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w, use_bi
             ux, uy = ca * jp[j, _WAX] - sa * jp[j, _WAY], sa * jp[j, _WAX] + ca * jp[j, _WAY]
             vax, vay, wa, vbx, vby, wb = _prismatic(jf, jp, imp, j, angle, ux, uy, sx, sy, rax, ray, rbx, rby, ma, ia,
                                                     mb, ib, vax, vay, wa, vbx, vby, wb, use_bias, csoft, h, inv_h)
+        elif kind == WHEEL:
+            ux, uy = ca * jp[j, _WAX] - sa * jp[j, _WAY], sa * jp[j, _WAX] + ca * jp[j, _WAY]
+            vax, vay, wa, vbx, vby, wb = _wheel(jf, jp, imp, j, ux, uy, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
+                                                vax, vay, wa, vbx, vby, wb, use_bias, csoft, h, inv_h)
         elif kind == WELD:
             angle = rotb - rota - jf[j, _REF]
             vax, vay, wa, vbx, vby, wb = _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
@@ -383,6 +397,56 @@ def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia
     la, lb = p1 * s1 + p2, p1 * s2 + p2
     return (vax - ma * p1 * nx, vay - ma * p1 * ny, wa - ia * la,
             vbx + mb * p1 * nx, vby + mb * p1 * ny, wb + ib * lb)
+
+
+@njit(cache=True)
+def _wheel(jf, jp, imp, j, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias,
+           csoft, h, inv_h):
+    """Box2D's ``b2SolveWheelJoint``: the motor's turn, the suspension spring along the axis
+    ``(ux, uy)`` (a real spring: in the relax too), the limits of the slide, then the point kept on
+    the axis's line (``dx, dy``: the anchors' separation, b's less a's)."""
+    if jf[j, _TORQUE] > 0.0 and ia + ib > 0.0:
+        old = imp[j, _IANG]
+        most = h * jf[j, _TORQUE]
+        new = min(max(old - jp[j, _K22] * (wb - wa - jf[j, _SPEED]), -most), most)
+        imp[j, _IANG] = new
+        wa -= ia * (new - old)
+        wb += ib * (new - old)
+    a1, a2 = (dx + rax) * uy - (dy + ray) * ux, rbx * uy - rby * ux
+    mass = jp[j, _AXM]
+    slide = ux * dx + uy * dy
+    if jf[j, _HZ] > 0.0:
+        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
+        s = -jp[j, _SM] * mass * (cdot + jp[j, _SB] * slide) - jp[j, _SI] * imp[j, _PY]
+        imp[j, _PY] += s
+        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
+        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
+    if jf[j, _HAS_LOWER] != 0.0:
+        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
+        old = imp[j, _ILO]
+        new = _limit(slide - jf[j, _LOWER], cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _ILO] = new
+        s = new - old
+        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
+        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
+    if jf[j, _HAS_UPPER] != 0.0:  # (signs flipped)
+        cdot = ux * (vax - vbx) + uy * (vay - vby) + a1 * wa - a2 * wb
+        old = imp[j, _IUP]
+        new = _limit(jf[j, _UPPER] - slide, cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _IUP] = new
+        s = new - old
+        vax, vay, wa = vax + ma * s * ux, vay + ma * s * uy, wa + ia * s * a1
+        vbx, vby, wb = vbx - mb * s * ux, vby - mb * s * uy, wb - ib * s * a2
+    nx, ny = -uy, ux  # across the axis: the point on the line
+    s1, s2 = (dx + rax) * ny - (dy + ray) * nx, rbx * ny - rby * nx
+    bias, ms, isc = 0.0, 1.0, 0.0
+    if use_bias:
+        bias, ms, isc = csoft[0] * (nx * dx + ny * dy), csoft[1], csoft[2]
+    cdot = nx * (vbx - vax) + ny * (vby - vay) + s2 * wb - s1 * wa
+    s = -ms * jp[j, _K11] * (cdot + bias) - isc * imp[j, _PX]
+    imp[j, _PX] += s
+    return (vax - ma * s * nx, vay - ma * s * ny, wa - ia * s * s1,
+            vbx + mb * s * nx, vby + mb * s * ny, wb + ib * s * s2)
 
 
 @njit(cache=True)

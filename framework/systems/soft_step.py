@@ -32,11 +32,13 @@ from ..joints import (
     PRISMATIC,
     REVOLUTE,
     WELD,
+    WHEEL,
     DistanceJoint,
     Joint,
     PrismaticJoint,
     RevoluteJoint,
     WeldJoint,
+    WheelJoint,
     check_joints,
     joint_components,
 )
@@ -111,6 +113,17 @@ def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tup
             if j.upper is not None:
                 row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
             row[_JF["speed"]], row[_JF["force"]] = j.motor_speed, j.max_motor_force
+            row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
+        elif j.kind == WHEEL:  # as the slider: the kernel turns and slides its b on its a
+            assert isinstance(j, WheelJoint)
+            jint[i] = (WHEEL, jint[i, 2], ra)
+            row[0:5] = (frame[2], frame[3], frame[0], frame[1], -frame[4])
+            if j.lower is not None:
+                row[_JF["lower"]], row[_JF["has_lower"]] = j.lower, 1.0
+            if j.upper is not None:
+                row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
+            row[_JF["speed"]], row[_JF["torque"]] = j.motor_speed, j.max_motor_torque
+            row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
             row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
         elif j.kind == MOUSE:  # the world's anchor is the target; the body is b to the kernel
             jint[i] = (MOUSE, -1, ra)
@@ -252,14 +265,18 @@ class SoftStep(Stage):
             if d == 0.0:
                 return 0.0, 0.0, 0.0
             return -axial * (bx - ax) / d * inv_h, -axial * (by - ay) / d * inv_h, 0.0
-        if joint.kind == PRISMATIC:  # along the axis (turned with b), across it, and the angle's torque
-            assert isinstance(joint, PrismaticJoint)
+        if joint.kind in (PRISMATIC, WHEEL):  # along the axis (turned with b), across it, and the torque
+            assert isinstance(joint, (PrismaticJoint, WheelJoint))
             store = self.bodies.store
             rot = 0.0 if joint.b is None else float(store.cols["rot"][store.row_of[joint.b]])
             lx, ly = joint._axis_local
             ux, uy = math.cos(rot) * lx - math.sin(rot) * ly, math.sin(rot) * lx + math.cos(rot) * ly
-            axial = angular + lower - upper  # (the kernel's b is the joint's a: it takes +impulse)
-            return (axial * ux - px * uy) * inv_h, (axial * uy + px * ux) * inv_h, py * inv_h
+            # (the kernel's b is the joint's a: it takes +impulse)
+            if joint.kind == PRISMATIC:  # along: motor and limits; about: the angle's
+                axial, turn = angular + lower - upper, py
+            else:  # along: spring and limits; about: the motor's
+                axial, turn = py + lower - upper, angular
+            return (axial * ux - px * uy) * inv_h, (axial * uy + px * ux) * inv_h, turn * inv_h
         turn = (angular + lower - upper) * inv_h
         if joint.kind in (REVOLUTE, MOUSE):  # the kernel's b is the joint's a (see joint_tables)
             return px * inv_h, py * inv_h, turn
