@@ -351,7 +351,38 @@ class MouseJoint(Joint):
         self._frame = (lx, ly, 0.0, 0.0, 0.0)
 
 
-class PrismaticJoint(Joint):
+class _SlidingJoint(Joint):
+    """What a slider and a wheel share: ``a`` slides along ``axis`` on ``b`` (a world direction when
+    spawned, kept in ``b``'s frame after), within ``lower`` and ``upper``."""
+
+    anchor: tuple[float, float]
+    axis: tuple[float, float]
+    lower: float | None
+    upper: float | None
+    _axis_local: tuple[float, float]
+
+    def _check_slide(self) -> None:
+        """Check (and normalise) the anchor, the axis and the limits of the slide."""
+        name = type(self).__name__
+        self.anchor = vector2(f"{name} anchor", self.anchor)
+        ax, ay = vector2(f"{name} axis", self.axis)
+        length = math.hypot(ax, ay)
+        if not length > 0.0 or not math.isfinite(length):
+            raise InvalidValue(f"{name} axis must be a direction (not zero), got {self.axis!r}")
+        self.axis = (ax / length, ay / length)
+        self.lower = None if self.lower is None else finite(f"{name} lower", self.lower)
+        self.upper = None if self.upper is None else finite(f"{name} upper", self.upper)
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise InvalidValue(f"{name} lower ({self.lower}) is more than upper ({self.upper})")
+
+    def _measure(self, store: BodyStore) -> None:
+        self._anchors_at(store, self.anchor)
+        rot = 0.0 if self.b is None else _pose(store, self.b)[2]
+        c, s = math.cos(rot), math.sin(rot)
+        self._axis_local = (c * self.axis[0] + s * self.axis[1], -s * self.axis[0] + c * self.axis[1])
+
+
+class PrismaticJoint(_SlidingJoint):
     """A slider: body ``a`` slides along ``axis`` on ``b`` (the world with ``b=None``): they keep
     their relative angle, and ``a``'s point ``anchor`` stays on the line along ``axis`` through
     ``b``'s (``axis``: a world direction when spawned, turning with ``b`` after). ``lower`` and
@@ -378,27 +409,12 @@ class PrismaticJoint(Joint):
 
     def check(self) -> None:
         self.check_breaking()
-        self.anchor = vector2("PrismaticJoint anchor", self.anchor)
-        ax, ay = vector2("PrismaticJoint axis", self.axis)
-        length = math.hypot(ax, ay)
-        if not length > 0.0 or not math.isfinite(length):
-            raise InvalidValue(f"PrismaticJoint axis must be a direction (not zero), got {self.axis!r}")
-        self.axis = (ax / length, ay / length)
-        self.lower = None if self.lower is None else finite("PrismaticJoint lower", self.lower)
-        self.upper = None if self.upper is None else finite("PrismaticJoint upper", self.upper)
+        self._check_slide()
         self.motor_speed = finite("PrismaticJoint motor_speed", self.motor_speed)
         self.max_motor_force = _at_least_zero("PrismaticJoint max_motor_force", self.max_motor_force)
-        if self.lower is not None and self.upper is not None and self.lower > self.upper:
-            raise InvalidValue(f"PrismaticJoint lower ({self.lower}) is more than upper ({self.upper})")
-
-    def _measure(self, store: BodyStore) -> None:
-        self._anchors_at(store, self.anchor)
-        rot = 0.0 if self.b is None else _pose(store, self.b)[2]
-        c, s = math.cos(rot), math.sin(rot)
-        self._axis_local = (c * self.axis[0] + s * self.axis[1], -s * self.axis[0] + c * self.axis[1])
 
 
-class WheelJoint(Joint):
+class WheelJoint(_SlidingJoint):
     """A wheel on a chassis: body ``a`` (the wheel) turns freely about its point ``anchor`` and
     slides along ``axis`` on ``b`` (the chassis; the world with ``b=None``), held by a suspension
     spring of ``hertz`` and damping ratio ``damping`` toward where it was spawned (``hertz`` 0: no
@@ -427,26 +443,11 @@ class WheelJoint(Joint):
 
     def check(self) -> None:
         self.check_breaking()
-        self.anchor = vector2("WheelJoint anchor", self.anchor)
-        ax, ay = vector2("WheelJoint axis", self.axis)
-        length = math.hypot(ax, ay)
-        if not length > 0.0 or not math.isfinite(length):
-            raise InvalidValue(f"WheelJoint axis must be a direction (not zero), got {self.axis!r}")
-        self.axis = (ax / length, ay / length)
+        self._check_slide()
         self.hertz = _at_least_zero("WheelJoint hertz", self.hertz)
         self.damping = _at_least_zero("WheelJoint damping", self.damping)
-        self.lower = None if self.lower is None else finite("WheelJoint lower", self.lower)
-        self.upper = None if self.upper is None else finite("WheelJoint upper", self.upper)
         self.motor_speed = finite("WheelJoint motor_speed", self.motor_speed)
         self.max_motor_torque = _at_least_zero("WheelJoint max_motor_torque", self.max_motor_torque)
-        if self.lower is not None and self.upper is not None and self.lower > self.upper:
-            raise InvalidValue(f"WheelJoint lower ({self.lower}) is more than upper ({self.upper})")
-
-    def _measure(self, store: BodyStore) -> None:
-        self._anchors_at(store, self.anchor)
-        rot = 0.0 if self.b is None else _pose(store, self.b)[2]
-        c, s = math.cos(rot), math.sin(rot)
-        self._axis_local = (c * self.axis[0] + s * self.axis[1], -s * self.axis[0] + c * self.axis[1])
 
 
 JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint, PrismaticJoint,

@@ -339,6 +339,33 @@ def _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
 
 
 @njit(cache=True)
+def _along(s, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb):
+    """The velocities after the impulse ``s`` along a slide's axis ``(ux, uy)`` (B takes it, A its
+    opposite; ``a1``, ``a2``: the turning arms, Box2D's crosses of ``d + rA`` and ``rB`` with it)."""
+    return (vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1,
+            vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2)
+
+
+@njit(cache=True)
+def _slide_limits(jf, imp, j, slide, ux, uy, a1, a2, mass, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias, csoft,
+                  inv_h):
+    """The lower and upper limits of a slide (prismatic and wheel joints) at ``slide`` along the axis."""
+    if jf[j, _HAS_LOWER] != 0.0:
+        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
+        old = imp[j, _ILO]
+        new = _limit(slide - jf[j, _LOWER], cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _ILO] = new
+        vax, vay, wa, vbx, vby, wb = _along(new - old, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb)
+    if jf[j, _HAS_UPPER] != 0.0:  # (signs flipped)
+        cdot = ux * (vax - vbx) + uy * (vay - vby) + a1 * wa - a2 * wb
+        old = imp[j, _IUP]
+        new = _limit(jf[j, _UPPER] - slide, cdot, mass, old, use_bias, csoft, inv_h)
+        imp[j, _IUP] = new
+        vax, vay, wa, vbx, vby, wb = _along(old - new, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb)
+    return vax, vay, wa, vbx, vby, wb
+
+
+@njit(cache=True)
 def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
                use_bias, csoft, h, inv_h):
     """Box2D's ``b2SolvePrismaticJoint``: the motor along the axis ``(ux, uy)``, the limits of the
@@ -352,26 +379,10 @@ def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia
         most = h * jf[j, _FORCE]
         new = min(max(old + mass * (jf[j, _SPEED] - cdot), -most), most)
         imp[j, _IANG] = new
-        s = new - old
-        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
-        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
+        vax, vay, wa, vbx, vby, wb = _along(new - old, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb)
     slide = ux * dx + uy * dy
-    if jf[j, _HAS_LOWER] != 0.0:
-        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
-        old = imp[j, _ILO]
-        new = _limit(slide - jf[j, _LOWER], cdot, mass, old, use_bias, csoft, inv_h)
-        imp[j, _ILO] = new
-        s = new - old
-        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
-        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
-    if jf[j, _HAS_UPPER] != 0.0:  # (signs flipped)
-        cdot = ux * (vax - vbx) + uy * (vay - vby) + a1 * wa - a2 * wb
-        old = imp[j, _IUP]
-        new = _limit(jf[j, _UPPER] - slide, cdot, mass, old, use_bias, csoft, inv_h)
-        imp[j, _IUP] = new
-        s = new - old
-        vax, vay, wa = vax + ma * s * ux, vay + ma * s * uy, wa + ia * s * a1
-        vbx, vby, wb = vbx - mb * s * ux, vby - mb * s * uy, wb - ib * s * a2
+    vax, vay, wa, vbx, vby, wb = _slide_limits(jf, imp, j, slide, ux, uy, a1, a2, mass, ma, ia, mb, ib, vax, vay, wa,
+                                               vbx, vby, wb, use_bias, csoft, inv_h)
     # across the axis (its left perpendicular) and the angle, as one 2x2 block
     nx, ny = -uy, ux
     s1, s2 = (dx + rax) * ny - (dy + ray) * nx, rbx * ny - rby * nx
@@ -419,24 +430,9 @@ def _wheel(jf, jp, imp, j, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, v
         cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
         s = -jp[j, _SM] * mass * (cdot + jp[j, _SB] * slide) - jp[j, _SI] * imp[j, _PY]
         imp[j, _PY] += s
-        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
-        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
-    if jf[j, _HAS_LOWER] != 0.0:
-        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
-        old = imp[j, _ILO]
-        new = _limit(slide - jf[j, _LOWER], cdot, mass, old, use_bias, csoft, inv_h)
-        imp[j, _ILO] = new
-        s = new - old
-        vax, vay, wa = vax - ma * s * ux, vay - ma * s * uy, wa - ia * s * a1
-        vbx, vby, wb = vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2
-    if jf[j, _HAS_UPPER] != 0.0:  # (signs flipped)
-        cdot = ux * (vax - vbx) + uy * (vay - vby) + a1 * wa - a2 * wb
-        old = imp[j, _IUP]
-        new = _limit(jf[j, _UPPER] - slide, cdot, mass, old, use_bias, csoft, inv_h)
-        imp[j, _IUP] = new
-        s = new - old
-        vax, vay, wa = vax + ma * s * ux, vay + ma * s * uy, wa + ia * s * a1
-        vbx, vby, wb = vbx - mb * s * ux, vby - mb * s * uy, wb - ib * s * a2
+        vax, vay, wa, vbx, vby, wb = _along(s, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb)
+    vax, vay, wa, vbx, vby, wb = _slide_limits(jf, imp, j, slide, ux, uy, a1, a2, mass, ma, ia, mb, ib, vax, vay, wa,
+                                               vbx, vby, wb, use_bias, csoft, inv_h)
     nx, ny = -uy, ux  # across the axis: the point on the line
     s1, s2 = (dx + rax) * ny - (dy + ray) * nx, rbx * ny - rby * nx
     bias, ms, isc = 0.0, 1.0, 0.0

@@ -92,39 +92,27 @@ def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tup
             row[_JF["length"]], row[_JF["lo"]] = length, lo
             row[_JF["hi"]], row[_JF["has_hi"]] = (0.0, 0.0) if hi is None else (hi, 1.0)
             row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
-        elif j.kind == REVOLUTE:  # the kernel's angle is its b's turn relative to its a: a and b swap
-            assert isinstance(j, RevoluteJoint)
-            jint[i] = (REVOLUTE, jint[i, 2], ra)
-            row[0:5] = (frame[2], frame[3], frame[0], frame[1], -frame[4])
-            if j.lower is not None:
-                row[_JF["lower"]], row[_JF["has_lower"]] = j.lower, 1.0
-            if j.upper is not None:
-                row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
-            row[_JF["speed"]], row[_JF["torque"]] = j.motor_speed, j.max_motor_torque
         elif j.kind == WELD:
             assert isinstance(j, WeldJoint)
             row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
-        elif j.kind == PRISMATIC:  # the kernel slides its b along its a's axis: a and b swap
-            assert isinstance(j, PrismaticJoint)
-            jint[i] = (PRISMATIC, jint[i, 2], ra)
+        elif j.kind in (REVOLUTE, PRISMATIC, WHEEL):
+            # the kernel turns (and slides) its b relative to its a, along its a's axis: a and b swap
+            assert isinstance(j, (RevoluteJoint, PrismaticJoint, WheelJoint))
+            jint[i] = (j.kind, jint[i, 2], ra)
             row[0:5] = (frame[2], frame[3], frame[0], frame[1], -frame[4])
             if j.lower is not None:
                 row[_JF["lower"]], row[_JF["has_lower"]] = j.lower, 1.0
             if j.upper is not None:
                 row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
-            row[_JF["speed"]], row[_JF["force"]] = j.motor_speed, j.max_motor_force
-            row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
-        elif j.kind == WHEEL:  # as the slider: the kernel turns and slides its b on its a
-            assert isinstance(j, WheelJoint)
-            jint[i] = (WHEEL, jint[i, 2], ra)
-            row[0:5] = (frame[2], frame[3], frame[0], frame[1], -frame[4])
-            if j.lower is not None:
-                row[_JF["lower"]], row[_JF["has_lower"]] = j.lower, 1.0
-            if j.upper is not None:
-                row[_JF["upper"]], row[_JF["has_upper"]] = j.upper, 1.0
-            row[_JF["speed"]], row[_JF["torque"]] = j.motor_speed, j.max_motor_torque
-            row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
-            row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
+            row[_JF["speed"]] = j.motor_speed
+            if isinstance(j, PrismaticJoint):  # a motor along the axis
+                row[_JF["force"]] = j.max_motor_force
+            else:  # a motor turning it
+                row[_JF["torque"]] = j.max_motor_torque
+            if isinstance(j, WheelJoint):  # the suspension
+                row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
+            if not isinstance(j, RevoluteJoint):
+                row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
         elif j.kind == MOUSE:  # the world's anchor is the target; the body is b to the kernel
             jint[i] = (MOUSE, -1, ra)
             row[0:5] = (*j.target, frame[0], frame[1], 0.0)  # type: ignore[attr-defined]
@@ -242,11 +230,12 @@ class SoftStep(Stage):
         length; the torque is the joint's angular part: a motor's, a limit's, a weld's, not the
         moment of the force). Zeros before a step has solved it."""
         keys, imp, jf = self.joints
-        at = np.flatnonzero(keys == 8 * entity + joint.kind)
+        key = 8 * entity + joint.kind
+        i = int(np.searchsorted(keys, key))  # (keys are sorted: the joints come by entity, then kind)
         dt, nsub = self._params[PARAMS.index("dt")], self._params[PARAMS.index("substeps")]
-        if at.size == 0 or dt <= 0.0 or nsub <= 0:
+        if i == keys.size or keys[i] != key or dt <= 0.0 or nsub <= 0:
             return 0.0, 0.0, 0.0
-        i, inv_h = int(at[0]), nsub / dt
+        inv_h = nsub / dt
         px, py, lower, upper, angular = (float(v) for v in imp[i])
         if joint.kind == DISTANCE:  # along the line between the anchors (the kernel's b takes +impulse)
             store = self.bodies.store
