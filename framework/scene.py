@@ -86,7 +86,7 @@ class Scene:
     ``response_iterations``: passes of the response over bodies in several contacts (accuracy
     knob: more passes settle stacks and corners better).
     ``substeps``: pipeline runs per :meth:`step` (accuracy knob: smaller steps tunnel and
-    sink less, at a proportional cost).
+    sink less, at a proportional cost; the soft solver's joints get ``N`` times as many hertz).
     ``effects``: what the scene simulates (see :data:`EFFECTS`); the default,
     :data:`DEFAULT_EFFECTS`, is a typical game's: movement, gravity, detection, events, response,
     continuous detection and sleeping. Rendering is added when a renderer is attached.

@@ -5,10 +5,12 @@ contacts as Box2D does: :func:`prepare_joints` once a step (anchors relative to 
 at the step's start, effective masses, spring coefficients), then every sub-step
 :func:`warm_start_joints` (last step's impulses) and :func:`solve_joints`, once with the bias that
 pulls a joint back together (soft: Box2D's joint stiffness, 60 hertz at most a quarter of the
-sub-step rate, damping ratio 2) and once without (the relax). As for contacts, nothing is
-re-measured geometrically inside the solve: a joint's error is its separation at the step's start
-plus the bodies' motion since (``x - x0``) and their anchors turned by the bodies' turn since
-(``qc, qs``), Box2D's ``deltaPosition`` and ``deltaRotation``. A body's angle is its ``rot``.
+sub-step rate, damping ratio 2; ``Scene(substeps=n)`` makes it ``60 n`` hertz, so the joints of a
+scene that pays for n times the sub-steps are n**2 times as stiff) and once without (the
+relax). As for contacts, nothing is re-measured geometrically inside the solve: a joint's error
+is its separation at the step's start plus the bodies' motion since (``x - x0``) and their
+anchors turned by the bodies' turn since (``qc, qs``), Box2D's ``deltaPosition`` and
+``deltaRotation``. A body's angle is its ``rot``.
 
 The tables (packed by :class:`~framework.systems.soft_step.SoftStep` from the joint components,
 :mod:`framework.joints`): ``jint`` rows ``(kind, row a, row b)`` (row -1: the world, where an

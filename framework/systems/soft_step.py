@@ -323,7 +323,9 @@ class SoftStep(Stage):
         """The kernel's ``params`` for this step (rebuilt only when a setting changed)."""
         pipe, store = self.pipeline, self.bodies.store
         effects = pipe.effects
-        key = (frame.dt, effects, pipe.gravity, pipe.length_unit, store.layers_all_meet())
+        # the scene's own sub-steps stiffen the joints with the sub-step rate (see joint_stiffness)
+        runs = int(getattr(pipe.view, "substeps", 1))
+        key = (frame.dt, effects, pipe.gravity, pipe.length_unit, store.layers_all_meet(), runs)
         if key != self._settings_key:
             unit, s = pipe.length_unit, SOFT_SETTINGS
             gx, gy = pipe.active_gravity()
@@ -332,7 +334,7 @@ class SoftStep(Stage):
                                4.0 * s["slop"] * unit, s["hertz"], s["damping"], s["push_speed"] * unit,
                                s["restitution_threshold"] * unit, float(key[-1]), float("response" in effects),
                                float("rotation" in effects), float("friction" in effects), s["fat_margin"] * unit,
-                               s["joint_hertz"], s["joint_damping"])
+                               s["joint_hertz"] * runs, s["joint_damping"])
             self._settings_key = key
         return self._params
 
