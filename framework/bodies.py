@@ -46,6 +46,16 @@ class Bodies:
             self._geometry_stamp = stamp
         return self.geometry
 
+    def place_row(self, row: int, x: float, y: float) -> None:
+        """Put one moving row at ``(x, y)`` (it does not turn), keeping the geometry current if it
+        was (:meth:`Geometry.move_row`: one row's bounds, not every moving row's)."""
+        store = self.store
+        current = self._geometry_stamp == (store.motion, store.writes, store.version, store.n)
+        store.place(row, x, y)
+        if current and store.cols["body"][row] != STATIC and store.cols["kind"][row] >= 0:
+            self.geometry.move_row(store, row)
+            self._geometry_stamp = (store.motion, store.writes, store.version, store.n)
+
     def sync_static(self) -> int:
         """Hash the static bodies again if the static set changed (waking the sleepers: the level
         changed under them); return how many were hashed (0: the hash was current)."""

@@ -1,9 +1,10 @@
 """Shape casts: sweep a shape through a scene and find the first hitbox it would enter.
 
 A cast is :func:`~framework.collision.time_of_impact` of the moving shape against every hitbox
-whose bounds meet the swept box (the static hash for statics, one vectorised bounds test for the
-rest), the earliest impact winning (ties: the lowest entity). The scene's ``shape_cast`` query and
-the character controller (:mod:`framework.character`) both cast through :func:`cast_rows`.
+whose bounds meet the swept box (one compiled pass over the bounds, :mod:`~framework.collision.box_rows`;
+the static hash in very large scenes), the earliest impact winning (ties: the lowest entity).
+The scene's ``shape_cast`` query and the character controller (:mod:`framework.character`) both
+cast through :func:`cast_rows`.
 
 Conventions follow the ray queries: the hit's ``normal`` is the unit normal of the surface that
 was hit, facing the cast shape (so a shape cast down onto a floor gets ``(0, 1)``); grazing a
@@ -21,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .collision import collide, time_of_impact
+from .collision.box_rows import rows_within
 from .collision.results import Vec2
 from .shapes import AABB, Circle, Polygon, Shape
 
@@ -28,6 +30,8 @@ if TYPE_CHECKING:
     from .queries import SpatialQueries
 
 __all__ = ["ShapeHit", "candidate_rows", "cast_rows", "overlapping_rows", "shape_bounds", "touch_point"]
+
+_NONE = np.zeros(0, dtype=np.int64)
 
 
 class ShapeHit(NamedTuple):
@@ -108,8 +112,9 @@ def _in_box(
     queries: SpatialQueries, rows: NDArray[np.intp], x0: float, y0: float, x1: float, y1: float,
 ) -> NDArray[np.intp]:
     """The ``rows`` whose current bounds meet the box (closed): the candidates worth an exact test."""
-    g = queries.bodies.geometry
-    return rows[(g.minx[rows] <= x1) & (g.maxx[rows] >= x0) & (g.miny[rows] <= y1) & (g.maxy[rows] >= y0)]
+    g, store = queries.bodies.geometry, queries.bodies.store
+    return rows_within(rows, g.minx, g.miny, g.maxx, g.maxy, x0, y0, x1, y1, store.layer, store.sensor, -1, _NONE,
+                       store.entity, _NONE)
 
 
 def candidate_rows(queries: SpatialQueries, x0: float, y0: float, x1: float, y1: float, mask: int,

@@ -1,7 +1,8 @@
 """Spatial queries over a scene's hitboxes: rays, shape casts, boxes, points and shapes.
 
-Candidates come from the static hash (static bodies) and one vectorised bounds test (everything
-that moves); the exact answer from the collision functions of :mod:`framework.collision`. Rays
+Candidates come from one compiled pass over the hitboxes' bounds (the static hash and a vectorised
+bounds test in scenes of more than :data:`~framework.collision.broad_phase.DIRECT_QUERY` rows);
+the exact answer from the collision functions of :mod:`framework.collision`. Rays
 cast during a step are logged in the step's frame for the debug overlay.
 """
 
@@ -16,6 +17,8 @@ from numpy.typing import NDArray
 
 from .casting import ShapeHit, cast_rows, shape_bounds, touch_point
 from .collision import batch, collide
+from .collision.box_rows import rows_meeting
+from .collision.broad_phase import DIRECT_QUERY
 from .collision.distance import Distance, point_distance
 from .collision.distance import distance as shape_distance
 from .collision.placement import check_shape
@@ -58,13 +61,18 @@ class SpatialQueries:
         self.bodies = pipeline.bodies
 
     def _candidate_rows(self, minx: float, miny: float, maxx: float, maxy: float) -> NDArray[np.intp]:
-        """Rows whose current bounds strictly meet the box: statics via the hash, moving bodies by
-        one vectorised test over their current bounds."""
+        """Rows whose current bounds strictly meet the box: one compiled pass over the bounds, or,
+        in scenes of more rows than :data:`DIRECT_QUERY`, statics via the hash and moving bodies
+        by one vectorised test over their current bounds."""
         bodies = self.bodies
         store = bodies.store
         geom = bodies.ensure_geometry()
         self.pipeline.frame.counters["rehashed"] = (self.pipeline.frame.counters.get("rehashed", 0)
                                                     + bodies.sync_static())
+        if store.n <= DIRECT_QUERY:  # one compiled pass over every row's bounds (the same rows)
+            found: NDArray[np.intp] = rows_meeting(store.kind, geom.minx, geom.miny, geom.maxx, geom.maxy, float(minx),
+                                                   float(miny), float(maxx), float(maxy))
+            return found
         st = bodies.static_rows_in_box(minx, miny, maxx, maxy)
         mv = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
         hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)

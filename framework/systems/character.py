@@ -13,10 +13,11 @@ from typing import TYPE_CHECKING, Any
 import esper
 import numpy as np
 
-from ..arrays import BoolArray, IntpArray
-from ..casting import candidate_rows, cast_rows, overlapping_rows, shape_bounds, touch_point
+from ..arrays import IntpArray
+from ..casting import cast_rows, overlapping_rows, shape_bounds, touch_point
 from ..character import CharacterController
 from ..collision import collide
+from ..collision.box_rows import rows_within
 from ..components import Velocity
 from ..frame import StepFrame
 from ..store import DYNAMIC, KINEMATIC, STATIC
@@ -28,6 +29,8 @@ if TYPE_CHECKING:
     from ..shapes import Shape
 
 __all__ = ["CharacterStage"]
+
+_NONE = np.zeros(0, dtype=np.int64)
 
 
 @dataclass
@@ -95,7 +98,7 @@ class CharacterStage(Stage):
             if row is None or store.hitboxes[row] is None:
                 continue
             if moved and row < frame.start_x.size:
-                store.place(row, frame.start_x[row], frame.start_y[row])  # undo movement: ours to move
+                self.bodies.place_row(row, frame.start_x[row], frame.start_y[row])  # undo movement: ours to move
             self._move(frame, e, row, ctrl, moved)
         frame.counters["characters"] = len(found)
         return True
@@ -195,7 +198,7 @@ class CharacterStage(Stage):
         ctrl.on_ceiling = mv.ceiling
         if ctrl.push_mass > 0.0 and dt > 0.0:
             self._push(mv, ctrl.push_mass, mx / dt, my / dt)
-        store.place(row, mv.x - ox, mv.y - oy)
+        self.bodies.place_row(row, mv.x - ox, mv.y - oy)
         if vel.x != vx:
             vel.x = vx
         if vel.y != vy:
@@ -247,32 +250,28 @@ class CharacterStage(Stage):
                  + snap + 0.5 * size + 8.0 * mv.skin)
         x0, y0, x1, y1 = _bounds(mv)
         mv.box = (x0 - reach, y0 - reach, x1 + reach, y1 + reach)
-        mv.rows = candidate_rows(self.queries, *mv.box, mv.mask, self._skip(mv))
+        mv.rows = None
+        mv.rows = self._near(mv, mv.box)
 
-    def _near(self, mv: _Move, box: tuple[float, float, float, float]) -> IntpArray | None:
-        """The gathered candidates (minus those ignored for now), if ``box`` lies in the gathered
-        region; None: look up afresh."""
+    def _near(self, mv: _Move, box: tuple[float, float, float, float]) -> IntpArray:
+        """The rows that may block the body whose bounds meet ``box`` (minus those ignored for
+        now): from the gathered candidates if ``box`` lies in the gathered region, else looked up
+        afresh (layers, sensors, the dropped platforms). One compiled pass (:mod:`~framework.collision.box_rows`)."""
+        store, geom = self.bodies.store, self.bodies.ensure_geometry()
         b = mv.box
-        if mv.rows is None or b is None or not (b[0] <= box[0] and b[1] <= box[1] and box[2] <= b[2]
-                                                and box[3] <= b[3]):
-            return None
-        rows = mv.rows
-        if mv.ignore and rows.size:
-            rows = rows[~np.isin(rows, np.fromiter(mv.ignore, dtype=np.int64))]
-        return rows
+        skip_rows = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64)
+        if mv.rows is not None and b is not None and (b[0] <= box[0] and b[1] <= box[1] and box[2] <= b[2]
+                                                      and box[3] <= b[3]):
+            source, mask, drop = mv.rows, -1, _NONE  # (already filtered by layers, sensors and drops)
+        else:
+            source, mask, drop = self.queries._candidate_rows(*box), mv.mask, self._dropped(mv)
+        return rows_within(source, geom.minx, geom.miny, geom.maxx, geom.maxy, *box, store.layer, store.sensor, mask,
+                           skip_rows, store.entity, drop)
 
-    def _skip(self, mv: _Move):
-        store = self.bodies.store
-        drop = np.array(sorted(mv.dropping), dtype=np.int64)
-        ignore = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64)
-
-        def skip(rows: IntpArray) -> BoolArray:
-            keep = ~np.isin(rows, ignore)
-            if drop.size:
-                keep &= ~np.isin(store.entity[rows], drop)
-            return keep
-
-        return skip
+    @staticmethod
+    def _dropped(mv: _Move) -> IntpArray:
+        """The entities of the one-way platforms the body is dropping through, sorted."""
+        return np.array(sorted(mv.dropping), dtype=np.int64) if mv.dropping else _NONE
 
     def _cast(self, mv: _Move, mx: float, my: float) -> tuple[int, float, float, float] | None:
         store = self.bodies.store
@@ -293,7 +292,7 @@ class CharacterStage(Stage):
         pad = 1e-6 * (abs(x0) + abs(y0) + abs(mx) + abs(my) + x1 - x0 + y1 - y0)
         box = (min(x0, x0 + mx) - pad, min(y0, y0 + my) - pad, max(x1, x1 + mx) + pad, max(y1, y1 + my) + pad)
         return cast_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mx, my, accept, mask=mv.mask,
-                         skip=self._skip(mv), rows=self._near(mv, box), exact=False)
+                         rows=self._near(mv, box), exact=False)
 
     def _advance(self, mv: _Move, mx: float, my: float, f: float, nx: float, ny: float) -> None:
         """Move by ``f`` of ``(mx, my)`` (up to a contact of normal ``n``), then back along the way
@@ -492,8 +491,8 @@ class CharacterStage(Stage):
         store = self.bodies.store
         free = True
         for _ in range(4):
-            found = overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask, self._skip(mv),
-                                     self._near(mv, _bounds(mv)), apart=0.5 * mv.skin)
+            found = overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask,
+                                     rows=self._near(mv, _bounds(mv)), apart=0.5 * mv.skin)
             found = [o for o in found if self._holds(mv, o, start_bottom, frame, moved)]
             if not found:
                 return free
@@ -511,7 +510,7 @@ class CharacterStage(Stage):
             if ny >= mv.floor_cos:
                 mv.floor = (r, nx, ny)
         return free and not overlapping_rows(self.queries, mv.shape, mv.x, mv.y, mv.rot, mv.mask,
-                                             self._skip(mv), self._near(mv, _bounds(mv)), apart=0.5 * mv.skin)
+                                             rows=self._near(mv, _bounds(mv)), apart=0.5 * mv.skin)
 
     def _holds(self, mv: _Move, overlap: tuple[int, float, float, float], start_bottom: float,
                frame: StepFrame, moved: bool) -> bool:
