@@ -49,10 +49,10 @@ class CarSpec:
     wheel_mass: float = 1.0
     wheelbase: float = 1.4  # between the wheels' centres
     ride: float = 0.5  # the wheels' centres below the chassis' centre
-    hertz: float = 4.0  # the suspension
-    damping: float = 0.7
+    hertz: float = 6.0  # the suspension: stiff enough that the car does not pitch much as it drives off
+    damping: float = 1.0
     speed: float = 10.0  # the motor's speed, rad/s (about 4 m/s on the flat)
-    torque: float = 40.0  # the motor's most torque while driving
+    torque: float = 10.0  # the motor's most torque while driving (more lifts the front wheel off: a wheelie)
     brake_torque: float = 10.0  # held at speed 0 when no key is down: the car parks on the slope
     friction: float = 0.9
 
