@@ -178,6 +178,39 @@ def test_grabbing_again_lets_go_of_the_first_body(sandbox):
     assert joint_count(sandbox) == JOINTS + 1
 
 
+def test_the_windows_mouse_handlers_drag_what_is_under_the_cursor(render):
+    # The window's own events (pyglet's, in screen pixels) through the handlers the command
+    # installs: a press over the lone crate grabs it, a drag moves the target to the world point
+    # under the cursor, the release lets go; a press over the ground grabs nothing.
+    from pyglet.window import mouse
+
+    from examples.sandbox.__main__ import open_window, parse_args
+
+    with make_sandbox() as sb:
+        runner, drags = open_window(sb, parse_args([]))
+        try:
+            camera = runner.renderer.camera
+
+            def event(*args) -> None:  # queued by the window, handled as its event loop does
+                runner.window.dispatch_event(*args)
+                runner.window.dispatch_events()
+
+            t = sb.scene.get(sb.crates[2], Transform)
+            x, y = camera.world_to_screen(t.x, t.y)
+            event("on_mouse_press", x, y, mouse.LEFT, 0)
+            assert drags == [sb.drag] and sb.scene.get(sb.drag, MouseJoint).body == sb.crates[2]
+            event("on_mouse_drag", x + 50, y + 100, 50, 100, mouse.LEFT, 0)
+            assert sb.scene.get(sb.drag, MouseJoint).target == pytest.approx(camera.screen_to_world(x + 50, y + 100))
+            assert sb.scene.get(sb.drag, MouseJoint).target == pytest.approx((t.x + 50 / camera.zoom,
+                                                                              t.y + 100 / camera.zoom), abs=0.05)
+            event("on_mouse_release", x + 50, y + 100, mouse.LEFT, 0)
+            assert sb.drag is None and joint_count(sb) == JOINTS
+            event("on_mouse_press", *camera.world_to_screen(-6.0, -0.5), mouse.LEFT, 0)
+            assert sb.drag is None and len(drags) == 1
+        finally:
+            runner.close()
+
+
 # --- the command ------------------------------------------------------------------------------------
 
 # `framework.examples` is the installed name of the checkout's examples/ (as in test_play_command.py):

@@ -29,7 +29,7 @@ from .controls import drag_to, drive_system, grab, joint_count, release
 from .demo import DEMO_STEPS, DemoState, demo_step
 from .world import DT, ZOOM, Sandbox, make_sandbox
 
-__all__ = ["BACKGROUND", "camera", "main", "parse_args", "run_headless", "run_window", "summary"]
+__all__ = ["BACKGROUND", "camera", "main", "open_window", "parse_args", "run_headless", "run_window", "summary"]
 
 WIDTH, HEIGHT = 1280, 540
 BACKGROUND = (24, 26, 38)
@@ -79,24 +79,27 @@ def run_headless(sandbox: Sandbox, args: argparse.Namespace) -> dict[str, Any]:
             "drags": state.drags, "lifted": state.lifted}
 
 
-def run_window(sandbox: Sandbox, args: argparse.Namespace) -> dict[str, Any]:
-    """The sandbox in a window: the mouse's presses, drags and releases go (as world points) to
-    grab, drag_to and release; the keys to the scene's Input, which the drive system reads."""
+def open_window(sandbox: Sandbox, args: argparse.Namespace) -> tuple[Any, list[int]]:
+    """The sandbox's window (a :class:`~framework.render.Runner`, not yet running) and a list that
+    counts the drags made in it. The mouse's presses, drags and releases go, as world points, to
+    grab, drag_to and release; the keys to the scene's Input, which the drive system reads.
+    :class:`~framework.render.NoDisplayError` where no window can be shown."""
     from pyglet.window import mouse
 
     from framework.render import Runner
 
     runner = Runner(sandbox.scene, width=WIDTH, height=HEIGHT, title=TITLE, fps=round(1.0 / DT), camera=camera(),
                     debug=args.debug, max_frames=args.frames, background=BACKGROUND)
-    drags = 0
+    drags: list[int] = []
 
     def world(x: float, y: float) -> tuple[float, float]:
         return runner.renderer.camera.screen_to_world(x, y)
 
     def on_mouse_press(x: int, y: int, button: int, modifiers: int) -> None:
-        nonlocal drags
-        if button == mouse.LEFT and grab(sandbox, world(x, y)) is not None:
-            drags += 1
+        if button == mouse.LEFT:
+            joint = grab(sandbox, world(x, y))
+            if joint is not None:
+                drags.append(joint)
 
     def on_mouse_drag(x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
         drag_to(sandbox, world(x, y))
@@ -107,10 +110,15 @@ def run_window(sandbox: Sandbox, args: argparse.Namespace) -> dict[str, Any]:
 
     runner.window.push_handlers(on_mouse_press=on_mouse_press, on_mouse_drag=on_mouse_drag,
                                 on_mouse_release=on_mouse_release)
+    return runner, drags
+
+
+def run_window(sandbox: Sandbox, args: argparse.Namespace) -> dict[str, Any]:
+    runner, drags = open_window(sandbox, args)
     t0 = time.perf_counter()
     runner.run()
     ms = 1e3 * (time.perf_counter() - t0) / max(sandbox.scene.frame, 1)
-    return {"frames": sandbox.scene.frame, "ms_per_frame": round(ms, 4), **summary(sandbox), "drags": drags,
+    return {"frames": sandbox.scene.frame, "ms_per_frame": round(ms, 4), **summary(sandbox), "drags": len(drags),
             "lifted": None}
 
 
