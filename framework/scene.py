@@ -311,14 +311,27 @@ class Scene:
         self.handlers.remember(entity, {type(c) for c in comps})
         store = self.bodies.store
         row = store.row_of.get(entity)
+        self._wake_joined(comps)  # a joint that goes: its bodies
         if row is not None:
-            if store.asleep.any() and store.kind[row] >= 0:
-                self.bodies.wake_near(row)
+            if store.asleep.any():
+                if store.kind[row] >= 0:
+                    self.bodies.wake_near(row)
+                self._wake_joined(j for _e, j in joint_components() if entity in j.bodies())
             store.remove(entity, comps)
         esper.delete_entity(entity, immediate=True)
         if row is not None:  # a body: its joints go with it (and the entities they leave empty)
             for e in remove_joints_of(entity):
                 self._remove(e)
+
+    def _wake_joined(self, joints: Iterable[Any]) -> None:
+        """Wake the bodies of the joints (of the components) given, which are going: a body asleep
+        while a joint held it (a crate a mouse joint held up) must not hang there once let go."""
+        store = self.bodies.store
+        if not store.asleep.any():
+            return
+        rows = [store.row_of[e] for j in joints if isinstance(j, Joint) for e in j.bodies() if e in store.row_of]
+        if rows:
+            store.wake(np.asarray(rows, dtype=np.intp))
 
     def _was_entity(self, entity: Any) -> bool:
         """Whether ``entity`` is an id this scene gave out (esper never gives one out twice): one
@@ -375,6 +388,7 @@ class Scene:
             name = getattr(component_type, "__name__", repr(component_type))
             raise InvalidValue(f"entity {entity} has no {name} component")
         comp: Any = esper.remove_component(entity, component_type)
+        self._wake_joined((comp,))
         store = self.bodies.store
         if component_type is Velocity and entity in store.row_of:
             store.unbind(entity, comp)  # before the row forgets its values

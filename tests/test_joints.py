@@ -278,6 +278,28 @@ def test_a_mouse_joint_pulls_with_at_most_its_force():
     assert s.get(body, Velocity).x == pytest.approx(0.5, rel=1e-6)
 
 
+@pytest.mark.parametrize("let_go", ["despawn", "remove_component"])
+def test_a_body_a_mouse_joint_held_still_until_it_slept_falls_when_let_go(let_go):
+    # held up still, the box falls asleep in the joint's grip; removing the joint wakes it (a
+    # sleeper nobody touches would otherwise hang in the air), and it falls at g
+    s = soft()
+    body = s.spawn(Transform(0.0, 2.0), Velocity(), Hitbox(box(0.25, 0.25)))
+    j = s.spawn(MouseJoint(body, (0.0, 2.0), max_force=64.0, hertz=4.0, damping=1.0))
+    for _ in range(128):
+        s.step(DT)
+    assert s.store.asleep[s.store.row_of[body]]
+    y0 = pose(s, body)[1]
+    if let_go == "despawn":
+        s.despawn(j)
+    else:
+        s.remove_component(j, MouseJoint)
+    assert not s.store.asleep[s.store.row_of[body]]
+    for _ in range(16):
+        s.step(DT)
+    assert s.get(body, Velocity).y == pytest.approx(-G * 16 * DT, rel=1e-6)
+    assert pose(s, body)[1] < y0 - 0.5 * G * 0.25 ** 2 * 0.9
+
+
 # --- ECS: validation, removal, collisions ---------------------------------------------------------
 
 
