@@ -143,6 +143,30 @@ def test_friction_rows_meet_the_analytic_answers():
         assert row["rel_error"] < 1e-12, (case, row)
 
 
+def test_pendulum_period_is_the_small_angle_one_corrected_for_amplitude():
+    small = 2 * math.pi * math.sqrt(1.0 / 20.0)
+    assert acc.pendulum_period(1.0, 20.0, 1e-9) == pytest.approx(small, rel=1e-15)
+    a = 0.05  # the series: 1 + a^2 / 16 + 11 a^4 / 3072 + ...
+    assert acc.pendulum_period(1.0, 20.0, a) / small == pytest.approx(1 + a * a / 16 + 11 * a ** 4 / 3072, rel=1e-10)
+    assert acc.pendulum_period(1.0, 9.81, math.pi / 2) == pytest.approx(1.18034 * 2 * math.pi / math.sqrt(9.81),
+                                                                        rel=1e-5)  # 90 degrees: 1.18034 times
+
+
+@pytest.mark.parametrize("case", ["pendulum-distance", "pendulum-revolute"])
+def test_soft_pendulum_swings_at_its_exact_period(case):
+    row = acc.run_joint(case, "soft", periods=2)
+    assert row["scenario"] == "joints" and row["case"] == case and list(row) == acc.ROW_KEYS
+    assert row["rel_error"] < 2e-4 and row["measured"] == pytest.approx(row["expected"], rel=2e-4)
+    assert 0.0 <= row["max_stretch"] < 1e-3 and abs(row["apex_drop"]) < 5e-3
+
+
+def test_rope_rows_measure_its_stretch():
+    for case in ("rope-20-hanging", "rope-20-swinging"):
+        row = acc.run_joint(case, "soft", steps=30)
+        assert row["expected"] == 5.0 and row["measured"] == pytest.approx(5.0 * (1 + row["rel_error"]))
+        assert 0.0 < row["rel_error"] <= row["max_stretch"] < 0.1, row  # a few percent at most, never negative
+
+
 def test_resting_stack_metrics_have_the_documented_keys():
     row = acc.run_rest("stack", "response-iterations-4", steps=20)
     assert row["max_depth"] >= 0.0 and row["jitter"] >= 0.0 and row["snags"] is None
@@ -231,7 +255,8 @@ def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
 
 @pytest.mark.slow
 def test_accuracy_report_of_a_tiny_configuration(tmp_path):
-    cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1}
+    cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1,
+           "pendulum_periods": 2, "rope_steps": 12}
     report = acc.run_accuracy(cfg, progress=False, speeds=(1.0, 64.0))
     rows = report["rows"]
     assert {r["scenario"] for r in rows} == set(acc.SCENARIOS)
