@@ -628,7 +628,7 @@ def _pendulum_run(case: str, mode: str, periods: int) -> tuple[list[float], dict
                 stretch[k] = math.hypot(t.x + c * lx - s * ly, t.y + s * lx + c * ly) / length
 
         times = _timed_steps(scene, steps, after=after)
-        when = _crossings((np.arange(steps) + 1.0) * DT, xs)
+        when = _crossings(np.arange(1, steps + 1, dtype=np.float64) * DT, xs)
         # crossings come every half period: twice the least-squares slope of their times
         measured = 2.0 * float(np.polyfit(np.arange(when.size), when, 1)[0]) if when.size >= 2 else math.nan
         last = swing[-int(expected / DT):]  # the last period's widest swing, against the first
