@@ -143,6 +143,30 @@ def test_friction_rows_meet_the_analytic_answers():
         assert row["rel_error"] < 1e-12, (case, row)
 
 
+def test_pendulum_period_is_the_small_angle_one_corrected_for_amplitude():
+    small = 2 * math.pi * math.sqrt(1.0 / 20.0)
+    assert acc.pendulum_period(1.0, 20.0, 1e-9) == pytest.approx(small, rel=1e-15)
+    a = 0.05  # the series: 1 + a^2 / 16 + 11 a^4 / 3072 + ...
+    assert acc.pendulum_period(1.0, 20.0, a) / small == pytest.approx(1 + a * a / 16 + 11 * a ** 4 / 3072, rel=1e-10)
+    assert acc.pendulum_period(1.0, 9.81, math.pi / 2) == pytest.approx(1.18034 * 2 * math.pi / math.sqrt(9.81),
+                                                                        rel=1e-5)  # 90 degrees: 1.18034 times
+
+
+@pytest.mark.parametrize("case", ["pendulum-distance", "pendulum-revolute"])
+def test_soft_pendulum_swings_at_its_exact_period(case):
+    row = acc.run_joint(case, "soft", periods=2)
+    assert row["scenario"] == "joints" and row["case"] == case and list(row) == acc.ROW_KEYS
+    assert row["rel_error"] < 2e-4 and row["measured"] == pytest.approx(row["expected"], rel=2e-4)
+    assert 0.0 <= row["max_stretch"] < 1e-3 and abs(row["apex_drop"]) < 5e-3
+
+
+def test_rope_rows_measure_its_stretch():
+    for case in ("rope-20-hanging", "rope-20-swinging"):
+        row = acc.run_joint(case, "soft", steps=30)
+        assert row["expected"] == 5.0 and row["measured"] == pytest.approx(5.0 * (1 + row["rel_error"]))
+        assert 0.0 < row["rel_error"] <= row["max_stretch"] < 0.1, row  # a few percent at most, never negative
+
+
 def test_resting_stack_metrics_have_the_documented_keys():
     row = acc.run_rest("stack", "response-iterations-4", steps=20)
     assert row["max_depth"] >= 0.0 and row["jitter"] >= 0.0 and row["snags"] is None
@@ -231,7 +255,8 @@ def test_cli_quick_json_of_a_tiny_configuration(capsys, tmp_path):
 
 @pytest.mark.slow
 def test_accuracy_report_of_a_tiny_configuration(tmp_path):
-    cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1}
+    cfg = {"lanes": 4, "crates": 40, "rest_steps": 12, "ball_steps": 40, "runs": 1, "crate_steps": 1, "crowds": 1,
+           "pendulum_periods": 2, "rope_steps": 12}
     report = acc.run_accuracy(cfg, progress=False, speeds=(1.0, 64.0))
     rows = report["rows"]
     assert {r["scenario"] for r in rows} == set(acc.SCENARIOS)
@@ -349,6 +374,109 @@ def test_friction_regimes_give_every_engine_the_same_friction(shape):
             eng.close()
 
 
+JOINT_SCENES = ("chain-100", "bridge-30", "ragdolls-20")
+
+
+def _joint_gaps(eng):
+    """Each hinge's gap as the engine's own joint measures it (its anchors on its bodies now)."""
+    if eng.name == "pymunk":
+        return [(j.a.local_to_world(j.anchor_a) - j.b.local_to_world(j.anchor_b)).length for j in eng.joints]
+    if eng.name == "box2d":
+        out = []
+        for j in eng.joints:
+            pa, pb = j.body_a.world_point(j.local_anchor_a), j.body_b.world_point(j.local_anchor_b)
+            out.append(math.hypot(pa.x - pb.x, pa.y - pb.y))
+        return out
+    from framework import RevoluteJoint, Transform
+
+    out = []
+    for e in eng.joints:
+        j = eng.scene.get(e, RevoluteJoint)
+        ends = []
+        for body, (lx, ly) in ((j.a, j._frame[0:2]), (j.b, j._frame[2:4])):
+            t = eng.scene.get(body, Transform)
+            c, s = math.cos(t.rotation), math.sin(t.rotation)
+            ends.append((t.x + c * lx - s * ly, t.y + s * lx + c * ly))
+        out.append(math.dist(*ends))
+    return out
+
+
+@pytest.mark.parametrize("name", JOINT_SCENES)
+def test_joint_regimes_build_the_same_hinged_bodies_in_every_engine(name):
+    regime = reg.SCENES[name]()
+    assert regime.kind == "joints" and regime.tumbling and regime.hinges
+    assert {"chain-100": 100, "bridge-30": 35, "ragdolls-20": 200}[name] == regime.bodies
+    assert len(regime.hinges) == {"chain-100": 101, "bridge-30": 31, "ragdolls-20": 180}[name]
+    engines = reg.make_engines(regime)
+    try:
+        # the exact solver refuses joints: ours runs them soft only
+        assert [e.name for e in engines] == ["soft"] + [n for n, m in reg.peer_modules().items() if m]
+        for eng in engines:
+            x, y, _, _, alive = eng.state()
+            assert alive.all()
+            assert x == pytest.approx([p.x for p in regime.pieces], abs=1e-6), eng.name  # Box2D keeps float32
+            assert y == pytest.approx([p.y for p in regime.pieces], abs=1e-6), eng.name
+            assert eng.angles() == pytest.approx([p.angle for p in regime.pieces], abs=1e-6), eng.name
+            assert len(eng.joints) == len(regime.hinges), eng.name
+            assert reg.hinge_stretch(regime, x, y, eng.angles()) < 1e-5, eng.name  # every hinge shut at spawn
+        for eng in engines:
+            for _ in range(3):
+                eng.step()
+            x, y, _, _, _ = eng.state()
+            # the engine's own joints are the regime's hinges: their gaps are the ones the oracle measures
+            assert _joint_gaps(eng) == pytest.approx(reg.hinge_gaps(regime, x, y, eng.angles()), abs=1e-5), eng.name
+            fig = reg.judge(regime, eng)
+            assert fig["stretch"] < 0.05 and fig["pen"] < 0.05, (eng.name, fig)
+    finally:
+        for eng in engines:
+            eng.close()
+
+
+@pytest.mark.parametrize("left", [False, True])
+def test_hinge_limits_turn_the_same_way_in_every_engine(left):
+    # A bar hinged at one end to a post (or, pointing left, to the world) with a limit on its turn
+    # of [0, 0.5]: pointing right, gravity turns it clockwise (negative), the lower limit 0 holds it
+    # level; pointing left, it turns counter-clockwise until the upper limit, 0.5.
+    side = -1.0 if left else 1.0
+    post = reg.Piece(AABB(0.5, 0.5), 5.0 if left else 0.0, 0.0, kind="static")  # (left: out of the way)
+    bar = reg.Piece(AABB(1.0, 0.1), side * 0.5, 0.0)
+    regime = reg.Regime("bar", "joints", [post, bar], tumbling=True,
+                        hinges=[reg.Hinge(1, None if left else 0, 0.0, 0.0, 0.0, 0.5)])
+    engines = reg.make_engines(regime)
+    try:
+        for eng in engines:
+            for _ in range(90):
+                eng.step()
+            assert eng.angles()[1] == pytest.approx(0.5 if left else 0.0, abs=0.03), eng.name
+    finally:
+        for eng in engines:
+            eng.close()
+
+
+def test_jointed_pairs_are_left_out_of_the_penetration_figure():
+    chain = reg.chain(links=10, span=2.0)  # a deep V: its links overlap at the bottom hinge
+    frozen = _Frozen(chain)
+    frozen.angles = lambda: np.array([p.angle for p in chain.pieces])
+    shapes = [reg._ours_shape(chain, p.shape) for p in chain.pieces]
+    static = [p.kind == "static" for p in chain.pieces]
+    args = (shapes, frozen.x, frozen.y, static, True, frozen.angles())
+    assert reg.max_penetration(*args) > 0.001  # the two links at the V's bottom hinge, and each link at its anchor
+    assert reg.judge(chain, frozen)["pen"] == 0.0 and reg.judge(chain, frozen)["stretch"] < 1e-12
+
+
+def test_chain_and_bridge_hang_between_their_anchors():
+    chain = reg.chain()
+    links = [p for p in chain.pieces if p.kind == "dynamic"]
+    assert sum(p.shape.width for p in links) == pytest.approx(25.0) and chain.pieces[1].x == 18.0
+    h = chain.hinges
+    assert (h[-2].x, h[-2].y) == (0.0, 0.0) and (h[-1].x, h[-1].y) == pytest.approx((18.0, 0.0), abs=1e-9)
+    assert min(p.y for p in links) < -5.0  # with slack
+    bridge = reg.bridge()
+    ends = sorted((hh.x, hh.y) for hh in bridge.hinges)
+    assert ends[0] == (-7.0, 0.0) and ends[-1] == pytest.approx((7.0, 0.0))  # the posts' inner top corners
+    assert all(y <= 1e-12 for _, y in ends)  # hanging, lowest in the middle
+
+
 @pytest.mark.slow
 def test_regimes_report_of_a_tiny_configuration(tmp_path):
     report = reg.run_regimes(TINY_REGIMES, scenes=("stack-20", "scattered-10", "platformer-1"), crowds=("boxes",),
@@ -372,6 +500,22 @@ def test_regimes_report_of_a_tiny_configuration(tmp_path):
     text = reg.text_report(report)
     assert "| stack-20" in text and "Platformer: of our" in text
     assert "| scene" in reg.markdown(report, "python -m framework.bench regimes", "images/regimes.png")
+
+
+def test_regimes_report_of_a_joint_scene():
+    report = reg.run_regimes(TINY_REGIMES, scenes=("bridge-30",), crowds=(), progress=False)
+    (row,) = report["rows"]
+    peers = reg.peer_modules()
+    assert list(row) == reg.ROW_KEYS
+    # no exact column: the soft solver's time is the one compared
+    assert row["ours_ms"] is None and row["ratio"] is None and row["pen_ours"] is None and row["stretch_ours"] is None
+    assert row["ours_stages_ms"] is None
+    assert row["soft_ms"] > 0 and 0.0 <= row["stretch_soft"] < 0.05 and row["pen_soft"] >= 0.0
+    for n in ("pymunk", "box2d"):
+        assert (row[f"stretch_{n}"] is not None) == (peers[n] is not None)
+    if any(peers.values()):
+        assert row["ratio_soft"] > 0 and row["time_pass"] == (row["ratio_soft"] <= row["target"])
+    assert "| bridge-30" in reg.text_report(report)
 
 
 def test_regimes_without_peers_has_null_columns(monkeypatch, tmp_path):

@@ -55,6 +55,20 @@ Scenarios (each has an exact reference, so every error is measured, not judged b
   taken to reach x = 10 from x = 2, ``expected``: at constant speed (80). ``ride-reverse``: standing
   on a platform that turns back every 20 steps and up and down every 15 (``measured``: the largest
   drift of the character from where it stood on it). Modes ``substeps-N``.
+- **joints** (the soft solver: the exact one refuses joints): ``pendulum-distance``: a ball of
+  radius 0.05 on a rod (``DistanceJoint`` to the world) 1 long, let go 0.05 rad from the
+  vertical; exact period ``2 pi sqrt(L / g) / AGM(1, cos(a / 2))`` (the finite amplitude's, 1.6e-4
+  above the small-angle ``2 pi sqrt(L / g)``); ``pendulum-revolute``: the ball hinged to the world
+  (``RevoluteJoint``) turns with the rod, a physical pendulum of length ``L + r^2 / (2 L)``.
+  ``measured``: the period from the zero crossings (least squares over the run's, 10 periods;
+  quick 4); ``max_stretch``: the rod's largest change of length, over L; ``apex_drop``: how much
+  less than 0.05 rad the last period's widest swing was, relative (sampled once a step: to about
+  1e-3). ``rope-20-hanging``: 20 links (0.25 x 0.05, mass 1) hinged end to end, hanging at rest
+  from a hinge to the world; ``rope-20-swinging``: laid out level, falling and swinging.
+  ``measured``: the rope's length along its links (the links' plus every hinge's gap), the mean
+  over the second half of the run (600 steps; quick 240); ``rel_error``: that stretch over the
+  rope's 5; ``max_stretch``: the largest over the run. Modes ``soft`` and ``soft-substeps-N``
+  (the scene's ``substeps``: N soft steps, of the solver's own 4 sub-steps each, a step).
 
 Sleeping is off in every scene (except ``default-sleeping``) so the solver is measured, not the
 sleep. ``ms_per_step``: median over the steps of every repeated run, timed in the same process
@@ -84,9 +98,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BULLET_MODES", "CONTROLLER_CASES", "CONTROLLER_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES",
-    "FRICTION_CASES", "FRICTION_MODES", "ROW_KEYS",
+    "FRICTION_CASES", "FRICTION_MODES", "JOINT_CASES", "JOINT_MODES", "ROW_KEYS",
     "analytic_bullet_toi", "bullet_lanes", "crate_placements", "crates_overlap_exact", "markdown", "run_accuracy",
-    "run_ball", "run_bullets", "run_controller", "run_crates", "run_friction", "run_rest", "text_report",
+    "pendulum_period", "run_ball", "run_bullets", "run_controller", "run_crates", "run_friction", "run_joint",
+    "run_rest", "text_report",
 ]
 
 DT = 1.0 / 60.0
@@ -107,19 +122,22 @@ FRICTION_MODES = ("substeps-1", "substeps-2", "substeps-4", "soft")
 FRICTION_CASES = ("crate-stop", "slope-hold", "slope-slide", "disk-roll", "disk-slip", "box-tip", "box-tip-one-point")
 CONTROLLER_CASES = ("slope-45-up", "slope-45-down", "slope-2:1-up", "slope-2:1-down", "step-up", "ride-reverse")
 CONTROLLER_MODES = ("substeps-1", "substeps-4")
-SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction", "controller")
+JOINT_CASES = ("pendulum-distance", "pendulum-revolute", "rope-20-hanging", "rope-20-swinging")
+JOINT_MODES = ("soft", "soft-substeps-2", "soft-substeps-4")  # (the exact solver refuses joints)
+SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction", "controller",
+             "joints")
 DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
 
 FULL: dict[str, Any] = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3,
-                        "crate_steps": 10, "crowds": 15}
+                        "crate_steps": 10, "crowds": 15, "pendulum_periods": 10, "rope_steps": 600}
 QUICK: dict[str, Any] = {"lanes": 32, "crates": 2_000, "rest_steps": 240, "ball_steps": 1_000, "runs": 1,
-                         "crate_steps": 3, "crowds": 5}
+                         "crate_steps": 3, "crowds": 5, "pendulum_periods": 4, "rope_steps": 240}
 CROWD_MODES = REST_MODES[:-1]
 CROWD_BOXES = 64
 
 ROW_KEYS = ["scenario", "mode", "speed", "ms_per_step", "missed", "undetected", "stop_error", "fp_rate", "fn_rate",
             "max_depth", "jitter", "sink", "snags", "residual", "energy_drift", "apex_drop", "case", "measured",
-            "expected", "rel_error", "samples", "steps", "gap_max", "gap_min", "speed_error"]
+            "expected", "rel_error", "samples", "steps", "gap_max", "gap_min", "speed_error", "max_stretch"]
 
 
 def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
@@ -130,12 +148,15 @@ def _row(scenario: str, mode: str, **values: Any) -> dict[str, Any]:
 
 def _scene_for(mode: str, gravity=(0.0, 0.0), effects=None):
     """A scene configured by a mode name: ``substeps-N``, ``response-iterations-N``, ``soft`` (the
-    soft-step solver), else defaults. Sleeping is off unless the mode is ``default-sleeping``."""
+    soft-step solver), ``soft-substeps-N`` (it, N pipeline steps a step), else defaults. Sleeping
+    is off unless the mode is ``default-sleeping``."""
     from ..scene import DEFAULT_EFFECTS, Scene
 
     kw: dict[str, Any] = {}
     if mode == "soft":
         kw["solver"] = "soft"
+    elif mode.startswith("soft-substeps-"):
+        kw["solver"], kw["substeps"] = "soft", int(mode.rsplit("-", 1)[1])
     elif mode.startswith("substeps-"):
         kw["substeps"] = int(mode.rsplit("-", 1)[1])
     elif mode.startswith("response-iterations-"):
@@ -542,6 +563,126 @@ def _friction_run(case: str, mode: str) -> tuple[list[float], float, float, int]
         scene.close()
 
 
+# --- joints: a pendulum's period, a rope's stretch ----------------------------------------------------
+
+PENDULUM_LENGTH = 1.0
+PENDULUM_AMPLITUDE = 0.05  # radians: small, and the exact period at it is known all the same
+BOB_RADIUS = 0.05
+ROPE_LINKS = 20
+ROPE_LINK = 0.25
+
+
+def pendulum_period(length: float, g: float, amplitude: float) -> float:
+    """The exact period of a simple pendulum of ``length`` swinging ``amplitude`` radians either
+    side: ``2 pi sqrt(L / g) / AGM(1, cos(amplitude / 2))`` (the complete elliptic integral by the
+    arithmetic-geometric mean; 1 + amplitude^2 / 16 + ... times the small-angle period)."""
+    a, b = 1.0, math.cos(amplitude / 2)
+    while abs(a - b) > 1e-15 * a:
+        a, b = 0.5 * (a + b), math.sqrt(a * b)
+    return 2.0 * math.pi * math.sqrt(length / g) / a
+
+
+def _crossings(t: F64Array, x: F64Array) -> F64Array:
+    """The times at which ``x`` crosses 0 (linear between samples)."""
+    k = np.flatnonzero((x[:-1] < 0.0) != (x[1:] < 0.0))
+    return t[k] + (t[k + 1] - t[k]) * x[k] / (x[k] - x[k + 1])
+
+
+def run_joint(case: str, mode: str, periods: int = 10, steps: int = 600, runs: int = 1) -> dict[str, Any]:
+    """One joint case (see the module's docstring) in one mode; the row."""
+    times: list[float] = []
+    out: dict[str, Any] = {}
+    for _ in range(runs):
+        ms, out = (_pendulum_run(case, mode, periods) if case.startswith("pendulum") else
+                   _rope_run(case, mode, steps))
+        times += ms
+    return _row("joints", mode, case=case, ms_per_step=median(times), samples=1, **out)
+
+
+def _pendulum_run(case: str, mode: str, periods: int) -> tuple[list[float], dict[str, Any]]:
+    from ..joints import DistanceJoint, RevoluteJoint
+
+    g, length, a0, r = -GRAVITY[1], PENDULUM_LENGTH, PENDULUM_AMPLITUDE, BOB_RADIUS
+    scene = _scene_for(mode, gravity=GRAVITY)
+    try:
+        bob = scene.spawn(Transform(length * math.sin(a0), -length * math.cos(a0)), Velocity(),
+                          Hitbox(Circle(r), mass=1.0))
+        if case == "pendulum-distance":  # a point mass: the rod pulls through its centre, it never turns
+            scene.spawn(DistanceJoint(bob, None, anchor_b=(0.0, 0.0)))
+            reach = length
+        else:  # the disk turns with the rod: a physical pendulum, of length L + I / (m L)
+            scene.spawn(RevoluteJoint(bob, None, (0.0, 0.0)))
+            reach = length + 0.5 * r * r / length
+        expected = pendulum_period(reach, g, a0)
+        steps = int(math.ceil(periods * expected / DT)) + 2
+        t = scene.get(bob, Transform)
+        xs, swing, stretch = np.zeros(steps), np.zeros(steps), np.zeros(steps)
+
+        def after(k: int) -> None:
+            xs[k], swing[k] = t.x, math.atan2(t.x, -t.y)
+            if case == "pendulum-distance":
+                stretch[k] = abs(math.hypot(t.x, t.y) - length) / length
+            else:  # the disk's point that was at the hinge, against the hinge
+                c, s = math.cos(t.rotation), math.sin(t.rotation)
+                lx, ly = -length * math.sin(a0), length * math.cos(a0)  # (the hinge in the disk's frame at spawn)
+                stretch[k] = math.hypot(t.x + c * lx - s * ly, t.y + s * lx + c * ly) / length
+
+        times = _timed_steps(scene, steps, after=after)
+        when = _crossings(np.arange(1, steps + 1, dtype=np.float64) * DT, xs)
+        # crossings come every half period: twice the least-squares slope of their times
+        measured = 2.0 * float(np.polyfit(np.arange(when.size), when, 1)[0]) if when.size >= 2 else math.nan
+        last = swing[-int(expected / DT):]  # the last period's widest swing, against the first
+        return times, {"measured": measured, "expected": expected, "rel_error": abs(measured - expected) / expected,
+                       "apex_drop": float(1.0 - np.abs(last).max() / a0),
+                       "max_stretch": float(stretch.max()), "steps": steps}
+    finally:
+        scene.close()
+
+
+def _rope_run(case: str, mode: str, steps: int) -> tuple[list[float], dict[str, Any]]:
+    """``rope-20-hanging``: 20 links hanging straight down at rest from a hinge at the origin;
+    ``rope-20-swinging``: the same laid out level to the right, falling and swinging. The rope's
+    length along its links is its links' plus every hinge's gap (each link's point at the hinge
+    against the next's, the first's against the world point)."""
+    from ..joints import RevoluteJoint
+
+    n, link = ROPE_LINKS, ROPE_LINK
+    level = case.endswith("swinging")
+    scene = _scene_for(mode, gravity=GRAVITY)
+    try:
+        links = []
+        for k in range(n):
+            c = (k + 0.5) * link
+            links.append(scene.spawn(Transform(c, 0.0) if level else Transform(0.0, -c), Velocity(),
+                                     Hitbox(Polygon.box(link, link / 5) if level else Polygon.box(link / 5, link),
+                                            mass=1.0)))
+        for k in range(n):
+            scene.spawn(RevoluteJoint(links[k], links[k - 1] if k else None, (k * link, 0.0) if level else
+                                      (0.0, -k * link)))
+        poses = [scene.get(e, Transform) for e in links]
+        # each link's ends in its frame: at its hinge with the one before (or the world), at the next's
+        ex, ey = ((-0.5 * link, 0.0), (0.5 * link, 0.0)) if level else ((0.0, 0.5 * link), (0.0, -0.5 * link))
+        total = n * link
+        stretch = np.zeros(steps)
+
+        def point(t: Transform, lx: float, ly: float) -> tuple[float, float]:
+            c, s = math.cos(t.rotation), math.sin(t.rotation)
+            return t.x + c * lx - s * ly, t.y + s * lx + c * ly
+
+        def after(k: int) -> None:
+            gaps = math.dist((0.0, 0.0), point(poses[0], *ex))
+            for a, b in zip(poses, poses[1:]):
+                gaps += math.dist(point(a, *ey), point(b, *ex))
+            stretch[k] = gaps / total
+
+        times = _timed_steps(scene, steps, after=after)
+        half = stretch[steps // 2:]
+        return times, {"measured": total * (1.0 + float(half.mean())), "expected": total,
+                       "rel_error": float(half.mean()), "max_stretch": float(stretch.max()), "steps": steps}
+    finally:
+        scene.close()
+
+
 # --- the character controller -------------------------------------------------------------------------
 
 WALK = 6.0  # units/s: 0.1 a step
@@ -692,6 +833,11 @@ def run_accuracy(config: dict[str, Any] | None = None, progress: bool = True, qu
         for case in CONTROLLER_CASES:
             for mode in CONTROLLER_MODES:
                 jobs.append((f"controller {case} {mode}", partial(run_controller, case, mode, cfg["runs"])))
+    if "joints" in want:
+        for case in JOINT_CASES:
+            for mode in JOINT_MODES:
+                jobs.append((f"joints {case} {mode}", partial(run_joint, case, mode, cfg["pendulum_periods"],
+                                                             cfg["rope_steps"], cfg["runs"])))
     rows = []
     with Progress(len(jobs), "accuracy", enabled=progress) as bar:
         for name, job in jobs:
@@ -738,6 +884,12 @@ TABLES: dict[str, tuple[str, list[Column]]] = {
                    [("case", "case", "str"), *_COMMON, ("gap_max", "feet above surface, max", "sci"),
                     ("gap_min", "min", "sci"), ("speed_error", "x advance error", "sci"),
                     ("measured", "steps / drift", "g"), ("expected", "exact", "g")]),
+    "joints": (f"Joints (soft solver): a pendulum's period (L = {PENDULUM_LENGTH:g}, {PENDULUM_AMPLITUDE:g} rad), "
+               f"a rope of {ROPE_LINKS} links' length (g = 20)",
+               [("case", "case", "str"), *_COMMON, ("measured", "period (s) / rope length", "g7"),
+                ("expected", "exact", "g7"), ("rel_error", "relative error (rope: stretch)", "sci"),
+                ("max_stretch", "largest stretch, of the length", "sci"),
+                ("apex_drop", "swing lost over the run", "sci")]),
 }
 
 

@@ -21,6 +21,15 @@ bodies. Scenes (``dt = 1/60`` s, gravity (0, -10), unless said):
   tile units), their enemies patrolling and the platform moving back and forth (:func:`platformer`).
   Our player and walkers are kinematic bodies moved by the character controller (shape casts
   against the level); the peers have no controller and get them as dynamic bodies.
+- **chain-100**, **bridge-30**, **ragdolls-20** (joints: :class:`Hinge`, a revolute joint built
+  alike in the three engines; every body turns, friction 0.6): a chain of 100 thin links hinged
+  end to end between two static anchors, laid out with slack as a lopsided V so it swings
+  (:func:`chain`); a bridge of 30 planks between two posts, laid out as it hangs, five boxes
+  dropped onto it (:func:`bridge`); 20 ragdolls of ten bodies and nine limited hinges each
+  dropped into a pit (:func:`ragdolls`). Ours runs them in the soft solver only (the exact one
+  refuses joints: its columns stay empty, and the row's verdict is the soft one's). ``stretch``:
+  the widest any hinge stands open at the end (:func:`hinge_stretch`, one measure for all three),
+  how tight each engine holds its joints.
 
 Every engine's bodies are of mass 1 and cannot rotate (our AABBs never turn): pymunk
 ``Body(1, inf)``, Box2D ``fixed_rotation=True`` with density 1 / area; friction and restitution 0.
@@ -71,10 +80,11 @@ from .progress import Progress
 from .report import Column, format_table, machine_info, median, optional_module, provenance
 
 __all__ = [
-    "COLUMNS", "CROWDS", "CROWD_COLUMNS", "CROWD_KEYS", "Box2DEngine", "Engine", "Ours", "Piece", "PymunkEngine",
-    "ROW_KEYS", "Regime", "SCENES", "box_pile", "crowd", "goals", "judge", "make_engines", "markdown",
-    "max_penetration", "peer_modules", "pile_layout", "platformer", "pyramid", "run_crowd", "run_regimes",
-    "run_scene", "scattered", "shape_pile", "stack", "text_report", "with_friction",
+    "COLUMNS", "CROWDS", "CROWD_COLUMNS", "CROWD_KEYS", "Box2DEngine", "Engine", "Hinge", "Ours", "Piece",
+    "PymunkEngine", "ROW_KEYS", "Regime", "SCENES", "box_pile", "bridge", "chain", "crowd", "goals", "hinge_gaps",
+    "hinge_stretch", "judge", "make_engines", "markdown", "max_penetration", "peer_modules", "pile_layout",
+    "platformer", "pyramid", "ragdolls", "run_crowd", "run_regimes", "run_scene", "scattered", "shape_pile", "stack",
+    "text_report", "with_friction",
 ]
 
 DT = 1.0 / 60.0
@@ -86,7 +96,7 @@ ENGINES = ("ours", "soft", "pymunk", "box2d")  # soft: ours with Scene(solver="s
 
 CROWDS = ("balls", "boxes", "mixed", "mixed-friction")
 #: untimed steps before timing, by scene kind (the same in --quick: the accuracy figures do not move)
-SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer": 0, "toy": 0}
+SETTLE = {"pile": 240, "stack": 240, "pyramid": 240, "scattered": 0, "platformer": 0, "toy": 0, "joints": 120}
 # timed rounds by the number of moving bodies (the first bound that is >= it); the crowds' step cap
 FULL: dict[str, Any] = {"rounds": ((100, 500), (1_000, 200), (10**9, 80)), "platformer_rounds": 900,
         "crowd_steps": CROWD["max_steps"]}
@@ -103,7 +113,8 @@ class Piece:
     ``judged``: taken into account by the penetration oracle (not sensors, not one-way slabs that
     bodies may pass through from below). ``role``/``params``: what the peers' untimed game logic
     does with it in the platformer (``enemy``: patrol; ``platform``: back and forth). ``mass``: a
-    dynamic piece's, in every engine (its inertia scales with it)."""
+    dynamic piece's, in every engine (its inertia scales with it). ``angle``: a moving piece's
+    rotation at spawn (static pieces never turn: 0)."""
 
     shape: Shape
     x: float
@@ -116,6 +127,23 @@ class Piece:
     role: str | None = None
     params: tuple = ()
     mass: float = 1.0
+    angle: float = 0.0
+
+
+@dataclass(frozen=True)
+class Hinge:
+    """A revolute joint between pieces ``a`` and ``b`` (indices into the regime's pieces; ``b``
+    ``None``: the world) at the world point ``(x, y)`` (where the pieces are at spawn), built alike
+    in the three engines. ``lower``, ``upper``: limits on ``a``'s turn relative to ``b`` since
+    spawn (radians, counter-clockwise; ``None``: none), as :class:`~framework.RevoluteJoint` says.
+    The two bodies do not collide with each other (in every engine)."""
+
+    a: int
+    b: int | None
+    x: float
+    y: float
+    lower: float | None = None
+    upper: float | None = None
 
 
 @dataclass
@@ -130,7 +158,9 @@ class Regime:
     inertia for mass 1 in every engine).
     ``kind`` picks the untimed steps before timing (:data:`SETTLE`). ``dynamic_pairs``:
     whether overlaps between two moving bodies count in the penetration figure. ``pit``: ``(minx, maxx, floor)`` for the
-    crowds' outside count."""
+    crowds' outside count. ``hinges``: the scene's joints (:class:`Hinge`); a scene with any runs
+    in our soft solver only (the exact one refuses joints), and its jointed pairs are left out of
+    the penetration figure (they overlap at their hinges by design)."""
 
     name: str
     kind: str
@@ -151,6 +181,12 @@ class Regime:
     entities: list[int] = field(default_factory=list)  # ... the entity of each piece ...
     scale: float = 1.0  # ... and the game's units per piece unit
     remake: Any = None  # platformer only: the regime again, its game in the named solver (``remake("soft")``)
+    hinges: list[Hinge] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        for p in self.pieces:
+            if p.kind == "static" and p.angle != 0.0:
+                raise ValueError("a static piece never turns: its angle must be 0")
 
     @property
     def bodies(self) -> int:
@@ -254,6 +290,134 @@ def physics_toy() -> Regime:
     pieces.append(Piece(Circle(0.5), 15.0, 4.5))  # the barrel, dropped onto the slope
     regime = with_friction(Regime("toy", "toy", pieces, top=[top], height=10.0), 0.6, tumbling=True)
     return replace(regime, name="toy-62")
+
+
+JOINT_FRICTION = 0.6  # the joint scenes' friction (every body turns)
+
+
+def _hinged_run(pieces: list[Piece], hinges: list[Hinge], ends: list[tuple[float, float]], shape: Shape,
+                first: int | None, last: int | None) -> list[int]:
+    """Links of ``shape`` (a box as long as a link) from each point of ``ends`` to the next, each
+    turned along its run, hinged to the next at their shared end, and the first and last ends to
+    pieces ``first`` and ``last`` (``None``: left free); append them; return their indices."""
+    links = []
+    for (x0, y0), (x1, y1) in zip(ends, ends[1:]):
+        links.append(len(pieces))
+        pieces.append(Piece(shape, 0.5 * (x0 + x1), 0.5 * (y0 + y1), angle=math.atan2(y1 - y0, x1 - x0)))
+    hinges += [Hinge(links[k], links[k - 1], *ends[k]) for k in range(1, len(links))]
+    if first is not None:
+        hinges.append(Hinge(links[0], first, *ends[0]))
+    if last is not None:
+        hinges.append(Hinge(links[-1], last, *ends[-1]))
+    return links
+
+
+def chain(links: int = 100, length: float = 0.25, span: float = 18.0, first_run: float = 0.6) -> Regime:
+    """``chain-N``: ``links`` boxes ``length`` x ``length / 4`` (mass 1) hinged end to end between
+    two small static anchors ``span`` apart at the same height, laid out with slack as a lopsided
+    V: the first ``first_run`` of the links straight down to the right, the rest straight up to
+    the other anchor (the two runs' slopes such that they meet the anchors). Far from the hanging
+    shape, it swings from the first step and does not stop (hinges have no friction)."""
+    n1 = round(links * first_run)
+    n2 = links - n1
+    lo, hi = 0.0, math.pi / 2  # the first run's slope: the runs' heights cancel, their widths make the span
+    for _ in range(100):
+        a = 0.5 * (lo + hi)
+        b = math.asin(min(1.0, n1 / n2 * math.sin(a)))
+        if length * (n1 * math.cos(a) + n2 * math.cos(b)) > span:
+            lo = a
+        else:
+            hi = a
+    b = math.asin(min(1.0, n1 / n2 * math.sin(a)))
+    ends = [(0.0, 0.0)]
+    for k in range(links):
+        slope = -a if k < n1 else b
+        ends.append((ends[-1][0] + length * math.cos(slope), ends[-1][1] + length * math.sin(slope)))
+    ends[-1] = (span, 0.0)  # (within rounding already)
+    pieces = [Piece(AABB(0.25, 0.25), 0.0, 0.0, kind="static"), Piece(AABB(0.25, 0.25), span, 0.0, kind="static")]
+    hinges: list[Hinge] = []
+    _hinged_run(pieces, hinges, ends, AABB(length, length / 4), 0, 1)
+    return Regime(f"chain-{links}", "joints", pieces, friction=JOINT_FRICTION, rolling=True, tumbling=True,
+                  hinges=hinges)
+
+
+def _chain_slopes(links: int, length: float, half_span: float) -> list[float]:
+    """The slopes (radians below level, from the middle out) of a chain of ``links`` rigid links of
+    ``length`` (equal weights at their middles) hanging at rest between two points at the same
+    height ``2 half_span`` apart: the horizontal tension H is the same in every link, the vertical
+    one in the k-th from the middle is ``(k - 1/2)`` links' weight, so its slope is atan((k - 1/2)
+    w / H); H (in weights) is the one whose links span the gap (bisection). tests/test_joint_scenes
+    checks the same statics."""
+    half = links // 2
+
+    def slopes(h: float) -> list[float]:
+        return [math.atan((k - 0.5) / h) for k in range(1, half + 1)]
+
+    lo, hi = 1e-9, 1e9
+    for _ in range(200):
+        h = math.sqrt(lo * hi)
+        if sum(length * math.cos(a) for a in slopes(h)) < half_span:
+            lo = h
+        else:
+            hi = h
+    return slopes(lo)
+
+
+def bridge(planks: int = 30, boxes: int = 5) -> Regime:
+    """``bridge-N``: ``planks`` planks 0.5 x 0.125 (mass 1) hinged end to end between the top
+    corners of two static posts 14 apart (the planks span 15), laid out as the rigid chain hangs at
+    rest (:func:`_chain_slopes`); ``boxes`` boxes of side 0.5 (mass 1) dropped onto it from 1.5
+    above its ends' height, spread along it, which roll and slide toward its middle."""
+    plank, half_span = 0.5, 7.0
+    slopes = _chain_slopes(planks, plank, half_span)[::-1]  # from the left post in
+    ends = [(-half_span, 0.0)]
+    for a in slopes:
+        ends.append((ends[-1][0] + plank * math.cos(a), ends[-1][1] - plank * math.sin(a)))
+    ends += [(-ends[k][0], ends[k][1]) for k in range(planks // 2 - 1, -1, -1)]
+    pieces = [Piece(AABB(0.5, 1.0), -half_span - 0.25, -0.5, kind="static"),
+              Piece(AABB(0.5, 1.0), half_span + 0.25, -0.5, kind="static")]
+    hinges: list[Hinge] = []
+    _hinged_run(pieces, hinges, ends, AABB(plank, plank / 4), 0, 1)
+    for k in range(boxes):
+        pieces.append(Piece(AABB(0.5, 0.5), -half_span + (k + 0.5) * 2 * half_span / boxes, 1.5))
+    return Regime(f"bridge-{planks}", "joints", pieces, friction=JOINT_FRICTION, rolling=True, tumbling=True,
+                  hinges=hinges)
+
+
+def _ragdoll(pieces: list[Piece], hinges: list[Hinge], x0: float, y0: float) -> None:
+    """One ragdoll of ten bodies with its torso's centre at ``(x0, y0)`` (tests/test_joint_scenes'):
+    torso 0.3 x 0.6 (mass 2), head of radius 0.12 (1/2), upper and lower arms 0.3 x 0.1 (1/4
+    each), thighs and shins 0.12 x 0.3 (1/2 each), hinged where they touch, with limits."""
+    def part(x: float, y: float, shape: Shape, mass: float) -> int:
+        pieces.append(Piece(shape, x, y, mass=mass))
+        return len(pieces) - 1
+
+    torso = part(x0, y0, AABB(0.3, 0.6), 2.0)
+    head = part(x0, y0 + 0.45, Circle(0.12), 0.5)
+    hinges.append(Hinge(head, torso, x0, y0 + 0.33, -0.5, 0.5))
+    for side in (-1.0, 1.0):
+        upper_arm = part(x0 + side * 0.3, y0 + 0.2, AABB(0.3, 0.1), 0.25)
+        lower_arm = part(x0 + side * 0.6, y0 + 0.2, AABB(0.3, 0.1), 0.25)
+        thigh = part(x0 + side * 0.08, y0 - 0.45, AABB(0.12, 0.3), 0.5)
+        shin = part(x0 + side * 0.08, y0 - 0.75, AABB(0.12, 0.3), 0.5)
+        hinges += [Hinge(upper_arm, torso, x0 + side * 0.15, y0 + 0.2, -1.5, 1.5),
+                   Hinge(lower_arm, upper_arm, x0 + side * 0.45, y0 + 0.2, -1.5, 0.0),
+                   Hinge(thigh, torso, x0 + side * 0.08, y0 - 0.3, -1.0, 1.0),
+                   Hinge(shin, thigh, x0 + side * 0.08, y0 - 0.6, 0.0, 1.5)]
+
+
+def ragdolls(count: int = 20, cols: int = 5) -> Regime:
+    """``ragdolls-N``: ``count`` ragdolls (:func:`_ragdoll`: ten bodies, nine limited hinges) in rows
+    of ``cols``, 2.4 apart, rows 2 apart and every other one shifted by 0.6, dropped into a pit
+    ``2.4 cols`` wide from 0.6 above its floor up: they fall, land and pile."""
+    width = 2.4 * cols
+    pieces = _pit(width, 30.0)
+    hinges: list[Hinge] = []
+    for k in range(count):
+        r, c = divmod(k, cols)
+        _ragdoll(pieces, hinges, 1.2 + 2.4 * c + (0.6 if r % 2 else 0.0) - 0.3, 1.5 + 2.0 * r)
+    return Regime(f"ragdolls-{count}", "joints", pieces, friction=JOINT_FRICTION, rolling=True, tumbling=True,
+                  hinges=hinges)
 
 
 def scattered(n: int, seed: int = 0) -> Regime:
@@ -415,7 +579,8 @@ class Engine:
 class Ours(Engine):
     """Our :class:`~framework.scene.Scene`, through its public API only: one entity per piece
     (``Transform``, ``Velocity`` unless static, ``Hitbox``, mass 1, restitution 0, the regime's
-    friction on every hitbox, none when 0); or, for the
+    friction on every hitbox, none when 0), a :class:`~framework.RevoluteJoint` entity per hinge
+    (soft solver only); or, for the
     platformer, the game the regime carries. Effects: the regime's, else the default effects, minus
     ``sleeping`` unless the regime sleeps."""
 
@@ -426,6 +591,8 @@ class Ours(Engine):
         super().__init__(regime)
         from ..scene import DEFAULT_EFFECTS, Scene
 
+        self.joints: list[Any] = []  # the hinges' joint entities
+
         if regime.game is not None:
             mine = regime if self.solver == "exact" else regime.remake(self.solver)
             self.scene, self.entities, self._step = mine.game.scene, mine.entities, mine.game.step
@@ -435,11 +602,17 @@ class Ours(Engine):
         mu = regime.friction or None
         self.entities = [scene.spawn(Transform(p.x, p.y), Hitbox(p.shape, body=p.kind, sensor=p.sensor, friction=mu))
                          if p.kind == "static" else
-                         scene.spawn(Transform(p.x, p.y), Velocity(p.vx, p.vy),
+                         scene.spawn(Transform(p.x, p.y, p.angle), Velocity(p.vx, p.vy),
                                      Hitbox(_ours_shape(regime, p.shape), body=p.kind, sensor=p.sensor, friction=mu,
                                             mass=p.mass if p.kind == "dynamic" else 1.0,
                                             inertia=None if _turns(regime, p.shape) else math.inf))
                          for p in regime.pieces]
+        if regime.hinges:
+            from ..joints import RevoluteJoint
+
+            ents = self.entities
+            self.joints = [scene.spawn(RevoluteJoint(ents[h.a], None if h.b is None else ents[h.b], (h.x, h.y),
+                                                     h.lower, h.upper)) for h in regime.hinges]
         dt = regime.dt
         self._step = lambda: scene.step(dt)
 
@@ -505,6 +678,7 @@ class Peer(Engine):
     def __init__(self, regime: Regime) -> None:
         super().__init__(regime)
         self.handles: list[Any] = []
+        self.joints: list[Any] = []  # each hinge's joint (pymunk: its PivotJoint)
         self.heading = {i: p.params[1] for i, p in enumerate(regime.pieces) if p.role == "enemy"}
         self.toward_end = {i: True for i, p in enumerate(regime.pieces) if p.role == "platform"}
         # the cells (unit tiles) holding a solid static piece, for the enemies' ledge probe
@@ -562,7 +736,9 @@ class PymunkEngine(Peer):
     ``Body(1, r^2 / 2)``), kinematic ones on kinematic
     bodies, static ones as shapes of the space's static body; elasticity 0, friction the square root
     of the regime's on every shape (pymunk multiplies a pair's: the pair then has the regime's); sleeping
-    (when the regime sleeps) after ``SLEEP_TIME`` s idle; everything else pymunk's defaults."""
+    (when the regime sleeps) after ``SLEEP_TIME`` s idle; everything else pymunk's defaults. Hinges
+    are a ``PivotJoint`` and, with limits, a ``RotaryLimitJoint``, neither letting its bodies
+    collide."""
 
     name = "pymunk"
 
@@ -573,20 +749,42 @@ class PymunkEngine(Peer):
         if regime.sleeping:
             space.sleep_time_threshold = SLEEP_TIME
         items: list[Any] = []
-        for p in regime.pieces:
-            if p.kind == "static":
+        hinged = _hinged_statics(regime)
+        bodies = []  # each piece's body (a jointed static piece's is its own)
+        for k, p in enumerate(regime.pieces):
+            if p.kind == "static" and k not in hinged:
                 body, ox, oy, handle = space.static_body, p.x, p.y, None
+            elif p.kind == "static":
+                body, ox, oy, handle = pymunk.Body(body_type=pymunk.Body.STATIC), 0.0, 0.0, None
+                body.position = (p.x, p.y)
+                items.append(body)
             else:
                 moment = p.mass * p.shape.second_moment if _turns(regime, p.shape) else math.inf
                 body = handle = (pymunk.Body(p.mass, moment) if p.kind == "dynamic"
                                  else pymunk.Body(body_type=pymunk.Body.KINEMATIC))
-                body.position, body.velocity, ox, oy = (p.x, p.y), (p.vx, p.vy), 0.0, 0.0
+                body.position, body.velocity, body.angle, ox, oy = (p.x, p.y), (p.vx, p.vy), p.angle, 0.0, 0.0
                 items.append(body)
             shape = (pymunk.Circle(body, p.shape.radius, (ox, oy)) if isinstance(p.shape, Circle)
                      else pymunk.Poly(body, _outline(p.shape, ox, oy)))
             shape.friction, shape.elasticity, shape.sensor = math.sqrt(regime.friction), 0.0, p.sensor
             items.append(shape)
             self.handles.append(handle)
+            bodies.append(body)
+        if regime.hinges:
+            world = pymunk.Body(body_type=pymunk.Body.STATIC)  # (b None: a body of its own, which nothing touches)
+            items.append(world)
+            for h in regime.hinges:
+                a, b = bodies[h.a], world if h.b is None else bodies[h.b]
+                joints = [pymunk.PivotJoint(a, b, (h.x, h.y))]
+                if h.lower is not None or h.upper is not None:
+                    # pymunk limits b's angle minus a's: ours are a's turn relative to b since spawn
+                    ref = _angle0(regime, h.a) - _angle0(regime, h.b)
+                    joints.append(pymunk.RotaryLimitJoint(b, a, ref + (-math.inf if h.lower is None else h.lower),
+                                                          ref + (math.inf if h.upper is None else h.upper)))
+                for j in joints:
+                    j.collide_bodies = False
+                items += joints
+                self.joints.append(joints[0])
         space.add(*items)
         self.dt = regime.dt
         self._start_logic()
@@ -621,14 +819,19 @@ class Box2DEngine(Peer):
         world = self.world = b2.World(gravity=regime.gravity)
         world.sleeping_enabled = regime.sleeping
         ground = world.create_static_body(position=(0.0, 0.0))
-        for p in regime.pieces:
-            if p.kind == "static":
+        hinged = _hinged_statics(regime)
+        bodies = []  # each piece's body (a jointed static piece's is its own)
+        for k, p in enumerate(regime.pieces):
+            if p.kind == "static" and k not in hinged:
                 body, ox, oy, handle = ground, p.x, p.y, None
+            elif p.kind == "static":
+                body, ox, oy, handle = world.create_static_body(position=(p.x, p.y)), 0.0, 0.0, None
             else:
                 make = world.create_dynamic_body if p.kind == "dynamic" else world.create_kinematic_body
-                body = handle = make(position=(p.x, p.y), linear_velocity=(p.vx, p.vy),
-                                     fixed_rotation=not _turns(regime, p.shape))
+                body = handle = make(position=(p.x, p.y), rotation=b2.Rot(p.angle),  # (make_rot: an approximation)
+                                     linear_velocity=(p.vx, p.vy), fixed_rotation=not _turns(regime, p.shape))
                 ox = oy = 0.0
+            bodies.append(body)
             sd = b2.shape_def(density=p.mass / _area(p.shape), is_sensor=p.sensor,
                               material=b2.surface_material(friction=regime.friction, restitution=0.0))
             if isinstance(p.shape, Circle):
@@ -638,6 +841,17 @@ class Box2DEngine(Peer):
             else:
                 body.create_polygon_shape(sd, b2.polygon(points=_outline(p.shape, ox, oy)))
             self.handles.append(handle)
+        world_body = world.create_static_body(position=(0.0, 0.0)) if regime.hinges else None
+        for h in regime.hinges:
+            # Box2D's angle is body_b's minus body_a's: ours (a's turn relative to b) with body_a = our b
+            a, b = bodies[h.a], world_body if h.b is None else bodies[h.b]
+            limited = h.lower is not None or h.upper is not None
+            self.joints.append(world.create_revolute_joint(
+                body_a=b, body_b=a, local_anchor_a=_local(regime, h.b, h.x, h.y),
+                local_anchor_b=_local(regime, h.a, h.x, h.y),
+                reference_angle=_angle0(regime, h.a) - _angle0(regime, h.b), enable_limit=limited,
+                lower_angle=-math.pi if h.lower is None else h.lower,
+                upper_angle=math.pi if h.upper is None else h.upper, collide_connected=False))
         self.dt = regime.dt
         self._start_logic()
 
@@ -655,11 +869,37 @@ class Box2DEngine(Peer):
     def _set_vel(self, h, vx: float, vy: float) -> None:
         h.linear_velocity = (vx, vy)
 
+    def angles(self) -> F64Array:
+        # from the rotation's cosine and sine: Box2D's own angle (b2Rot_GetAngle) is an approximate atan2
+        return np.array([0.0 if h is None else math.atan2((r := h.rotation).s, r.c) for h in self.handles])
+
     def asleep(self) -> bool:
         return not any(h.awake for h, p in zip(self.handles, self.regime.pieces) if p.kind == "dynamic")
 
     def close(self) -> None:
         self.world.destroy()
+
+
+def _hinged_statics(regime: Regime) -> set[int]:
+    """The static pieces a hinge holds: the peers give each a static body of its own (a peer's
+    jointed bodies do not collide, and its other static pieces share one body)."""
+    held = {k for h in regime.hinges for k in (h.a, h.b) if k is not None}
+    return {k for k in held if regime.pieces[k].kind == "static"}
+
+
+def _angle0(regime: Regime, k: int | None) -> float:
+    """Piece ``k``'s rotation at spawn (the world's, ``None``: 0)."""
+    return 0.0 if k is None else regime.pieces[k].angle
+
+
+def _local(regime: Regime, k: int | None, x: float, y: float) -> tuple[float, float]:
+    """The world point ``(x, y)`` in piece ``k``'s frame at spawn (the world's, ``None``: itself)."""
+    if k is None:
+        return x, y
+    p = regime.pieces[k]
+    c, s = math.cos(p.angle), math.sin(p.angle)
+    dx, dy = x - p.x, y - p.y
+    return c * dx + s * dy, -s * dx + c * dy
 
 
 def peer_modules() -> dict[str, Any]:
@@ -668,9 +908,10 @@ def peer_modules() -> dict[str, Any]:
 
 
 def make_engines(regime: Regime, peers: dict[str, Any] | None = None) -> list[Engine]:
-    """Ours and every installed peer, each with the regime built."""
+    """Ours (exact, unless the regime has hinges; and soft) and every installed peer, each with the
+    regime built."""
     peers = peer_modules() if peers is None else peers
-    out: list[Engine] = [Ours(regime)]
+    out: list[Engine] = [] if regime.hinges else [Ours(regime)]  # (the exact solver refuses joints)
     if regime.game is None or regime.remake is not None:
         out.append(OursSoft(regime))
     if peers.get("pymunk") is not None:
@@ -692,14 +933,15 @@ def _half_extents(shape: Shape) -> tuple[float, float]:
     return max(abs(x) for x, _ in pts), max(abs(y) for _, y in pts)
 
 
-def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool = True, rot=None) -> float:
+def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool = True, rot=None,
+                    skip: set[tuple[int, int]] | None = None) -> float:
     """The deepest overlap among the shapes at ``(x, y)`` (turned by ``rot``, default none), by our
     exact geometry: the
     pairs whose bounds overlap (:func:`~framework.collision.broad_phase.brute_force_pairs`, numpy in
     row blocks, never two static ones: once per scene, so its O(N^2) does not matter), then
     ``collide_many`` (the same answers as :func:`~framework.collision.collide`).
-    ``dynamic_pairs=False``: only pairs with a static one. The same oracle judges all three
-    engines, from their final positions."""
+    ``dynamic_pairs=False``: only pairs with a static one; ``skip``: pairs ``(i, j)``, ``i < j``,
+    left out (jointed ones). The same oracle judges all three engines, from their final positions."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     static = np.asarray(static, dtype=bool)
     if x.size < 2:
@@ -714,6 +956,9 @@ def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool =
     if not dynamic_pairs:
         keep = static[i] | static[j]
         i, j = i[keep], j[keep]
+    if skip:
+        keep = np.array([(min(a, b), max(a, b)) not in skip for a, b in zip(i.tolist(), j.tolist())], dtype=bool)
+        i, j = i[keep], j[keep]
     if i.size == 0:
         return 0.0
     res = collide_many([shapes[k] for k in i.tolist()], list(zip(x[i].tolist(), y[i].tolist(), rot[i].tolist())),
@@ -721,17 +966,44 @@ def max_penetration(shapes: Sequence[Shape], x, y, static, dynamic_pairs: bool =
     return float(res.depth[res.hit].max()) if res.hit.any() else 0.0
 
 
+def hinge_gaps(regime: Regime, x, y, rot) -> list[float]:
+    """How wide each hinge of the regime stands open with its pieces at ``(x, y)`` turned by ``rot``:
+    the distance between the hinge's point on ``a`` and on ``b`` (each the point that was at the
+    hinge at spawn, carried with its piece; the world's stays put)."""
+    out = []
+    for h in regime.hinges:
+        ends = []
+        for k in (h.a, h.b):
+            if k is None:
+                ends.append((h.x, h.y))
+                continue
+            lx, ly = _local(regime, k, h.x, h.y)
+            c, s = math.cos(float(rot[k])), math.sin(float(rot[k]))
+            ends.append((float(x[k]) + c * lx - s * ly, float(y[k]) + s * lx + c * ly))
+        out.append(math.dist(*ends))
+    return out
+
+
+def hinge_stretch(regime: Regime, x, y, rot) -> float | None:
+    """The widest gap of :func:`hinge_gaps` (``None`` without hinges): how tight an engine holds
+    its joints."""
+    return max(hinge_gaps(regime, x, y, rot)) if regime.hinges else None
+
+
 def judge(regime: Regime, engine: Engine) -> dict[str, Any]:
     """An engine's accuracy figures on the regime, from its bodies' positions now: ``pen`` (the
-    deepest overlap among the judged pieces), ``sink`` (where an exact height exists), and, for the
+    deepest overlap among the judged pieces, jointed pairs left out), ``sink`` (where an exact
+    height exists), ``stretch`` (:func:`hinge_stretch`, where there are hinges), and, for the
     crowds, ``speed2`` (sum of squared speeds) and ``outside`` (bodies whose centre left the pit)."""
     x, y, vx, vy, alive = engine.state()
     pieces = regime.pieces
     sel = np.flatnonzero(alive & np.array([p.judged for p in pieces]))
     shapes = [_ours_shape(regime, pieces[k].shape) if pieces[k].kind == "dynamic" else pieces[k].shape for k in sel]
+    at = {k: n for n, k in enumerate(sel.tolist())}
+    skip = {(min(at[h.a], at[h.b]), max(at[h.a], at[h.b])) for h in regime.hinges if h.a in at and h.b in at}
     pen = max_penetration(shapes, x[sel], y[sel], [pieces[k].kind != "dynamic" for k in sel], regime.dynamic_pairs,
-                          engine.angles()[sel] if regime.tumbling else None)
-    out: dict[str, Any] = {"pen": pen, "sink": None}
+                          engine.angles()[sel] if regime.tumbling else None, skip)
+    out: dict[str, Any] = {"pen": pen, "sink": None, "stretch": hinge_stretch(regime, x, y, engine.angles())}
     if regime.exact_top is not None:
         out["sink"] = float((regime.exact_top - y[regime.top].min()) / regime.height)
     dyn = np.array([p.kind == "dynamic" for p in pieces]) & alive
@@ -746,7 +1018,8 @@ def judge(regime: Regime, engine: Engine) -> dict[str, Any]:
 
 ROW_KEYS = ["scene", "bodies", "static", "ours_ms", "soft_ms", "pymunk_ms", "box2d_ms", "faster_peer", "ratio",
             "ratio_soft", "target", "time_pass", "ours_stages_ms", "sink_ours", "sink_soft", "sink_pymunk",
-            "sink_box2d", "pen_ours", "pen_soft", "pen_pymunk", "pen_box2d", "sink_pass", "rounds", "settle"]
+            "sink_box2d", "pen_ours", "pen_soft", "pen_pymunk", "pen_box2d", "sink_pass", "rounds", "settle",
+            "stretch_ours", "stretch_soft", "stretch_pymunk", "stretch_box2d"]
 SINK_GOAL = 0.01
 
 
@@ -774,19 +1047,25 @@ def run_scene(regime: Regime, rounds: int, settle: int = 0, peers: dict[str, Any
             eng.close()
     ms = {t.name.rsplit("/", 1)[1]: median(t.ms) for t in tasks}
     row: dict[str, Any] = {k: None for k in ROW_KEYS}
+    exact = next((t for t in tasks if t.name.endswith("/ours")), None)  # (none in a scene with joints)
     row.update(scene=regime.name, bodies=regime.bodies, static=regime.statics, rounds=rounds, settle=settle,
-               ours_stages_ms=median(e["stages_ms"] for e in tasks[0].extra), target=target_ratio(regime))
+               ours_stages_ms=median(e["stages_ms"] for e in exact.extra) if exact else None,
+               target=target_ratio(regime))
     for name in ENGINES:
         row[f"{name}_ms"] = ms.get(name)
         if name in figures:
             row[f"sink_{name}"], row[f"pen_{name}"] = figures[name]["sink"], figures[name]["pen"]
+            row[f"stretch_{name}"] = figures[name]["stretch"]
     peer_ms = {n: cast(float, ms[n]) for n in ("pymunk", "box2d") if ms.get(n)}
     if peer_ms:
         row["faster_peer"] = min(peer_ms, key=peer_ms.__getitem__)
-        row["ratio"] = cast(float, ms["ours"]) / peer_ms[row["faster_peer"]]  # (timed rounds: never empty)
+        if ms.get("ours"):
+            row["ratio"] = cast(float, ms["ours"]) / peer_ms[row["faster_peer"]]  # (timed rounds: never empty)
         if ms.get("soft"):
             row["ratio_soft"] = cast(float, ms["soft"]) / peer_ms[row["faster_peer"]]
-        row["time_pass"] = bool(row["ratio"] <= row["target"])
+        # a scene with joints has only the soft solver: its time verdict is the soft one's
+        judged = row["ratio"] if row["ratio"] is not None else row["ratio_soft"]
+        row["time_pass"] = None if judged is None else bool(judged <= row["target"])
     if row["sink_ours"] is not None:
         row["sink_pass"] = bool(row["sink_ours"] <= SINK_GOAL)
     return row
@@ -856,6 +1135,9 @@ SCENES: dict[str, Callable[[], Regime | None]] = {
     "scattered-10000": lambda: scattered(10_000),
     "platformer-1": platformer,
     "platformer-crates": lambda: platformer(crates=20),
+    "chain-100": chain,
+    "bridge-30": bridge,
+    "ragdolls-20": ragdolls,
 }
 
 
@@ -923,6 +1205,8 @@ COLUMNS: list[Column] = [
     ("ours_stages_ms", "ours stages ms", "ms"), ("sink_ours", "sink ours", "pct"), ("sink_soft", "sink soft", "pct"),
     ("sink_pymunk", "sink pymunk", "pct"), ("sink_box2d", "sink box2d", "pct"), ("pen_ours", "pen ours", "sci"),
     ("pen_soft", "pen soft", "sci"), ("pen_pymunk", "pen pymunk", "sci"), ("pen_box2d", "pen box2d", "sci"),
+    ("stretch_soft", "stretch soft", "sci"), ("stretch_pymunk", "stretch pymunk", "sci"),
+    ("stretch_box2d", "stretch box2d", "sci"),
 ]
 CROWD_COLUMNS: list[Column] = [
     ("crowd", "crowd", "str"), ("engine", "engine", "str"), ("bodies", "bodies", "int"),

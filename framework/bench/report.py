@@ -111,6 +111,8 @@ def fmt(value: Any, kind: str) -> str:
     if kind == "sci":
         v = float(value)
         return "0" if v == 0 else f"{v:.2e}"
+    if kind == "g7":  # (seven significant digits: a period against its exact value)
+        return f"{float(value):.7g}"
     return f"{float(value):.4g}"
 
 
