@@ -115,6 +115,14 @@ class Joint(ABC):
     break_force: float = math.inf
     break_torque: float = math.inf
 
+    def __setattr__(self, name: str, value: object) -> None:
+        # A parameter written (by the game, or normalised by check) makes the joint unchecked and
+        # its packed tables stale: check_joints checks it again, the soft step packs it again.
+        object.__setattr__(self, name, value)
+        if not name.startswith("_"):
+            self.__dict__["_checked"] = None
+            _WRITES[0] += 1
+
     def check_breaking(self) -> None:
         """:class:`InvalidValue` unless ``break_force`` and ``break_torque`` are > 0 (inf: never)."""
         name = type(self).__name__
@@ -455,6 +463,9 @@ JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint,
 _JOINT_SET = frozenset(JOINT_TYPES)
 
 
+_WRITES = [0]  # joint parameters written, ever (see joint_writes)
+
+
 def joint_components() -> list[tuple[int, Joint]]:
     """Every joint of the current esper world as ``(entity, joint)``, by entity then kind. A world
     without joints answers from esper's table of component types (which drops a type when its last
@@ -476,12 +487,22 @@ def check_joints(joints: list[tuple[int, Joint]], store: BodyStore, solver: str)
         e, j = joints[0]
         raise InvalidValue(f"entity {e} holds a {type(j).__name__}: joints need Scene(solver=\"soft\"); the exact "
                            "solver does not solve joints yet")
+    stamp = (id(store), store.version)  # (a body gone or its Hitbox removed changes the version)
     for e, j in joints:
+        if j.__dict__.get("_checked") == stamp:
+            continue  # (nothing written since it was checked against these bodies)
         try:
             j.check()
             j.check_bodies(store)
         except InvalidValue as exc:
             raise InvalidValue(f"entity {e}: {exc}") from None
+        j.__dict__["_checked"] = stamp
+
+
+def joint_writes() -> int:
+    """How many times a joint parameter was written in this process: the soft step packs its joint
+    tables again only when this, its joints or the scene's structure changed."""
+    return _WRITES[0]
 
 
 def remove_joints_of(entity: int) -> list[int]:

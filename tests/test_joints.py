@@ -352,6 +352,30 @@ def test_a_bad_value_written_later_is_refused_before_the_step_changes_anything()
     assert s.frame == 0 and pose(s, a) == (0.0, 0.0, 0.0)
 
 
+def test_a_joint_checked_by_earlier_steps_is_checked_again_when_written_or_its_body_changes():
+    # a joint is checked (and packed) again only when something changed since: these changes must
+    # each be seen, however many steps ran before them
+    s = soft(gravity=0.0)
+    a, b, _p = bodies(s)
+    j = s.spawn(RevoluteJoint(a, b, (0.5, 0.0), motor_speed=0.0, max_motor_torque=10.0))
+    for _ in range(3):
+        s.step(DT)
+    s.get(j, RevoluteJoint).motor_speed = 2.0  # a good value: packed again, the motor turns b
+    for _ in range(8):
+        s.step(DT)
+    assert s.get(a, Velocity).angular - s.get(b, Velocity).angular == pytest.approx(2.0, abs=0.01)  # a's turn on b
+    s.get(j, RevoluteJoint).lower = math.nan
+    with pytest.raises(InvalidValue, match=f"entity {j}.*lower"):
+        s.step(DT)
+    s.get(j, RevoluteJoint).lower = None
+    s.step(DT)
+    before = (s.frame, pose(s, a), pose(s, b))
+    s.remove_component(b, Hitbox)  # its body is no body any more
+    with pytest.raises(InvalidValue, match=f"entity {j}.*has no Hitbox"):
+        s.step(DT)
+    assert (s.frame, pose(s, a), pose(s, b)) == before
+
+
 def test_despawning_a_body_removes_its_joints():
     s = soft()
     a, b, _p = bodies(s)

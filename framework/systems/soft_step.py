@@ -41,6 +41,7 @@ from ..joints import (
     WheelJoint,
     check_joints,
     joint_components,
+    joint_writes,
 )
 from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
 from .soft_joints import JOINT_F, JOINT_IMP
@@ -205,6 +206,8 @@ class SoftStep(Stage):
         self._faces_key: tuple[int, int, int, bool] | None = None
         self._faces = np.zeros(0, dtype=np.int64)
         self._no_driven = np.zeros(0, dtype=np.bool_)
+        self._joint_key: tuple[Any, ...] | None = None  # what the packed joint tables were packed from
+        self._joint_tables: tuple[np.ndarray, ...] = ()
         self.reset()
 
     def reset(self) -> None:
@@ -354,7 +357,11 @@ class SoftStep(Stage):
             if j._frame is None:  # (added to the world by hand, not by the scene: measured now)
                 j.attach(store)
         check_joints(joints, store, "soft")
-        jint, jf, keys, apart = joint_tables(joints, store.row_of)
+        key = (store.version, joint_writes(), [(e, id(j)) for e, j in joints])
+        if key != self._joint_key:  # (packed again only when a joint, its bodies or the rows changed)
+            self._joint_tables = joint_tables(joints, store.row_of)
+            self._joint_key = key
+        jint, jf, keys, apart = self._joint_tables
         if np.array_equal(keys, old_keys):
             imp = old_imp
             changed = np.any(jf != old_jf, axis=1)
