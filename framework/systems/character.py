@@ -131,23 +131,31 @@ class CharacterStage(Stage):
                     was_on_floor, floor_row = False, None
         self._forget_dropped(mv, ctrl)
 
-        # 1. Ride: the displacement of what it stood on, this step.
+        # 1. Ride: the displacement of the point under its feet on what it stood on, this step (the
+        # floor's own displacement, and where the floor turns, that point turned about its origin).
         carried = (0.0, 0.0)
+        going = (was_on_floor and floor_row is not None and bool(store.has_vel[floor_row])
+                 and store.body[floor_row] != STATIC and not store.asleep[floor_row])
+        pivot = None
+        ride_after = False
         if was_on_floor and floor_row is not None and moved and floor_row < frame.start_x.size:
             carried = (float(store.x[floor_row] - frame.start_x[floor_row]),
                        float(store.y[floor_row] - frame.start_y[floor_row]))
-        elif (was_on_floor and floor_row is not None and self.pipeline.solver == "soft"
-              and store.has_vel[floor_row] and store.body[floor_row] != STATIC and not store.asleep[floor_row]):
-            # (the soft step moves what it stands on after this stage: by its velocity, as here)
+            pivot = (float(frame.start_x[floor_row]), float(frame.start_y[floor_row]))
+        elif going and self.pipeline.solver == "soft":
+            # (the soft step moves what it stands on after this stage, by its velocity: the body
+            # moves on it where it is now, then rides to where it will be)
             carried = (float(store.vx[floor_row]) * dt, float(store.vy[floor_row]) * dt)
+            pivot = (float(store.x[floor_row]), float(store.y[floor_row]))
+            ride_after = True
+        turn = float(store.w[floor_row]) * dt if going and pivot is not None else 0.0
+        if turn != 0.0 and pivot is not None:  # (moved by the movement stage, or by the soft step next)
+            dx, dy = x0 - pivot[0], start_bottom - pivot[1]
+            c, s = math.cos(turn), math.sin(turn)
+            carried = (carried[0] + (c * dx - s * dy - dx), carried[1] + (s * dx + c * dy - dy))
         self._gather(mv, ctrl, carried, vx, vy, dt, size)
-        if carried != (0.0, 0.0) and floor_row is not None:
-            mv.ignore.add(floor_row)
-            self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
-            mv.ignore.discard(floor_row)
-            mv.floor = mv.wall = None
-            mv.ceiling = False
-            mv.hits.clear()
+        if carried != (0.0, 0.0) and floor_row is not None and not ride_after:
+            self._ride(mv, floor_row, carried)
         # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
         if not self._depenetrate(mv, start_bottom, frame, moved):
             ctrl.crushed = True
@@ -182,6 +190,11 @@ class CharacterStage(Stage):
             mv.floor = self._land(mv, reach)
         elif mv.floor is not None:  # jumping: only a floor it still touches (no pull down)
             mv.floor = self._land(mv, 4.0 * skin)
+        if ride_after and carried != (0.0, 0.0) and floor_row is not None:
+            # (what it met and stands on is kept: the floor takes it along, as the others would)
+            kept = (mv.floor, mv.wall, mv.ceiling, list(mv.hits))
+            self._ride(mv, floor_row, carried)
+            mv.floor, mv.wall, mv.ceiling, mv.hits = kept
         # 5. State and velocity.
         ctrl.on_floor = mv.floor is not None
         if mv.floor is not None:
@@ -205,6 +218,16 @@ class CharacterStage(Stage):
             vel.y = vy
 
     # --- moving ----------------------------------------------------------------------------
+
+    def _ride(self, mv: _Move, floor_row: int, carried: tuple[float, float]) -> None:
+        """Move by what the floor carries it (the floor itself not in the way); what that move
+        meets is not the body's own contact."""
+        mv.ignore.add(floor_row)
+        self._slide(mv, carried[0], carried[1], on_floor=False, step=0.0)
+        mv.ignore.discard(floor_row)
+        mv.floor = mv.wall = None
+        mv.ceiling = False
+        mv.hits.clear()
 
     def _row_of(self, entity: int | None) -> int | None:
         if entity is None:

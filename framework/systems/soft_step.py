@@ -328,14 +328,15 @@ class SoftStep(Stage):
         effects = pipe.effects
         # the scene's own sub-steps stiffen the joints with the sub-step rate (see joint_stiffness)
         runs = int(getattr(pipe.view, "substeps", 1))
-        key = (frame.dt, effects, pipe.gravity, pipe.length_unit, store.layers_all_meet(), runs)
+        open_layers = store.layers_all_meet()
+        key = (frame.dt, effects, pipe.gravity, pipe.length_unit, open_layers, runs)
         if key != self._settings_key:
             unit, s = pipe.length_unit, SOFT_SETTINGS
             gx, gy = pipe.active_gravity()
             moves = "movement" in effects
             self._params[:] = (frame.dt if moves else 0.0, s["substeps"] if moves else 0, gx, gy, s["slop"] * unit,
                                4.0 * s["slop"] * unit, s["hertz"], s["damping"], s["push_speed"] * unit,
-                               s["restitution_threshold"] * unit, float(key[-1]), float("response" in effects),
+                               s["restitution_threshold"] * unit, float(open_layers), float("response" in effects),
                                float("rotation" in effects), float("friction" in effects), s["fat_margin"] * unit,
                                s["joint_hertz"] * runs, s["joint_damping"])
             self._settings_key = key
