@@ -20,8 +20,9 @@ platforms have already moved). The game sets the velocity it wants (``Velocity``
   horizontal move) unless it is moving up (a jump);
 - **moving platforms**: the body is carried by the displacement of the point under its feet of
   the body it stands on this step (any kinematic or dynamic body; a platform that turns carries it
-  round with it), so it rides without jitter, also when the platform turns back; a platform that would carry it into a ceiling leaves it under the ceiling and marks it
-  ``crushed`` (it never escapes through);
+  round with it), so it rides without jitter, also when the platform turns back; a platform
+  that would carry it into a ceiling leaves it under the ceiling and marks it ``crushed`` (it
+  never escapes through);
 - **one-way platforms** (``Hitbox(one_way=True)``): stood on from above, passed from below and
   the sides; ``drop_through = True`` lets the body fall through the one it stands on.
 
