@@ -21,10 +21,11 @@ if the joint was all the entity held). The bodies of a joint do not collide with
   along a path.
 
 What a joint measures when it is spawned (a :class:`DistanceJoint`'s ``length`` if not given, a
-revolute or weld joint's anchor in each body's frame and the bodies' relative angle) is fixed
-then: the anchors are each body's own points, they turn with the body. Only ``Scene(solver="soft")``
-solves joints; stepping an exact-solver scene that holds one raises :class:`InvalidValue`. The
-solver is :mod:`framework.systems.soft_joints`; see docs/physics.md ("Joints").
+revolute or weld joint's anchor in each body's frame and the bodies' relative angle, where a
+spring rests; a :class:`MotorJoint`'s offsets if not given) is fixed then: the anchors are each
+body's own points, they turn with the body. Only ``Scene(solver="soft")`` solves joints; stepping
+an exact-solver scene that holds one raises :class:`InvalidValue`. The solver is
+:mod:`framework.systems.soft_joints`; see docs/physics.md ("Joints").
 """
 
 from __future__ import annotations

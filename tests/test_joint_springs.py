@@ -182,7 +182,7 @@ def test_a_mass_on_a_prismatic_spring_sags_its_weight_over_k_and_oscillates_at_i
 
 def test_a_prismatic_spring_between_two_bodies_pulls_them_back_to_their_offset():
     # no gravity: two boxes of mass 1 on a horizontal slider with a spring, pulled 0.25 apart
-    # beyond where they were made: they oscillate about it at f sqrt(2) (the reduced mass, 1/2)
+    # beyond where they were made: they oscillate about it at f, the centre of mass still
     s = soft(gravity=0.0)
     a = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
     b = s.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25)))
