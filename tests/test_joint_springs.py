@@ -127,6 +127,27 @@ def test_a_damped_revolute_spring_overshoots_only_below_a_damping_ratio_of_one(d
     assert abs(rs[-1]) < 0.125 * 0.05 and s.store.asleep[s.store.row_of[bar]]
 
 
+def test_a_spring_taken_off_leaves_a_free_hinge_and_put_back_starts_afresh():
+    s = soft(gravity=0.0)
+    bar, j = sprung_bar(s, hertz=2.0)
+    for _ in range(8):
+        s.step(DT)
+    s.get(j, RevoluteJoint).hertz = 0.0  # off: the bar turns on freely, at the speed it had
+    s.step(DT)
+    w = s.get(bar, Velocity).angular
+    assert w < -0.5 and s.joint_reaction(j).torque == 0.0
+    for _ in range(8):
+        s.step(DT)
+        assert s.get(bar, Velocity).angular == pytest.approx(w, abs=1e-12)
+    assert s._stages["soft_step"].joints[1][0, 5] == 0.0  # its impulse forgotten (JOINT_IMP "spring")
+    s.get(j, RevoluteJoint).hertz = 2.0  # back on: swinging about 0 again (free, it would turn 1.5 a second)
+    rs = []
+    for _ in range(64):
+        s.step(DT)
+        rs.append(pose(s, bar)[2])
+    assert min(rs) < 0.0 < max(rs) and max(abs(r) for r in rs) < 0.3
+
+
 def test_a_revolute_spring_and_its_limits_and_motor_work_together():
     # a spring stiff enough to hold a bar hinged at its end against gravity (torque m g L/2 = 8
     # at level): it sags to where the spring's torque k theta carries it, as long as a limit does

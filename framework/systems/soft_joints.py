@@ -179,6 +179,8 @@ def warm_start_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
                 axial = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
                 if jf[j, _HZ] > 0.0:  # (only then: a slider without a spring adds nothing, not even a 0)
                     axial += imp[j, _ISPR]
+                elif imp[j, _ISPR] != 0.0:  # a spring taken off: it starts afresh if put back (Box2D)
+                    imp[j, _ISPR] = 0.0
                 perp, turn = imp[j, _PX], imp[j, _PY]
             else:  # along (spring and limits), across; the motor's turn
                 axial = imp[j, _PY] + imp[j, _ILO] - imp[j, _IUP]
@@ -196,6 +198,8 @@ def warm_start_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
             ang = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
             if kind == REVOLUTE and jf[j, _HZ] > 0.0:  # the spring's turn
                 ang += imp[j, _ISPR]
+            elif imp[j, _ISPR] != 0.0:  # (a spring taken off, as above)
+                imp[j, _ISPR] = 0.0
         ma, ia, mb, ib = jp[j, _MA], jp[j, _IA], jp[j, _MB], jp[j, _IB]
         _store(a, ma, ia, vax - ma * px, vay - ma * py, wa - ia * (rax * py - ray * px + ang), vx, vy, w)
         _store(b, mb, ib, vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px + ang), vx, vy, w)
