@@ -301,6 +301,20 @@ def test_a_motor_joints_offset_is_in_its_b_frame_and_follows_a_path(most):
         assert step * 0.7 ** 4 / (1.0 - 0.7 ** 4) < max(lags[64 * 2:]) < step
 
 
+def test_a_motor_joint_between_two_bodies_pushes_both_and_keeps_their_centre_of_mass():
+    # no gravity: a (mass 1) driven to 2 right of b (mass 3), 3 apart at first: they close in on
+    # each other, a three times as far (0.75 and 0.25), and the centre of mass stays where it was
+    s = soft(gravity=0.0)
+    a = s.spawn(Transform(3.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25), mass=1.0))
+    b = s.spawn(Transform(0.0, 0.0), Velocity(), Hitbox(box(0.25, 0.25), mass=3.0))
+    s.spawn(MotorJoint(a, b, linear_offset=(2.0, 0.0), angular_offset=0.0, max_force=500.0, max_torque=50.0))
+    for _ in range(64 * 2):
+        s.step(DT)
+        assert (pose(s, a)[0] + 3.0 * pose(s, b)[0]) / 4.0 == pytest.approx(0.75, abs=1e-9)
+    assert pose(s, a) == pytest.approx((2.25, 0.0, 0.0), abs=1e-6)  # (a - b = 2, a + 3 b = 3)
+    assert pose(s, b) == pytest.approx((0.25, 0.0, 0.0), abs=1e-6)
+
+
 def test_a_motor_joint_turns_the_short_way():
     # angular_offset 2 pi is the turn it already has: nothing turns; 2 pi - 0.25 turns it by -0.25
     s = soft(gravity=0.0)
