@@ -15,14 +15,14 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
     from .collision import Contact, Impact, RayHit, Vec2, collide
     from .events import CollisionEvent
     from .input import Input
-    from .joints import DistanceJoint, MouseJoint, PrismaticJoint, RevoluteJoint, WeldJoint, WheelJoint
+    from .joints import DistanceJoint, MotorJoint, MouseJoint, PrismaticJoint, RevoluteJoint, WeldJoint, WheelJoint
     from .render import Camera, Renderer, run, screenshot
     from .scene import STAGES, Scene, SceneClosed, SceneHit
 
 __all__ = [
     "AABB", "Body", "Camera", "Capsule", "CharacterController", "Circle", "CollisionEvent", "Contact", "DistanceJoint",
-    "Hitbox", "Impact", "Input", "InvalidValue", "MouseJoint", "Polygon", "PrismaticJoint", "RayHit", "Renderer",
-    "RevoluteJoint",
+    "Hitbox", "Impact", "Input", "InvalidValue", "MotorJoint", "MouseJoint", "Polygon", "PrismaticJoint", "RayHit",
+    "Renderer", "RevoluteJoint",
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",
     "WeldJoint", "WheelJoint", "collide", "run", "screenshot",
 ]
@@ -32,8 +32,8 @@ _LAZY = {
     "Contact": "collision", "Impact": "collision", "RayHit": "collision", "Vec2": "collision",
     "collide": "collision", "CollisionEvent": "events", "STAGES": "scene", "Scene": "scene",
     "SceneClosed": "scene", "SceneHit": "scene", "CharacterController": "character", "Input": "input",
-    "DistanceJoint": "joints", "MouseJoint": "joints", "PrismaticJoint": "joints", "RevoluteJoint": "joints",
-    "WeldJoint": "joints", "WheelJoint": "joints",
+    "DistanceJoint": "joints", "MotorJoint": "joints", "MouseJoint": "joints", "PrismaticJoint": "joints",
+    "RevoluteJoint": "joints", "WeldJoint": "joints", "WheelJoint": "joints",
     # the render entry points (pyglet loads with them, on first use)
     "Camera": "render", "Renderer": "render", "run": "render", "screenshot": "render",
 }

@@ -9,15 +9,23 @@ if the joint was all the entity held). The bodies of a joint do not collide with
 
 - :class:`DistanceJoint`: keeps two anchors at a distance: a rod (rigid), a rope (``min_length=0``
   and a ``max_length``: only a most) or a spring (``hertz > 0``);
-- :class:`RevoluteJoint`: a hinge at a point both bodies share, with angle limits and a motor;
+- :class:`RevoluteJoint`: a hinge at a point both bodies share, with angle limits, a motor and a
+  spring (``hertz > 0``) toward the angle it was made at;
+- :class:`PrismaticJoint`: a slider along an axis, with limits, a motor and a spring toward where
+  it was made;
+- :class:`WheelJoint`: a wheel on a chassis: a slider on a suspension spring that turns freely;
 - :class:`WeldJoint`: glues two bodies in their relative pose (stiff, or springy with ``hertz``);
-- :class:`MouseJoint`: drags a point of a body toward a target with a limited force.
+- :class:`MouseJoint`: drags a point of a body toward a target with a limited force;
+- :class:`MotorJoint`: drives a body toward a position and an angle relative to another body (or
+  the world) with a limited force and torque: a moving platform, a crane's hook, a body steered
+  along a path.
 
 What a joint measures when it is spawned (a :class:`DistanceJoint`'s ``length`` if not given, a
-revolute or weld joint's anchor in each body's frame and the bodies' relative angle) is fixed
-then: the anchors are each body's own points, they turn with the body. Only ``Scene(solver="soft")``
-solves joints; stepping an exact-solver scene that holds one raises :class:`InvalidValue`. The
-solver is :mod:`framework.systems.soft_joints`; see docs/physics.md ("Joints").
+revolute or weld joint's anchor in each body's frame and the bodies' relative angle, where a
+spring rests; a :class:`MotorJoint`'s offsets if not given) is fixed then: the anchors are each
+body's own points, they turn with the body. Only ``Scene(solver="soft")`` solves joints; stepping
+an exact-solver scene that holds one raises :class:`InvalidValue`. The solver is
+:mod:`framework.systems.soft_joints`; see docs/physics.md ("Joints").
 """
 
 from __future__ import annotations
@@ -33,8 +41,8 @@ from .collision.results import Vec2
 from .store import KIND_NONE, BodyStore
 from .validation import InvalidValue, finite, positive, vector2
 
-__all__ = ["DistanceJoint", "Joint", "JointBroken", "JointReaction", "MouseJoint", "PrismaticJoint", "RevoluteJoint",
-           "WeldJoint", "WheelJoint"]
+__all__ = ["DistanceJoint", "Joint", "JointBroken", "JointReaction", "MotorJoint", "MouseJoint", "PrismaticJoint",
+           "RevoluteJoint", "WeldJoint", "WheelJoint"]
 
 class JointReaction(NamedTuple):
     """What a joint did to its body ``a`` in the last step (``Scene.joint_reaction``): the force
@@ -58,7 +66,7 @@ class JointBroken(NamedTuple):
 
 
 # The kernel's joint kinds (framework.systems.soft_joints reads them by number).
-DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC, WHEEL = 0, 1, 2, 3, 4, 5
+DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC, WHEEL, MOTOR = 0, 1, 2, 3, 4, 5, 6
 
 
 def _entity(name: str, value: object, optional: bool) -> int | None:
@@ -263,14 +271,17 @@ class RevoluteJoint(Joint):
     each body's point there turns with it) and turn freely about it, within ``lower`` and
     ``upper`` (radians of ``a``'s turn relative to ``b`` since the joint was made, counter-clockwise;
     with ``b=None``, ``a``'s own turn; ``None``: no limit). A motor (``max_motor_torque > 0``)
-    drives that turn at ``motor_speed`` radians a second with at most that torque."""
+    drives that turn at ``motor_speed`` radians a second with at most that torque. A spring
+    (``hertz > 0``, damping ratio ``damping``; Box2D's ``enableSpring``) pulls the turn toward 0,
+    the angle it was made at: its stiffness is ``I (2 pi hertz)^2`` for the moment of inertia ``I``
+    it turns (``hertz`` 0: no spring)."""
 
     kind = REVOLUTE
 
     def __init__(self, a: int, b: int | None, anchor: tuple[float, float], lower: float | None = None,
                  upper: float | None = None, motor_speed: float = 0.0, max_motor_torque: float = 0.0,
-                 collide_connected: bool = False, break_force: float = math.inf,
-                 break_torque: float = math.inf) -> None:
+                 hertz: float = 0.0, damping: float = 0.0, collide_connected: bool = False,
+                 break_force: float = math.inf, break_torque: float = math.inf) -> None:
         self._init_bodies(a, b, collide_connected)
         self.break_force, self.break_torque = break_force, break_torque
         self.anchor = anchor
@@ -278,6 +289,8 @@ class RevoluteJoint(Joint):
         self.upper = upper
         self.motor_speed = motor_speed
         self.max_motor_torque = max_motor_torque
+        self.hertz = hertz
+        self.damping = damping
         self.check()
 
     def check(self) -> None:
@@ -287,6 +300,8 @@ class RevoluteJoint(Joint):
         self.upper = None if self.upper is None else finite("RevoluteJoint upper", self.upper)
         self.motor_speed = finite("RevoluteJoint motor_speed", self.motor_speed)
         self.max_motor_torque = _at_least_zero("RevoluteJoint max_motor_torque", self.max_motor_torque)
+        self.hertz = _at_least_zero("RevoluteJoint hertz", self.hertz)
+        self.damping = _at_least_zero("RevoluteJoint damping", self.damping)
         if self.lower is not None and self.upper is not None and self.lower > self.upper:
             raise InvalidValue(f"RevoluteJoint lower ({self.lower}) is more than upper ({self.upper})")
 
@@ -396,13 +411,16 @@ class PrismaticJoint(_SlidingJoint):
     ``b``'s (``axis``: a world direction when spawned, turning with ``b`` after). ``lower`` and
     ``upper`` limit ``a``'s slide (world units along the axis from where it was when spawned;
     ``None``: no limit); a motor (``max_motor_force > 0``) drives it at ``motor_speed`` units a
-    second with at most that force."""
+    second with at most that force. A spring (``hertz > 0``, damping ratio ``damping``; Box2D's
+    ``enableSpring``) pulls the slide toward 0, where it was made: its stiffness is ``m (2 pi
+    hertz)^2`` for the mass ``m`` it moves (``hertz`` 0: no spring)."""
 
     kind = PRISMATIC
 
     def __init__(self, a: int, b: int | None, anchor: tuple[float, float], axis: tuple[float, float] = (1.0, 0.0),
                  lower: float | None = None, upper: float | None = None, motor_speed: float = 0.0,
-                 max_motor_force: float = 0.0, collide_connected: bool = False, break_force: float = math.inf,
+                 max_motor_force: float = 0.0, hertz: float = 0.0, damping: float = 0.0,
+                 collide_connected: bool = False, break_force: float = math.inf,
                  break_torque: float = math.inf) -> None:
         self._init_bodies(a, b, collide_connected)
         self.break_force, self.break_torque = break_force, break_torque
@@ -412,6 +430,8 @@ class PrismaticJoint(_SlidingJoint):
         self.upper = upper
         self.motor_speed = motor_speed
         self.max_motor_force = max_motor_force
+        self.hertz = hertz
+        self.damping = damping
         self._axis_local: tuple[float, float] = (1.0, 0.0)
         self.check()
 
@@ -420,6 +440,8 @@ class PrismaticJoint(_SlidingJoint):
         self._check_slide()
         self.motor_speed = finite("PrismaticJoint motor_speed", self.motor_speed)
         self.max_motor_force = _at_least_zero("PrismaticJoint max_motor_force", self.max_motor_force)
+        self.hertz = _at_least_zero("PrismaticJoint hertz", self.hertz)
+        self.damping = _at_least_zero("PrismaticJoint damping", self.damping)
 
 
 class WheelJoint(_SlidingJoint):
@@ -458,8 +480,56 @@ class WheelJoint(_SlidingJoint):
         self.max_motor_torque = _at_least_zero("WheelJoint max_motor_torque", self.max_motor_torque)
 
 
+class MotorJoint(Joint):
+    """Drives body ``a`` toward a pose relative to body ``b`` (the world with ``b=None``; Box2D's
+    motor joint): its origin (its Transform's position) toward the point ``linear_offset`` of ``b``'s
+    frame (a world point with ``b=None``) and its turn relative to ``b`` toward ``angular_offset``
+    radians, with at most ``max_force`` and ``max_torque`` (0: that part is free). Each sub-step it
+    asks for the velocity that would close ``correction_factor`` (0 to 1) of what is left; the force
+    and torque limits decide how much of that it gets. ``linear_offset`` or ``angular_offset``
+    ``None``: where ``a`` is when spawned (it holds it there). Change them at will (every frame, to
+    move a platform along a path) like any field."""
+
+    kind = MOTOR
+
+    def __init__(self, a: int, b: int | None, linear_offset: tuple[float, float] | None = None,
+                 angular_offset: float | None = None, max_force: float = 1.0, max_torque: float = 1.0,
+                 correction_factor: float = 0.3, collide_connected: bool = False, break_force: float = math.inf,
+                 break_torque: float = math.inf) -> None:
+        self._init_bodies(a, b, collide_connected)
+        self.break_force, self.break_torque = break_force, break_torque
+        self.linear_offset = linear_offset
+        self.angular_offset = angular_offset
+        self.max_force = max_force
+        self.max_torque = max_torque
+        self.correction_factor = correction_factor
+        self.check()
+
+    def check(self) -> None:
+        self.check_breaking()
+        if self.linear_offset is not None:
+            self.linear_offset = vector2("MotorJoint linear_offset", self.linear_offset)
+        if self.angular_offset is not None:
+            self.angular_offset = finite("MotorJoint angular_offset", self.angular_offset)
+        self.max_force = _at_least_zero("MotorJoint max_force", self.max_force)
+        self.max_torque = _at_least_zero("MotorJoint max_torque", self.max_torque)
+        factor = finite("MotorJoint correction_factor", self.correction_factor)
+        if not 0.0 <= factor <= 1.0:
+            raise InvalidValue(f"MotorJoint correction_factor must be between 0 and 1, got {self.correction_factor!r}")
+        self.correction_factor = factor
+
+    def _measure(self, store: BodyStore) -> None:
+        pa = _pose(store, self.a)
+        pb = (0.0, 0.0, 0.0) if self.b is None else _pose(store, self.b)
+        if self.linear_offset is None:
+            self.linear_offset = _to_local(pb, pa[0], pa[1])
+        if self.angular_offset is None:
+            self.angular_offset = pa[2] - pb[2]
+        self._frame = (0.0, 0.0, 0.0, 0.0, 0.0)
+
+
 JOINT_TYPES: tuple[type[Joint], ...] = (DistanceJoint, RevoluteJoint, WeldJoint, MouseJoint, PrismaticJoint,
-                                        WheelJoint)
+                                        WheelJoint, MotorJoint)
 _JOINT_SET = frozenset(JOINT_TYPES)
 
 

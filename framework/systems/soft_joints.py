@@ -1,4 +1,5 @@
-"""Joints in the soft step: Box2D v3's distance, revolute, weld and mouse joints, compiled.
+"""Joints in the soft step: Box2D v3's distance, revolute, prismatic, wheel, weld, mouse and motor
+joints, compiled.
 
 The soft step (:mod:`framework.systems.soft_kernel`) calls these in its sub-steps, joints before
 contacts as Box2D does: :func:`prepare_joints` once a step (anchors relative to each body's origin
@@ -32,22 +33,26 @@ from .softness import soft
 
 __all__ = ["JOINT_F", "JOINT_IMP", "prepare_joints", "solve_joints", "warm_start_joints"]
 
-DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC, WHEEL = 0, 1, 2, 3, 4, 5  # (as framework.joints)
+DISTANCE, REVOLUTE, WELD, MOUSE, PRISMATIC, WHEEL, MOTOR = 0, 1, 2, 3, 4, 5, 6  # (as framework.joints)
 
 #: A joint's parameters: its anchors in each body's frame (a world point for the world), the
 #: bodies' relative angle at creation; a distance joint's length, least and most length (and
-#: whether it has a most), spring frequency and damping ratio (also the weld's and the mouse's);
-#: a revolute joint's limits (and whether each is on), motor speed and torque; the mouse's force.
+#: whether it has a most), spring frequency and damping ratio (also the weld's, the mouse's, and
+#: the springs of the revolute, prismatic and wheel joints); a revolute joint's limits (and
+#: whether each is on), motor speed and torque; the mouse's force; a slide's axis; a motor
+#: joint's correction factor (its target is the anchors and ``ref``, its most force and torque
+#: ``force`` and ``torque``).
 JOINT_F = ("ax", "ay", "bx", "by", "ref", "length", "lo", "hi", "has_hi", "hertz", "damping", "lower", "upper",
-           "has_lower", "has_upper", "speed", "torque", "force", "axis_x", "axis_y")
+           "has_lower", "has_upper", "speed", "torque", "force", "axis_x", "axis_y", "correction")
 (_AX, _AY, _BX, _BY, _REF, _LEN, _LO, _HI, _HAS_HI, _HZ, _ZETA, _LOWER, _UPPER, _HAS_LOWER, _HAS_UPPER, _SPEED,
- _TORQUE, _FORCE, _AXIS_X, _AXIS_Y) = range(len(JOINT_F))
+ _TORQUE, _FORCE, _AXIS_X, _AXIS_Y, _CORRECTION) = range(len(JOINT_F))
 #: A joint's accumulated impulses: the linear impulse (x, y; a distance joint's along its axis in
 #: the first; a prismatic joint's across its axis, then its angular one; a wheel's across its axis,
-#: then its spring's), the lower and upper limits', and the angular one (a motor's, a weld's or a
-#: mouse's; a prismatic motor's, along its axis).
-JOINT_IMP = ("px", "py", "lower", "upper", "angular")
-_PX, _PY, _ILO, _IUP, _IANG = range(len(JOINT_IMP))
+#: then its spring's), the lower and upper limits', the angular one (a motor's, a weld's, a
+#: mouse's or a motor joint's; a prismatic motor's, along its axis) and the spring's of a revolute
+#: joint (angular) or a prismatic one (along its axis).
+JOINT_IMP = ("px", "py", "lower", "upper", "angular", "spring")
+_PX, _PY, _ILO, _IUP, _IANG, _ISPR = range(len(JOINT_IMP))
 # Columns of a prepared joint: on; anchors from each origin at the step's start; the origins'
 # offset (b - a); inverse masses; the axial (or angular) effective mass; the joint's own softness
 # (a spring's, else the joints' stiffness); the mouse's linear effective mass (a symmetric 2x2)
@@ -112,6 +117,15 @@ def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
             jp[j, _K11], jp[j, _K12], jp[j, _K22] = det * k22, -det * k12, det * k11
             jp[j, _AXM] = 1.0 / ib if ib > 0.0 else 0.0
             jp[j, _AB], jp[j, _AM], jp[j, _AI] = soft(0.5, 0.1, h)  # (Box2D's: damps the turn a little)
+        elif kind == MOTOR:  # the point's 2x2 effective mass (inverted) and the angular one
+            k11 = ma + mb + ray * ray * ia + rby * rby * ib
+            k12 = -ray * rax * ia - rby * rbx * ib
+            k22 = ma + mb + rax * rax * ia + rbx * rbx * ib
+            det = k11 * k22 - k12 * k12
+            det = 1.0 / det if det != 0.0 else 0.0
+            jp[j, _K11], jp[j, _K12], jp[j, _K22] = det * k22, -det * k12, det * k11
+            k = ia + ib
+            jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
         else:
             k = ia + ib
             jp[j, _AXM] = 1.0 / k if k > 0.0 else 0.0
@@ -144,7 +158,7 @@ def _store(r, m, i, vxr, vyr, wr, vx, vy, w):
 
 
 @njit(cache=True)
-def warm_start_joints(jint, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
+def warm_start_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
     """Apply each joint's accumulated impulses (Box2D's ``b2WarmStart*Joint``)."""
     for j in range(jint.shape[0]):
         if jp[j, _ON] == 0.0:
@@ -161,8 +175,12 @@ def warm_start_joints(jint, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
         elif kind == PRISMATIC or kind == WHEEL:  # Box2D's b2WarmStart{Prismatic,Wheel}Joint
             dx, dy = jp[j, _DCX] + dbx - dax + rbx - rax, jp[j, _DCY] + dby - day + rby - ray
             ux, uy = ca * jp[j, _WAX] - sa * jp[j, _WAY], sa * jp[j, _WAX] + ca * jp[j, _WAY]
-            if kind == PRISMATIC:  # along (motor and limits), across, about
+            if kind == PRISMATIC:  # along (motor, limits and spring), across, about
                 axial = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
+                if jf[j, _HZ] > 0.0:  # (only then: a slider without a spring adds nothing, not even a 0)
+                    axial += imp[j, _ISPR]
+                elif imp[j, _ISPR] != 0.0:  # a spring taken off: it starts afresh if put back (Box2D)
+                    imp[j, _ISPR] = 0.0
                 perp, turn = imp[j, _PX], imp[j, _PY]
             else:  # along (spring and limits), across; the motor's turn
                 axial = imp[j, _PY] + imp[j, _ILO] - imp[j, _IUP]
@@ -178,6 +196,10 @@ def warm_start_joints(jint, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
         else:
             px, py = imp[j, _PX], imp[j, _PY]
             ang = imp[j, _IANG] + imp[j, _ILO] - imp[j, _IUP]
+            if kind == REVOLUTE and jf[j, _HZ] > 0.0:  # the spring's turn
+                ang += imp[j, _ISPR]
+            elif imp[j, _ISPR] != 0.0:  # (a spring taken off, as above)
+                imp[j, _ISPR] = 0.0
         ma, ia, mb, ib = jp[j, _MA], jp[j, _IA], jp[j, _MB], jp[j, _IB]
         _store(a, ma, ia, vax - ma * px, vay - ma * py, wa - ia * (rax * py - ray * px + ang), vx, vy, w)
         _store(b, mb, ib, vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px + ang), vx, vy, w)
@@ -219,6 +241,10 @@ def solve_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w, use_bi
             angle = rotb - rota - jf[j, _REF]
             vax, vay, wa, vbx, vby, wb = _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
                                                vax, vay, wa, vbx, vby, wb, use_bias, csoft)
+        elif kind == MOTOR:
+            angle = _unwind(rotb - rota - jf[j, _REF])
+            vax, vay, wa, vbx, vby, wb = _motor(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
+                                                vax, vay, wa, vbx, vby, wb, h, inv_h)
         else:
             vbx, vby, wb = _mouse(jf, jp, imp, j, sx, sy, rbx, rby, mb, ib, vbx, vby, wb, h)
         _store(a, ma, ia, vax, vay, wa, vx, vy, w)
@@ -311,9 +337,16 @@ def _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa,
 @njit(cache=True)
 def _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
               use_bias, csoft, h, inv_h):
-    """Box2D's ``b2SolveRevoluteJoint``: the motor, the angle limits, then the shared point."""
+    """Box2D's ``b2SolveRevoluteJoint``: the spring (``hertz > 0``: toward the angle it was made
+    at; a real spring, in the relax too), the motor, the angle limits, then the shared point."""
     mass = jp[j, _AXM]
     if ia + ib > 0.0:
+        if jf[j, _HZ] > 0.0:
+            old = imp[j, _ISPR]
+            s = -jp[j, _SM] * mass * (wb - wa + jp[j, _SB] * angle) - jp[j, _SI] * old
+            imp[j, _ISPR] = old + s
+            wa -= ia * s
+            wb += ib * s
         if jf[j, _TORQUE] > 0.0:  # the motor: the relative turn at its speed, with at most its torque
             old = imp[j, _IANG]
             most = h * jf[j, _TORQUE]
@@ -370,11 +403,17 @@ def _slide_limits(jf, imp, j, slide, ux, uy, a1, a2, mass, ma, ia, mb, ib, vax, 
 @njit(cache=True)
 def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
                use_bias, csoft, h, inv_h):
-    """Box2D's ``b2SolvePrismaticJoint``: the motor along the axis ``(ux, uy)``, the limits of the
-    slide, then the block that keeps the anchors on the axis's line and the angle (``dx, dy``: the
-    anchors' separation, b's less a's)."""
+    """Box2D's ``b2SolvePrismaticJoint``: the spring along the axis ``(ux, uy)`` (``hertz > 0``:
+    toward where it was made; a real spring, in the relax too), the motor along it, the limits of
+    the slide, then the block that keeps the anchors on the axis's line and the angle (``dx, dy``:
+    the anchors' separation, b's less a's)."""
     a1, a2 = (dx + rax) * uy - (dy + ray) * ux, rbx * uy - rby * ux
     mass = jp[j, _AXM]
+    if jf[j, _HZ] > 0.0:
+        cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
+        s = -jp[j, _SM] * mass * (cdot + jp[j, _SB] * (ux * dx + uy * dy)) - jp[j, _SI] * imp[j, _ISPR]
+        imp[j, _ISPR] += s
+        vax, vay, wa, vbx, vby, wb = _along(s, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb)
     if jf[j, _FORCE] > 0.0:  # the motor: the slide at its speed, with at most its force
         cdot = ux * (vbx - vax) + uy * (vby - vay) + a2 * wb - a1 * wa
         old = imp[j, _IANG]
@@ -490,3 +529,40 @@ def _mouse(jf, jp, imp, j, sx, sy, rbx, rby, mb, ib, vbx, vby, wb, h):
     imp[j, _PX], imp[j, _PY] = nx, ny
     px, py = nx - ox, ny - oy
     return vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px)
+
+
+@njit(cache=True)
+def _unwind(angle):
+    """``angle`` brought into [-pi, pi) by whole turns."""
+    if -math.pi <= angle < math.pi:
+        return angle
+    return angle - 2.0 * math.pi * math.floor((angle + math.pi) / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def _motor(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, h, inv_h):
+    """Box2D's ``b2SolveMotorJoint``: the relative turn, then the point, each driven toward its
+    target at ``correction`` of the error a sub-step (``angle``: b's turn relative to a's less the
+    target, unwound; ``sx, sy``: b's origin less a's target point), the accumulated impulses at most
+    ``torque * h`` and (in length) ``force * h``. Always biased: in the relax too, as Box2D does."""
+    beta = jf[j, _CORRECTION] * inv_h
+    if ia + ib > 0.0:
+        old = imp[j, _IANG]
+        most = h * jf[j, _TORQUE]
+        new = min(max(old - jp[j, _AXM] * (wb - wa + beta * angle), -most), most)
+        imp[j, _IANG] = new
+        wa -= ia * (new - old)
+        wb += ib * (new - old)
+    cx = vbx - wb * rby - vax + wa * ray + beta * sx
+    cy = vby + wb * rbx - vay - wa * rax + beta * sy
+    ox, oy = imp[j, _PX], imp[j, _PY]
+    nx = ox - (jp[j, _K11] * cx + jp[j, _K12] * cy)
+    ny = oy - (jp[j, _K12] * cx + jp[j, _K22] * cy)
+    most = h * jf[j, _FORCE]
+    mag = math.sqrt(nx * nx + ny * ny)
+    if mag > most:
+        nx, ny = nx * most / mag, ny * most / mag
+    imp[j, _PX], imp[j, _PY] = nx, ny
+    px, py = nx - ox, ny - oy
+    return (vax - ma * px, vay - ma * py, wa - ia * (rax * py - ray * px),
+            vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px))

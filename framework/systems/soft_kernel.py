@@ -696,7 +696,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
                 vx[r] += h * gx
                 vy[r] += h * gy
         if nj:
-            warm_start_joints(jint, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
+            warm_start_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
         for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
             if relax:

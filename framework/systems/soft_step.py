@@ -28,6 +28,7 @@ from ..events import StepContacts
 from ..frame import StepFrame
 from ..joints import (
     DISTANCE,
+    MOTOR,
     MOUSE,
     PRISMATIC,
     REVOLUTE,
@@ -35,6 +36,7 @@ from ..joints import (
     WHEEL,
     DistanceJoint,
     Joint,
+    MotorJoint,
     PrismaticJoint,
     RevoluteJoint,
     WeldJoint,
@@ -110,8 +112,8 @@ def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tup
                 row[_JF["force"]] = j.max_motor_force
             else:  # a motor turning it
                 row[_JF["torque"]] = j.max_motor_torque
-            if isinstance(j, WheelJoint):  # the suspension
-                row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
+            # the wheel's suspension; the revolute's or the prismatic's spring (hertz 0: none)
+            row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping
             if not isinstance(j, RevoluteJoint):
                 row[_JF["axis_x"]], row[_JF["axis_y"]] = j._axis_local
         elif j.kind == MOUSE:  # the world's anchor is the target; the body is b to the kernel
@@ -119,6 +121,12 @@ def joint_tables(joints: list[tuple[int, Joint]], row_of: dict[int, int]) -> tup
             row[0:5] = (*j.target, frame[0], frame[1], 0.0)  # type: ignore[attr-defined]
             row[_JF["hertz"]], row[_JF["damping"]] = j.hertz, j.damping  # type: ignore[attr-defined]
             row[_JF["force"]] = j.max_force  # type: ignore[attr-defined]
+        elif j.kind == MOTOR:  # b (the frame of the target) is the kernel's a, the body driven its b
+            assert isinstance(j, MotorJoint) and j.linear_offset is not None and j.angular_offset is not None
+            jint[i] = (MOTOR, jint[i, 2], ra)
+            row[0:5] = (*j.linear_offset, 0.0, 0.0, j.angular_offset)
+            row[_JF["force"]], row[_JF["torque"]] = j.max_force, j.max_torque
+            row[_JF["correction"]] = j.correction_factor
         if j.b is not None and not j.collide_connected:
             apart.append((min(j.a, j.b) << 32) | max(j.a, j.b))
     return jint, jf, keys, np.array(sorted(set(apart)), dtype=np.int64)
@@ -239,7 +247,7 @@ class SoftStep(Stage):
         if i == keys.size or keys[i] != key or dt <= 0.0 or nsub <= 0:
             return 0.0, 0.0, 0.0
         inv_h = nsub / dt
-        px, py, lower, upper, angular = (float(v) for v in imp[i])
+        px, py, lower, upper, angular, spring = (float(v) for v in imp[i])
         if joint.kind == DISTANCE:  # along the line between the anchors (the kernel's b takes +impulse)
             store = self.bodies.store
             c = store.cols
@@ -264,13 +272,13 @@ class SoftStep(Stage):
             lx, ly = joint._axis_local
             ux, uy = math.cos(rot) * lx - math.sin(rot) * ly, math.sin(rot) * lx + math.cos(rot) * ly
             # (the kernel's b is the joint's a: it takes +impulse)
-            if joint.kind == PRISMATIC:  # along: motor and limits; about: the angle's
-                axial, turn = angular + lower - upper, py
+            if joint.kind == PRISMATIC:  # along: motor, limits and spring; about: the angle's
+                axial, turn = angular + lower - upper + spring, py
             else:  # along: spring and limits; about: the motor's
                 axial, turn = py + lower - upper, angular
             return (axial * ux - px * uy) * inv_h, (axial * uy + px * ux) * inv_h, turn * inv_h
-        turn = (angular + lower - upper) * inv_h
-        if joint.kind in (REVOLUTE, MOUSE):  # the kernel's b is the joint's a (see joint_tables)
+        turn = (angular + lower - upper + spring) * inv_h  # (spring: a revolute joint's)
+        if joint.kind in (REVOLUTE, MOUSE, MOTOR):  # the kernel's b is the joint's a (see joint_tables)
             return px * inv_h, py * inv_h, turn
         return -px * inv_h, -py * inv_h, -turn  # a weld: the kernel's a is the joint's a
 
