@@ -26,7 +26,7 @@ __all__ = [
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",
     "WeldJoint", "WheelJoint", "collide", "run", "screenshot",
 ]
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 _LAZY = {
     "Contact": "collision", "Impact": "collision", "RayHit": "collision", "Vec2": "collision",
