@@ -1,0 +1,127 @@
+"""The soft solver turns a body about its centre of mass (issue 38, part 1).
+
+A hitbox whose offset, or whose outline, puts its centre of mass off the entity's origin
+(``Hitbox.mass_data.center``) turns about that centre, as in Box2D and pymunk: spinning free it
+keeps its centre still while its origin circles it; on a ledge it tips exactly when its centre of
+mass is past the edge; hinged at one end it swings as the physical pendulum of its centre. The
+velocity of such a body is its centre's. Kinematic bodies spin about their origin (as Box2D's,
+which have no mass), and the exact solver still turns a body about its origin (docs/physics.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from framework import AABB, Hitbox, Polygon, RevoluteJoint, Scene, Transform, Velocity
+from framework.systems.soft_step import SOFT_SETTINGS
+
+SLOP = SOFT_SETTINGS["slop"]
+DT = 1 / 64
+G = 8.0
+TRIANGLE = Polygon([(0.0, 0.0), (2.0, 0.0), (0.0, 2.0)])  # centroid (2/3, 2/3), off its origin
+
+
+def centre(s: Scene, e: int) -> tuple[float, float]:
+    """The world position of the body's centre of mass."""
+    t = s.get(e, Transform)
+    cx, cy = s.get(e, Hitbox).mass_data.center
+    c, si = math.cos(t.rotation), math.sin(t.rotation)
+    return t.x + c * cx - si * cy, t.y + si * cx + c * cy
+
+
+@pytest.mark.parametrize("make", [
+    lambda: Hitbox(Polygon.box(1.0, 0.5), (1.0, 0.5)),  # an offset box
+    lambda: Hitbox(TRIANGLE),  # an outline off its origin
+    lambda: Hitbox(TRIANGLE, (-2.0, 1.0), mass=3.0),  # both
+])
+@pytest.mark.parametrize("v", [(0.0, 0.0), (1.0, -0.5)])
+def test_a_body_spinning_free_keeps_its_centre_of_mass_on_a_straight_line(make, v):
+    s = Scene(solver="soft")
+    hitbox = make()
+    e = s.spawn(Transform(0.25, -0.5, 0.125), Velocity(v[0], v[1], 2.0), hitbox)
+    c0 = centre(s, e)
+    radius = math.hypot(*hitbox.mass_data.center)
+    for k in range(1, 3 * 64 + 1):
+        s.step(DT)
+        cx, cy = centre(s, e)
+        assert (cx, cy) == pytest.approx((c0[0] + v[0] * k * DT, c0[1] + v[1] * k * DT), abs=1e-12)
+        t = s.get(e, Transform)
+        assert math.hypot(t.x - cx, t.y - cy) == pytest.approx(radius, rel=1e-12)  # the origin circles it
+        assert t.rotation == pytest.approx(0.125 + 2.0 * k * DT, rel=1e-12)
+    assert (s.get(e, Velocity).x, s.get(e, Velocity).y, s.get(e, Velocity).angular) == (v[0], v[1], 2.0)
+
+
+def test_a_kinematic_body_spins_about_its_origin_as_in_box2d():
+    s = Scene(solver="soft")
+    e = s.spawn(Transform(1.0, 2.0), Velocity(0.0, 0.0, 2.0), Hitbox(TRIANGLE, (0.5, 0.0), body="kinematic"))
+    for _ in range(64):
+        s.step(DT)
+    t = s.get(e, Transform)
+    assert (t.x, t.y) == (1.0, 2.0) and t.rotation == pytest.approx(2.0, rel=1e-12)
+
+
+def test_the_exact_solver_still_turns_a_body_about_its_origin():
+    s = Scene()
+    e = s.spawn(Transform(1.0, 2.0), Velocity(0.0, 0.0, 2.0), Hitbox(TRIANGLE))
+    for _ in range(64):
+        s.step(DT)
+    t = s.get(e, Transform)
+    assert (t.x, t.y) == (1.0, 2.0) and t.rotation == pytest.approx(2.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("start, tips", [(-0.75, False), (-0.5, True), (-0.625, True), (-0.6875, False)])
+def test_a_lopsided_body_on_a_ledge_tips_exactly_when_its_centre_of_mass_is_past_the_edge(start, tips):
+    # The right triangle with legs 2 on its long leg, its right angle (its origin) at x = start on a
+    # ledge ending at x = 0: its centre of mass is at start + 2/3, past the edge iff start > -2/3.
+    # Its origin is always on the ledge and the middle of its base always past the edge: neither
+    # turning about the origin nor about the middle of the outline would tell these apart.
+    s = Scene(gravity=(0.0, -G), solver="soft")
+    s.spawn(Transform(-5.0, -0.5), Hitbox(AABB(10.0, 1.0), body="static"))  # top y = 0, edge x = 0
+    e = s.spawn(Transform(start, 0.0), Velocity(), Hitbox(TRIANGLE, friction=0.5))
+    assert (start + 2 / 3 > 0.0) == tips and start + 1.0 > 0.0 and start < 0.0
+    for _ in range(3 * 64):
+        s.step(DT)
+    t = s.get(e, Transform)
+    if tips:
+        assert t.y < -1.0 and t.rotation < -0.3  # over the edge, clockwise
+    else:
+        assert abs(t.x - start) < 1e-9 and abs(t.y) < 0.05 * SLOP and abs(t.rotation) < 2e-4
+
+
+@pytest.mark.parametrize("make, anchor", [
+    (lambda: Hitbox(Polygon.box(2.0, 0.125), (1.0, 0.0)), (0.0, 0.0)),  # origin at the hinge, box offset
+    (lambda: Hitbox(Polygon([(0.0, -0.0625), (2.0, -0.0625), (2.0, 0.0625), (0.0, 0.0625)])), (0.0, 0.0)),
+    (lambda: Hitbox(Polygon.box(2.0, 0.125), (-1.0, 0.0)), (-2.0, 0.0)),  # origin at the far end
+])
+def test_a_rod_hinged_at_one_end_swings_as_the_physical_pendulum_of_its_centre_of_mass(make, anchor):
+    # a rod 2 long, 1/8 thick, mass 1, hinged at one end to the world: about the hinge its inertia
+    # is m (L^2 + t^2) / 12 + m d^2 with d = L/2 = 1 the centre's distance; period
+    # 2 pi sqrt(I / (m g d)), lengthened by (1 + th0^2 / 16) at an amplitude th0. (Turning about its
+    # origin, the first two would not swing at all: gravity would act at the hinge.)
+    s = Scene(gravity=(0.0, -G), solver="soft")
+    hitbox = make()
+    th0 = 0.125
+    rot = -math.pi / 2 + th0  # hanging, turned th0 from straight down
+    c, si = math.cos(rot), math.sin(rot)
+    ax, ay = anchor  # the hinge in the rod's frame; the hinge is at the world origin
+    e = s.spawn(Transform(-(c * ax - si * ay), -(si * ax + c * ay), rot), Velocity(), hitbox)
+    s.spawn(RevoluteJoint(e, None, (0.0, 0.0)))
+    md = hitbox.mass_data
+    assert md.inertia == pytest.approx((4.0 + 1 / 64) / 12.0, rel=1e-14)
+    assert math.hypot(md.center[0] - ax, md.center[1] - ay) == 1.0
+    ts, xs = [], []
+    for k in range(64 * 8):
+        s.step(DT)
+        x, y = centre(s, e)
+        assert abs(math.hypot(x, y) - 1.0) < SLOP  # the centre stays 1 from the hinge
+        ts.append((k + 1) * DT)
+        xs.append(x)
+    crossings = [ts[k - 1] + xs[k - 1] / (xs[k - 1] - xs[k]) * DT for k in range(1, len(xs))
+                 if (xs[k - 1] < 0.0) != (xs[k] < 0.0)]
+    assert len(crossings) >= 5
+    period = 2.0 * (crossings[-1] - crossings[0]) / (len(crossings) - 1)
+    expected = 2 * math.pi * math.sqrt((md.inertia + 1.0) / G) * (1 + th0 * th0 / 16)
+    assert period == pytest.approx(expected, rel=0.01)
+    assert max(abs(x) for x in xs) <= math.sin(th0) * (1 + 1e-3)  # no higher than it started
