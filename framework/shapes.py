@@ -59,7 +59,9 @@ class Shape:
     @property
     def centroid(self) -> tuple[float, float]:
         """The centre of the shape's area (its centre of mass, uniformly filled), in its local
-        coordinates: (0, 0) for every shape but a :class:`Polygon` whose outline is not centred."""
+        coordinates: (0, 0) for every shape but a :class:`Polygon` whose outline is not centred (a
+        polygon's centroid within ``2**-40`` of its bounding radius of the origin, the rounding of a
+        symmetric outline's computed points, is the origin)."""
         return (0.0, 0.0)
 
     @property
