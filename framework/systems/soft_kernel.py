@@ -12,7 +12,9 @@ Read top to bottom, one step is:
 3. **narrow phase**: a manifold per pair (:mod:`framework.collision.soft_manifold`), reported up
    to a speculative distance that grows with the pair's motion this step, so a fast body meets a
    wall it would otherwise pass in one step (no tunnelling, without a separate sweep);
-4. **prepare**: anchors relative to each body's origin, effective masses, the impulses of last
+4. **prepare**: anchors relative to each body's origin (a body turning about a centre of mass off
+   its entity's origin has its position moved to that centre for the step, and back after:
+   :func:`_to_centres`, :func:`_from_centres`), effective masses, the impulses of last
    step's matching points (by pair slot and feature id) to warm start with; where nothing turns, a
    face's two points are one row; the joints prepared likewise (:mod:`.soft_joints`), and the
    pairs of a joint's bodies never touch (unless it says they collide);
