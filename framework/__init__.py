@@ -5,7 +5,7 @@ Importing it (and running scenes without a renderer) never imports pyglet's GL m
 
 from typing import TYPE_CHECKING, Any
 
-from .components import Body, Hitbox, Transform, Velocity, Visual
+from .components import Body, Hitbox, MassData, Transform, Velocity, Visual
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .text import Text
 from .validation import InvalidValue
@@ -21,7 +21,8 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
 
 __all__ = [
     "AABB", "Body", "Camera", "Capsule", "CharacterController", "Circle", "CollisionEvent", "Contact", "DistanceJoint",
-    "Hitbox", "Impact", "Input", "InvalidValue", "MotorJoint", "MouseJoint", "Polygon", "PrismaticJoint", "RayHit",
+    "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Polygon", "PrismaticJoint",
+    "RayHit",
     "Renderer", "RevoluteJoint",
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",
     "WeldJoint", "WheelJoint", "collide", "run", "screenshot",

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import os
 from enum import Enum
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 from .shapes import AABB, Capsule, Circle, Polygon, Shape
 from .sprites import Animation, Frame
@@ -24,7 +24,7 @@ from .validation import InvalidValue, finite, vector2
 if TYPE_CHECKING:
     from .store import BodyStore
 
-__all__ = ["Body", "Hitbox", "Transform", "Velocity", "Visual"]
+__all__ = ["Body", "Hitbox", "MassData", "Transform", "Velocity", "Visual"]
 
 
 class _Columns:
@@ -126,6 +126,17 @@ class Body(Enum):
     STATIC = "static"
 
 
+class MassData(NamedTuple):
+    """A body's mass properties (:attr:`Hitbox.mass_data`), as Box2D's ``b2MassData``: its
+    ``mass``, its centre of mass ``center`` in the entity's frame (the hitbox offset plus the
+    shape's centroid, turning with the transform), and ``inertia``, its moment of inertia about
+    that centre."""
+
+    mass: float
+    center: tuple[float, float]
+    inertia: float
+
+
 _HITBOX_FIELDS = (
     "shape", "offset", "layer", "mask", "sensor", "body", "mass", "restitution", "ccd", "one_way", "friction",
     "inertia", "density",
@@ -153,11 +164,15 @@ class Hitbox:
       A pair where both hitboxes give one uses ``sqrt(f1 * f2)`` (Box2D's rule); where one does,
       that one (a crate given 0.5 slides with 0.5 on a plain floor); where neither does, none.
       Needs the ``"friction"`` effect (on by default); see docs/physics.md.
-    - ``inertia``: moment of inertia about the centre (> 0), or None (the default: from the shape
-      and ``mass``, a solid disk's ``m r^2 / 2``, a box's ``m (w^2 + h^2) / 12``); ``math.inf``
-      keeps the body from turning (a player that must never tip). Contacts turn dynamic circles,
-      boxes and polygons centred on their entity: boxes tip and tumble, circles roll (through
-      friction). An ``AABB`` never turns. Needs the ``"rotation"`` effect (on by default).
+    - ``inertia``: moment of inertia about the body's centre of mass (> 0), or None (the default:
+      from the shape and ``mass`` about its centroid, a solid disk's ``m r^2 / 2``, a box's
+      ``m (w^2 + h^2) / 12``); ``math.inf`` keeps the body from turning (a player that must never
+      tip). Contacts turn dynamic circles, boxes and polygons: boxes tip and tumble, circles roll
+      (through friction). In the soft solver (``Scene(solver="soft")``) a body turns about its
+      centre of mass (:attr:`mass_data`), wherever the hitbox offset and the outline put it. The
+      exact solver turns only bodies without an offset, about their entity's position, with the
+      inertia given or the shape's about that point: there, give an outline whose centroid is at
+      the origin. An ``AABB`` never turns. Needs the ``"rotation"`` effect (on by default).
     - ``ccd``: continuous detection. The body is swept along its motion each step so it cannot
       pass through thin walls; bodies without it pay nothing for it.
     - ``one_way``: a platform that is solid only from above (its local +y, turning with its
@@ -269,6 +284,22 @@ class Hitbox:
         if self._density is not None:
             return self._density * self._shape.area
         return self._mass
+
+    @property
+    def mass_data(self) -> MassData:
+        """The body's mass properties (:class:`MassData`): its mass (:attr:`effective_mass`), its
+        centre of mass in the entity's frame (the ``offset`` plus the shape's centroid: (0, 0) for
+        a centred shape) and its moment of inertia about that centre: the ``inertia`` given, else
+        the mass times the shape's :attr:`~framework.shapes.Shape.central_moment` (the moment about
+        the hitbox origin, less ``m d^2`` for a centroid ``d`` from it: the parallel-axis theorem).
+        What the soft solver turns a dynamic body with; the fields as they are now (outside a scene,
+        checked; inside one, a field written since the last step is read as written)."""
+        shape = self._shape
+        mass = self.effective_mass
+        cx, cy = shape.centroid
+        ox, oy = self._offset
+        inertia = self._inertia if self._inertia is not None else mass * shape.central_moment
+        return MassData(mass, (ox + cx, oy + cy), inertia)
 
     @property
     def inverse_mass(self) -> float:

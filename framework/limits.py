@@ -12,7 +12,7 @@ changes anything:
   ``[MIN_SIZE, MAX_SIZE]``, its area at least ``MIN_SIZE**2``, its offset at most ``MAX_SIZE``;
 - a dynamic body's mass (given, or density times area) within ``[MIN_MASS, MAX_MASS]`` (or
   ``math.inf``: a body nothing moves), and a finite moment of inertia (given, or mass times the
-  shape's second moment) at least ``MIN_INERTIA``;
+  shape's moment about its centroid) at least ``MIN_INERTIA``;
 - a position within ``MAX_COORD`` of the origin, and a step that would carry a body beyond it
   (``|x| + |v| dt + |g| dt^2``): refused before it starts.
 
@@ -74,7 +74,7 @@ def check_hitbox_limits(hitbox: Any) -> None:
         source = "mass" if hitbox.density is None else f"mass (density {hitbox.density!r} x area {shape.area!r})"
         raise InvalidValue(f"Hitbox {source} is {mass!r}: a scene takes masses from {MIN_MASS:g} to "
                            f"{MAX_MASS:g}, or math.inf (see framework.limits)")
-    inertia = hitbox.inertia if hitbox.inertia is not None else mass * shape.second_moment
+    inertia = hitbox.inertia if hitbox.inertia is not None else mass * shape.central_moment  # (the least)
     if not math.isinf(inertia) and inertia < MIN_INERTIA:
         raise InvalidValue(f"Hitbox moment of inertia is {inertia!r}: a scene takes {MIN_INERTIA:g} or more, or "
                            "math.inf (see framework.limits)")

@@ -29,6 +29,9 @@ __all__ = ["AABB", "Capsule", "Circle", "Polygon", "Shape"]
 # enough for a 1 x 1e13 sliver to be a polygon, large enough to absorb computed collinear points.
 _COLLINEAR_REL = 1e-14
 _ROUNDING = 16.0 * 2.0**-52
+# A polygon's centroid closer to its origin than this fraction of its bounding radius is its origin
+# (the rounding of a centred outline's computed points, a thousand times over).
+_CENTRED = 2.0**-40
 
 
 class Shape:
@@ -52,6 +55,21 @@ class Shape:
         """The moment of inertia of the shape, uniformly filled, about its origin, per unit of
         mass (a body of mass ``m`` turning about its hitbox origin has inertia ``m`` times this)."""
         raise NotImplementedError
+
+    @property
+    def centroid(self) -> tuple[float, float]:
+        """The centre of the shape's area (its centre of mass, uniformly filled), in its local
+        coordinates: (0, 0) for every shape but a :class:`Polygon` whose outline is not centred (a
+        polygon's centroid within ``2**-40`` of its bounding radius of the origin, the rounding of a
+        symmetric outline's computed points, is the origin)."""
+        return (0.0, 0.0)
+
+    @property
+    def central_moment(self) -> float:
+        """The moment of inertia of the shape, uniformly filled, about its :attr:`centroid`, per unit
+        of mass: :attr:`second_moment` less the squared distance of the centroid from the origin
+        (the parallel-axis theorem), worked without that subtraction's cancellation."""
+        return self.second_moment
 
 
 @dataclass(frozen=True, slots=True)
@@ -212,6 +230,40 @@ class Polygon(Shape):
         # Each edge and the origin span a triangle; summed with the sign of their winding (the
         # points are counter-clockwise), they give the polygon's integrals of 1 and x^2 + y^2.
         pts = self.points
+        twice_area, moment = [], []
+        for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]):
+            cross = x0 * y1 - x1 * y0
+            twice_area.append(cross)
+            moment.append(cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1))
+        return math.fsum(moment) / (6.0 * math.fsum(twice_area))
+
+    @property
+    def centroid(self) -> tuple[float, float]:
+        # A fan of triangles from the first vertex (a point of the outline: the terms stay as small
+        # as the polygon, wherever it lies); triangle (p0, p_i, p_i+1) of twice-area D has its
+        # centroid at p0 + (e1 + e2) / 3, e1 and e2 its edges from p0.
+        pts = self.points
+        x0, y0 = pts[0]
+        twice_area, mx, my = [], [], []
+        for (x1, y1), (x2, y2) in zip(pts[1:-1], pts[2:]):
+            e1x, e1y, e2x, e2y = x1 - x0, y1 - y0, x2 - x0, y2 - y0
+            d = e1x * e2y - e1y * e2x
+            twice_area.append(d)
+            mx.append(d * (e1x + e2x))
+            my.append(d * (e1y + e2y))
+        three_a = 3.0 * math.fsum(twice_area)
+        cx, cy = x0 + math.fsum(mx) / three_a, y0 + math.fsum(my) / three_a
+        # A centroid within rounding of the origin (a symmetric outline whose points were computed,
+        # a regular hexagon's) is the origin: the body is centred, as its outline was meant to be.
+        if math.hypot(cx, cy) <= _CENTRED * self._radius:
+            return (0.0, 0.0)
+        return (cx, cy)
+
+    @property
+    def central_moment(self) -> float:
+        # The origin formula of second_moment, on the outline moved so its centroid is the origin.
+        cx, cy = self.centroid
+        pts = [(x - cx, y - cy) for x, y in self.points]
         twice_area, moment = [], []
         for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]):
             cross = x0 * y1 - x1 * y0

@@ -555,7 +555,9 @@ def _inverse_inertia(hb: Hitbox) -> float:
     position), of finite mass and inertia; the inertia given, or the mass times the shape's second
     moment about that point (a solid disk's ``m r^2 / 2``, a box's ``m (w^2 + h^2) / 12``). An
     ``AABB`` never turns, and neither does a ``Capsule`` (contacts push it like an AABB; its
-    rotation is the game's to set)."""
+    rotation is the game's to set). This is the exact solver's column: the soft step turns a body
+    whose centre of mass is off its origin about that centre, with its inertia about it
+    (:func:`~framework.systems.soft_step.kernel_tables`)."""
     shape = hb._shape
     if hb._body is not Body.DYNAMIC or isinstance(shape, (AABB, Capsule)) or hb._offset != (0.0, 0.0):
         return 0.0

@@ -12,7 +12,9 @@ Read top to bottom, one step is:
 3. **narrow phase**: a manifold per pair (:mod:`framework.collision.soft_manifold`), reported up
    to a speculative distance that grows with the pair's motion this step, so a fast body meets a
    wall it would otherwise pass in one step (no tunnelling, without a separate sweep);
-4. **prepare**: anchors relative to each body's origin, effective masses, the impulses of last
+4. **prepare**: anchors relative to each body's origin (a body turning about a centre of mass off
+   its entity's origin has its position moved to that centre for the step, and back after:
+   :func:`_to_centres`, :func:`_from_centres`), effective masses, the impulses of last
    step's matching points (by pair slot and feature id) to warm start with; where nothing turns, a
    face's two points are one row; the joints prepared likewise (:mod:`.soft_joints`), and the
    pairs of a joint's bodies never touch (unless it says they collide);
@@ -620,6 +622,27 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             turns = True
             break
     rotation = rotation and turns
+    turning = np.zeros(n, dtype=np.bool_)
+    for r in range(n):
+        turning[r] = moving[r] and (ii[r] > 0.0 or w[r] != 0.0)
+
+    # --- bodies that turn about a centre of mass off their origin ------------------------------
+    # (Box2D's local centre.) Such a body is stepped as if its origin were its centre of mass: its
+    # position is moved there, its hitbox offset and joint anchors are measured from there, and it
+    # is moved back at the end. Rows whose centre is their origin are not touched: not a bit of
+    # them changes, and a scene without such a body pays one pass over the rows.
+    conv = np.zeros(n, dtype=np.bool_)
+    shifted = False
+    x_origin, y_origin, centre0 = x, y, np.zeros((0, 2))
+    for r in range(n):
+        if turning[r] and not driven[r] and body[r] == _DYNAMIC and (off[r, 2] != 0.0 or off[r, 3] != 0.0):
+            conv[r] = True
+            shifted = True
+    if shifted:
+        x_origin, y_origin = x.copy(), y.copy()
+        off, bound, centre0 = _to_centres(x, y, rot, off, bound, conv)
+        if jint.shape[0]:
+            jf = _anchors_from_centres(jint, jf, off, conv)
 
     # --- shapes, fat bounds and the broad phase ----------------------------------------------------
     wc = np.empty((n, 2))
@@ -687,9 +710,6 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     y0 = y.copy()
     qc = np.ones(n)
     qs = np.zeros(n)
-    turning = np.zeros(n, dtype=np.bool_)
-    for r in range(n):
-        turning[r] = moving[r] and (ii[r] > 0.0 or w[r] != 0.0)
     for _sub in range(nsub):
         for r in range(n):  # integrate velocities
             if moving[r] and body[r] == _DYNAMIC and not driven[r]:
@@ -717,11 +737,68 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
                    inv_h, push)
     _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, params[_REST])
+    if shifted:
+        _from_centres(x, y, rot, off, conv, x_origin, y_origin, x0, y0, centre0)
 
     # --- store the impulses in the slots; which pairs are in contact ----------------------------
     touch_i, touch_f, end_i, end_f, info = _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
                                                    ended_keys, ended_f, n_end, rebuilt, sleepers)
     return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp
+
+
+@njit(cache=True)
+def _to_centres(x, y, rot, off, bound, conv):
+    """Move the ``conv`` rows' positions from their origins to their centres of mass (``off``
+    columns 2, 3, in the body's frame): returns copies of ``off`` and ``bound`` for the step, the
+    hitbox offsets measured from the centres and the reach of each hitbox about them, and each
+    centre turned into the world at the step's start (``R(rot) c``)."""
+    n = x.size
+    off = off.copy()
+    bound = bound.copy()
+    centre0 = np.zeros((n, 2))
+    for r in range(n):
+        if not conv[r]:
+            continue
+        cx, cy = off[r, 2], off[r, 3]
+        c, s = math.cos(rot[r]), math.sin(rot[r])
+        centre0[r, 0], centre0[r, 1] = c * cx - s * cy, s * cx + c * cy
+        x[r] += centre0[r, 0]
+        y[r] += centre0[r, 1]
+        off[r, 0] -= cx
+        off[r, 1] -= cy
+        bound[r] += math.sqrt(off[r, 0] * off[r, 0] + off[r, 1] * off[r, 1])
+    return off, bound, centre0
+
+
+@njit(cache=True)
+def _anchors_from_centres(jint, jf, off, conv):
+    """A copy of the joints' parameters with the anchors on the ``conv`` rows measured from their
+    centres of mass (a world anchor, row -1, stays)."""
+    jf = jf.copy()
+    for j in range(jint.shape[0]):
+        a, b = jint[j, 1], jint[j, 2]
+        if a >= 0 and conv[a]:
+            jf[j, 0] -= off[a, 2]
+            jf[j, 1] -= off[a, 3]
+        if b >= 0 and conv[b]:
+            jf[j, 2] -= off[b, 2]
+            jf[j, 3] -= off[b, 3]
+    return jf
+
+
+@njit(cache=True)
+def _from_centres(x, y, rot, off, conv, x_origin, y_origin, x0, y0, centre0):
+    """Move the ``conv`` rows back from their centres of mass to their origins: the origin at the
+    step's start plus the centre's motion since, less the centre's turn since (``R(rot) c`` now less
+    at the start), so a body that did not move is back on its origin's very bits."""
+    for r in range(x.size):
+        if not conv[r]:
+            continue
+        cx, cy = off[r, 2], off[r, 3]
+        c, s = math.cos(rot[r]), math.sin(rot[r])
+        ex, ey = c * cx - s * cy, s * cx + c * cy
+        x[r] = x_origin[r] + ((x[r] - x0[r]) - (ex - centre0[r, 0]))
+        y[r] = y_origin[r] + ((y[r] - y0[r]) - (ey - centre0[r, 1]))
 
 
 @njit(cache=True)

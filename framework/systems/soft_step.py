@@ -137,13 +137,34 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     shape, its body kind, its entity): ``(fprops, iprops, off, verts)``, see
     :func:`~framework.systems.soft_kernel.soft_step`. Every hitbox is a rounded polygon about its
     hitbox origin (vertex count 0: no hitbox, or ``detection`` off): AABBs do not turn with the
-    transform (their offset does); circles are one vertex, capsules their segment."""
+    transform (their offset does); circles are one vertex, capsules their segment.
+
+    ``off`` rows: the hitbox offset, then the centre of mass the soft step turns the body about
+    (:attr:`~framework.components.Hitbox.mass_data`'s ``center``: a dynamic circle's or polygon's
+    whose centre is not its entity's origin; (0, 0) for every other row, which turns about its
+    origin as before: a kinematic body, as in Box2D; a capsule and an AABB, which contacts do not
+    turn). Such a body's inverse inertia (``fprops`` row 1) is about that centre: the store's
+    column holds the exact solver's, about the origin."""
     n = store.n
     polys = [store.shapes[r] for r in range(n)]
     kinds = store.kind[:n].tolist()
     K = max([4] + [len(s.points) for s, k in zip(polys, kinds) if k == KIND_POLYGON])
-    off = np.zeros((n, 2))
+    off = np.zeros((n, 4))
     off[:, 0], off[:, 1] = store.ox, store.oy
+    inv_inertia = store.inv_inertia
+    bodies = store.body[:n].tolist()
+    for r, k in enumerate(kinds):
+        if (k == KIND_CIRCLE or k == KIND_POLYGON) and bodies[r] == DYNAMIC:
+            hb = store.hitboxes[r]
+            gx, gy = polys[r].centroid
+            cx, cy = float(store.ox[r]) + gx, float(store.oy[r]) + gy
+            if hb is None or (cx == 0.0 and cy == 0.0):
+                continue
+            if inv_inertia is store.inv_inertia:
+                inv_inertia = inv_inertia.copy()
+            off[r, 2], off[r, 3] = cx, cy
+            inertia = hb._inertia if hb._inertia is not None else hb.effective_mass * polys[r].central_moment
+            inv_inertia[r] = 0.0 if math.isinf(inertia) else 1.0 / inertia
     verts = np.zeros((n, K, 4))  # local vertices (x, y), then the edges' outward normals
     cnt = np.zeros(n, dtype=np.int64)
     rr = np.zeros(n)
@@ -173,7 +194,7 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
             cnt[r] = m
     if not detection:
         cnt[:] = 0
-    fprops = np.stack([store.inv_mass, store.inv_inertia, store.friction, store.restitution, store.bound, rr])
+    fprops = np.stack([store.inv_mass, inv_inertia, store.friction, store.restitution, store.bound, rr])
     iprops = np.stack([store.body.astype(np.int64), store.kind.astype(np.int64), store.layer, store.mask,
                        store.entity, store.sensor.astype(np.int64), store.one_way.astype(np.int64),
                        store.has_vel.astype(np.int64), cnt, spin])
