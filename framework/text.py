@@ -57,7 +57,8 @@ class Text:
     0-255. ``screen``: placed on the screen (a HUD) instead of in the world. ``offset``: from the
     entity's Transform (world), or from ``corner`` of the view in pixels, y up (screen).
     ``corner``: one of :data:`CORNERS` (screen texts). ``anchor_x``, ``anchor_y``: which point of
-    the text is at its position (:data:`ANCHORS_X`, :data:`ANCHORS_Y`). ``z``: higher draws on top
+    the text is at its position (:data:`ANCHORS_X`, :data:`ANCHORS_Y`; None, the default: the
+    corner's sides for a screen text, so it stays inside the view, else left and bottom). ``z``: higher draws on top
     of lower among texts (texts draw over the scene's sprites). ``visible=False`` hides it.
     ``font``: a font family name (``None``: pyglet's default)."""
 
@@ -69,8 +70,8 @@ class Text:
     _screen: bool
     _offset: tuple[float, float]
     _corner: str
-    _anchor_x: str
-    _anchor_y: str
+    _anchor_x: str | None
+    _anchor_y: str | None
     _z: int
     _visible: bool
     _font: str | None
@@ -85,8 +86,8 @@ class Text:
         screen: bool = False,
         offset: Any = (0.0, 0.0),
         corner: str = "bottom_left",
-        anchor_x: str = "left",
-        anchor_y: str = "bottom",
+        anchor_x: str | None = None,
+        anchor_y: str | None = None,
         z: int = 0,
         visible: bool = True,
         font: str | None = None,
@@ -170,19 +171,32 @@ class Text:
 
     @property
     def anchor_x(self) -> str:
-        return self._anchor_x
+        """Which point across is at its position; unset (None): the corner's side for a screen
+        text (``"right"`` at a right corner, ``"center"`` at the centre), else ``"left"``."""
+        if self._anchor_x is not None:
+            return self._anchor_x
+        if self._screen and self._corner.endswith("right"):
+            return "right"
+        return "center" if self._screen and self._corner == "center" else "left"
 
     @anchor_x.setter
-    def anchor_x(self, value: str) -> None:
-        self._set("_anchor_x", _choice("anchor_x", value, ANCHORS_X))
+    def anchor_x(self, value: str | None) -> None:
+        self._set("_anchor_x", None if value is None else _choice("anchor_x", value, ANCHORS_X))
 
     @property
     def anchor_y(self) -> str:
-        return self._anchor_y
+        """Which point up is at its position; unset (None): the corner's side for a screen text
+        (``"top"`` at a top corner, so a HUD line at ``top_left`` hangs inside the view,
+        ``"center"`` at the centre), else ``"bottom"``."""
+        if self._anchor_y is not None:
+            return self._anchor_y
+        if self._screen and self._corner.startswith("top"):
+            return "top"
+        return "center" if self._screen and self._corner == "center" else "bottom"
 
     @anchor_y.setter
-    def anchor_y(self, value: str) -> None:
-        self._set("_anchor_y", _choice("anchor_y", value, ANCHORS_Y))
+    def anchor_y(self, value: str | None) -> None:
+        self._set("_anchor_y", None if value is None else _choice("anchor_y", value, ANCHORS_Y))
 
     @property
     def z(self) -> int:

@@ -421,6 +421,31 @@ def test_text_is_drawn_where_its_label_is_and_nowhere_else(render, scene):
     assert (without[..., :3] == BG).all()
 
 
+def test_a_screen_text_at_a_corner_hangs_inside_the_view_by_default(render, scene):
+    # no anchors given: a top corner's text hangs below its point, a right corner's ends at it,
+    # the same pixels as with the anchors spelt out (before, the default bottom-left anchor drew a
+    # top-left HUD line above the view's top edge, clipped)
+    defaults = [Text("coins 3", size=10.0, color=SCREEN_TEXT, screen=True, corner=c, offset=o)
+                for c, o in (("top_left", (4.0, -4.0)), ("top_right", (-4.0, -4.0)), ("bottom_right", (-4.0, 4.0)))]
+    assert [(t.anchor_x, t.anchor_y) for t in defaults] == [("left", "top"), ("right", "top"), ("right", "bottom")]
+    assert (Text("x").anchor_x, Text("x").anchor_y) == ("left", "bottom")  # a world text's
+    assert (Text("x", screen=True, corner="center").anchor_x, Text("x", screen=True, corner="center").anchor_y) == \
+        ("center", "center")
+    for t in defaults:
+        scene.spawn(t)
+    img = render.screenshot(scene, width=160, height=100, background=BG)
+    spelt = Scene()
+    for t in defaults:
+        spelt.spawn(Text(t.text, size=10.0, color=SCREEN_TEXT, screen=True, corner=t.corner, offset=t.offset,
+                         anchor_x=t.anchor_x, anchor_y=t.anchor_y))
+    assert np.array_equal(img, render.screenshot(spelt, width=160, height=100, background=BG))
+    _world, hud = _inked(img)
+    rows = np.flatnonzero(hud.any(axis=1))  # (top first) every line fully inside, none at an edge
+    cols = np.flatnonzero(hud.any(axis=0))
+    assert rows.size and rows[0] >= 4 and rows[-1] <= 100 - 4 and cols[0] >= 4 and cols[-1] <= 160 - 4
+    assert hud[:50].sum() > 30 and hud[50:].sum() > 30  # the top two and the bottom one all drawn
+
+
 def test_a_world_text_moves_with_the_camera_and_a_screen_text_does_not(render, scene):
     _text_scene(scene)
     a = render.screenshot(scene, width=160, height=100, background=BG)
@@ -485,7 +510,7 @@ def test_a_world_text_without_a_transform_is_not_drawn(render, scene):
     ("offset", (1.0, float("inf")), "offset[1] must be finite"), ("offset", 3.0, "offset must be a pair"),
     ("color", (300, 0, 0), "color must be 3 or 4 ints"), ("color", (1.5, 0, 0), "color must be 3 or 4 ints"),
     ("color", 7, "color must be (r, g, b)"), ("corner", "middle", "corner must be one of"),
-    ("anchor_x", "top", "anchor_x must be one of"), ("anchor_y", None, "anchor_y must be one of"),
+    ("anchor_x", "top", "anchor_x must be one of"), ("anchor_y", 3, "anchor_y must be one of"),
     ("text", 12, "text must be a str"), ("text", "two\nlines", "one line"), ("z", 1.0, "z must be an int"),
     ("z", True, "z must be an int"), ("screen", 1, "screen must be True or False"),
     ("visible", "no", "visible must be True or False"), ("font", "", "font must be a font family name"),
