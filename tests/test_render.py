@@ -780,6 +780,16 @@ def test_runner_fixed_timestep_accumulator(render, scene):
         runner.close()
 
 
+def test_run_twice_in_one_process_opens_a_window_each_time(render):
+    # pyglet's app.run() leaves the window event queue off when it returns; a window made after
+    # that handled its first resize before it could draw, so a second run() (a game's restart,
+    # a menu's "play again") failed with AttributeError 'ubo'
+    for k in range(2):
+        s = Scene()
+        render.run(s, width=48, height=32, max_frames=2)
+        assert s.frame >= 1, k
+
+
 def test_run_opens_steps_and_closes(render, scene, monkeypatch):
     e = scene.spawn(Transform(10.0, 10.0), Velocity(60.0, 0.0), Hitbox(AABB(4.0, 4.0)), Visual(RED))
     seen = []

@@ -50,6 +50,11 @@ def _open_window(width: int, height: int, title: str) -> Any:
     the display fails to open), never an invisible one."""
     reason = no_display_reason()
     if reason is None:
+        if not pyglet.app.event_loop.is_running:
+            # pyglet's app.run() turns the window event queue off for good: a window made after an
+            # earlier run() ended would handle its first resize before it can draw (AttributeError
+            # 'ubo'), so the second run() of a process (a game's restart) failed. Queue, as at start.
+            pyglet.window.Window._enable_event_queue = True
         try:
             return pyglet.window.Window(width, height, caption=title, resizable=True, visible=True)
         except Exception as exc:
