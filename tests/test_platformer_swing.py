@@ -13,8 +13,9 @@ from dataclasses import replace
 
 import pytest
 
-from examples.platformer import Game, LevelError, load_level, parse_text, parse_tmj
+from examples.platformer import Game, LevelError, builtin_levels, load_level, parse_text, parse_tmj
 from examples.platformer.components import SwingingPlatform, SwingRope, Tuning
+from examples.platformer.demo import Autoplay, level4
 from examples.platformer.levels import to_tmj
 from framework import Hitbox, Polygon, Scene, Transform, Velocity
 from framework.character import CharacterController
@@ -249,3 +250,35 @@ def test_good_swing_properties_load(tmp_path):
 def test_bad_text_swings_are_level_errors(text, problem):
     with pytest.raises(LevelError, match=problem):
         parse_text(text, "s.txt")
+
+
+# --- the shipped level 4 ---------------------------------------------------------------------------------
+
+
+def test_the_swings_level_has_three_swings_over_pits_a_checkpoint_and_a_goal():
+    level = load_level(builtin_levels()[3])
+    assert level.name == "Swings" and len(builtin_levels()) == 4
+    swings = level.of_kind("swing")
+    assert len(swings) == 3 and len(level.of_kind("checkpoint")) == 1 and len(level.of_kind("goal")) == 1
+    ground = len(level.tiles) - 1
+    for sw in swings:  # each hangs over a pit: no floor under the board's middle
+        col = int(sw.x // level.tile)
+        assert level.tiles[ground][col] is None and level.tiles[ground - 1][col] is None
+    # the ropes grow longer, the pits wider
+    assert [sw.props["length"] for sw in swings] == sorted(sw.props["length"] for sw in swings)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_demo_crosses_the_swings_to_the_goal_with_every_coin(solver):
+    g = Game([builtin_levels()[3]], autoplay=Autoplay(level4), scene=Scene(solver=solver))
+    rides = set()
+    while not g.state.reached_goal and g.scene.frame < 2000:
+        g.step()
+        ground = g.player_state.ground
+        if ground is not None and g.scene.try_get(ground, SwingingPlatform) is not None:
+            rides.add(ground)
+    assert g.state.reached_goal and g.state.deaths == 0
+    assert len(rides) == 3  # it rode every swing
+    assert g.state.coins == g.state.coin_total_in_level == 12
+    assert g.scene.frame == 1356  # (docs/platformer.md gives it)
