@@ -81,7 +81,7 @@ def test_the_board_follows_the_pendulum_exactly_every_step(solver, props):
 def test_the_swing_is_a_kinematic_polygon_with_a_rope_that_meets_nothing():
     g, board, swing = swing_game()
     hb = g.scene.get(board, Hitbox)
-    assert isinstance(hb.shape, Polygon) and hb.body.value == "kinematic" and not hb.one_way
+    assert isinstance(hb.shape, Polygon) and hb.body.value == "kinematic" and hb.one_way  # (by default)
     (rope, r), = g.scene.query(SwingRope)
     assert r.swing is swing
     rope_box = g.scene.get(rope, Hitbox)
@@ -118,10 +118,13 @@ def place(g: Game, board: int) -> tuple[float, float]:
 
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("at", [0.0, 28.0, -28.0])
-def test_a_player_standing_on_the_board_rides_a_whole_period_in_its_place(solver, at):
+@pytest.mark.parametrize("one_way", [False, True])
+def test_a_player_standing_on_the_board_rides_a_whole_period_in_its_place(solver, at, one_way):
     # phase 90: the board starts at the end of its swing, at rest, tilted by the amplitude (30
-    # degrees), and the player lands on it there
-    g, board, swing = swing_game(solver, phase=90.0)
+    # degrees), and the player lands on it there. One-way or not, the board holds its rider (the
+    # one-way test, whether the feet were above the board's top, is not asked of the floor it
+    # stood on: for a tilted board that top is its higher end, above the feet)
+    g, board, swing = swing_game(solver, phase=90.0, one_way=one_way)
     stand_on(g, board, at)
     along0, _ = place(g, board)
     ctrl = g.scene.get(g.player, CharacterController)
@@ -170,16 +173,41 @@ def test_jumping_off_the_board_keeps_the_velocity_of_its_point_under_the_feet(so
     assert abs(carried_x / DT) > 50.0  # (the board was moving)
 
 
-@pytest.mark.xfail(strict=True, reason="the character controller holds a body on a one-way platform by the "
-                   "platform's bounding-box top, for a tilted board its higher end: a one-way swing lets its rider "
-                   "fall through once it tilts the other way")
-def test_a_one_way_swing_carries_its_rider_too():
-    g, board, swing = swing_game(one_way=True, phase=90.0)
-    stand_on(g, board, 0.0)
-    ctrl = g.scene.get(g.player, CharacterController)
-    for _ in range(round(swing.period / DT)):
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("when", [0.0, 0.2, 0.45, 0.7])
+def test_the_player_lands_on_a_one_way_swing_from_above(solver, when):
+    g, board, swing = swing_game(solver, phase=90.0, one_way=True)
+    while swing.time < when * swing.period:
         g.step(set())
-        assert ctrl.on_floor and ctrl.floor_entity == board
+    # dropped from two tiles above the board's middle, wherever the board is in its swing
+    p = g.scene.get(board, Transform)
+    t = g.player_transform
+    t.x, t.y = p.x, p.y + 2 * T
+    ctrl = g.scene.get(g.player, CharacterController)
+    for _ in range(40):
+        g.step(set())
+        if ctrl.on_floor:
+            break
+    assert ctrl.on_floor and ctrl.floor_entity == board
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("when", [0.0, 0.2, 0.45, 0.7])
+@pytest.mark.parametrize("one_way", [True, False])
+def test_the_player_jumps_up_through_a_one_way_swing_and_bumps_into_a_solid_one(solver, when, one_way):
+    g, board, swing = swing_game(solver, phase=90.0, one_way=one_way)
+    while swing.time < when * swing.period:
+        g.step(set())
+    p = g.scene.get(board, Transform)
+    t, v = g.player_transform, g.scene.get(g.player, Velocity)
+    t.x, t.y = p.x, p.y - 8.0 - H / 2 - 4.0  # just under the board's middle, going up fast
+    v.y = 600.0
+    above = False
+    for _ in range(30):
+        g.step(set())
+        top = g.scene.get(board, Transform).y + 8.0
+        above = above or g.player_transform.y - H / 2 > top
+    assert above == one_way
 
 
 # --- level files ---------------------------------------------------------------------------------------
@@ -189,7 +217,7 @@ def test_a_text_swing_hangs_below_its_pivot_and_round_trips_through_tiled_json()
     level = parse_text(SWING)
     (sw,) = level.of_kind("swing")
     assert (sw.x, sw.y, sw.width, sw.height) == (368.0, 56.0, 96.0, 16.0)
-    assert sw.props == {"length": LENGTH}
+    assert sw.props == {"length": LENGTH, "one_way": True}
     back = parse_tmj(json.loads(json.dumps(to_tmj(level))), "swing.tmj")  # its Tiled form loads back the same
     assert back.of_kind("swing") == [sw]
 

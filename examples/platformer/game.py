@@ -232,13 +232,9 @@ class Game:
         """A board hanging ``length`` tiles below its pivot (the rectangle is the board at rest,
         straight below the pivot), swinging as a pendulum (:class:`.SwingingPlatform`): a kinematic
         Polygon, since it turns with its rope (a box never turns). The period defaults to the
-        pendulum's, ``2 pi sqrt(length / gravity)``, in tiles and the game's gravity.
-
-        Solid unless the map says ``one_way``: the character controller decides whether a one-way
-        platform holds a body by the platform's top as its bounding box has it, which for a tilted
-        board is its higher end, so a one-way board tilted under a rider's feet lets it fall through
-        (tests/test_platformer_swing.py records this as a strict xfail)."""
-        one_way = bool(obj.props.get("one_way", False))
+        pendulum's, ``2 pi sqrt(length / gravity)``, in tiles and the game's gravity. One-way
+        unless the map says otherwise (``one_way`` false), like a moving platform."""
+        one_way = bool(obj.props.get("one_way", True))
         length = float(obj.props["length"])
         period = obj.props.get("period")
         period = float(period) if period is not None else 2.0 * math.pi * math.sqrt(length / self.tuning.gravity)

@@ -16,7 +16,7 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
     B  crate (pushable)    O  barrel (rolls)
     M  moving platform (a run of M is one platform, half a tile thick, one-way)
     ~  the cells a moving platform sweeps: to its right, left, above or below (one side)
-    S  swing: a run of S (an odd number of cells) is its board at rest, half a tile thick, solid
+    S  swing: a run of S (an odd number of cells) is its board at rest, half a tile thick, one-way
     o  a swing's pivot, straight above the middle of its board (only empty cells or objects between)
 
 Lines starting with ``;`` are comments; short rows are padded with empty cells.
@@ -40,8 +40,7 @@ work. Properties:
 from the pivot down to the board's centre, > 0; required), ``angle`` (the largest swing, degrees,
 0 < angle < 90; default 30), ``period`` (s, > 0; default the pendulum's, 2 pi sqrt(length /
 gravity), gravity in tiles/s^2 from the game's ``Tuning``), ``phase`` (degrees; default 0: the
-swing starts at rest position going right), ``one_way`` (bool, default false: see the game's
-``Game._swing`` for why);
+swing starts at rest position going right), ``one_way`` (bool, default true);
 ``enemy``: ``speed`` (tiles/s), ``direction`` (-1 left, 1 right).
 
 A malformed file raises :class:`LevelError`, a ``ValueError`` whose message starts with the
@@ -373,7 +372,7 @@ def _text_swings(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
             y = (height - row) * tile - tile * 0.25
             length = ((height - r - 0.5) * tile - y) / tile
             out.append(LevelObject("swing", (mid + 0.5) * tile, y, (col - start) * tile, tile * 0.5,
-                                   {"length": length}))
+                                   {"length": length, "one_way": True}))
     for row, line in enumerate(grid):
         for col, ch in enumerate(line):
             if ch == "o" and (row, col) not in pivots:
