@@ -100,3 +100,22 @@ def test_a_character_on_a_rising_or_sinking_board_stays_on_its_top_every_step(so
         assert s.get(e, CharacterController).on_floor
         gap = s.get(e, Transform).y - H / 2 - (s.get(plat, Transform).y + 8.0)
         assert 0.0 <= gap < 1e-6
+
+
+@pytest.mark.parametrize("solver", ["exact", "soft"])
+@pytest.mark.parametrize("at, spin", [(40.0, 0.5), (-40.0, 0.5), (0.0, 0.5), (40.0, -0.5)])
+def test_a_one_way_board_turning_under_a_character_holds_it(solver, at, spin):
+    # a one-way platform holds a body whose feet were above its top when the step began; for a
+    # tilted board that top (its bounding box's) is its higher end, above the feet of a character
+    # standing anywhere else on it: the board it stood on when the step began holds it regardless
+    # (it was above it then), so it rides a one-way board as it tilts (before: it fell through)
+    s = Scene(gravity=(0.0, -1024.0), solver=solver)
+    plat = s.spawn(Transform(200.0, 100.0), Velocity(), Hitbox(board(64.0, 8.0), body="kinematic", one_way=True))
+    e = s.spawn(Transform(200.0 + at, 108.0 + H / 2), Velocity(), Hitbox(AABB(W, H), body="kinematic"),
+                CharacterController())
+    for _ in range(20):
+        s.step(DT)
+    s.get(plat, Velocity).angular = spin
+    for _ in range(32):
+        s.step(DT)
+        assert s.get(e, CharacterController).on_floor and s.get(e, CharacterController).floor_entity == plat

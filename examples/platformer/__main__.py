@@ -4,7 +4,8 @@ Plays in a window by default (arrows/WASD to run, space/up/W to jump, down+jump 
 one-way platform, R to restart the level, F1 for the debug overlay, Esc to quit).
 
 --headless         run without a window; print a one-line JSON summary as the last line
---demo             scripted input instead of the keyboard (headless: stops at the first goal)
+--demo             scripted input instead of the keyboard (headless: stops at the first goal; with
+                   --level, that level's script if it is a shipped one, else the first level's)
 --frames N         stop after N frames (headless default: 600, or 3600 with --demo)
 --level PATH       play this map (.tmj or .txt) instead of the shipped levels
 --screenshot PATH  after the run, write a PNG of the last frame (headless rendering)
@@ -21,14 +22,16 @@ import argparse
 import json
 import sys
 import time
+from pathlib import Path
 from typing import Any
 
-from .demo import Autoplay, level1, play_all
+from .demo import SCRIPTS, Autoplay, level1, play_all
 from .game import DT, Game
 from .hud import install_hud
 from .levels import LevelError, builtin_levels
 
-__all__ = ["BACKGROUND", "camera_for", "hud", "main", "make_game", "parse_args", "run_headless", "run_window"]
+__all__ = ["BACKGROUND", "camera_for", "demo_script", "hud", "main", "make_game", "parse_args", "run_headless",
+           "run_window"]
 
 WIDTH, HEIGHT = 960, 540
 BACKGROUND = (24, 26, 38)
@@ -51,11 +54,22 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return args
 
 
+def demo_script(level: str | None, headless: bool) -> Any:
+    """What ``--demo`` plays: the shipped levels one after the other in a window; headless, the
+    first level; with ``--level``, the script of that level if it is a shipped one (else the first
+    level's)."""
+    if level is not None:
+        shipped = [p.resolve() for p in builtin_levels()]
+        path = Path(level).resolve()
+        return SCRIPTS[shipped.index(path)] if path in shipped[:len(SCRIPTS)] else level1
+    return level1 if headless else play_all
+
+
 def make_game(args: argparse.Namespace) -> Game:
     levels = [args.level] if args.level else builtin_levels()
     autoplay = None
     if args.demo:
-        autoplay = Autoplay(level1 if args.headless or args.level else play_all)
+        autoplay = Autoplay(demo_script(args.level, args.headless))
     view = (WIDTH / args.zoom, HEIGHT / args.zoom)
     return Game(levels, view=view, autoplay=autoplay)
 

@@ -6,11 +6,12 @@ these only mark what an entity *is* to the game and hold its game state.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 __all__ = [
     "ALL", "Checkpoint", "Coin", "ENEMY", "Enemy", "GameState", "Goal", "Hazard", "LevelPiece",
-    "MovingPlatform", "ONE_WAY", "PICKUP", "PLAYER", "Player", "SOLID", "Tuning",
+    "MovingPlatform", "ONE_WAY", "PICKUP", "PLAYER", "Player", "SOLID", "SwingRope", "SwingingPlatform", "Tuning",
 ]
 
 # Collision layers (Hitbox.layer / Hitbox.mask bits).
@@ -84,6 +85,40 @@ class MovingPlatform:
     pause: float = 0.5                       # s it waits at each end
     toward_end: bool = True
     waiting: float = 0.0
+
+
+@dataclass
+class SwingingPlatform:
+    """A kinematic board hanging from ``pivot`` on a rope ``length`` long (world units), swinging
+    as a pendulum: at time ``t`` its angle from straight down is ``theta(t) = amplitude *
+    sin(2 pi t / period + phase)`` (radians, counter-clockwise), its centre is ``pivot + length *
+    (sin theta, -cos theta)`` and it is turned by ``theta`` (the board tilts with its rope).
+    ``time`` is the swing's clock, advanced by :func:`.systems.swing_platforms` each step."""
+
+    pivot: tuple[float, float]
+    length: float
+    amplitude: float                         # radians, the largest angle
+    period: float                            # s
+    phase: float = 0.0                       # radians
+    time: float = 0.0
+
+    def angle(self, t: float) -> float:
+        """theta(t), radians from straight down (counter-clockwise: the board swung to the right)."""
+        return self.amplitude * math.sin(2.0 * math.pi * t / self.period + self.phase)
+
+    def pose(self, t: float) -> tuple[float, float, float]:
+        """The board's centre and rotation at time ``t``: ``(x, y, theta)``."""
+        theta = self.angle(t)
+        return (self.pivot[0] + self.length * math.sin(theta), self.pivot[1] - self.length * math.cos(theta),
+                theta)
+
+
+@dataclass
+class SwingRope:
+    """The drawn rope of a swing (no collisions): a thin box from the pivot down to the board,
+    turned with it."""
+
+    swing: SwingingPlatform
 
 
 @dataclass

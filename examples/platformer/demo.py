@@ -11,12 +11,13 @@ from collections.abc import Callable, Iterator
 
 from framework import Transform
 
-from .components import Enemy, MovingPlatform
+from .components import Enemy, MovingPlatform, SwingingPlatform
 
-__all__ = ["Autoplay", "SCRIPTS", "level1", "level2", "level3", "play_all"]
+__all__ = ["Autoplay", "SCRIPTS", "level1", "level2", "level3", "level4", "play_all"]
 
 Keys = set[str]
 TIMEOUT = 600  # steps any one wait may take before the script gives up on it
+JUMP_ONTO = 42  # steps a full jump takes to come down onto a board a tile and a half up
 
 
 def _x(game) -> float:
@@ -127,6 +128,49 @@ def lift(game, step_off_x: float) -> Iterator[Keys]:
     yield from run_to(game, step_off_x)
 
 
+def swing(game, edge_x: float) -> Iterator[Keys]:
+    """Cross a pit on the swing over it. Walk to ``edge_x`` (the pit's edge) and watch the board
+    (the nearest ahead) swing once: the steps it takes from its far end to its near end. Then, as
+    it leaves the far end again, wait until a jump's fall from now would meet it at the near end,
+    and jump on, steering over its middle; ride without a key held until it comes to the far end
+    and jump off toward the far side."""
+    tile = game.state.tile
+    yield from land(game, ("right",))
+    yield from run_to(game, edge_x)
+    boards = [(game.scene.get(e, Transform).x / tile, e) for e, _sw in game.scene.query(SwingingPlatform)]
+    _bx, be = min((b for b in boards if b[0] > _x(game)), default=min(boards))
+    board = game.scene.get(be, Transform)
+
+    def until_it_turns(way: float) -> Iterator[Keys]:
+        """Until the board, moving the other way (or at rest), moves ``way`` (+1 right, -1 left)."""
+        last = board.x
+        for _ in range(2 * TIMEOUT):
+            moved, last = board.x - last, board.x
+            if moved * way > 0.0:
+                return
+            yield set()
+
+    yield from until_it_turns(+1.0)     # (somewhere in its swing: to the far end, then back)
+    yield from until_it_turns(-1.0)     # it left the far end
+    start = game.scene.frame
+    yield from until_it_turns(+1.0)     # and came to the near end: half a swing
+    half = game.scene.frame - start
+    yield from until_it_turns(-1.0)     # it leaves the far end again
+    yield from idle(max(0, half - JUMP_ONTO))
+    for i in range(60):  # jump on, steering over its middle
+        keys = {"space"} if i < 25 else set()
+        if _x(game) < board.x / tile - 0.2:
+            keys.add("right")
+        yield keys
+        if i > 5 and game.player_state.grounded:
+            break
+    yield from land(game, ())
+    yield from until_it_turns(+1.0)     # ride it across: from the near end...
+    yield from until_it_turns(-1.0)     # ...until it stops at the far end
+    yield from jump(40)
+    yield from land(game)
+
+
 def drop(game) -> Iterator[Keys]:
     """Down + jump: fall through the one-way platform underfoot, then land on whatever is below."""
     yield from land(game, ())
@@ -191,7 +235,16 @@ def level3(game) -> Iterator[Keys]:
     yield from run_to(game, 62.0)
 
 
-SCRIPTS = (level1, level2, level3)
+def level4(game) -> Iterator[Keys]:
+    """Plays ``04-swings.tmj``: three pits, each crossed on a swing (longer ropes, wider pits),
+    the coins on the way and at the bottom of each swing, the checkpoint, the goal."""
+    yield from swing(game, 9.5)
+    yield from swing(game, 25.5)
+    yield from swing(game, 43.5)
+    yield from run_to(game, 64.0)               # the coins, the goal
+
+
+SCRIPTS = (level1, level2, level3, level4)
 
 
 def play_all(game) -> Iterator[Keys]:

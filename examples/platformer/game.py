@@ -13,6 +13,7 @@ inside it by despawning one level's entities and spawning the next one's (see
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -41,6 +42,8 @@ from .components import (
     LevelPiece,
     MovingPlatform,
     Player,
+    SwingingPlatform,
+    SwingRope,
     Tuning,
 )
 from .demo import Autoplay
@@ -52,7 +55,7 @@ DT = 1.0 / 60.0
 COLORS = {
     "solid": (86, 98, 128), "oneway": (176, 134, 82), "spikes": (226, 70, 70), "player": (84, 176, 255),
     "enemy": (196, 84, 164), "coin": (255, 212, 64), "goal": (90, 224, 120), "checkpoint": (150, 150, 150),
-    "platform": (214, 170, 96), "crate": (168, 112, 64), "barrel": (120, 84, 52),
+    "platform": (214, 170, 96), "crate": (168, 112, 64), "barrel": (120, 84, 52), "rope": (150, 120, 80),
 }
 PROP_MASK = SOLID | ONE_WAY | PLAYER | ENEMY  # crates and barrels: solid to everything that moves
 PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
@@ -179,6 +182,8 @@ class Game:
                     self._spikes(x, obj.bottom, obj.width / n, piece)
             elif obj.kind == "platform":
                 self._platform(obj, t, piece)
+            elif obj.kind == "swing":
+                self._swing(obj, t, piece)
             elif obj.kind == "crate":
                 s = tu.crate_size * t
                 piece("crate", Transform(obj.x, obj.bottom + s * 0.5), Velocity(), Hitbox(
@@ -222,6 +227,30 @@ class Game:
             AABB(obj.width, obj.height), body="kinematic", layer=ONE_WAY if one_way else SOLID, mask=ALL,
             one_way=one_way), MovingPlatform((obj.x, obj.y), (obj.x + dx, obj.y + dy), speed, pause),
             Visual(COLORS["platform"], z=1))
+
+    def _swing(self, obj, t: float, piece) -> None:
+        """A board hanging ``length`` tiles below its pivot (the rectangle is the board at rest,
+        straight below the pivot), swinging as a pendulum (:class:`.SwingingPlatform`): a kinematic
+        Polygon, since it turns with its rope (a box never turns). The period defaults to the
+        pendulum's, ``2 pi sqrt(length / gravity)``, in tiles and the game's gravity. One-way
+        unless the map says otherwise (``one_way`` false), like a moving platform."""
+        one_way = bool(obj.props.get("one_way", True))
+        length = float(obj.props["length"])
+        period = obj.props.get("period")
+        period = float(period) if period is not None else 2.0 * math.pi * math.sqrt(length / self.tuning.gravity)
+        swing = SwingingPlatform(
+            (obj.x, obj.y + length * t), length * t, math.radians(float(obj.props.get("angle", 30.0))), period,
+            math.radians(float(obj.props.get("phase", 0.0))))
+        x, y, theta = swing.pose(0.0)
+        hw, hh = obj.width * 0.5, obj.height * 0.5
+        board = Polygon([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
+        piece("swing", Transform(x, y, theta), Velocity(), Hitbox(
+            board, body="kinematic", layer=ONE_WAY if one_way else SOLID, mask=ALL, one_way=one_way),
+            swing, Visual(COLORS["platform"], z=1))
+        # The rope: drawn only (no layer, no mask: it meets nothing), from the pivot to the board.
+        rope = Polygon([(-1.0, -swing.length + hh), (1.0, -swing.length + hh), (1.0, 0.0), (-1.0, 0.0)])
+        piece("rope", Transform(*swing.pivot, theta), Velocity(), Hitbox(
+            rope, body="kinematic", sensor=True, layer=0, mask=0), SwingRope(swing), Visual(COLORS["rope"], z=0))
 
     def _autoplay(self, scene: Scene, dt: float) -> None:
         playing = self.state.player is not None and self.state.pending is None

@@ -16,6 +16,8 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
     B  crate (pushable)    O  barrel (rolls)
     M  moving platform (a run of M is one platform, half a tile thick, one-way)
     ~  the cells a moving platform sweeps: to its right, left, above or below (one side)
+    S  swing: a run of S (an odd number of cells) is its board at rest, half a tile thick, one-way
+    o  a swing's pivot, straight above the middle of its board (only empty cells or objects between)
 
 Lines starting with ``;`` are comments; short rows are padded with empty cells.
 
@@ -31,8 +33,14 @@ tiles are ignored. Layers named ``background`` or ``decoration`` (or ``kind`` = 
 ignored. Layer ``data`` may
 be a plain array or base64 (uncompressed, zlib or gzip). One object layer (or more) holds
 objects whose ``type``/``class`` (or ``name``) is ``player``, ``coin``, ``enemy``, ``goal``,
-``checkpoint``, ``platform``, ``spikes``, ``crate`` or ``barrel``; points and rectangles both work. Properties:
+``checkpoint``, ``platform``, ``swing``, ``spikes``, ``crate`` or ``barrel``; points and rectangles both
+work. Properties:
 ``platform``: ``dx``, ``dy`` (travel in tiles, y up), ``speed`` (tiles/s), ``one_way`` (bool);
+``swing`` (a rectangle: its board at rest, hanging straight below the pivot): ``length`` (tiles
+from the pivot down to the board's centre, > 0; required), ``angle`` (the largest swing, degrees,
+0 < angle < 90; default 30), ``period`` (s, > 0; default the pendulum's, 2 pi sqrt(length /
+gravity), gravity in tiles/s^2 from the game's ``Tuning``), ``phase`` (degrees; default 0: the
+swing starts at rest position going right), ``one_way`` (bool, default true);
 ``enemy``: ``speed`` (tiles/s), ``direction`` (-1 left, 1 right).
 
 A malformed file raises :class:`LevelError`, a ``ValueError`` whose message starts with the
@@ -60,7 +68,7 @@ __all__ = [
 LEVEL_DIR = Path(__file__).with_name("levels")
 # The order gives the tile ids of the tileset ``to_tmj`` writes: new kinds go at the end.
 TILE_KINDS = ("solid", "oneway", "spikes", *terrain.SLOPES, terrain.STEP)
-OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel")
+OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel", "swing")
 DECORATION = ("background", "decoration")
 DEFAULT_TILE = 32.0
 
@@ -172,6 +180,8 @@ class Level:
                     fail(f"platform at ({o.x:g}, {o.y:g}) does not move: give it dx or dy")
                 if not float(o.props.get("speed", 2.0)) > 0:
                     fail(f"platform at ({o.x:g}, {o.y:g}): speed must be > 0")
+            if o.kind == "swing":
+                _check_swing(o, fail)
             if o.kind == "enemy":
                 if not _is_number(o.props.get("speed", 2.0)) or not float(o.props.get("speed", 2.0)) >= 0:
                     fail(f"enemy at ({o.x:g}, {o.y:g}): speed must be a number >= 0")
@@ -179,6 +189,28 @@ class Level:
                     fail(f"enemy at ({o.x:g}, {o.y:g}): direction must be -1 or 1, "
                          f"got {_show(o.props.get('direction'))}")
         return self
+
+
+def _check_swing(o: LevelObject, fail: Fail) -> None:
+    """A swing: a board (a rectangle) ``length`` tiles below its pivot; ``angle`` (degrees, the
+    largest swing), ``period`` (s), ``phase`` (degrees) and ``one_way`` (bool), all optional."""
+    where = f"swing at ({o.x:g}, {o.y:g})"
+    if o.width <= 0 or o.height <= 0:
+        fail(f"{where} needs a rectangle, the board (width and height > 0)")
+    if "length" not in o.props:
+        fail(f"{where} has no length: give it 'length', tiles from the pivot down to the board's centre")
+    for key in ("length", "angle", "period", "phase"):
+        if key in o.props and not _is_number(o.props[key]):
+            fail(f"{where}: {key} must be a number, got {_show(o.props[key])}")
+    if not float(o.props["length"]) > 0:
+        fail(f"{where}: length must be > 0 (tiles from the pivot to the board), got {_show(o.props['length'])}")
+    if not 0 < float(o.props.get("angle", 30.0)) < 90:
+        fail(f"{where}: angle must be between 0 and 90 degrees (the largest swing), "
+             f"got {_show(o.props['angle'])}")
+    if "period" in o.props and not float(o.props["period"]) > 0:
+        fail(f"{where}: period must be > 0 seconds, got {_show(o.props['period'])}")
+    if not isinstance(o.props.get("one_way", True), bool):
+        fail(f"{where}: one_way must be true or false, got {_show(o.props['one_way'])}")
 
 
 def _is_number(v: object) -> bool:
@@ -241,7 +273,7 @@ def parse_text(
     height = len(grid)
     tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
     objects: list[LevelObject] = []
-    known = set(_TEXT_TILES) | set(_TEXT_OBJECTS) | set(_TEXT_EMPTY) | {"M", "~"}
+    known = set(_TEXT_TILES) | set(_TEXT_OBJECTS) | set(_TEXT_EMPTY) | {"M", "~", "S", "o"}
 
     def center(col: int, row: int) -> tuple[float, float]:
         return (col + 0.5) * tile, (height - row - 0.5) * tile
@@ -257,6 +289,7 @@ def parse_text(
                 x, y = center(col, row)
                 objects.append(LevelObject(_TEXT_OBJECTS[ch], x, y, tile, tile))
     objects.extend(_text_platforms(grid, tile, fail))
+    objects.extend(_text_swings(grid, tile, fail))
     return Level(name or Path(source).stem, source, float(tile), width, height, tiles, objects).validate()
 
 
@@ -305,6 +338,46 @@ def _text_platforms(grid: list[str], tile: float, fail: Fail) -> list[LevelObjec
         for col, ch in enumerate(line):
             if ch == "~" and (row, col) not in used:
                 fail(f"'~' at line {row + 1}, column {col + 1} is not next to a moving platform's path")
+    return out
+
+
+def _text_swings(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
+    """Swings: a run of ``S`` (an odd number of cells) is the board at rest, half a tile thick on
+    the top of its cells; the ``o`` straight above its middle cell (only empty cells or objects
+    between) is the pivot, at that cell's centre."""
+    height, width = len(grid), len(grid[0])
+    out = []
+    pivots = set()
+    for row, line in enumerate(grid):
+        col = 0
+        while col < width:
+            if line[col] != "S":
+                col += 1
+                continue
+            start = col
+            while col < width and line[col] == "S":
+                col += 1
+            where = f"swing at line {row + 1}, column {start + 1}"
+            if (col - start) % 2 == 0:
+                fail(f"{where}: its board is {col - start} cells long; make it an odd number, so that "
+                     "its pivot 'o' can stand above its middle cell")
+            mid = (start + col) // 2
+            r = row - 1
+            while r >= 0 and (grid[r][mid] in _TEXT_EMPTY or grid[r][mid] in _TEXT_OBJECTS):
+                r -= 1
+            if r < 0 or grid[r][mid] != "o":
+                fail(f"{where} has no pivot: put an 'o' above the middle of its board (column {mid + 1}), "
+                     "with only empty cells (or objects) between")
+            pivots.add((r, mid))
+            y = (height - row) * tile - tile * 0.25
+            length = ((height - r - 0.5) * tile - y) / tile
+            out.append(LevelObject("swing", (mid + 0.5) * tile, y, (col - start) * tile, tile * 0.5,
+                                   {"length": length, "one_way": True}))
+    for row, line in enumerate(grid):
+        for col, ch in enumerate(line):
+            if ch == "o" and (row, col) not in pivots:
+                fail(f"'o' at line {row + 1}, column {col + 1} is not the pivot of a swing "
+                     "(a run of 'S' straight below it)")
     return out
 
 

@@ -2,7 +2,7 @@
 
 Where each runs in a step (see :func:`install`)::
 
-    before movement   level_flow -> move_platforms -> control_player -> walk_enemies
+    before movement   level_flow -> move_platforms -> swing_platforms -> control_player -> walk_enemies
     movement          (framework: integrate velocities, gravity; moving platforms move)
     character         (framework: the player and the walkers move and slide with their
                        CharacterController: slopes, steps, riding platforms, one-way platforms)
@@ -40,6 +40,8 @@ from .components import (
     Hazard,
     MovingPlatform,
     Player,
+    SwingingPlatform,
+    SwingRope,
     Tuning,
 )
 
@@ -111,6 +113,23 @@ def move_platforms(scene: Scene, dt: float) -> None:
             v.x, v.y = dx / dist * plat.speed, dy / dist * plat.speed
 
 
+def swing_platforms(scene: Scene, dt: float) -> None:
+    """Give each swinging platform the velocity (x, y and angular) that takes it from where it is
+    to its exact pendulum pose at the end of this step (:meth:`.SwingingPlatform.pose` of its
+    clock advanced by ``dt``): the path is the analytic one, no error adds up from step to step.
+    Whoever stands on the board is carried by the motion of the board's point under its feet (its
+    displacement and its turn: the character controller's riding). Ropes turn with their swings."""
+    if dt <= 0.0:
+        return
+    for _e, (sw, t, v) in scene.query(SwingingPlatform, Transform, Velocity):
+        sw.time += dt
+        x, y, theta = sw.pose(sw.time)
+        v.x, v.y, v.angular = (x - t.x) / dt, (y - t.y) / dt, (theta - t.rotation) / dt
+    for _e, (rope, t, v) in scene.query(SwingRope, Transform, Velocity):
+        v.x, v.y = (rope.swing.pivot[0] - t.x) / dt, (rope.swing.pivot[1] - t.y) / dt
+        v.angular = (rope.swing.angle(rope.swing.time) - t.rotation) / dt
+
+
 def control_player(scene: Scene, dt: float) -> None:
     """Input -> the velocity the player wants: run, jump (coyote time, buffering, variable
     height), drop through one-way platforms. The character controller moves the body."""
@@ -180,8 +199,8 @@ def sense_enemies(scene: Scene, dt: float) -> None:
     """Walkers turn where their controller met a wall (or another walker) ahead, where they touch
     spikes ahead (the pipeline's contacts with the sensor), and before a ledge: a ray down from
     just past their front foot finds no ground within LEDGE_PROBE tiles (deep enough for the
-    ground under the front foot on a 45-degree slope, 0.75 tiles; moving platforms do not count,
-    walkers keep off them)."""
+    ground under the front foot on a 45-degree slope, 0.75 tiles; moving and swinging platforms do
+    not count, walkers keep off them)."""
     tile = _tile(scene)
     for e, (en, t, hb, ctrl) in scene.query(Enemy, Transform, Hitbox, CharacterController):
         turn = ctrl.on_wall and ctrl.wall_normal[0] * en.direction < 0.0
@@ -193,7 +212,8 @@ def sense_enemies(scene: Scene, dt: float) -> None:
             feet = t.y - hb.shape.height * 0.5
             hits = scene.raycast_all((front, feet + 0.05 * tile), (0.0, -1.0), (LEDGE_PROBE + 0.05) * tile,
                                      mask=SOLID | ONE_WAY)
-            if not any(scene.try_get(h.entity, MovingPlatform) is None for h in hits):
+            if not any(scene.try_get(h.entity, MovingPlatform) is None
+                       and scene.try_get(h.entity, SwingingPlatform) is None for h in hits):
                 turn = True  # a ledge ahead
         if turn and en.turned_frame != scene.frame:
             en.direction = -en.direction
@@ -345,7 +365,7 @@ def install(scene: Scene) -> None:
     """Add the game's systems and handlers to ``scene`` (once)."""
     from .components import Player as P
 
-    for system in (level_flow, move_platforms, control_player, walk_enemies):
+    for system in (level_flow, move_platforms, swing_platforms, control_player, walk_enemies):
         scene.add_system(system, before="movement")
     for system in (sense_player, sense_enemies, fall_out, animate, follow_camera):
         scene.add_system(system, after="response")

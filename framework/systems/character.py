@@ -54,6 +54,7 @@ class _Move:
     ceiling: bool = False
     hits: list[tuple[int, float, float]] = field(default_factory=list)  # surfaces the own motion met
     pushed: list[tuple[int, float, float]] = field(default_factory=list)
+    stood_on: int | None = None  # the row it stood on when the step began
 
 
 class CharacterStage(Stage):
@@ -130,6 +131,7 @@ class CharacterStage(Stage):
                 if floor_row is not None and int(store.entity[floor_row]) in under:
                     was_on_floor, floor_row = False, None
         self._forget_dropped(mv, ctrl)
+        mv.stood_on = floor_row if was_on_floor else None
 
         # 1. Ride: the displacement of the point under its feet on what it stood on, this step (the
         # floor's own displacement, and where the floor turns, that point turned about its origin).
@@ -545,6 +547,11 @@ class CharacterStage(Stage):
             return True
         if ny < mv.floor_cos:
             return False
+        if r == mv.stood_on:
+            # (it stood on it when the step began, so it was above it: a turning board tilts up
+            # under one lower corner, below the board's highest point, which the test below takes
+            # for its top)
+            return True
         top = float(geom.maxy[r])
         if moved and r < frame.start_y.size:
             top -= float(store.y[r] - frame.start_y[r])
