@@ -202,7 +202,7 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
 
 
 _COMPILED = False
-COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 25 seconds; later runs load "
+COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 25 to 30 seconds; later runs load "
                   "it from numba's cache)")
 
 
