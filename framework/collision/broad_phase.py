@@ -28,6 +28,7 @@ import math
 from typing import cast
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from ..arrays import distinct
@@ -230,6 +231,19 @@ class SpatialHash:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))
 
+    def enter_few(self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike) -> None:
+        """Take up to :data:`SMALL` moving bodies as a :meth:`pairs` call does (for the queries
+        and the overlay's cells), without pairing them: the caller paired them itself
+        (:func:`direct_pairs`)."""
+        b = as_bounds(minx, miny, maxx, maxy)
+        mids = _as_ids(ids, b[0].shape[0])
+        self._choose_cell(b)
+        self._moving = _FewBodies((b[0].copy(), b[1].copy(), b[2].copy(), b[3].copy()))
+        self._moving_cells = None
+        self._queries = 0
+        self._moving_ids = mids.copy()
+        self.rehashed_last = b[0].shape[0]
+
     def static_pairs(
         self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike,
     ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -399,3 +413,46 @@ class SpatialHash:
         cells = np.stack([np.concatenate(cols), np.concatenate(rows)], axis=1)
         return np.unique(cells, axis=0) if cells.shape[0] else cells.reshape(0, 2)
 
+
+
+#: A step pairs its moving bodies with every other hitbox directly (one compiled pass, no hash)
+#: when there are at most :data:`SMALL` of them and this many tests or fewer (moving x rows): a
+#: platformer's dozen movers among a few hundred tiles. The hash's answer is the same pairs.
+DIRECT_PAIRS = 1 << 16
+
+
+@njit(cache=True)
+def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind):  # pragma: no cover
+    """The sorted pair keys (``entity a << 32 | entity b``, a < b) of every moving row (``moving``,
+    sorted rows) with every other hitbox row whose bounds strictly overlap its own (touching is no
+    overlap): the static ones, the sleeping ones and the moving ones (each moving pair once)."""
+    n = kind.size
+    is_moving = np.zeros(n, dtype=np.bool_)
+    for k in range(moving.size):
+        is_moving[moving[k]] = True
+    out = np.empty(16, dtype=np.int64)
+    m = 0
+    for k in range(moving.size):
+        i = moving[k]
+        ax0, ay0, ax1, ay1 = minx[i], miny[i], maxx[i], maxy[i]
+        for r in range(n):
+            if r == i or kind[r] < 0:
+                continue
+            if is_moving[r]:
+                if r < i:
+                    continue  # (this pair was found from r)
+            elif not (body[r] == static_kind or asleep[r]):
+                continue
+            if ax1 > minx[r] and maxx[r] > ax0 and ay1 > miny[r] and maxy[r] > ay0:
+                a, b = entity[i], entity[r]
+                if a > b:
+                    a, b = b, a
+                if m == out.size:
+                    grown = np.empty(2 * m, dtype=np.int64)
+                    grown[:m] = out
+                    out = grown
+                out[m] = (a << 32) | b
+                m += 1
+    keys = out[:m].copy()
+    keys.sort()
+    return keys

@@ -1,9 +1,12 @@
-"""Broad phase: the candidate pairs of the step, from the spatial hash.
+"""Broad phase: the candidate pairs of the step, from the spatial hash (a few movers: directly).
 
 Moving bodies are hashed every step against the static hash (kept until the static set changes)
 and against each other; sleeping bodies are kept in a hash of their own, entered only when one
-falls asleep or wakes. Pairs whose layers and masks do not meet are dropped here, and, in a scene
-without the events effect, pairs nobody reads (neither the response nor a collision handler).
+falls asleep or wakes. Up to :data:`~framework.collision.broad_phase.SMALL` moving bodies among
+not too many rows are paired with every hitbox in one compiled pass instead (the same pairs, in
+the same order; :func:`~framework.collision.broad_phase.direct_pairs`). Pairs whose layers and
+masks do not meet are dropped here, and, in a scene without the events effect, pairs nobody reads
+(neither the response nor a collision handler).
 """
 
 from __future__ import annotations
@@ -11,8 +14,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..arrays import BoolArray, IntpArray
+from ..collision.broad_phase import DIRECT_PAIRS, SMALL, direct_pairs
 from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
+from ..store import STATIC
 from .narrow_phase import filter_layers
 from .stage import Stage
 
@@ -34,8 +39,15 @@ class BroadPhase(Stage):
         counters["rehashed"] += bodies.sync_static()
         moving = store.active_sel()[1]  # a slice where the bodies are one run of rows: views, no gathers
         bounds = (geom.minx[moving], geom.miny[moving], geom.maxx[moving], geom.maxy[moving])
-        ea, eb = bodies.hash.pairs(*bounds, store.entity[moving])
-        counters["rehashed"] += int(store.active()[1].size)
+        movers = store.active()[1]
+        # A few movers among not too many rows: paired with every hitbox directly, in one compiled
+        # pass (the hash's pairs, without its numpy calls); else through the hashes.
+        direct = movers.size <= SMALL and movers.size * store.n <= DIRECT_PAIRS
+        if direct:
+            bodies.hash.enter_few(*bounds, store.entity[moving])
+        else:
+            ea, eb = bodies.hash.pairs(*bounds, store.entity[moving])
+        counters["rehashed"] += int(movers.size)
         if store.sleep_dirty:
             sleepers = np.flatnonzero(store.asleep)
             bodies.sleep_hash.set_static(geom.minx[sleepers], geom.miny[sleepers], geom.maxx[sleepers],
@@ -43,7 +55,11 @@ class BroadPhase(Stage):
             counters["rehashed"] += int(sleepers.size)
             store.sleep_dirty = False
         counters["asleep"] = frame.n_asleep = int(np.count_nonzero(store.asleep[store.active_sel()[2]]))
-        if frame.n_asleep:
+        if direct:
+            c, n = store.cols, store.n
+            ea, eb = pair_parts(direct_pairs(movers, c["kind"][:n], c["body"][:n], c["asleep"][:n], c["entity"][:n],
+                                             geom.minx, geom.miny, geom.maxx, geom.maxy, STATIC))
+        elif frame.n_asleep:
             sa, sb = bodies.sleep_hash.pairs(*bounds, store.entity[moving], moving_pairs=False)
             if sa.size:
                 keys = np.concatenate([pair_keys(ea, eb), pair_keys(sa, sb)])
