@@ -113,8 +113,9 @@ def _in_box(
 ) -> NDArray[np.intp]:
     """The ``rows`` whose current bounds meet the box (closed): the candidates worth an exact test."""
     g, store = queries.bodies.geometry, queries.bodies.store
-    return rows_within(rows, g.minx, g.miny, g.maxx, g.maxy, x0, y0, x1, y1, store.layer, store.sensor, -1, _NONE,
-                       store.entity, _NONE)
+    c = store.cols
+    return rows_within(rows, g.minx, g.miny, g.maxx, g.maxy, x0, y0, x1, y1, c["layer"], c["sensor"], -1, _NONE,
+                       c["entity"], _NONE)
 
 
 def candidate_rows(queries: SpatialQueries, x0: float, y0: float, x1: float, y1: float, mask: int,
@@ -123,7 +124,7 @@ def candidate_rows(queries: SpatialQueries, x0: float, y0: float, x1: float, y1:
     mask) removes, whose bounds meet the box ``(x0, y0, x1, y1)``."""
     store = queries.bodies.store
     rows = queries._candidate_rows(x0, y0, x1, y1)
-    rows = rows[((store.layer[rows] & mask) != 0) & ~store.sensor[rows]]
+    rows = rows[((store.cols["layer"][rows] & mask) != 0) & ~store.cols["sensor"][rows]]
     if skip is not None and rows.size:
         rows = rows[skip(rows)]
     return _in_box(queries, rows, x0, y0, x1, y1)
@@ -192,12 +193,12 @@ def cast_rows(
             if quick is None:
                 continue
             if isinstance(quick, tuple):
-                found.append((quick[0], int(store.entity[r]), r, quick[1], quick[2]))
+                found.append((quick[0], int(store.cols["entity"][r]), r, quick[1], quick[2]))
                 continue
-        pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))
+        pose_b = (float(geom.hx[r]), float(geom.hy[r]), float(store.cols["rot"][r]))
         hit = time_of_impact(shape, (x, y, rotation), (mx, my), other, pose_b)
         if hit is not None:
-            found.append((hit.fraction, int(store.entity[r]), r, -hit.normal.x + 0.0, -hit.normal.y + 0.0))
+            found.append((hit.fraction, int(store.cols["entity"][r]), r, -hit.normal.x + 0.0, -hit.normal.y + 0.0))
     found.sort()
     for fraction, _e, r, nx, ny in found:
         if accept is None or accept(r, fraction, nx, ny):
@@ -231,7 +232,7 @@ def overlapping_rows(queries: SpatialQueries, shape: Shape, x: float, y: float, 
                 abs(float(geom.hx[r]) - x) < (shape.width + other.width) * 0.5  # type: ignore[attr-defined]
                 and abs(float(geom.hy[r]) - y) < (shape.height + other.height) * 0.5):  # type: ignore[attr-defined]
             continue  # two boxes touching (or apart): not overlapping, to rounding
-        c = collide(store.hitboxes[r].shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
+        c = collide(store.hitboxes[r].shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.cols["rot"][r])),
                     shape, (x, y, rotation))
         if c is not None:
             out.append((r, c.normal.x, c.normal.y, c.depth))

@@ -55,6 +55,7 @@ class _Move:
     hits: list[tuple[int, float, float]] = field(default_factory=list)  # surfaces the own motion met
     pushed: list[tuple[int, float, float]] = field(default_factory=list)
     stood_on: int | None = None  # the row it stood on when the step began
+    own: IntpArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # [row]: never its own candidate
 
 
 class CharacterStage(Stage):
@@ -80,9 +81,9 @@ class CharacterStage(Stage):
             hb = store.hitboxes[row] if row is not None else None
             if hb is None:
                 raise InvalidValue(f"entity {e}: a CharacterController needs a Transform and a Hitbox")
-            if not store.has_vel[row]:
+            if not store.cols["has_vel"][row]:
                 raise InvalidValue(f"entity {e}: a CharacterController needs a Velocity (the velocity it wants)")
-            if store.body[row] != KINEMATIC:
+            if store.cols["body"][row] != KINEMATIC:
                 raise InvalidValue(f"entity {e}: a CharacterController moves a kinematic body; "
                                    f"give its Hitbox body='kinematic' (it has {hb.body.value!r})")
 
@@ -111,14 +112,15 @@ class CharacterStage(Stage):
         assert hb is not None  # (run() moves only rows with a hitbox)
         shape = hb.shape
         dt = frame.dt
-        ox, oy = float(geom.hx[row] - store.x[row]), float(geom.hy[row] - store.y[row])
+        ox, oy = float(geom.hx[row] - store.cols["x"][row]), float(geom.hy[row] - store.cols["y"][row])
         x0, y0 = float(geom.hx[row]), float(geom.hy[row])
         size = min(_extent(shape))
         skin = ctrl.skin if ctrl.skin is not None else default_skin(size, x0, y0)
         mask = ctrl.solid_mask if ctrl.solid_mask is not None else int(hb.mask)
-        mv = _Move(shape, x0, y0, float(store.rot[row]), row, mask, skin, ctrl.floor_cos, ctrl.dropping)
+        mv = _Move(shape, x0, y0, float(store.cols["rot"][row]), row, mask, skin, ctrl.floor_cos, ctrl.dropping)
+        mv.own = np.array([row], dtype=np.int64)
         vel: Velocity = esper.component_for_entity(entity, Velocity)
-        vx, vy = float(store.vx[row]), float(store.vy[row])
+        vx, vy = float(store.cols["vx"][row]), float(store.cols["vy"][row])
         was_on_floor, floor_row = ctrl.on_floor, self._row_of(ctrl.floor_entity)
         start_bottom = shape_bottom(shape, x0, y0, mv.rot)
         ctrl.crushed = False
@@ -128,7 +130,7 @@ class CharacterStage(Stage):
             under = self._one_way_under(mv, size)
             if under:
                 ctrl.dropping.update(under)
-                if floor_row is not None and int(store.entity[floor_row]) in under:
+                if floor_row is not None and int(store.cols["entity"][floor_row]) in under:
                     was_on_floor, floor_row = False, None
         self._forget_dropped(mv, ctrl)
         mv.stood_on = floor_row if was_on_floor else None
@@ -136,21 +138,21 @@ class CharacterStage(Stage):
         # 1. Ride: the displacement of the point under its feet on what it stood on, this step (the
         # floor's own displacement, and where the floor turns, that point turned about its origin).
         carried = (0.0, 0.0)
-        going = (was_on_floor and floor_row is not None and bool(store.has_vel[floor_row])
-                 and store.body[floor_row] != STATIC and not store.asleep[floor_row])
+        going = (was_on_floor and floor_row is not None and bool(store.cols["has_vel"][floor_row])
+                 and store.cols["body"][floor_row] != STATIC and not store.cols["asleep"][floor_row])
         pivot = None
         ride_after = False
         if was_on_floor and floor_row is not None and moved and floor_row < frame.start_x.size:
-            carried = (float(store.x[floor_row] - frame.start_x[floor_row]),
-                       float(store.y[floor_row] - frame.start_y[floor_row]))
+            carried = (float(store.cols["x"][floor_row] - frame.start_x[floor_row]),
+                       float(store.cols["y"][floor_row] - frame.start_y[floor_row]))
             pivot = (float(frame.start_x[floor_row]), float(frame.start_y[floor_row]))
         elif going and self.pipeline.solver == "soft":
             # (the soft step moves what it stands on after this stage, by its velocity: the body
             # moves on it where it is now, then rides to where it will be)
-            carried = (float(store.vx[floor_row]) * dt, float(store.vy[floor_row]) * dt)
-            pivot = (float(store.x[floor_row]), float(store.y[floor_row]))
+            carried = (float(store.cols["vx"][floor_row]) * dt, float(store.cols["vy"][floor_row]) * dt)
+            pivot = (float(store.cols["x"][floor_row]), float(store.cols["y"][floor_row]))
             ride_after = True
-        turn = float(store.w[floor_row]) * dt if going and pivot is not None else 0.0
+        turn = float(store.cols["w"][floor_row]) * dt if going and pivot is not None else 0.0
         if turn != 0.0 and pivot is not None:  # (moved by the movement stage, or by the soft step next)
             dx, dy = x0 - pivot[0], start_bottom - pivot[1]
             c, s = math.cos(turn), math.sin(turn)
@@ -201,7 +203,7 @@ class CharacterStage(Stage):
         ctrl.on_floor = mv.floor is not None
         if mv.floor is not None:
             r, nx, ny = mv.floor
-            ctrl.floor_normal, ctrl.floor_entity = (nx, ny), int(store.entity[r])
+            ctrl.floor_normal, ctrl.floor_entity = (nx, ny), int(store.cols["entity"][r])
             vy = 0.0  # (a jump that ends on a floor is cut; velocity on a floor is along it)
         else:
             ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
@@ -259,9 +261,9 @@ class CharacterStage(Stage):
         x0, y0, x1, _y1 = _bounds(mv)
         eps = max(4.0 * mv.skin, 1e-6 * size)
         rows = self.queries._candidate_rows(x0, y0 - eps, x1, y0 + eps)
-        rows = rows[store.one_way[rows] & ((store.layer[rows] & mv.mask) != 0) & (rows != mv.row)]
+        rows = rows[store.cols["one_way"][rows] & ((store.cols["layer"][rows] & mv.mask) != 0) & (rows != mv.row)]
         rows = rows[np.abs(geom.maxy[rows] - y0) <= eps]
-        return {int(e) for e in store.entity[rows]}
+        return {int(e) for e in store.cols["entity"][rows]}
 
     def _gather(self, mv: _Move, ctrl: CharacterController, carried: tuple[float, float], vx: float, vy: float,
                 dt: float, size: float) -> None:
@@ -284,14 +286,15 @@ class CharacterStage(Stage):
         afresh (layers, sensors, the dropped platforms). One compiled pass (:mod:`~framework.collision.box_rows`)."""
         store, geom = self.bodies.store, self.bodies.ensure_geometry()
         b = mv.box
-        skip_rows = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64)
+        skip_rows = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64) if mv.ignore else mv.own
         if mv.rows is not None and b is not None and (b[0] <= box[0] and b[1] <= box[1] and box[2] <= b[2]
                                                       and box[3] <= b[3]):
             source, mask, drop = mv.rows, -1, _NONE  # (already filtered by layers, sensors and drops)
         else:
             source, mask, drop = self.queries._candidate_rows(*box), mv.mask, self._dropped(mv)
-        return rows_within(source, geom.minx, geom.miny, geom.maxx, geom.maxy, *box, store.layer, store.sensor, mask,
-                           skip_rows, store.entity, drop)
+        c = store.cols
+        return rows_within(source, geom.minx, geom.miny, geom.maxx, geom.maxy, *box, c["layer"], c["sensor"], mask,
+                           skip_rows, c["entity"], drop)
 
     @staticmethod
     def _dropped(mv: _Move) -> IntpArray:
@@ -302,7 +305,7 @@ class CharacterStage(Stage):
         store = self.bodies.store
 
         def accept(r: int, f: float, nx: float, ny: float) -> bool:
-            if not store.one_way[r]:
+            if not store.cols["one_way"][r]:
                 return True
             # A one-way platform blocks only a body coming down onto its top.
             if ny < mv.floor_cos or (my > 0.0 and f == 0.0):
@@ -310,7 +313,7 @@ class CharacterStage(Stage):
             if f == 0.0:  # touching, or already inside it (then it does not hold the body)
                 geom = self.bodies.geometry
                 return collide(mv.shape, (mv.x, mv.y, mv.rot), store.hitboxes[r].shape,  # type: ignore[union-attr]
-                               (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))) is None
+                               (float(geom.hx[r]), float(geom.hy[r]), float(store.cols["rot"][r]))) is None
             return True
 
         x0, y0, x1, y1 = _bounds(mv)
@@ -360,7 +363,7 @@ class CharacterStage(Stage):
                 d = rx * nx + ry * ny
                 mx, my = (rx - d * nx, ry - d * ny) if d < 0.0 else (rx, ry)
             else:  # a wall, or a slope too steep to walk
-                if self.bodies.store.body[r] == DYNAMIC:
+                if self.bodies.store.cols["body"][r] == DYNAMIC:
                     mv.pushed.append((r, nx, ny))  # it may give way: the walk keeps its velocity
                 if on_floor and step > 0.0 and rx != 0.0 and abs(ny) < cos_f and self._step_up(mv, rx, step):
                     return  # (climbed: the step's face is behind it, not a wall it stands at)
@@ -433,7 +436,7 @@ class CharacterStage(Stage):
         other = store.hitboxes[r]
         assert other is not None  # (a cast meets only rows with a hitbox)
         at = touch_point(mv.shape, (mv.x, mv.y, mv.rot), other.shape,
-                         (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])), -nx, -ny)
+                         (float(geom.hx[r]), float(geom.hy[r]), float(store.cols["rot"][r])), -nx, -ny)
         return float(at.y)
 
     def _to_stand(self, mv: _Move, nx: float, ny: float, rx: float) -> float:
@@ -486,7 +489,7 @@ class CharacterStage(Stage):
         surface met is taken away (it slides along them); if that cannot be done for all of them
         at once (a crease), it stops."""
         store = self.bodies.store
-        planes = [(nx, ny) for r, nx, ny in mv.hits if store.body[r] != DYNAMIC]
+        planes = [(nx, ny) for r, nx, ny in mv.hits if store.cols["body"][r] != DYNAMIC]
         if not planes:
             return vx, vy
         if mv.floor is not None:
@@ -521,7 +524,7 @@ class CharacterStage(Stage):
             found = [o for o in found if self._holds(mv, o, start_bottom, frame, moved)]
             if not found:
                 return free
-            r, nx, ny, depth = max(found, key=lambda o: (o[3], -store.entity[o[0]]))
+            r, nx, ny, depth = max(found, key=lambda o: (o[3], -store.cols["entity"][o[0]]))
             push = depth + mv.skin
             mv.ignore.add(r)
             hit = self._cast(mv, nx * push, ny * push)
@@ -543,7 +546,7 @@ class CharacterStage(Stage):
         from below its feet (its top, when the step began, was under them)."""
         r, _nx, ny, _depth = overlap
         store, geom = self.bodies.store, self.bodies.geometry
-        if not store.one_way[r]:
+        if not store.cols["one_way"][r]:
             return True
         if ny < mv.floor_cos:
             return False
@@ -554,7 +557,7 @@ class CharacterStage(Stage):
             return True
         top = float(geom.maxy[r])
         if moved and r < frame.start_y.size:
-            top -= float(store.y[r] - frame.start_y[r])
+            top -= float(store.cols["y"][r] - frame.start_y[r])
         return start_bottom >= top - 1e-6 * (abs(top) + _extent(mv.shape)[1])
 
     def _push(self, mv: _Move, mass: float, vx: float, vy: float) -> None:
@@ -563,15 +566,15 @@ class CharacterStage(Stage):
         store = self.bodies.store
         for r, nx, ny in mv.pushed:
             vn = -(vx * nx + vy * ny)  # the body's speed into the other one
-            other = -(float(store.vx[r]) * nx + float(store.vy[r]) * ny)
+            other = -(float(store.cols["vx"][r]) * nx + float(store.cols["vy"][r]) * ny)
             if vn <= other:
                 continue
-            inv = float(store.inv_mass[r])
+            inv = float(store.cols["inv_mass"][r])
             share = (mass * inv) / (1.0 + mass * inv) if math.isfinite(mass) else 1.0
             dv = (vn - other) * share
-            store.vx[r] -= dv * nx
-            store.vy[r] -= dv * ny
-            if store.asleep[r]:
+            store.cols["vx"][r] -= dv * nx
+            store.cols["vy"][r] -= dv * ny
+            if store.cols["asleep"][r]:
                 store.wake(r)
 
 
