@@ -7,39 +7,10 @@ from __future__ import annotations
 import math
 
 import pytest
+from joint_helpers import DT, SLOP, G, box
 
-from framework import AABB, Circle, Hitbox, Polygon, RevoluteJoint, Scene, Transform, Velocity
-from framework.systems.soft_step import SOFT_SETTINGS
-
-G = 8.0
-DT = 1 / 64
-SLOP = SOFT_SETTINGS["slop"]
-
-
-def box(hw: float, hh: float) -> Polygon:
-    return Polygon([(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)])
-
-
-def chain_slopes(links: int, length: float, weight: float, load: float, half_span: float) -> list[float]:
-    """The slopes (radians below level) of the links of a chain at rest, from the middle out: ``links``
-    rigid links (each ``length`` long and ``weight`` heavy, at its middle), ``load`` hanging at its
-    middle hinge, between two points at the same height ``2 half_span`` apart. Statics: the
-    horizontal tension H is the same in every link; the vertical one in the k-th link from the
-    middle is the load's half and the weight of the links between, so its slope is
-    atan((load/2 + (k - 1/2) weight) / H); H is the one whose links span the gap (a bisection)."""
-    half = links // 2
-
-    def slopes(h: float) -> list[float]:
-        return [math.atan((0.5 * load + (k - 0.5) * weight) / h) for k in range(1, half + 1)]
-
-    lo, hi = 1e-9, 1e9
-    for _ in range(200):
-        h = math.sqrt(lo * hi)
-        if sum(length * math.cos(a) for a in slopes(h)) < half_span:
-            lo = h
-        else:
-            hi = h
-    return slopes(lo)
+from framework import AABB, Circle, Hitbox, RevoluteJoint, Scene, Transform, Velocity
+from framework.bench.regimes import chain_slopes
 
 
 def chain_sag(links: int, length: float, weight: float, load: float, half_span: float) -> float:

@@ -81,7 +81,8 @@ from .report import Column, format_table, machine_info, median, optional_module,
 
 __all__ = [
     "COLUMNS", "CROWDS", "CROWD_COLUMNS", "CROWD_KEYS", "Box2DEngine", "Engine", "Hinge", "Ours", "Piece",
-    "PymunkEngine", "ROW_KEYS", "Regime", "SCENES", "box_pile", "bridge", "chain", "crowd", "goals", "hinge_gaps",
+    "PymunkEngine", "ROW_KEYS", "Regime", "SCENES", "box_pile", "bridge", "chain", "chain_slopes", "crowd", "goals",
+    "hinge_gaps",
     "hinge_stretch", "judge", "make_engines", "markdown", "max_penetration", "peer_modules", "pile_layout",
     "platformer", "pyramid", "ragdolls", "run_crowd", "run_regimes", "run_scene", "scattered", "shape_pile", "stack",
     "text_report", "with_friction",
@@ -341,17 +342,18 @@ def chain(links: int = 100, length: float = 0.25, span: float = 18.0, first_run:
                   hinges=hinges)
 
 
-def _chain_slopes(links: int, length: float, half_span: float) -> list[float]:
-    """The slopes (radians below level, from the middle out) of a chain of ``links`` rigid links of
-    ``length`` (equal weights at their middles) hanging at rest between two points at the same
-    height ``2 half_span`` apart: the horizontal tension H is the same in every link, the vertical
-    one in the k-th from the middle is ``(k - 1/2)`` links' weight, so its slope is atan((k - 1/2)
-    w / H); H (in weights) is the one whose links span the gap (bisection). tests/test_joint_scenes
-    checks the same statics."""
+def chain_slopes(links: int, length: float, weight: float, load: float, half_span: float) -> list[float]:
+    """The slopes (radians below level) of the links of a chain at rest, from the middle out: ``links``
+    rigid links (each ``length`` long and ``weight`` heavy, at its middle), ``load`` hanging at its
+    middle hinge, between two points at the same height ``2 half_span`` apart. Statics: the
+    horizontal tension H is the same in every link; the vertical one in the k-th link from the
+    middle is the load's half and the weight of the links between, so its slope is
+    atan((load/2 + (k - 1/2) weight) / H); H is the one whose links span the gap (a bisection).
+    The bridge regime is laid out by it; tests/test_joint_scenes.py holds a bridge to it."""
     half = links // 2
 
     def slopes(h: float) -> list[float]:
-        return [math.atan((k - 0.5) / h) for k in range(1, half + 1)]
+        return [math.atan((0.5 * load + (k - 0.5) * weight) / h) for k in range(1, half + 1)]
 
     lo, hi = 1e-9, 1e9
     for _ in range(200):
@@ -366,10 +368,10 @@ def _chain_slopes(links: int, length: float, half_span: float) -> list[float]:
 def bridge(planks: int = 30, boxes: int = 5) -> Regime:
     """``bridge-N``: ``planks`` planks 0.5 x 0.125 (mass 1) hinged end to end between the top
     corners of two static posts 14 apart (the planks span 15), laid out as the rigid chain hangs at
-    rest (:func:`_chain_slopes`); ``boxes`` boxes of side 0.5 (mass 1) dropped onto it from 1.5
+    rest (:func:`chain_slopes`); ``boxes`` boxes of side 0.5 (mass 1) dropped onto it from 1.5
     above its ends' height, spread along it, which roll and slide toward its middle."""
     plank, half_span = 0.5, 7.0
-    slopes = _chain_slopes(planks, plank, half_span)[::-1]  # from the left post in
+    slopes = chain_slopes(planks, plank, 1.0, 0.0, half_span)[::-1]  # from the left post in
     ends = [(-half_span, 0.0)]
     for a in slopes:
         ends.append((ends[-1][0] + plank * math.cos(a), ends[-1][1] - plank * math.sin(a)))
