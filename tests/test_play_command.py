@@ -7,38 +7,20 @@ this process): headless rendering was not asked for, so there is no window to be
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import pytest
+from example_commands import ROOT, child_env, commands
 
-ROOT = Path(__file__).resolve().parents[1]
 HINT = "--headless --demo"
 
-# `framework.examples` is the installed name of the checkout's examples/ (pyproject's package-dir).
-# An editable install elsewhere maps it onto that checkout, so the child maps it onto this one the
-# same way (the folder on the package's path) and runs the module as `python -m` would.
-_AS_INSTALLED = ("import runpy, sys, framework\n"
-                 f"framework.__path__.insert(0, {str(ROOT)!r})\n"
-                 "sys.argv[0] = 'framework.examples.platformer'\n"
-                 "runpy.run_module('framework.examples.platformer', run_name='__main__', alter_sys=True)\n")
-COMMANDS = {
-    "examples.platformer": [sys.executable, "-m", "examples.platformer"],
-    "framework.examples.platformer": [sys.executable, "-c", _AS_INSTALLED],
-}
+COMMANDS = commands("platformer")
 DISPLAYS = {  # no display at all; one named that cannot be opened (nothing listens on :987)
     "no display": {},
     "a display that fails to open": {"DISPLAY": ":987"},
 }
-
-
-def _env(extra: dict[str, str]) -> dict[str, str]:
-    drop = {"DISPLAY", "WAYLAND_DISPLAY", "PYGLET_HEADLESS", "PYGLET_SHADOW_WINDOW"}
-    env = {k: v for k, v in os.environ.items() if k not in drop}
-    return {**env, "PYTHONPATH": str(ROOT), **extra}
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="DISPLAY / WAYLAND_DISPLAY are Linux's")
@@ -47,7 +29,7 @@ def _env(extra: dict[str, str]) -> dict[str, str]:
 def test_the_play_command_without_a_display_says_so_and_exits(module, display):
     t0 = time.perf_counter()
     try:
-        out = subprocess.run(COMMANDS[module], cwd=ROOT, env=_env(DISPLAYS[display]), capture_output=True,
+        out = subprocess.run(COMMANDS[module], cwd=ROOT, env=child_env(DISPLAYS[display]), capture_output=True,
                              text=True, timeout=60)
     except subprocess.TimeoutExpired:
         pytest.fail(f"`python -m {module}` without a display still ran after 60 s (an invisible window?)")
@@ -68,6 +50,6 @@ def test_the_play_command_without_a_display_says_so_and_exits(module, display):
 
 def test_headless_asked_for_still_plays_without_a_display():
     out = subprocess.run([sys.executable, "-m", "examples.platformer", "--headless", "--frames", "3"], cwd=ROOT,
-                         env=_env({}), capture_output=True, text=True, timeout=120)
+                         env=child_env({}), capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert '"frames": 3' in out.stdout.strip().splitlines()[-1]

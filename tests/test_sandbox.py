@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from example_commands import ROOT, child_env, commands
 
 from examples.sandbox import (
     CAR,
@@ -34,7 +33,6 @@ from examples.sandbox import (
 from examples.sandbox.world import DT
 from framework import Hitbox, Input, MouseJoint, Transform, Velocity, WheelJoint
 
-ROOT = Path(__file__).resolve().parents[1]
 JOINTS = 9 + 2  # the rope's nine hinges (eight links and the weight) and the car's two wheels
 
 
@@ -213,26 +211,11 @@ def test_the_windows_mouse_handlers_drag_what_is_under_the_cursor(render):
 
 # --- the command ------------------------------------------------------------------------------------
 
-# `framework.examples` is the installed name of the checkout's examples/ (as in test_play_command.py):
-# the child maps it onto this checkout and runs the module as `python -m` would.
-_AS_INSTALLED = ("import runpy, sys, framework\n"
-                 f"framework.__path__.insert(0, {str(ROOT)!r})\n"
-                 "sys.argv[0] = 'framework.examples.sandbox'\n"
-                 "runpy.run_module('framework.examples.sandbox', run_name='__main__', alter_sys=True)\n")
-COMMANDS = {
-    "examples.sandbox": [sys.executable, "-m", "examples.sandbox"],
-    "framework.examples.sandbox": [sys.executable, "-c", _AS_INSTALLED],
-}
-
-
-def _env(extra: dict[str, str]) -> dict[str, str]:
-    drop = {"DISPLAY", "WAYLAND_DISPLAY", "PYGLET_HEADLESS", "PYGLET_SHADOW_WINDOW"}
-    env = {k: v for k, v in os.environ.items() if k not in drop}
-    return {**env, "PYTHONPATH": str(ROOT), **extra}
+COMMANDS = commands("sandbox")
 
 
 def test_the_headless_demo_drives_drags_and_prints_its_summary():
-    out = subprocess.run([*COMMANDS["examples.sandbox"], "--headless", "--demo"], cwd=ROOT, env=_env({}),
+    out = subprocess.run([*COMMANDS["examples.sandbox"], "--headless", "--demo"], cwd=ROOT, env=child_env({}),
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     summary = json.loads(out.stdout.strip().splitlines()[-1])
@@ -245,7 +228,7 @@ def test_the_headless_demo_drives_drags_and_prints_its_summary():
 
 @pytest.mark.parametrize("module", list(COMMANDS))
 def test_the_headless_steps_option(module):
-    out = subprocess.run([*COMMANDS[module], "--headless", "--steps", "3"], cwd=ROOT, env=_env({}),
+    out = subprocess.run([*COMMANDS[module], "--headless", "--steps", "3"], cwd=ROOT, env=child_env({}),
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     summary = json.loads(out.stdout.strip().splitlines()[-1])
@@ -257,7 +240,7 @@ def test_the_headless_steps_option(module):
 @pytest.mark.parametrize("display", [{}, {"DISPLAY": ":987"}], ids=["no display", "a display that fails to open"])
 @pytest.mark.parametrize("module", list(COMMANDS))
 def test_without_a_display_it_says_so_in_one_line_and_exits_1(module, display):
-    out = subprocess.run(COMMANDS[module], cwd=ROOT, env=_env(display), capture_output=True, text=True, timeout=60)
+    out = subprocess.run(COMMANDS[module], cwd=ROOT, env=child_env(display), capture_output=True, text=True, timeout=60)
     assert out.returncode == 1, (out.returncode, out.stdout, out.stderr)
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1, out.stderr  # one line, no traceback

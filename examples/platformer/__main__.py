@@ -132,20 +132,14 @@ def run_window(game: Game, args: argparse.Namespace) -> dict[str, Any]:
     return {"frames": scene.frame, "ms_per_frame": round(ms, 4)}
 
 
-def no_window(reason: object) -> str:
-    """The one line said where no window can be shown: why, and how to play instead."""
-    return (f"error: {reason}. Play with a display (set DISPLAY), or without a window: "
-            f"python -m {__package__} --headless --demo")
-
-
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     if not args.headless:  # before loading the levels: say at once that no window can be shown
-        from framework.render.display import no_display_reason
+        from framework.render.display import no_display_reason, no_window_line
 
         reason = no_display_reason()
         if reason is not None:
-            print(no_window(reason), file=sys.stderr)
+            print(no_window_line(reason, __package__), file=sys.stderr)
             return 1
     try:
         game = make_game(args)
@@ -163,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
             try:
                 result = run_window(game, args)
             except NoDisplayError as exc:  # the display is there but fails to open
-                print(no_window(exc), file=sys.stderr)
+                print(no_window_line(exc, __package__), file=sys.stderr)
                 return 1
         if args.screenshot:
             from framework.render import screenshot

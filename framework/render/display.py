@@ -17,7 +17,7 @@ import sys
 
 import pyglet
 
-__all__ = ["NoDisplayError", "choose_headless", "no_display_reason", "open_failure"]
+__all__ = ["NoDisplayError", "choose_headless", "no_display_reason", "no_window_line", "open_failure"]
 
 _chose_headless = False  # True once choose_headless switched pyglet to headless for want of a display
 
@@ -51,6 +51,13 @@ def no_display_reason() -> str | None:
     if _chose_headless and pyglet.options["headless"]:
         return "no display (neither DISPLAY nor WAYLAND_DISPLAY is set)"
     return None
+
+
+def no_window_line(reason: object, module: str) -> str:
+    """The one line a ``python -m module`` command with a window says where none can be shown: why,
+    and how to run it instead (the examples' play commands)."""
+    return (f"error: {reason}. Play with a display (set DISPLAY), or without a window: "
+            f"python -m {module} --headless --demo")
 
 
 def open_failure(exc: BaseException) -> str | None:
