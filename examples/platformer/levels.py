@@ -53,7 +53,7 @@ import base64
 import json
 import math
 import zlib
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NoReturn
@@ -293,51 +293,65 @@ def parse_text(
     return Level(name or Path(source).stem, source, float(tile), width, height, tiles, objects).validate()
 
 
+def _runs(grid: list[str], ch: str) -> Iterator[tuple[int, int, int]]:
+    """``(row, start, end)`` of every run of ``ch`` in a row of the text map (columns start to
+    end - 1), top to bottom, left to right."""
+    for row, line in enumerate(grid):
+        col = 0
+        while col < len(line):
+            if line[col] != ch:
+                col += 1
+                continue
+            start = col
+            while col < len(line) and line[col] == ch:
+                col += 1
+            yield row, start, col
+
+
+def _cells(grid: list[str], ch: str) -> Iterator[tuple[int, int]]:
+    """``(row, col)`` of every ``ch`` in the text map."""
+    for row, line in enumerate(grid):
+        for col, c in enumerate(line):
+            if c == ch:
+                yield row, col
+
+
 def _text_platforms(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
     height, width = len(grid), len(grid[0])
     out = []
     used = set()
-    for row, line in enumerate(grid):
-        col = 0
-        while col < width:
-            if line[col] != "M":
-                col += 1
-                continue
-            start = col
-            while col < width and line[col] == "M":
-                col += 1
-            run = col - start
+    for row, start, col in _runs(grid, "M"):
+        run = col - start
 
-            def count(cells: Iterable[tuple[int, int]]) -> int:
-                n = 0
-                for r, c in cells:
-                    if not (0 <= r < height and 0 <= c < width) or grid[r][c] != "~":
-                        break
-                    used.add((r, c))
-                    n += 1
-                return n
+        def count(cells: Iterable[tuple[int, int]]) -> int:
+            n = 0
+            for r, c in cells:
+                if not (0 <= r < height and 0 <= c < width) or grid[r][c] != "~":
+                    break
+                used.add((r, c))
+                n += 1
+            return n
 
-            right = count((row, c) for c in range(col, width))
-            left = count((row, c) for c in range(start - 1, -1, -1))
-            up = count((r, start) for r in range(row - 1, -1, -1))
-            down = count((r, start) for r in range(row + 1, height))
-            sides = [(d, n) for d, n in (("right", right), ("left", left), ("up", up), ("down", down)) if n]
-            where = f"moving platform at line {row + 1}, column {start + 1}"
-            if not sides:
-                fail(f"{where} has no path: mark the cells it sweeps with '~' on one side")
-            if len(sides) > 1:
-                fail(f"{where} has '~' paths on several sides ({', '.join(d for d, _ in sides)}); use one")
-            side, n = sides[0]
-            dx = {"right": n, "left": -n}.get(side, 0)
-            dy = {"up": n, "down": -n}.get(side, 0)
-            x = (start + run * 0.5) * tile
-            y = (height - row) * tile - tile * 0.25
-            out.append(LevelObject("platform", x, y, run * tile, tile * 0.5,
-                                   {"dx": float(dx), "dy": float(dy), "speed": 2.0, "one_way": True}))
-    for row, line in enumerate(grid):
-        for col, ch in enumerate(line):
-            if ch == "~" and (row, col) not in used:
-                fail(f"'~' at line {row + 1}, column {col + 1} is not next to a moving platform's path")
+        right = count((row, c) for c in range(col, width))
+        left = count((row, c) for c in range(start - 1, -1, -1))
+        up = count((r, start) for r in range(row - 1, -1, -1))
+        down = count((r, start) for r in range(row + 1, height))
+        sides = [(d, n) for d, n in (("right", right), ("left", left), ("up", up), ("down", down)) if n]
+        where = f"moving platform at line {row + 1}, column {start + 1}"
+        if not sides:
+            fail(f"{where} has no path: mark the cells it sweeps with '~' on one side")
+        if len(sides) > 1:
+            fail(f"{where} has '~' paths on several sides ({', '.join(d for d, _ in sides)}); use one")
+        side, n = sides[0]
+        dx = {"right": n, "left": -n}.get(side, 0)
+        dy = {"up": n, "down": -n}.get(side, 0)
+        x = (start + run * 0.5) * tile
+        y = (height - row) * tile - tile * 0.25
+        out.append(LevelObject("platform", x, y, run * tile, tile * 0.5,
+                               {"dx": float(dx), "dy": float(dy), "speed": 2.0, "one_way": True}))
+    for row, col in _cells(grid, "~"):
+        if (row, col) not in used:
+            fail(f"'~' at line {row + 1}, column {col + 1} is not next to a moving platform's path")
     return out
 
 
@@ -345,39 +359,30 @@ def _text_swings(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
     """Swings: a run of ``S`` (an odd number of cells) is the board at rest, half a tile thick on
     the top of its cells; the ``o`` straight above its middle cell (only empty cells or objects
     between) is the pivot, at that cell's centre."""
-    height, width = len(grid), len(grid[0])
+    height = len(grid)
     out = []
     pivots = set()
-    for row, line in enumerate(grid):
-        col = 0
-        while col < width:
-            if line[col] != "S":
-                col += 1
-                continue
-            start = col
-            while col < width and line[col] == "S":
-                col += 1
-            where = f"swing at line {row + 1}, column {start + 1}"
-            if (col - start) % 2 == 0:
-                fail(f"{where}: its board is {col - start} cells long; make it an odd number, so that "
-                     "its pivot 'o' can stand above its middle cell")
-            mid = (start + col) // 2
-            r = row - 1
-            while r >= 0 and (grid[r][mid] in _TEXT_EMPTY or grid[r][mid] in _TEXT_OBJECTS):
-                r -= 1
-            if r < 0 or grid[r][mid] != "o":
-                fail(f"{where} has no pivot: put an 'o' above the middle of its board (column {mid + 1}), "
-                     "with only empty cells (or objects) between")
-            pivots.add((r, mid))
-            y = (height - row) * tile - tile * 0.25
-            length = ((height - r - 0.5) * tile - y) / tile
-            out.append(LevelObject("swing", (mid + 0.5) * tile, y, (col - start) * tile, tile * 0.5,
-                                   {"length": length, "one_way": True}))
-    for row, line in enumerate(grid):
-        for col, ch in enumerate(line):
-            if ch == "o" and (row, col) not in pivots:
-                fail(f"'o' at line {row + 1}, column {col + 1} is not the pivot of a swing "
-                     "(a run of 'S' straight below it)")
+    for row, start, col in _runs(grid, "S"):
+        where = f"swing at line {row + 1}, column {start + 1}"
+        if (col - start) % 2 == 0:
+            fail(f"{where}: its board is {col - start} cells long; make it an odd number, so that "
+                 "its pivot 'o' can stand above its middle cell")
+        mid = (start + col) // 2
+        r = row - 1
+        while r >= 0 and (grid[r][mid] in _TEXT_EMPTY or grid[r][mid] in _TEXT_OBJECTS):
+            r -= 1
+        if r < 0 or grid[r][mid] != "o":
+            fail(f"{where} has no pivot: put an 'o' above the middle of its board (column {mid + 1}), "
+                 "with only empty cells (or objects) between")
+        pivots.add((r, mid))
+        y = (height - row) * tile - tile * 0.25
+        length = ((height - r - 0.5) * tile - y) / tile
+        out.append(LevelObject("swing", (mid + 0.5) * tile, y, (col - start) * tile, tile * 0.5,
+                               {"length": length, "one_way": True}))
+    for row, col in _cells(grid, "o"):
+        if (row, col) not in pivots:
+            fail(f"'o' at line {row + 1}, column {col + 1} is not the pivot of a swing "
+                 "(a run of 'S' straight below it)")
     return out
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["rows_meeting", "rows_within"]
+__all__ = ["holds", "rows_meeting", "rows_within"]
 
 
 @njit(cache=True)
@@ -29,10 +29,17 @@ def rows_meeting(kind, minx, miny, maxx, maxy, x0, y0, x1, y1):  # pragma: no co
 
 
 @njit(cache=True)
-def _holds(sorted_values, v):  # pragma: no cover - compiled
-    """Whether ``v`` is in the sorted array (binary search)."""
-    i = np.searchsorted(sorted_values, v)
-    return i < sorted_values.size and sorted_values[i] == v
+def holds(keys, key):  # pragma: no cover - compiled
+    """Whether the sorted ``keys`` hold ``key`` (a binary search; the soft step's pair and joint
+    filters use it too)."""
+    lo, hi = 0, keys.size
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if keys[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo < keys.size and keys[lo] == key
 
 
 @njit(cache=True)
@@ -49,9 +56,9 @@ def rows_within(rows, minx, miny, maxx, maxy, x0, y0, x1, y1, layer, sensor, mas
             continue
         if mask >= 0 and ((layer[r] & mask) == 0 or sensor[r]):
             continue
-        if skip_rows.size and _holds(skip_rows, r):
+        if skip_rows.size and holds(skip_rows, r):
             continue
-        if skip_entities.size and _holds(skip_entities, entity[r]):
+        if skip_entities.size and holds(skip_entities, entity[r]):
             continue
         out[m] = r
         m += 1

@@ -43,6 +43,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..collision.box_rows import holds
 from ..collision.soft_manifold import (
     DOWN,
     LEFT,
@@ -260,19 +261,6 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
 
 
 @njit(cache=True)
-def _holds(keys, key):
-    """Whether the sorted ``keys`` hold ``key`` (a binary search)."""
-    lo, hi = 0, keys.size
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if keys[mid] < key:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo < keys.size and keys[lo] == key
-
-
-@njit(cache=True)
 def _fat_overlap(fat, i, j):
     return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
 
@@ -291,7 +279,7 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
         keep[p] = not (moved[a] or moved[b]) or _fat_overlap(fat, a, b)
         if keep[p]:
             n_keep += 1
-    old_keys = pairs[:, 2].copy()  # (contiguous: the one _holds the joints use too)
+    old_keys = pairs[:, 2].copy()  # (contiguous: the one holds the joints use too)
     cap = 16
     add = np.empty((cap, 3), dtype=np.int64)
     n_add = 0
@@ -307,7 +295,7 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
                 continue
             a, b = (e, j) if entity[e] < entity[j] else (j, e)
             key = (entity[a] << 32) | entity[b]
-            if _holds(old_keys, key):  # already a candidate (and kept: it still overlaps)
+            if holds(old_keys, key):  # already a candidate (and kept: it still overlaps)
                 continue
             if n_add == cap:
                 cap *= 2
@@ -389,7 +377,7 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
             tnow[p] = -1
             slots[p, _NP] = 0.0
             continue
-        if apart.size and _holds(apart, pairs[p, 2]):  # joined, not colliding
+        if apart.size and holds(apart, pairs[p, 2]):  # joined, not colliding
             tnow[p] = 0
             slots[p, _NP] = 0.0
             continue
