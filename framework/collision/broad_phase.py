@@ -188,18 +188,12 @@ class SpatialHash:
         second hash holding the sleeping ones).
         """
         b = as_bounds(minx, miny, maxx, maxy)
-        mids = _as_ids(ids, b[0].shape[0])
         n = b[0].shape[0]
-        cell = self._choose_cell(b)
         # Up to SMALL bodies are paired directly, every two of them (cheaper than sorting them into
         # strips), the statics through the bodies near one: the same pairs as the strips give.
         few = n <= SMALL
-        mov = self._moving = (_FewBodies((b[0].copy(), b[1].copy(), b[2].copy(), b[3].copy())) if few
-                              else StripSweep(b, cell))
-        self._moving_cells = None
-        self._queries = 0
-        self._moving_ids = ids = mids.copy()
-        self.rehashed_last = n
+        self._enter(b, ids, None if few else StripSweep(b, self._choose_cell(b)))
+        mov, ids = self._moving, self._moving_ids
 
         out_a: list[NDArray[np.int64]] = []
         out_b: list[NDArray[np.int64]] = []
@@ -235,10 +229,15 @@ class SpatialHash:
         """Take up to :data:`SMALL` moving bodies as a :meth:`pairs` call does (for the queries
         and the overlay's cells), without pairing them: the caller paired them itself
         (:func:`direct_pairs`)."""
-        b = as_bounds(minx, miny, maxx, maxy)
+        self._enter(as_bounds(minx, miny, maxx, maxy), ids, None)
+
+    def _enter(self, b: Bounds, ids: ArrayLike, strips: StripSweep | None) -> None:
+        """Take the moving bodies of a step: swept into ``strips``, or (None) kept as they are,
+        a few paired directly; the cell size chosen from them if none was yet."""
         mids = _as_ids(ids, b[0].shape[0])
         self._choose_cell(b)
-        self._moving = _FewBodies((b[0].copy(), b[1].copy(), b[2].copy(), b[3].copy()))
+        self._moving = strips if strips is not None else _FewBodies((b[0].copy(), b[1].copy(), b[2].copy(),
+                                                                     b[3].copy()))
         self._moving_cells = None
         self._queries = 0
         self._moving_ids = mids.copy()
