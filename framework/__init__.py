@@ -6,7 +6,7 @@ Importing it (and running scenes without a renderer) never imports pyglet's GL m
 from typing import TYPE_CHECKING, Any
 
 from .components import Body, Hitbox, MassData, Transform, Velocity, Visual
-from .shapes import AABB, Capsule, Circle, Polygon, Shape
+from .shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .text import Text
 from .validation import InvalidValue
 
@@ -23,7 +23,7 @@ __all__ = [
     "AABB", "Body", "Camera", "Capsule", "CharacterController", "Circle", "CollisionEvent", "Contact", "DistanceJoint",
     "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Polygon", "PrismaticJoint",
     "RayHit",
-    "Renderer", "RevoluteJoint",
+    "Renderer", "RevoluteJoint", "Segment",
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",
     "WeldJoint", "WheelJoint", "collide", "run", "screenshot",
 ]

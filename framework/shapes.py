@@ -10,6 +10,8 @@ hitbox origin is local (0, 0): AABBs and circles are centred on it, polygons rot
 - :class:`Polygon` is a convex outline, either winding; it is stored counter-clockwise, starting at
   its lowest (then leftmost) vertex, so equal outlines given in any order compare equal and give
   the same answers bit for bit.
+- :class:`Segment` is a two-sided line from ``a`` to ``b`` in local coordinates: no area, so it is
+  terrain (a static or kinematic body's hitbox), never a dynamic body's only shape.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from typing import ClassVar
 
 from .validation import InvalidValue, finite, positive
 
-__all__ = ["AABB", "Capsule", "Circle", "Polygon", "Shape"]
+__all__ = ["AABB", "Capsule", "Circle", "Polygon", "Segment", "Shape"]
 
 # Tolerance of the "collinear" test: a vertex within this fraction of the polygon's extent (plus 16
 # units of rounding of its coordinates) of the line through its neighbours is on that line. It is a
@@ -273,6 +275,86 @@ class Polygon(Shape):
 
     def __len__(self) -> int:
         return len(self.points)
+
+
+@dataclass(frozen=True, slots=True)
+class Segment(Shape):
+    """The straight line from ``a`` to ``b`` (points in local coordinates), two-sided; it rotates with
+    its transform about the hitbox origin, local (0, 0).
+
+    A segment has no interior of its own: another shape collides with it when the segment enters
+    that shape's interior (touching is no collision). Its area is 0, so it gives a body no mass:
+    it is for static and kinematic bodies (terrain drawn as lines). The two ends must be finite
+    and distinct; anything else raises :class:`ValueError` naming the bad value.
+    """
+
+    a: tuple[float, float]
+    b: tuple[float, float]
+    kind: ClassVar[str] = "segment"
+
+    def __post_init__(self) -> None:
+        a = _point("Segment a", self.a)
+        b = _point("Segment b", self.b)
+        if a == b:
+            raise InvalidValue(f"Segment ends must be distinct, got a = b = {self.a!r}")
+        if not math.isfinite(math.hypot(b[0] - a[0], b[1] - a[1])):
+            raise InvalidValue(f"Segment from {self.a!r} to {self.b!r} is too long: its length overflows float64")
+        object.__setattr__(self, "a", a)
+        object.__setattr__(self, "b", b)
+
+    @property
+    def length(self) -> float:
+        return math.hypot(self.b[0] - self.a[0], self.b[1] - self.a[1])
+
+    @property
+    def normal(self) -> tuple[float, float]:
+        """The unit normal on the right of the direction a -> b, ``(dy, -dx) / |d|``, in local
+        coordinates (for a segment drawn left to right, it points down)."""
+        dx, dy = self.b[0] - self.a[0], self.b[1] - self.a[1]
+        ln = math.hypot(dx, dy)
+        return dy / ln + 0.0, -dx / ln + 0.0
+
+    @property
+    def bounding_radius(self) -> float:
+        return max(math.hypot(*self.a), math.hypot(*self.b))
+
+    @property
+    def area(self) -> float:
+        return 0.0
+
+    @property
+    def second_moment(self) -> float:
+        # A uniform rod from a to b, about the origin: the mean of |a + t (b - a)|^2 over t in [0, 1].
+        (ax, ay), (bx, by) = self.a, self.b
+        return (ax * ax + ay * ay + ax * bx + ay * by + bx * bx + by * by) / 3.0
+
+    @property
+    def centroid(self) -> tuple[float, float]:
+        """The segment's midpoint (a uniform rod's centre)."""
+        return (0.5 * self.a[0] + 0.5 * self.b[0], 0.5 * self.a[1] + 0.5 * self.b[1])
+
+    @property
+    def central_moment(self) -> float:
+        ln = self.length
+        return ln * ln / 12.0
+
+
+def _point(name: str, p: object) -> tuple[float, float]:
+    """A finite (x, y) pair (-0.0 made 0.0), its distance from the origin finite."""
+    if isinstance(p, (str, bytes)):
+        raise InvalidValue(f"{name} must be an (x, y) pair, got {p!r}")
+    try:
+        n = len(p)  # type: ignore[arg-type]
+    except TypeError:
+        raise InvalidValue(f"{name} must be an (x, y) pair, got {p!r}") from None
+    if n != 2:
+        raise InvalidValue(f"{name} must be an (x, y) pair, got {p!r}")
+    seq: Sequence[object] = p  # type: ignore[assignment]
+    x = finite(f"{name} x", seq[0]) + 0.0
+    y = finite(f"{name} y", seq[1]) + 0.0
+    if not math.isfinite(math.hypot(x, y)):
+        raise InvalidValue(f"{name} {p!r} is too far from the origin: its distance overflows float64")
+    return x, y
 
 
 def _halvable(name: str, value: object) -> float:

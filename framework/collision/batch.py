@@ -43,7 +43,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue
 from .batch_box import aabb_aabb, aabb_aabb_fast
 from .batch_circle import circle_circle, polygon_circle
@@ -67,17 +67,23 @@ __all__ = [
 
 
 def _template(shape: object) -> tuple[tuple[tuple[float, float], ...], bool]:
-    """Local outline of a box or polygon and whether it turns with its transform."""
+    """Local outline of a box or polygon (or a segment: its two ends) and whether it turns with its
+    transform."""
     if isinstance(shape, AABB):
         hw, hh = shape.width * 0.5, shape.height * 0.5
         return ((-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)), False
     if isinstance(shape, Polygon):
         return shape.points, True
-    raise InvalidValue(f"outlines needs AABB or Polygon shapes, got {shape!r}")
+    if isinstance(shape, Segment):
+        return (shape.a, shape.b), True
+    raise InvalidValue(f"outlines needs AABB, Polygon or Segment shapes, got {shape!r}")
 
 
-def outlines(shapes: Sequence[AABB | Polygon], rotations: object) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    """Outlines of boxes and polygons, rotated, relative to their hitbox origins.
+def outlines(
+    shapes: Sequence[AABB | Polygon | Segment], rotations: object,
+) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """Outlines of boxes and polygons (a segment: its two ends), rotated, relative to their hitbox
+    origins.
 
     Returns ``(verts, counts)``: ``verts [N, K, 2]`` float64, counter-clockwise, ``K`` the largest
     vertex count, the slots past a shape's count repeating its last vertex; ``counts [N]``.
@@ -167,8 +173,8 @@ def collide_many(
     def shape_outlines(
         shapes: list[Shape], rot: NDArray[np.float64], rows: NDArray[np.intp],
     ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-        # (the pair table sends only boxes and polygons here)
-        return outlines(cast("list[AABB | Polygon]", [shapes[i] for i in rows]), rot[rows])
+        # (the pair table sends only boxes, polygons and segments here)
+        return outlines(cast("list[AABB | Polygon | Segment]", [shapes[i] for i in rows]), rot[rows])
 
     run(family == CIRCLES, lambda r: circle_circle(
         pa[r, 0], pa[r, 1], radius(sa, r), pb[r, 0], pb[r, 1], radius(sb, r)))
@@ -208,13 +214,13 @@ def core_rows(
 ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
     """The cores of shapes for :func:`capsule_many`, rotated, about their hitbox origins:
     ``(verts [N, K, 2], counts [N], radii [N])`` (a circle: its centre; a capsule: its ends ``-u``,
-    ``+u``; a box or polygon: its outline, radius 0)."""
+    ``+u``; a box or polygon: its outline, a segment: its two ends, radius 0)."""
     n = len(shapes)
     rot = np.broadcast_to(np.asarray(rotations, dtype=F64), (n,))
-    outl = [i for i, s in enumerate(shapes) if isinstance(s, (AABB, Polygon))]
+    outl = [i for i, s in enumerate(shapes) if isinstance(s, (AABB, Polygon, Segment))]
     caps = [i for i, s in enumerate(shapes) if isinstance(s, Capsule)]
-    verts_o, count_o = (outlines(cast("list[AABB | Polygon]", [shapes[i] for i in outl]), rot[outl]) if outl
-                        else (np.zeros((0, 2, 2)), None))
+    outlined = cast("list[AABB | Polygon | Segment]", [shapes[i] for i in outl])
+    verts_o, count_o = outlines(outlined, rot[outl]) if outl else (np.zeros((0, 2, 2)), None)
     k = max(2, verts_o.shape[1])
     verts = np.zeros((n, k, 2))
     counts = np.ones(n, dtype=np.int64)

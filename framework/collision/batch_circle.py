@@ -97,6 +97,10 @@ def _polygon_circle(ax, ay, averts, acount, bx, by, br, flip, size, fallback: bo
     s = ey * wx - ex * wy  # unnormalised distance outside each face; 0 on padding edges
     out = s > 0.0
     inside = ~out.any(axis=0) & valid.any(axis=0)  # (a polygon shrunk to a point has no faces)
+    if (count == 2).any():
+        # A segment (an outline of two points): on its line is inside only between its ends.
+        t0, e0 = wx[0] * ex[0] + wy[0] * ey[0], ex[0] * ex[0] + ey[0] * ey[0]
+        inside &= (count != 2) | ((t0 >= 0.0) & (t0 <= e0))
     # Inside (or on the boundary): out through the nearest face, plus the radius.
     absent = (~valid).astype(F64)
     ln = norm(ex, ey) + absent  # 1 on padding edges

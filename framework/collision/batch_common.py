@@ -141,8 +141,9 @@ def finish(
 def outline_rows(
     verts: object, count: object, name: str,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]:
-    """``(vx [K, P], vy [K, P], count [P])`` of an outline batch ``[P, K, 2]``; the padding is
-    rewritten to repeat each outline's last vertex, whatever the caller put there."""
+    """``(vx [K, P], vy [K, P], count [P])`` of an outline batch ``[P, K, 2]`` (an outline of two
+    points is a segment); the padding is rewritten to repeat each outline's last vertex, whatever
+    the caller put there."""
     v = np.asarray(verts, dtype=F64)
     if v.ndim != 3 or v.shape[2] != 2:
         raise InvalidValue(f"{name} must have shape [P, K, 2], got {v.shape}")
@@ -151,8 +152,8 @@ def outline_rows(
     if c.shape != (p,):
         c = np.broadcast_to(c, (p,))
     c = c.astype(np.intp, copy=False)
-    if p and (c.min() < 3 or c.max() > k):
-        raise InvalidValue(f"{name} counts must lie in [3, {k}], got {c.min()}..{c.max()}")
+    if p and (c.min() < 2 or c.max() > k):
+        raise InvalidValue(f"{name} counts must lie in [2, {k}], got {c.min()}..{c.max()}")
     vx = np.ascontiguousarray(v[:, :, 0].T)
     vy = np.ascontiguousarray(v[:, :, 1].T)
     if p and c.min() < k:

@@ -1,6 +1,7 @@
 """The contact point of two overlapping convex outlines, vectorised over pairs.
 
-As ``collide.overlap_point``: the mean of the vertices of A ∩ B, i.e. A's vertices inside B, B's
+As ``collide.overlap_point``: the mean of the vertices of A ∩ B (an outline of two points is a
+segment), i.e. A's vertices inside B, B's
 vertices inside A (``[Ka, Kb, P]`` edge tests) and the crossings of every edge of A with every edge
 of B (``[Ka, Kb, P]``), each included by the same closed tests. The mean is a convex combination of
 points of A ∩ B, so it lies in the overlap.
@@ -24,12 +25,25 @@ def _inside(x, y, ox, oy, ex, ey, tol):
     return ~(cross < -tol * norm(ex, ey)[None]).any(axis=1)
 
 
+def _within_segment(x, y, ox, oy, count, tol):
+    """``[Kp, P]``: for the outlines of two points (segments, ``count`` 2), points (x, y) between the
+    ends along the segment (their being on its line is :func:`_inside`'s test), as
+    ``collide._inside``; true for the other outlines."""
+    ex, ey = ox[1] - ox[0], oy[1] - oy[0]
+    along = ex * (x - ox[0]) + ey * (y - oy[0])
+    slack = tol * norm(ex, ey)
+    return (count != 2) | ((along >= -slack) & (along <= ex * ex + ey * ey + slack))
+
+
 def overlap_point(avx, avy, acount, bvx, bvy, bcount, nx, ny, depth, size):
     """Mean of the vertices of A ∩ B for overlapping outlines ``[K, P]`` (B at its offset)."""
     tol = POINT_TOL * size
     exa, eya, exb, eyb = edges(avx), edges(avy), edges(bvx), edges(bvy)
     ina = _inside(avx, avy, bvx, bvy, exb, eyb, tol) & vertex_mask(acount, avx.shape[0])
     inb = _inside(bvx, bvy, avx, avy, exa, eya, tol) & vertex_mask(bcount, bvx.shape[0])
+    if (acount == 2).any() or (bcount == 2).any():
+        ina &= _within_segment(avx, avy, bvx, bvy, bcount, tol)
+        inb &= _within_segment(bvx, bvy, avx, avy, acount, tol)
     ina, inb = ina.astype(F64), inb.astype(F64)
     sx = sum_leading(avx * ina) + sum_leading(bvx * inb)
     sy = sum_leading(avy * ina) + sum_leading(bvy * inb)

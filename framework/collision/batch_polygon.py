@@ -115,7 +115,8 @@ def _sat(avx, avy, acount, bvx, bvy, bcount, ax, ay, bx, by, dx, dy, k, size, fa
     bwd = (bmax - amin) + ud
     least = np.minimum(fwd, bwd)
     tol = BAND * (np.abs(ux) + np.abs(uy)) * (size + np.abs(dx) + np.abs(dy))
-    apart = ((least < -tol) & valid).any(axis=0) | ~valid.any(axis=0)
+    # (two outlines of two points, two segments, have no interior to overlap)
+    apart = ((least < -tol) & valid).any(axis=0) | ~valid.any(axis=0) | ((acount == 2) & (bcount == 2))
     border = ((least <= tol) & valid).any(axis=0) & ~apart
     hit = ~apart & ~border
     for i in np.flatnonzero(border) if fallback else ():

@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .exact import BAND, TINY, Offset, float_approx, ratio_approx, rounded_exact
 from .ray import closest_on_segment
 from .tiebreak import DEPTH_TOL, DIR_TOL
@@ -83,9 +83,12 @@ def half_segments(half_length: ArrayLike, rotation: ArrayLike) -> tuple[NDArray[
 
 def core_points(shape: Shape, rotation: float, k: int = 0) -> tuple[list[tuple[float, float]], float]:
     """The core of a shape about its hitbox origin, scaled by ``2**-k``, and its radius: a circle's
-    centre, a capsule's two segment ends (``-u``, ``+u``), a box's or polygon's outline (radius 0)."""
+    centre, a capsule's two segment ends (``-u``, ``+u``), a box's or polygon's outline, a segment's
+    two ends (radius 0)."""
     from .placement import local_outline
 
+    if isinstance(shape, Segment):
+        return local_outline(shape, rotation, k), 0.0
     if isinstance(shape, Circle):
         return [(0.0, 0.0)], math.ldexp(shape.radius, -k)
     if isinstance(shape, Capsule):

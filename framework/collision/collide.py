@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue
 from .capsule import capsule_first, capsule_pair
 from .exact import (
@@ -127,9 +127,9 @@ def _pair(
         # (the pair rule puts the box or polygon first)
         res = polygon_circle(local_outline(cast("AABB | Polygon", sa), rot_a, k), dx, dy, math.ldexp(sb.radius, -k),
                              off, size, flip)
-    else:  # BOXES or POLYGONS: boxes are polygons here
-        res = polygon_polygon(local_outline(cast("AABB | Polygon", sa), rot_a, k),
-                              local_outline(cast("AABB | Polygon", sb), rot_b, k), dx, dy, off, size)
+    else:  # BOXES or POLYGONS: boxes are polygons here, and a segment an outline of two points
+        res = polygon_polygon(local_outline(cast("AABB | Polygon | Segment", sa), rot_a, k),
+                              local_outline(cast("AABB | Polygon | Segment", sb), rot_b, k), dx, dy, off, size)
     return None if res is None else (res, k)
 
 
@@ -181,7 +181,7 @@ def polygon_circle(
     faces = _faces(poly)
     # Unnormalised signed distances of the centre outside each face (outward normal (ey, -ex)).
     seps = [ey * (cx - x0) - ex * (cy - y0) for x0, y0, ex, ey, _, _ in faces]
-    if faces and all(s <= 0.0 for s in seps):
+    if faces and all(s <= 0.0 for s in seps) and (len(poly) != 2 or _between(poly, cx, cy)):
         # Centre inside (or on the boundary): push out through the nearest face, plus the radius.
         cands = _inside_candidates(faces, seps, r, f)
         if min(c[0] for c in cands) > tol:
@@ -212,6 +212,15 @@ def polygon_circle(
     if dist > r - tol:
         return _polygon_circle_exact(poly, cx, cy, r, off, size, f)
     return f * nx, f * ny, r - dist, px, py
+
+
+def _between(seg: Pts, cx: float, cy: float) -> bool:
+    """The projection of (cx, cy) on the segment (an outline of two points) lies between its ends
+    (with the centre on its line, the centre is then on the segment: "inside" it)."""
+    (x0, y0), (x1, y1) = seg
+    ex, ey = x1 - x0, y1 - y0
+    t = (cx - x0) * ex + (cy - y0) * ey
+    return 0.0 <= t <= ex * ex + ey * ey
 
 
 Face = tuple[float, float, float, float, float, int]
@@ -314,7 +323,10 @@ def _extent(poly: Pts, ux: float, uy: float) -> tuple[float, float]:
 def polygon_polygon(
     pa: Pts, lb: Pts, dx: float, dy: float, off: Offset, size: float
 ) -> Res | None:
-    """Convex CCW outline A at the origin and B (outline ``lb`` about its own origin) at (dx, dy)."""
+    """Convex CCW outline A at the origin and B (outline ``lb`` about its own origin) at (dx, dy).
+    Two outlines of two points (segments) have no interior between them: never a contact."""
+    if len(pa) == 2 and len(lb) == 2:
+        return None
     edges = _axes(pa, lb)
     # Each axis times 2**-k (exact): its larger component in [0.5, 1), so that a very short edge's
     # products with small coordinates do not underflow. No decision or result bit changes.
@@ -376,8 +388,16 @@ POINT_TOL = 1e-12
 
 
 def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:
-    """(x, y) in the closed convex CCW polygon, allowing ``tol`` (relative) of rounding."""
+    """(x, y) in the closed convex CCW polygon, allowing ``tol`` (relative) of rounding. An outline
+    of two points is a segment: on its line and between its ends."""
     n = len(poly)
+    if n == 2:
+        (x0, y0), (x1, y1) = poly
+        ex, ey = x1 - x0, y1 - y0
+        ln = math.hypot(ex, ey)
+        along = ex * (x - x0) + ey * (y - y0)
+        if not -tol * ln <= along <= ex * ex + ey * ey + tol * ln:
+            return False
     for i in range(n):
         x0, y0 = poly[i]
         x1, y1 = poly[(i + 1) % n]
@@ -388,7 +408,8 @@ def _inside(poly: Pts, x: float, y: float, tol: float) -> bool:
 
 
 def overlap_point(pa: Pts, pb: Pts, nx: float, ny: float, depth: float, size: float) -> tuple[float, float]:
-    """A point of the intersection of two overlapping convex polygons.
+    """A point of the intersection of two overlapping convex polygons (or a polygon and a segment,
+    an outline of two points).
 
     The vertices of A ∩ B are A's vertices inside B, B's vertices inside A and the crossings of
     their edges; their mean is a convex combination, so it lies in A ∩ B.

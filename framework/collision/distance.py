@@ -1,11 +1,13 @@
 """The distance between two shapes and their closest points (aiming, AI, "how far is the wall").
 
 Every shape is a *rounded convex core*: an AABB or polygon its corners (radius 0), a circle its
-centre (radius r), a capsule its segment (radius r). Two shapes that overlap or touch are at
+centre (radius r), a capsule its segment (radius r), a segment its two ends
+(radius 0). Two shapes that overlap or touch are at
 distance 0 (:func:`~framework.collision.collide` decides overlap exactly; a touching pair's
 feature distance rounds to 0). Apart, the distance is the least distance between the cores' features
 (a vertex of one against an edge or vertex of the other) less the two radii, and the closest
-points lie on the surfaces along the line between the cores' closest points. Floats: the distance
+points lie on the surfaces along the line between the cores' closest points. Two segments that
+cross (or touch) are at distance 0, with their crossing as both points. Floats: the distance
 is within a few ulps of the exact one.
 """
 
@@ -14,7 +16,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .collide import collide
 from .placement import check_shape, pose
 from .ray import closest_on_segment
@@ -42,6 +44,9 @@ def shape_core(shape: Shape, x: float, y: float, rotation: float) -> tuple[list[
     if isinstance(shape, Capsule):
         h = 0.5 * shape.length
         return [(x + s * h, y - c * h), (x - s * h, y + c * h)], shape.radius
+    if isinstance(shape, Segment):
+        (ax, ay), (bx, by) = shape.a, shape.b
+        return [(x + c * ax - s * ay, y + s * ax + c * ay), (x + c * bx - s * by, y + s * bx + c * by)], 0.0
     if isinstance(shape, AABB):  # never turns
         hw, hh = shape.half_width, shape.half_height
         return [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)], 0.0
@@ -71,6 +76,21 @@ def _closest_cores(a: list[tuple[float, float]], b: list[tuple[float, float]]):
     return best
 
 
+def _crossing(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> tuple[float, float] | None:
+    """A point where two segments meet (crossing, or touching at an end), or ``None``."""
+    (p0x, p0y), (p1x, p1y) = a
+    (q0x, q0y), (q1x, q1y) = b
+    rx, ry, sx, sy = p1x - p0x, p1y - p0y, q1x - q0x, q1y - q0y
+    den = rx * sy - ry * sx
+    if den == 0.0:
+        return None  # parallel: the closest features give the distance (0 if they overlap)
+    wx, wy = q0x - p0x, q0y - p0y
+    t, u = (wx * sy - wy * sx) / den, (wx * ry - wy * rx) / den
+    if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0:
+        return p0x + t * rx, p0y + t * ry
+    return None
+
+
 def distance(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: object) -> Distance:
     """The distance from shape A to shape B and their closest points (see the module docstring).
     Transforms as :func:`~framework.collision.collide` takes them; bad shapes or non-finite
@@ -83,6 +103,10 @@ def distance(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: o
         return Distance(0.0, contact.point, contact.point)
     core_a, ra = shape_core(shape_a, *pa)
     core_b, rb = shape_core(shape_b, *pb)
+    if isinstance(shape_a, Segment) and isinstance(shape_b, Segment):
+        cross = _crossing(core_a, core_b)
+        if cross is not None:  # (collide never calls two segments a contact: no interior)
+            return Distance(0.0, Vec2(*cross), Vec2(*cross))
     d, (ax, ay), (bx, by) = _closest_cores(core_a, core_b)
     gap = d - ra - rb
     if d > 0.0:

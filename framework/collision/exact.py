@@ -102,7 +102,8 @@ class PolygonCircleExact(NamedTuple):
 
 def polygon_circle_exact(poly: Pts, offset: Offset, r: float) -> PolygonCircleExact | None:
     """Convex CCW outline at the origin against the circle of radius ``r`` at the offset, on exact
-    integers: ``None`` if they do not overlap (touching is no overlap)."""
+    integers: ``None`` if they do not overlap (touching is no overlap). An outline of two points is
+    a segment: its centre is "inside" only on the segment itself."""
     n = len(poly)
     ecx, ecy, rest, e = exact_ints(offset, [r, *(c for p in poly for c in p)])
     er, pts = rest[0], [(rest[1 + 2 * i], rest[2 + 2 * i]) for i in range(n)]
@@ -110,7 +111,9 @@ def polygon_circle_exact(poly: Pts, offset: Offset, r: float) -> PolygonCircleEx
     for i in range(n):
         (x0, y0), (x1, y1) = pts[i], pts[(i + 1) % n]
         seps.append((y1 - y0) * (ecx - x0) - (x1 - x0) * (ecy - y0))
-    if any(pts[i] != pts[(i + 1) % n] for i in range(n)) and all(s <= 0 for s in seps):
+    on_segment = n != 2 or 0 <= (ecx - pts[0][0]) * (pts[1][0] - pts[0][0]) + (ecy - pts[0][1]) * (
+        pts[1][1] - pts[0][1]) <= (pts[1][0] - pts[0][0]) ** 2 + (pts[1][1] - pts[0][1]) ** 2
+    if any(pts[i] != pts[(i + 1) % n] for i in range(n)) and all(s <= 0 for s in seps) and on_segment:
         # Inside or on the boundary: always an overlap (r > 0).
         return PolygonCircleExact("inside", -1, seps, 0, 0, 0, 0, e)
     # Outside: the nearest point is on the first face whose region holds the centre, or a vertex.

@@ -7,7 +7,10 @@ that segment's ends (a box on one point would rock). :func:`manifold` clips, as 
 contact normal (on A, or on B against it); the *incident* face of the other shape is its face
 most opposed to that; the incident face, clipped to the reference face's extent, gives up to two
 points, and those below the reference face are the manifold, each with its depth below it.
-Circles touch at one point: collide's. Points are in the overlap region (the contract's rule for
+A segment is an outline of two points here (its two faces are its two sides); as a reference face
+it clips the incident face to its own extent, the planes through its ends (as Box2D's
+``b2ClipPolygons`` does with a reference edge's side planes). Circles touch at one point:
+collide's. Points are in the overlap region (the contract's rule for
 ``Contact.point``), on the boundary of one of the shapes, deepest first.
 """
 
@@ -16,7 +19,7 @@ from __future__ import annotations
 import math
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .collide import collide
 from .placement import local_outline, pose
 from .results import Manifold, ManifoldPoint, Vec2
@@ -38,9 +41,9 @@ def manifold(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: o
     single = Manifold(c.normal, (ManifoldPoint(c.point, c.depth),))
     if isinstance(shape_a, (Circle, Capsule)) or isinstance(shape_b, (Circle, Capsule)):
         return single  # (a round shape touches at one point)
-    # (collide accepted them and neither is round: boxes or polygons)
-    pa = _world(cast("AABB | Polygon", shape_a), *pose("transform_a", transform_a))
-    pb = _world(cast("AABB | Polygon", shape_b), *pose("transform_b", transform_b))
+    # (collide accepted them and neither is round: boxes, polygons or a segment)
+    pa = _world(cast("AABB | Polygon | Segment", shape_a), *pose("transform_a", transform_a))
+    pb = _world(cast("AABB | Polygon | Segment", shape_b), *pose("transform_b", transform_b))
     nx, ny = c.normal
     ia, along_a = _facing(pa, nx, ny)
     ib, along_b = _facing(pb, -nx, -ny)
@@ -54,7 +57,7 @@ def manifold(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: o
     return Manifold(c.normal, tuple(points))
 
 
-def _world(shape: AABB | Polygon, x: float, y: float, rotation: float) -> Pts:
+def _world(shape: AABB | Polygon | Segment, x: float, y: float, rotation: float) -> Pts:
     """The shape's outline in world coordinates, counter-clockwise."""
     return [(x + px, y + py) for px, py in local_outline(shape, rotation)]
 
@@ -86,11 +89,15 @@ def _clip(ref: Pts, i: int, inc: Pts) -> list[ManifoldPoint]:
     j, _ = _facing(inc, -fx, -fy)
     (v0x, v0y), (v1x, v1y) = inc[j], inc[(j + 1) % len(inc)]
     lo, hi = 0.0, 1.0
-    for k in range(len(ref)):
-        if k == i:
-            continue
-        kx, ky = _normal(ref, k)
-        rx, ry = ref[k]
+    if len(ref) == 2:
+        # A segment: its extent is between the planes through its ends, facing out along it.
+        (ax, ay), (bx, by) = ref[i], ref[1 - i]
+        ln = math.hypot(bx - ax, by - ay)
+        ux, uy = (bx - ax) / ln, (by - ay) / ln
+        planes = [(ax, ay, -ux, -uy), (bx, by, ux, uy)]
+    else:
+        planes = [(*ref[k], *_normal(ref, k)) for k in range(len(ref)) if k != i]
+    for rx, ry, kx, ky in planes:
         s0 = (rx - v0x) * kx + (ry - v0y) * ky  # >= 0: v0 inside face k
         s1 = (rx - v1x) * kx + (ry - v1y) * ky
         if s0 < 0.0 and s1 < 0.0:

@@ -10,15 +10,15 @@ import math
 from collections.abc import Sequence
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue, finite
 
 __all__ = ["pose", "local_outline", "check_shape"]
 
 
 def check_shape(name: str, shape: object) -> Shape:
-    if not isinstance(shape, (AABB, Capsule, Circle, Polygon)):
-        raise InvalidValue(f"{name} must be an AABB, Capsule, Circle or Polygon, got {shape!r}")
+    if not isinstance(shape, (AABB, Capsule, Circle, Polygon, Segment)):
+        raise InvalidValue(f"{name} must be an AABB, Capsule, Circle, Polygon or Segment, got {shape!r}")
     return shape
 
 
@@ -42,9 +42,11 @@ def pose(name: str, transform: object) -> tuple[float, float, float]:
             finite(f"{name}[2]", rot))
 
 
-def local_outline(shape: AABB | Polygon, rotation: float, k: int = 0) -> list[tuple[float, float]]:
+def local_outline(shape: AABB | Polygon | Segment, rotation: float, k: int = 0) -> list[tuple[float, float]]:
     """Outline (counter-clockwise) of a box or polygon about its own hitbox origin, rotated, and
-    scaled by ``2**-k`` (exact, bar underflow) before rotating so that nothing overflows.
+    scaled by ``2**-k`` (exact, bar underflow) before rotating so that nothing overflows; a
+    segment's outline is its two ends, ``a`` then ``b`` (an outline of two points, whose two edges
+    are the segment both ways).
 
     AABBs ignore ``rotation``. A query that scales its whole scene by the same power of two gets
     the answers of the unscaled scene bit for bit, without overflow or underflow at the extremes.
@@ -52,7 +54,8 @@ def local_outline(shape: AABB | Polygon, rotation: float, k: int = 0) -> list[tu
     if isinstance(shape, AABB):
         hw, hh = math.ldexp(shape.width, -1 - k), math.ldexp(shape.height, -1 - k)
         return [(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)]
-    pts = [(math.ldexp(px, -k), math.ldexp(py, -k)) for px, py in shape.points]
+    src = (shape.a, shape.b) if isinstance(shape, Segment) else shape.points
+    pts = [(math.ldexp(px, -k), math.ldexp(py, -k)) for px, py in src]
     if rotation == 0.0:
         return pts
     c, s = math.cos(rotation), math.sin(rotation)

@@ -18,6 +18,11 @@ as :func:`~framework.collision.collide.collide` decides touching.
   redone on exact rationals.
 - Circles use the discriminant written as ``|d|^2 r^2 - (m x d)^2`` and the numerically stable
   root (:func:`~framework.collision.pieces.disc_interval`, exact near tangency).
+- A segment has no interior: a ray hits it where it crosses it (a closed segment: through an end
+  counts, so a ray through the shared vertex of two segments of a chain hits), and a ray parallel
+  to it (along it included) misses, as a graze. The crossing's three signs (the ray against the
+  segment's line, and the crossing against either end) are decided exactly where rounding could
+  flip them (:func:`_ray_segment`).
 - A capsule is the union of an open rectangle (its segment pushed out both ways by the radius) and
   two open discs at the segment's ends (:func:`~framework.collision.pieces.rounded_segment`). Each
   piece's interval is kept on its own and the ray enters where it first enters one of them: a ray
@@ -36,9 +41,9 @@ from fractions import Fraction
 from numbers import Real
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue, vector2
-from .exact import BAND, TINY
+from .exact import BAND, TINY, ratio_approx
 from .pieces import TIE, disc_interval, first_entry, ints, rounded_segment
 from .placement import check_shape, pose
 from .results import RayHit, Vec2
@@ -84,6 +89,11 @@ def raycast(
         res = _ray_circle(mx, my, math.ldexp(shape.radius, -k), ux, uy)
     elif isinstance(shape, Capsule):
         res = _ray_capsule(mx, my, shape, rot, k, ux, uy)
+    elif isinstance(shape, Segment):
+        from .placement import local_outline
+
+        (s0x, s0y), (s1x, s1y) = local_outline(shape, rot, k)
+        res = _ray_segment(mx, my, s0x, s0y, s1x, s1y, ux, uy)
     else:
         # (not a circle or a capsule: check_shape let only a box or a polygon through)
         res = _ray_polygon(scaled_outline(cast("AABB | Polygon", shape), 0.0, 0.0, rot, k), mx, my, ux, uy, ulen)
@@ -157,6 +167,50 @@ def _ray_circle(mx: float, my: float, r: float, dx: float, dy: float) -> _Res | 
     return t1, ((hx / ln, hy / ln) if ln > 0.0 else (0.0, 1.0))
 
 
+def _ray_segment(mx: float, my: float, s0x: float, s0y: float, s1x: float, s1y: float, dx: float,
+                 dy: float) -> _Res | None:
+    """The ray ``m + tau d`` against the closed segment s0 s1: where it crosses it, with the
+    segment's normal facing the ray; ``None`` if it is parallel to it (a graze) or passes by.
+
+    With ``w = s0 - m`` and ``e = s1 - s0``, the crossing is at ``tau = (w x e) / (d x e)`` and
+    ``s = (w x d) / (d x e)`` along the segment; it is a hit for ``tau >= 0`` and ``0 <= s <= 1``.
+    Where ``d x e``, ``tau`` or ``s`` is within rounding of a boundary of those tests, the three
+    cross products are worked again on exact integers."""
+    ex, ey = s1x - s0x, s1y - s0y
+    wx, wy = s0x - mx, s0y - my
+    den = dx * ey - dy * ex
+    num_t = wx * ey - wy * ex
+    num_s = wx * dy - wy * dx
+    band_den = BAND * (abs(dx * ey) + abs(dy * ex))
+    band_t = BAND * (abs(wx * ey) + abs(wy * ex))
+    band_s = BAND * (abs(wx * dy) + abs(wy * dx))
+    if (abs(den) <= band_den or abs(num_t) <= band_t
+            or abs(num_s) <= band_s or abs(num_s - den) <= band_s + band_den):
+        (imx, imy, i0x, i0y, i1x, i1y, idx, idy), e = ints((mx, my, s0x, s0y, s1x, s1y, dx, dy))
+        iex, iey, iwx, iwy = i1x - i0x, i1y - i0y, i0x - imx, i0y - imy
+        iden = idx * iey - idy * iex
+        if iden == 0:
+            return None  # parallel: along the segment, or beside it
+        inum_t = iwx * iey - iwy * iex
+        inum_s = iwx * idy - iwy * idx
+        if iden < 0:
+            iden, inum_t, inum_s = -iden, -inum_t, -inum_s
+        if inum_t < 0 or inum_s < 0 or inum_s > iden:
+            return None
+        tau = 0.0 if inum_t == 0 else ratio_approx(inum_t, iden, 0)
+    else:
+        if den < 0.0:
+            den, num_t, num_s = -den, -num_t, -num_s
+        if num_t < 0.0 or num_s < 0.0 or num_s > den:
+            return None
+        tau = num_t / den
+    ln = math.hypot(ex, ey)
+    nx, ny = ey / ln, -ex / ln
+    if nx * dx + ny * dy > 0.0:
+        nx, ny = -nx, -ny
+    return tau, (nx, ny)
+
+
 def _ray_capsule(mx: float, my: float, shape: Capsule, rot: float, k: int, dx: float, dy: float) -> _Res | None:
     from .capsule import segment
 
@@ -214,6 +268,8 @@ def extent(shape: Shape) -> float:
         return shape.bounding_radius
     if isinstance(shape, AABB):
         return max(shape.width, shape.height)
+    if isinstance(shape, Segment):
+        return max(abs(shape.a[0]), abs(shape.a[1]), abs(shape.b[0]), abs(shape.b[1]))
     assert isinstance(shape, Polygon)
     return max(max(abs(x), abs(y)) for x, y in shape.points)
 
@@ -237,13 +293,15 @@ def local_exponent(sizes: list[float], offsets: list[tuple[float, int]]) -> int:
     return k
 
 
-def scaled_outline(shape: AABB | Polygon, x: float, y: float, rotation: float, k: int) -> Pts:
+def scaled_outline(shape: AABB | Polygon | Segment, x: float, y: float, rotation: float, k: int) -> Pts:
     """World outline (counter-clockwise) of a box or polygon scaled by ``2**-k`` (exactly: scaled
-    operands), its hitbox origin at the already scaled (x, y). AABBs ignore ``rotation``."""
+    operands), its hitbox origin at the already scaled (x, y). AABBs ignore ``rotation``. A
+    segment's outline is its two ends."""
     if isinstance(shape, AABB):
         hw, hh = math.ldexp(shape.width, -k - 1), math.ldexp(shape.height, -k - 1)
         return [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)]
-    pts = [(math.ldexp(px, -k), math.ldexp(py, -k)) for px, py in shape.points]
+    src = (shape.a, shape.b) if isinstance(shape, Segment) else shape.points
+    pts = [(math.ldexp(px, -k), math.ldexp(py, -k)) for px, py in src]
     if rotation == 0.0:
         return [(px + x, py + y) for px, py in pts]
     c, s = math.cos(rotation), math.sin(rotation)

@@ -40,7 +40,7 @@ from __future__ import annotations
 import math
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Shape
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from ..validation import vector2
 from .capsule import capsule_first, core_points
 from .collide import collide
@@ -118,6 +118,8 @@ def _sweep_pair(
     (vx, vy), sizes scaled by ``2**-k``), computed as :data:`~framework.collision.kinds.PAIRS` says."""
     (ax, ay, ar), (bx, by, br) = pose_a, pose_b
     rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
+    if isinstance(shape_a, Segment) and isinstance(shape_b, Segment):
+        return []  # two segments: no interior to enter
     if rule.family == CAPSULES:
         # The capsule first (of two, the one placed first), as collide does; then turned round.
         # (of a capsule pair the rule does not flip, A is a capsule)
@@ -158,14 +160,20 @@ def _turned_round(pieces: list[Piece]) -> list[Piece]:
     return [(a, b, [(t, -nx, -ny) for t, nx, ny in cands]) for a, b, cands in pieces]
 
 
-def _outlined(shape: Shape) -> AABB | Polygon:
-    """``shape`` as the box or polygon that the pair rule says it is here (no check made)."""
-    return cast("AABB | Polygon", shape)
+def _outlined(shape: Shape) -> AABB | Polygon | Segment:
+    """``shape`` as the box, polygon or segment that the pair rule says it is here (no check made)."""
+    return cast("AABB | Polygon | Segment", shape)
 
 
 def _order_key(shape: Shape, x: float, y: float, rotation: float) -> tuple[object, ...]:
-    """A total order on placed boxes and polygons (equal keys: the same outline at the same place)."""
-    params = (shape.width, shape.height) if isinstance(shape, AABB) else cast(Polygon, shape).points
+    """A total order on placed boxes, polygons and segments (equal keys: the same outline at the
+    same place)."""
+    if isinstance(shape, AABB):
+        params: tuple[object, ...] = (shape.width, shape.height)
+    elif isinstance(shape, Segment):
+        params = (shape.a, shape.b)
+    else:
+        params = cast(Polygon, shape).points
     return (x, y, rotation, kind_of(shape), params)
 
 
