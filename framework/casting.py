@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from .collision import collide, time_of_impact
 from .collision.box_rows import rows_within
 from .collision.results import Vec2
-from .shapes import AABB, Circle, Polygon, Shape
+from .shapes import AABB, Circle, Polygon, Segment, Shape
 
 if TYPE_CHECKING:
     from .queries import SpatialQueries
@@ -51,10 +51,11 @@ def shape_bounds(shape: Shape, x: float, y: float, rotation: float) -> tuple[flo
     if isinstance(shape, AABB):
         hw, hh = shape.width * 0.5, shape.height * 0.5
         return x - hw, y - hh, x + hw, y + hh
-    if isinstance(shape, Polygon):
+    if isinstance(shape, (Polygon, Segment)):
         c, s = math.cos(rotation), math.sin(rotation)
-        xs = [x + px * c - py * s for px, py in shape.points]
-        ys = [y + px * s + py * c for px, py in shape.points]
+        src = shape.points if isinstance(shape, Polygon) else (shape.a, shape.b)
+        xs = [x + px * c - py * s for px, py in src]
+        ys = [y + px * s + py * c for px, py in src]
         return min(xs), min(ys), max(xs), max(ys)
     if shape.kind == "capsule":  # its segment's ends, grown by the radius
         # (kind "capsule": a Capsule, without importing it here)
@@ -72,9 +73,10 @@ def _support(shape: Shape, x: float, y: float, rotation: float, nx: float, ny: f
     if isinstance(shape, AABB):
         hw, hh = shape.width * 0.5, shape.height * 0.5
         pts = [(x - hw, y - hh), (x + hw, y - hh), (x + hw, y + hh), (x - hw, y + hh)]
-    elif isinstance(shape, Polygon):
+    elif isinstance(shape, (Polygon, Segment)):
         c, s = math.cos(rotation), math.sin(rotation)
-        pts = [(x + px * c - py * s, y + px * s + py * c) for px, py in shape.points]
+        src = shape.points if isinstance(shape, Polygon) else (shape.a, shape.b)
+        pts = [(x + px * c - py * s, y + px * s + py * c) for px, py in src]
     else:  # a rounded segment (a capsule): its segment's ends pushed out by the radius
         c, s = math.cos(rotation), math.sin(rotation)
         # (the shapes left are capsules)

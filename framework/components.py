@@ -17,7 +17,7 @@ import os
 from enum import Enum
 from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
-from .shapes import AABB, Capsule, Circle, Polygon, Shape
+from .shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .sprites import Animation, Frame
 from .validation import InvalidValue, finite, vector2
 
@@ -148,7 +148,9 @@ class Hitbox:
     """The collision shape of an entity and how it takes part in collisions.
 
     - ``shape``: an :class:`~framework.shapes.AABB`, :class:`~framework.shapes.Circle`,
-      :class:`~framework.shapes.Polygon` or :class:`~framework.shapes.Capsule`.
+      :class:`~framework.shapes.Polygon`, :class:`~framework.shapes.Capsule` or
+      :class:`~framework.shapes.Segment` (terrain: a segment has no area, so only a static or
+      kinematic body takes one; a dynamic one is refused).
     - ``offset``: the hitbox origin relative to the entity's Transform; it turns with the
       transform's rotation (an AABB's box itself never turns).
     - ``layer`` / ``mask``: 32-bit collision filter. A pair is tested only when each one's layer
@@ -245,6 +247,7 @@ class Hitbox:
         ):
             object.__setattr__(self, "_" + name, check_hitbox_field(name, value))
         check_mass_and_density(self)
+        check_body_shape(self)
 
     def __getattr__(self, name: str) -> Any:
         if name == "mass":
@@ -267,6 +270,9 @@ class Hitbox:
                 except InvalidValue as exc:
                     fix = "set its mass back to 1.0 first" if name == "density" else "set its density to None first"
                     raise InvalidValue(f"{exc}; to change from one to the other, {fix}") from None
+            if name in ("shape", "body"):  # a segment on a dynamic body: refused, as the scene's step does
+                _check_body_shape(value if name == "shape" else object.__getattribute__(self, "_shape"),
+                                  value if name == "body" else object.__getattribute__(self, "_body"))
         else:
             self._store.hitbox_changed(self._entity)
         object.__setattr__(self, "_" + name, value)
@@ -313,8 +319,8 @@ class Hitbox:
 def check_hitbox_field(name: str, value: object) -> Any:
     """Validate one Hitbox field; return its normalised value or raise :class:`InvalidValue`."""
     if name == "shape":
-        if not isinstance(value, (AABB, Circle, Polygon, Capsule)):
-            raise InvalidValue(f"Hitbox shape must be an AABB, Circle, Polygon or Capsule, got {value!r}")
+        if not isinstance(value, (AABB, Circle, Polygon, Capsule, Segment)):
+            raise InvalidValue(f"Hitbox shape must be an AABB, Circle, Polygon, Capsule or Segment, got {value!r}")
         return value
     if name == "offset":
         return vector2("Hitbox offset", value)
@@ -383,6 +389,19 @@ def _check_mass_and_density(mass: float, density: float | None) -> None:
                            "(the mass of a body with a density is the density times its area)")
 
 
+def check_body_shape(hb: Hitbox) -> None:
+    """:class:`InvalidValue` if a hitbox puts a shape without area (a segment) on a dynamic body (its
+    fields as written: a body written in place may still be its name)."""
+    _check_body_shape(object.__getattribute__(hb, "_shape"),
+                      check_hitbox_field("body", object.__getattribute__(hb, "_body")))
+
+
+def _check_body_shape(shape: object, body: object) -> None:
+    if isinstance(shape, Segment) and body is Body.DYNAMIC:
+        raise InvalidValue(f"Hitbox shape {shape!r} has no area, so it cannot be a dynamic body's shape (it "
+                           "would have no mass): give the hitbox body='static' or body='kinematic'")
+
+
 def check_component(comp: object) -> None:
     """Raise :class:`InvalidValue` if ``comp``, about to join an entity, holds a bad value (one
     written after it was made, or while it belonged to another entity). Normalises a Hitbox's
@@ -393,6 +412,7 @@ def check_component(comp: object) -> None:
     elif isinstance(comp, Hitbox):
         fields = [check_hitbox_field(f, object.__getattribute__(comp, "_" + f)) for f in _HITBOX_FIELDS]
         _check_mass_and_density(fields[_HITBOX_FIELDS.index("mass")], fields[_HITBOX_FIELDS.index("density")])
+        _check_body_shape(fields[_HITBOX_FIELDS.index("shape")], fields[_HITBOX_FIELDS.index("body")])
         for name, value in zip(_HITBOX_FIELDS, fields):
             object.__setattr__(comp, "_" + name, value)
 

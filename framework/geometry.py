@@ -1,5 +1,5 @@
 """Per-step geometry of the hitboxes, as columns: hitbox origins, bounds, polygon outlines and
-capsules' half segments.
+capsules' half segments. A segment's outline (its two ends) is kept with the polygons'.
 
 Derived from the store each step for the rows that can move; static rows are derived once and
 cached until the static set changes.
@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from .arrays import F64Array, I64Array, IntpArray
-from .shapes import Capsule, Polygon
-from .store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, BodyStore
+from .shapes import Capsule, Polygon, Segment
+from .store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, KIND_SEGMENT, BodyStore
 
 __all__ = ["Geometry", "widen_down", "widen_up"]
 
@@ -63,17 +63,22 @@ class Geometry:
         self.cap_rows = np.zeros(0, dtype=np.int64)
         self.cap_half = np.zeros(0)  # per row: a capsule's half length (0 elsewhere)
         self.K = 4
+        self.segments = False  # whether some rows are segments (outlines of two points)
 
     def rebuild_tables(self, store: BodyStore) -> None:
         """Re-read the polygon outlines after a structural change."""
         n = store.n
-        self.poly_rows = np.flatnonzero(store.kind == KIND_POLYGON)
-        shapes: list[Polygon] = [store.shapes[r] for r in self.poly_rows.tolist()]  # as the columns know them
-        K = max([4] + [len(s.points) for s in shapes])
+        self.segments = bool((store.kind == KIND_SEGMENT).any())
+        # Segments are outlines of two points, kept with the polygons' (only where a scene has some).
+        outlined = (store.kind == KIND_POLYGON) | (store.kind == KIND_SEGMENT) if self.segments else \
+            store.kind == KIND_POLYGON
+        self.poly_rows = np.flatnonzero(outlined)
+        shapes: list[Polygon | Segment] = [store.shapes[r] for r in self.poly_rows.tolist()]  # as the columns know them
+        K = max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)])
         local = np.zeros((n, K, 2))
         count = np.zeros(n, dtype=np.int64)
         for r, s in zip(self.poly_rows.tolist(), shapes):
-            pts = np.asarray(s.points)
+            pts = np.asarray(s.points if isinstance(s, Polygon) else (s.a, s.b))
             m = len(pts)
             local[r, :m] = pts
             local[r, m:] = pts[-1]  # pad by repeating the last vertex
@@ -121,7 +126,7 @@ class Geometry:
             self.hx[row], self.hy[row] = x, y
         # (else hx, hy are the store's x, y columns: already moved)
         kind = int(store.cols["kind"][row])
-        if kind == KIND_POLYGON:
+        if kind == KIND_POLYGON or kind == KIND_SEGMENT:
             local = self.world_poly[self.poly_slot[row]]
             lo_x, hi_x = x + float(local[:, 0].min()), x + float(local[:, 0].max())
             lo_y, hi_y = y + float(local[:, 1].min()), y + float(local[:, 1].max())
@@ -153,7 +158,12 @@ class Geometry:
             if self.has_offset:
                 self.hx, self.hy = x.copy(), y.copy()
         offset = rows[(ox[sel] != 0.0) | (oy[sel] != 0.0)] if self.has_offset else rows[:0]
-        polys = rows[store.kind[sel] == KIND_POLYGON] if self.poly_rows.size else rows[:0]
+        if not self.poly_rows.size:
+            polys = rows[:0]
+        elif self.segments:
+            polys = rows[(store.kind[sel] == KIND_POLYGON) | (store.kind[sel] == KIND_SEGMENT)]
+        else:
+            polys = rows[store.kind[sel] == KIND_POLYGON]
         caps = rows[store.kind[sel] == KIND_CAPSULE] if self.cap_rows.size else rows[:0]
         # Rotations matter only to polygons, capsules and offset hitboxes (AABBs and circles ignore
         # them).
@@ -211,7 +221,8 @@ class Geometry:
                     hi[sel] = widen_up(hi[sel])
 
     def outlines(self, store: BodyStore, rows: IntpArray) -> tuple[F64Array, I64Array]:
-        """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows."""
+        """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows (a
+        segment row: its two ends)."""
         K = self.K
         out = np.empty((rows.size, K, 2))
         count = np.empty(rows.size, dtype=np.int64)
@@ -226,7 +237,7 @@ class Geometry:
             b[:, 3:, 0], b[:, 3:, 1] = -hw[:, None], hh[:, None]
             out[box] = b
             count[box] = 4
-        poly = kind == KIND_POLYGON
+        poly = (kind == KIND_POLYGON) | (kind == KIND_SEGMENT) if self.segments else kind == KIND_POLYGON
         if poly.any():
             out[poly] = self.world_poly[self.poly_slot[rows[poly]]]
             count[poly] = self.count[rows[poly]]

@@ -9,7 +9,8 @@ at spawn, at ``add_component``, or (for a value written in place) by the next st
 changes anything:
 
 - a hitbox's size: the shape's bounding radius (its farthest point from the hitbox origin) within
-  ``[MIN_SIZE, MAX_SIZE]``, its area at least ``MIN_SIZE**2``, its offset at most ``MAX_SIZE``;
+  ``[MIN_SIZE, MAX_SIZE]``, its area at least ``MIN_SIZE**2`` (a segment, which has no area: its
+  length at least ``MIN_SIZE``), its offset at most ``MAX_SIZE``;
 - a dynamic body's mass (given, or density times area) within ``[MIN_MASS, MAX_MASS]`` (or
   ``math.inf``: a body nothing moves), and a finite moment of inertia (given, or mass times the
   shape's moment about its centroid) at least ``MIN_INERTIA``;
@@ -50,7 +51,12 @@ def check_shape_limits(shape: Shape, what: str = "Hitbox shape") -> None:
     if not (MIN_SIZE <= size <= MAX_SIZE):
         raise InvalidValue(f"{what} {shape!r} reaches {size!r} from its origin: a scene takes shapes from "
                            f"{MIN_SIZE:g} to {MAX_SIZE:g} (see framework.limits)")
-    if shape.area < MIN_SIZE * MIN_SIZE:
+    if shape.kind == "segment":  # (no area: its length instead)
+        length = shape.length  # type: ignore[attr-defined]
+        if length < MIN_SIZE:
+            raise InvalidValue(f"{what} {shape!r} is {length!r} long: a scene takes segments of length "
+                               f"{MIN_SIZE:g} or more (see framework.limits)")
+    elif shape.area < MIN_SIZE * MIN_SIZE:
         raise InvalidValue(f"{what} {shape!r} has an area of {shape.area!r}: a scene takes shapes of area "
                            f"{MIN_SIZE * MIN_SIZE:g} or more (see framework.limits)")
 
@@ -58,10 +64,11 @@ def check_shape_limits(shape: Shape, what: str = "Hitbox shape") -> None:
 def check_hitbox_limits(hitbox: Any) -> None:
     """Refuse a :class:`~framework.components.Hitbox` a scene cannot take: its shape, offset, and for a
     dynamic body its mass and moment of inertia (see the module docstring)."""
-    from .components import Body  # (components imports this module's users)
+    from .components import Body, check_body_shape  # (components imports this module's users)
 
     shape = hitbox.shape
     check_shape_limits(shape)
+    check_body_shape(hitbox)
     ox, oy = hitbox.offset
     if max(abs(ox), abs(oy)) > MAX_SIZE:
         raise InvalidValue(f"Hitbox offset {hitbox.offset!r} is beyond {MAX_SIZE:g} (see framework.limits)")

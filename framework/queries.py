@@ -229,6 +229,11 @@ class SpatialQueries:
             return (dx - cx) ** 2 + (dy - cy) ** 2 <= shape.radius * shape.radius
         verts, count = geom.outlines(store, np.array([r]))
         pts = verts[0, : int(count[0])]
+        if len(pts) == 2:  # a segment: the point on it, between its ends
+            (x0, y0), (x1, y1) = pts
+            along = (x1 - x0) * (dx - x0) + (y1 - y0) * (dy - y0)
+            if not 0.0 <= along <= (x1 - x0) ** 2 + (y1 - y0) ** 2:
+                return False
         for i in range(len(pts)):
             x0, y0 = pts[i]
             x1, y1 = pts[(i + 1) % len(pts)]

@@ -19,14 +19,15 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON
+from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON, KIND_SEGMENT
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import Body, Hitbox, Transform, Velocity, Visual, check_hitbox_field, check_mass_and_density
 from .limits import MAX_COORD, check_hitbox_limits, check_position, rows_sound
-from .shapes import AABB, Capsule, Circle
+from .shapes import AABB, Capsule, Circle, Segment
 from .validation import InvalidValue
 
-__all__ = ["BodyStore", "KIND_AABB", "KIND_CAPSULE", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "as_selector"]
+__all__ = ["BodyStore", "KIND_AABB", "KIND_CAPSULE", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "KIND_SEGMENT",
+           "as_selector"]
 
 BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
 DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
@@ -188,7 +189,7 @@ class BodyStore:
         a scene of boxes alone skips sorting its pairs by kind."""
         if self._kinds_key != self.version:
             kind = self.cols["kind"][: self.n]
-            self._kinds = frozenset(int(k) for k in (KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_CAPSULE)
+            self._kinds = frozenset(int(k) for k in (KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_CAPSULE, KIND_SEGMENT)
                                     if (kind == k).any())
             self._kinds_key = self.version
         return self._kinds
@@ -406,6 +407,10 @@ class BodyStore:
             c["kind"][row] = KIND_CAPSULE
             c["hw"][row] = c["radius"][row] = shape.radius
             c["hh"][row] = shape.half_length + shape.radius
+        elif isinstance(shape, Segment):
+            # (its outline of two points is in the geometry, as a polygon's)
+            c["kind"][row] = KIND_SEGMENT
+            c["hw"][row] = c["hh"][row] = c["radius"][row] = 0.0
         else:
             c["kind"][row] = KIND_POLYGON
             c["hw"][row] = c["hh"][row] = c["radius"][row] = 0.0

@@ -6,8 +6,9 @@ does the same clipping over the pairs of one step, from the outlines the step's 
 holds, and also for pairs a little apart (a box resting on another, both fallen by the same
 amount, merely touches): given the pair's normal, the *reference* face is the face (of A, or of B
 against the normal) whose outward normal lies closest to it, the *incident* face the other shape's
-face most opposed to that; the incident face clipped to the reference face's side planes gives up
-to two points, kept where they are less than ``margin`` above the reference face. Each point is
+face most opposed to that; the incident face clipped to the reference face's side planes (its
+neighbouring faces; a segment's: the planes through its ends) gives up to two points, kept where
+they are less than ``margin`` above the reference face. Each point is
 reported midway between the incident face and the reference face's plane, with its separation
 along the pair's normal (< 0: overlapping), ordered along the tangent ``(-ny, nx)``. Where the
 clipping leaves nothing (a deep overlap, the incident face beside the reference face), the point is
@@ -90,6 +91,28 @@ def pair_manifolds(ra, rb, nx, ny, margin, kind, hx, hy, hw, hh, slot, world_pol
         empty = False
         for k in range(mr):
             if k == i:
+                continue
+            if mr == 2:
+                # A segment's side planes: through its ends, facing out along it.
+                i1 = 1 - i
+                ux, uy = ref[i1, 0] - ref[i, 0], ref[i1, 1] - ref[i, 1]
+                ul = (ux * ux + uy * uy) ** 0.5
+                ux, uy = ux / ul, uy / ul
+                s0 = (ref[i, 0] - v0x) * -ux + (ref[i, 1] - v0y) * -uy
+                s1 = (ref[i, 0] - v1x) * -ux + (ref[i, 1] - v1y) * -uy
+                t0 = (ref[i1, 0] - v0x) * ux + (ref[i1, 1] - v0y) * uy
+                t1 = (ref[i1, 0] - v1x) * ux + (ref[i1, 1] - v1y) * uy
+                if (s0 < 0.0 and s1 < 0.0) or (t0 < 0.0 and t1 < 0.0):
+                    empty = True
+                    break
+                if s0 < 0.0:
+                    lo = max(lo, s0 / (s0 - s1))
+                elif s1 < 0.0:
+                    hi = min(hi, s0 / (s0 - s1))
+                if t0 < 0.0:
+                    lo = max(lo, t0 / (t0 - t1))
+                elif t1 < 0.0:
+                    hi = min(hi, t0 / (t0 - t1))
                 continue
             kx, ky = _face_normal(ref, mr, k)
             s0 = (ref[k, 0] - v0x) * kx + (ref[k, 1] - v0y) * ky  # >= 0: v0 inside face k

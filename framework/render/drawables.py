@@ -10,7 +10,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from ..shapes import AABB, Capsule, Circle, Polygon
+from ..shapes import AABB, Capsule, Circle, Polygon, Segment
 
 __all__ = ["capsule_outline", "circle_segments", "fan_indices", "fill_outline", "fill_triangles"]
 
@@ -52,6 +52,8 @@ def fill_outline(shape: Any, zoom: float = 1.0) -> list[tuple[float, float]]:
         return capsule_outline(shape, zoom)
     if isinstance(shape, Polygon):
         return list(shape.points)
+    if isinstance(shape, Segment):  # no area: its two ends (a fan of them fills nothing)
+        return [shape.a, shape.b]
     raise TypeError(f"cannot fill a {type(shape).__name__}")
 
 

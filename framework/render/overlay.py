@@ -39,7 +39,7 @@ from pyglet import gl
 from pyglet.graphics import Batch, Group
 
 from ..events import pair_keys, sorted_find
-from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
+from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT
 
 __all__ = ["HUD_FONT_SIZE", "HUD_LINE_PX", "OVERLAY_COLORS", "DebugOverlay", "wrap_figures"]
 
@@ -124,7 +124,7 @@ def _body_colors(store: Any, rows: np.ndarray) -> np.ndarray:
 
 def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segments]:
     """The outlines of the hitboxes of ``rows`` (rows with a hitbox), coloured by body type: boxes
-    and polygons edge by edge, circles as :data:`CIRCLE_SEGMENTS` chords and a radius showing
+    and polygons edge by edge (a segment: its line), circles as :data:`CIRCLE_SEGMENTS` chords and a radius showing
     their rotation, capsules as two half circles of as many chords joined by their sides."""
     out: list[Segments] = []
     if rows.size == 0:
@@ -132,7 +132,7 @@ def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segme
     colors = _body_colors(store, rows)
     kind = store.kind[rows]
     hx, hy = geometry.hx[rows], geometry.hy[rows]
-    polygons = np.flatnonzero((kind == KIND_AABB) | (kind == KIND_POLYGON))
+    polygons = np.flatnonzero((kind == KIND_AABB) | (kind == KIND_POLYGON) | (kind == KIND_SEGMENT))
     if polygons.size:
         local, _count = geometry.outlines(store, rows[polygons])  # padded by repeating the last vertex
         corners = local + np.stack([hx[polygons], hy[polygons]], axis=1)[:, None, :]

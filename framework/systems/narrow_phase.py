@@ -19,6 +19,7 @@ from ..collision.kinds import (
     KIND_CAPSULE,
     KIND_CIRCLE,
     KIND_POLYGON,
+    KIND_SEGMENT,
     PAIRS,
     POLYGON_CIRCLE,
     pair_code,
@@ -58,7 +59,7 @@ def pair_contacts(
     if P == 0:
         return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))
     kinds = store.kinds_present()
-    if len(kinds) == 1 and not kinds & {KIND_POLYGON, KIND_CAPSULE}:  # boxes alone, or circles alone
+    if len(kinds) == 1 and not kinds & {KIND_POLYGON, KIND_CAPSULE, KIND_SEGMENT}:  # boxes alone, or circles alone
         k = next(iter(kinds))
         rule = PAIRS[k, k]
         if counts is not None:
@@ -134,7 +135,7 @@ def _capsule_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray,
     k = max(geom.K, 2)
     verts = np.zeros((oth.size, k, 2))
     counts = np.ones(oth.size, dtype=np.int64)
-    outl = np.flatnonzero((ko == KIND_AABB) | (ko == KIND_POLYGON))
+    outl = np.flatnonzero((ko == KIND_AABB) | (ko == KIND_POLYGON) | (ko == KIND_SEGMENT))
     if outl.size:
         v, n = geom.outlines(store, oth[outl])
         verts[outl, : v.shape[1]] = v

@@ -45,7 +45,7 @@ from ..joints import (
     joint_components,
     joint_writes,
 )
-from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, STATIC
+from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT, STATIC
 from .soft_joints import JOINT_F, JOINT_IMP
 from .soft_kernel import PARAMS, SLOT, internal_faces, soft_step
 from .stage import PRIORITY, Stage
@@ -137,7 +137,8 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     shape, its body kind, its entity): ``(fprops, iprops, off, verts)``, see
     :func:`~framework.systems.soft_kernel.soft_step`. Every hitbox is a rounded polygon about its
     hitbox origin (vertex count 0: no hitbox, or ``detection`` off): AABBs do not turn with the
-    transform (their offset does); circles are one vertex, capsules their segment.
+    transform (their offset does); circles are one vertex, capsules their segment, segments their
+    two ends with radius 0 (Box2D's segment as a polygon of two points: each side a face).
 
     ``off`` rows: the hitbox offset, then the centre of mass the soft step turns the body about
     (:attr:`~framework.components.Hitbox.mass_data`'s ``center``: a dynamic circle's or polygon's
@@ -192,6 +193,12 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
                 d = math.hypot(ex, ey)
                 verts[r, i] = (x1, y1, ey / d, -ex / d)
             cnt[r] = m
+        elif k == KIND_SEGMENT:
+            (x1, y1), (x2, y2) = polys[r].a, polys[r].b
+            ex, ey = x2 - x1, y2 - y1
+            d = math.hypot(ex, ey)
+            verts[r, :2] = ((x1, y1, ey / d, -ex / d), (x2, y2, -ey / d, ex / d))
+            cnt[r] = 2
     if not detection:
         cnt[:] = 0
     fprops = np.stack([store.inv_mass, inv_inertia, store.friction, store.restitution, store.bound, rr])
