@@ -6,7 +6,7 @@ Importing it (and running scenes without a renderer) never imports pyglet's GL m
 from typing import TYPE_CHECKING, Any
 
 from .components import Body, Hitbox, MassData, Transform, Velocity, Visual
-from .shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
+from .shapes import AABB, Capsule, Chain, ChainSegment, Circle, Polygon, Segment, Shape
 from .text import Text
 from .validation import InvalidValue
 
@@ -20,7 +20,8 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
     from .scene import STAGES, Scene, SceneClosed, SceneHit
 
 __all__ = [
-    "AABB", "Body", "Camera", "Capsule", "CharacterController", "Circle", "CollisionEvent", "Contact", "DistanceJoint",
+    "AABB", "Body", "Camera", "Capsule", "Chain", "ChainSegment", "CharacterController", "Circle", "CollisionEvent",
+    "Contact", "DistanceJoint",
     "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Polygon", "PrismaticJoint",
     "RayHit",
     "Renderer", "RevoluteJoint", "Segment",

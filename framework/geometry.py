@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .arrays import F64Array, I64Array, IntpArray
-from .shapes import Capsule, Polygon, Segment
+from .shapes import Capsule, ChainSegment, Polygon, Segment
 from .store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, KIND_SEGMENT, BodyStore
 
 __all__ = ["Geometry", "widen_down", "widen_up"]
@@ -64,6 +64,9 @@ class Geometry:
         self.cap_half = np.zeros(0)  # per row: a capsule's half length (0 elsewhere)
         self.K = 4
         self.segments = False  # whether some rows are segments (outlines of two points)
+        self.chains = False  # whether some segments are chain segments (then the two below are filled)
+        self.is_chain = np.zeros(0, dtype=bool)  # per row: a chain segment
+        self.ghosts = np.zeros((0, 2, 2))  # per chain row: its ghost vertices, local (ghost1, ghost2)
 
     def rebuild_tables(self, store: BodyStore) -> None:
         """Re-read the polygon outlines after a structural change."""
@@ -77,6 +80,14 @@ class Geometry:
         K = max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)])
         local = np.zeros((n, K, 2))
         count = np.zeros(n, dtype=np.int64)
+        self.is_chain = np.zeros(n, dtype=bool)
+        if self.segments:
+            chain_rows = [r for r, s in zip(self.poly_rows.tolist(), shapes) if isinstance(s, ChainSegment)]
+            self.is_chain[chain_rows] = True
+            self.ghosts = np.zeros((n, 2, 2))
+            for r in chain_rows:
+                self.ghosts[r] = (store.shapes[r].ghost1, store.shapes[r].ghost2)
+        self.chains = bool(self.is_chain.any())
         for r, s in zip(self.poly_rows.tolist(), shapes):
             pts = np.asarray(s.points if isinstance(s, Polygon) else (s.a, s.b))
             m = len(pts)

@@ -12,6 +12,9 @@ hitbox origin is local (0, 0): AABBs and circles are centred on it, polygons rot
   the same answers bit for bit.
 - :class:`Segment` is a two-sided line from ``a`` to ``b`` in local coordinates: no area, so it is
   terrain (a static or kinematic body's hitbox), never a dynamic body's only shape.
+- :class:`ChainSegment` is a one-sided segment with ghost vertices, one link of a :class:`Chain`
+  (a polyline or loop of them: terrain drawn as lines that bodies slide along without catching on
+  a joint), as Box2D's chain shapes.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from typing import ClassVar
 
 from .validation import InvalidValue, finite, positive
 
-__all__ = ["AABB", "Capsule", "Circle", "Polygon", "Segment", "Shape"]
+__all__ = ["AABB", "Capsule", "Chain", "ChainSegment", "Circle", "Polygon", "Segment", "Shape"]
 
 # Tolerance of the "collinear" test: a vertex within this fraction of the polygon's extent (plus 16
 # units of rounding of its coordinates) of the line through its neighbours is on that line. It is a
@@ -337,6 +340,107 @@ class Segment(Shape):
     def central_moment(self) -> float:
         ln = self.length
         return ln * ln / 12.0
+
+
+@dataclass(frozen=True, slots=True)
+class ChainSegment(Segment):
+    """A one-sided segment from ``a`` to ``b`` with *ghost vertices*: ``ghost1``, the vertex before
+    ``a`` in its chain, and ``ghost2``, the one after ``b`` (Box2D's ``b2ChainSegment``). Made by
+    :class:`Chain`; rarely built by hand.
+
+    Its solid side is on the left of ``a -> b``: it collides with shapes on its right, the side of
+    :attr:`~Segment.normal` (for a loop drawn counter-clockwise, the outside), and lets a shape
+    whose centre is behind it pass. The ghost vertices give the shape of the terrain on either side,
+    so that a contact never pushes a body out sideways at a joint where the chain runs on straight
+    or bends inward (it is pushed out along this segment's normal instead), and leaves to the
+    neighbour the contacts that its own side owns at a joint that bends outward. The pair functions
+    (:func:`~framework.collision.collide` and the others) apply these rules; in every other way
+    it is a :class:`Segment`."""
+
+    ghost1: tuple[float, float]
+    ghost2: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        Segment.__post_init__(self)
+        g1 = _point("ChainSegment ghost1", self.ghost1)
+        g2 = _point("ChainSegment ghost2", self.ghost2)
+        if g1 == self.a or g2 == self.b:
+            raise InvalidValue(f"ChainSegment ghosts must differ from the ends they lead to and from, got "
+                               f"ghost1={self.ghost1!r}, a={self.a!r}, b={self.b!r}, ghost2={self.ghost2!r}")
+        object.__setattr__(self, "ghost1", g1)
+        object.__setattr__(self, "ghost2", g2)
+
+
+class Chain:
+    """A polyline (``loop=False``) or a closed loop (``loop=True``) of one-sided segments, terrain
+    drawn as lines: :attr:`segments` holds one :class:`ChainSegment` per pair of consecutive
+    points (and, for a loop, one from the last point back to the first), each with its neighbours'
+    far ends as ghost vertices. A body collides with the right side of each segment (the outside of
+    a loop drawn counter-clockwise, y up; the top of a polyline drawn right to left) and slides
+    along the chain without catching on a joint.
+
+    An open chain's two free ends are corners: a body meets them from the front as it meets a
+    segment's end (their ghosts are placed behind the end, square to the segment). ``points``: 2 or
+    more finite (x, y) pairs (3 or more for a loop), no two consecutive ones equal. A chain is not a
+    hitbox shape itself: :func:`framework.chains.spawn_chain` spawns one static body per segment.
+    """
+
+    __slots__ = ("loop", "points", "segments")
+
+    def __init__(self, points: Iterable[Sequence[float]], loop: bool = False) -> None:
+        if not isinstance(loop, bool):
+            raise InvalidValue(f"Chain loop must be True or False, got {loop!r}")
+        if isinstance(points, (str, bytes)):
+            raise InvalidValue(f"Chain points must be a sequence of (x, y) pairs, got {points!r}")
+        try:
+            raw = list(points)
+        except TypeError:
+            raise InvalidValue(f"Chain points must be a sequence of (x, y) pairs, got {points!r}") from None
+        pts = [_point(f"Chain point {i}", p) for i, p in enumerate(raw)]
+        if loop and len(pts) > 1 and pts[0] == pts[-1]:
+            pts.pop()  # a loop given closed
+        need = 3 if loop else 2
+        if len(pts) < need:
+            raise InvalidValue(f"Chain {'loop ' if loop else ''}needs at least {need} points, got {raw!r}")
+        n = len(pts)
+        for i in range(n if loop else n - 1):
+            if pts[i] == pts[(i + 1) % n]:
+                raise InvalidValue(f"Chain points {i} and {(i + 1) % n} are equal ({raw[i]!r}): a segment "
+                                   "needs two distinct ends")
+        self.points: tuple[tuple[float, float], ...] = tuple(pts)
+        self.loop = loop
+        segs = []
+        for i in range(n if loop else n - 1):
+            a, b = pts[i], pts[(i + 1) % n]
+            if loop or i > 0:
+                g1 = pts[i - 1]
+            else:  # a free end: behind it, square to the segment
+                g1 = _behind(a, a, b)
+            if loop or i < n - 2:
+                g2 = pts[(i + 2) % n]
+            else:
+                g2 = _behind(b, a, b)
+            segs.append(ChainSegment(a, b, g1, g2))
+        self.segments: tuple[ChainSegment, ...] = tuple(segs)
+
+    def __repr__(self) -> str:
+        return f"Chain({list(self.points)!r}, loop={self.loop!r})"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Chain) and (self.points, self.loop) == (other.points, other.loop)
+
+    def __hash__(self) -> int:
+        return hash((self.points, self.loop))
+
+    def __len__(self) -> int:
+        return len(self.segments)
+
+
+def _behind(p: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> tuple[float, float]:
+    """The ghost of a free chain end ``p`` of segment a -> b: one segment length behind it, square to
+    the segment (the segment's normal is on its right: behind is on its left)."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return p[0] - dy, p[1] + dx
 
 
 def _point(name: str, p: object) -> tuple[float, float]:

@@ -43,13 +43,14 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
+from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue
 from .batch_box import aabb_aabb, aabb_aabb_fast
 from .batch_circle import circle_circle, polygon_circle
 from .batch_common import F64, ContactArrays, no_contacts
 from .batch_polygon import polygon_polygon
 from .capsule import capsule_first, capsule_many, half_segments
+from .collide import collide
 from .kinds import BOXES, CAPSULES, CIRCLES, PAIRS, POLYGON_CIRCLE, POLYGONS, kind_of, pair_code
 from .placement import check_shape, pose
 
@@ -206,6 +207,15 @@ def collide_many(
     run(family == POLYGONS, lambda r: polygon_polygon(
         pa[r, 0], pa[r, 1], *shape_outlines(sa, pa[:, 2], r),
         pb[r, 0], pb[r, 1], *shape_outlines(sb, pb[:, 2], r), size=ra[r] + rb[r]))
+    for i in np.flatnonzero(out.hit).tolist():
+        if isinstance(sa[i], ChainSegment) or isinstance(sb[i], ChainSegment):
+            # What the chain's rules keep of it: collide's answer (worked with the segment first).
+            c = collide(sa[i], tuple(pa[i]), sb[i], tuple(pb[i]))
+            if c is None:
+                out.hit[i] = False
+                out.nx[i] = out.ny[i] = out.depth[i] = out.px[i] = out.py[i] = 0.0
+            else:
+                out.nx[i], out.ny[i], out.depth[i], out.px[i], out.py[i] = *c.normal, c.depth, *c.point
     return out
 
 

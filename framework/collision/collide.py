@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
+from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue
 from .capsule import capsule_first, capsule_pair
 from .exact import (
@@ -66,6 +66,10 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
     check_shape("shape_b", shape_b)
     ax, ay, ar = pose("transform_a", transform_a)
     bx, by, br = pose("transform_b", transform_b)
+    if isinstance(shape_b, ChainSegment) and not isinstance(shape_a, ChainSegment):
+        # A chain segment's contact is worked with the segment first, whichever comes first.
+        c = collide(shape_b, (bx, by, br), shape_a, (ax, ay, ar))
+        return None if c is None else Contact(Vec2(-c.normal.x + 0.0, -c.normal.y + 0.0), c.depth, c.point)
     rule = PAIRS[kind_of(shape_a), kind_of(shape_b)]
     flip = rule.flip
     if rule.family == CAPSULES and not flip and isinstance(shape_b, Capsule):
@@ -94,6 +98,14 @@ def collide(shape_a: Shape, transform_a: object, shape_b: Shape, transform_b: ob
             f"collide: the contact of {shape_a!r} at {(ax, ay)!r} and {shape_b!r} at {(bx, by)!r} "
             "is beyond float64's range"
         )
+    if isinstance(shape_a, ChainSegment) and not isinstance(shape_b, Segment):
+        # A chain segment keeps what its one side and its joints allow (framework.collision.chain).
+        from .chain import one_contact
+
+        kept = one_contact(shape_a, (ax, ay, ar), shape_b, (bx, by, br), nx, ny, depth, px, py)
+        if kept is None:
+            return None
+        nx, ny, depth, px, py = kept
     # "+ 0.0" turns a -0.0 component into 0.0, so normals compare and print cleanly.
     return Contact(Vec2(nx + 0.0, ny + 0.0), depth, Vec2(px, py))
 

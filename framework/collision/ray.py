@@ -41,7 +41,7 @@ from fractions import Fraction
 from numbers import Real
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
+from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue, vector2
 from .exact import BAND, TINY, ratio_approx
 from .pieces import TIE, disc_interval, first_entry, ints, rounded_segment
@@ -90,8 +90,11 @@ def raycast(
     elif isinstance(shape, Capsule):
         res = _ray_capsule(mx, my, shape, rot, k, ux, uy)
     elif isinstance(shape, Segment):
+        from .chain import one_sided_ray
         from .placement import local_outline
 
+        if isinstance(shape, ChainSegment) and not one_sided_ray(shape, rot, dx, dy):
+            return None  # a chain segment is met from its front only
         (s0x, s0y), (s1x, s1y) = local_outline(shape, rot, k)
         res = _ray_segment(mx, my, s0x, s0y, s1x, s1y, ux, uy)
     else:

@@ -26,6 +26,12 @@ within the pair's speculative distance (the body came that way this step); deepe
 belongs to the neighbour that covers the face (a box in the corner of a tiled floor and a wall is
 held by the floor and the wall, not lifted by the tile under the wall), and none is reported. A
 separation along a banned axis still proves the shapes apart.
+
+**Chain segments** (one-sided, with ghost vertices: :mod:`framework.collision.chain`) are a segment
+first (a polygon of two points, radius 0); :func:`chain_segment` then keeps what the chain's rules
+allow of that manifold: nothing where the body comes from behind or the neighbour owns the
+direction, and a manifold along the segment's own normal (the body's incident edge clipped to the
+segment, Box2D's ``b2ClipSegments``) where the normal points out of a straight or inward joint.
 """
 
 from __future__ import annotations
@@ -34,8 +40,8 @@ import math
 
 from numba import njit
 
-__all__ = ["DOWN", "LEFT", "RIGHT", "UP", "box_box", "capsule_capsule", "circle_circle", "face_bit", "polygon_circle",
-           "polygon_polygon"]
+__all__ = ["DOWN", "LEFT", "RIGHT", "UP", "box_box", "capsule_capsule", "chain_segment", "circle_circle", "face_bit",
+           "polygon_circle", "polygon_polygon"]
 
 _EPS = 1.1920929e-07  # Box2D's FLT_EPSILON, the scale of "safely outside"
 LEFT, RIGHT, DOWN, UP = 1, 2, 4, 8  # a static box's faces, by the direction a body leaves it through them
@@ -374,3 +380,121 @@ def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out, fa=0, fb
         if not keep1:
             return 1, nx, ny
     return k, nx, ny
+
+
+# framework.collision.chain's tolerances (Box2D's convexTol and sinTol) and its "same normal".
+_CONVEX_TOL = 0.01
+_SIN_TOL = 0.01
+_SAME = 1e-12
+
+
+@njit(cache=True)
+def _unit2(x, y):
+    ln = math.sqrt(x * x + y * y)
+    return x / ln, y / ln
+
+
+@njit(cache=True)
+def chain_segment(V, N, L, g, o, count, ro, cx, cy, k, nx, ny, speculative, out):
+    """What chain segment ``g`` (world ends ``V[g, 0:2]``; local ends and ghosts ``L[g, 0:4]``) keeps of
+    its manifold with body ``o`` (``count`` world vertices ``V[o]``, normals ``N[o]``, radius ``ro``,
+    hitbox origin ``(cx, cy)``): ``k`` points in ``out`` and the normal ``(nx, ny)`` from ``g`` toward
+    ``o``. Returns ``(count, nx, ny)``, the normal from ``g`` toward ``o``
+    (:func:`framework.collision.chain.classify`'s rules)."""
+    if k <= 0:
+        return k, nx, ny
+    p1x, p1y, p2x, p2y = V[g, 0, 0], V[g, 0, 1], V[g, 1, 0], V[g, 1, 1]
+    # The ghosts in the world: the turn taking the local segment to the world one.
+    lex, ley = L[g, 1, 0] - L[g, 0, 0], L[g, 1, 1] - L[g, 0, 1]
+    wex, wey = p2x - p1x, p2y - p1y
+    l2 = lex * lex + ley * ley
+    c, s = (lex * wex + ley * wey) / l2, (lex * wey - ley * wex) / l2
+    d1x, d1y = L[g, 2, 0] - L[g, 0, 0], L[g, 2, 1] - L[g, 0, 1]
+    d2x, d2y = L[g, 3, 0] - L[g, 0, 0], L[g, 3, 1] - L[g, 0, 1]
+    g1x, g1y = p1x + c * d1x - s * d1y, p1y + s * d1x + c * d1y
+    g2x, g2y = p1x + c * d2x - s * d2y, p1y + s * d2x + c * d2y
+    u1x, u1y = _unit2(wex, wey)
+    n1x, n1y = u1y, -u1x
+    u0x, u0y = _unit2(p1x - g1x, p1y - g1y)
+    u2x, u2y = _unit2(g2x - p2x, g2y - p2y)
+    n0x, n0y = u0y, -u0x
+    n2x, n2y = u2y, -u2x
+    convex1 = u0x * u1y - u0y * u1x >= _CONVEX_TOL
+    convex2 = u1x * u2y - u1y * u2x >= _CONVEX_TOL
+    behind1 = n1x * (cx - p1x) + n1y * (cy - p1y) < 0.0
+    behind0 = (not convex1) or n0x * (cx - p1x) + n0y * (cy - p1y) < 0.0
+    behind2 = (not convex2) or n2x * (cx - p2x) + n2y * (cy - p2y) < 0.0
+    if behind1 and behind0 and behind2:
+        return 0, 0.0, 0.0  # one-sided: the body comes from behind
+    length = math.sqrt(wex * wex + wey * wey)
+    if abs(nx - n1x) <= _SAME and abs(ny - n1y) <= _SAME:
+        return _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny)
+    if nx * u1x + ny * u1y <= 0.0:  # toward p1
+        if convex1:
+            if nx * n0y - ny * n0x > _SIN_TOL:
+                return 0, 0.0, 0.0  # the neighbour's
+            return _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny)
+    elif convex2:
+        if n2x * ny - n2y * nx > _SIN_TOL:
+            return 0, 0.0, 0.0
+        return _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny)
+    # Snapped: along the segment's normal, the body's incident edge clipped to the segment.
+    if count == 1:
+        qx, qy = V[o, 0, 0], V[o, 0, 1]
+        t = (qx - p1x) * u1x + (qy - p1y) * u1y
+        if t < 0.0 or t > length:
+            return 0, 0.0, 0.0  # beside the segment: the neighbour's
+        h = (qx - p1x) * n1x + (qy - p1y) * n1y
+        if h - ro > speculative:
+            return 0, 0.0, 0.0
+        out[0, 0], out[0, 1] = qx - n1x * 0.5 * (h + ro), qy - n1y * 0.5 * (h + ro)
+        out[0, 2], out[0, 3] = h - ro, 0.0
+        return _own_points(out, 1, p1x, p1y, u1x, u1y, length, convex1, convex2, n1x, n1y)
+    deep, low = 0, 1e300
+    for i in range(count):
+        h = (V[o, i, 0] - p1x) * n1x + (V[o, i, 1] - p1y) * n1y
+        if h < low:
+            deep, low = i, h
+    before = deep - 1 if deep > 0 else count - 1
+    e = before if N[o, before, 0] * n1x + N[o, before, 1] * n1y < N[o, deep, 0] * n1x + N[o, deep, 1] * n1y else deep
+    e1 = e + 1 if e + 1 < count else 0
+    ax, ay, bx, by = V[o, e, 0], V[o, e, 1], V[o, e1, 0], V[o, e1, 1]
+    ta, tb = (ax - p1x) * u1x + (ay - p1y) * u1y, (bx - p1x) * u1x + (by - p1y) * u1y
+    if max(ta, tb) < 0.0 or min(ta, tb) > length:
+        return 0, 0.0, 0.0
+    m = 0
+    # (an edge that meets the segment at one point, an end, gives that point once)
+    single = min(max(ta, tb), length) - max(min(ta, tb), 0.0) <= 1e-9 * length
+    for j in range(1 if single else 2):
+        t_end = ta if j == 0 else tb
+        qx, qy = (ax, ay) if j == 0 else (bx, by)
+        if (t_end < 0.0 or t_end > length) and ta != tb:
+            bound = 0.0 if t_end < 0.0 else length
+            f = (bound - ta) / (tb - ta)
+            qx, qy = ax + f * (bx - ax), ay + f * (by - ay)
+        h = (qx - p1x) * n1x + (qy - p1y) * n1y
+        if h - ro > speculative:
+            continue
+        out[m, 0], out[m, 1] = qx - n1x * 0.5 * (h + ro), qy - n1y * 0.5 * (h + ro)
+        out[m, 2], out[m, 3] = h - ro, float(j)
+        m += 1
+    return _own_points(out, m, p1x, p1y, u1x, u1y, length, convex1, convex2, n1x, n1y)
+
+
+@njit(cache=True)
+def _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny):
+    """The manifold's points that this segment owns: a point at or beyond a joint where the chain
+    runs on straight or bends inward is the neighbour's (at the joint itself, the segment that ends
+    there keeps it, the one that starts there leaves it), so a face resting across a joint is held
+    at its two ends, not at three points, two of them one. Returns ``(count, nx, ny)``."""
+    m = 0
+    for i in range(k):
+        t = (out[i, 0] - p1x) * u1x + (out[i, 1] - p1y) * u1y
+        if (not convex1 and t <= 1e-9 * length) or (not convex2 and t > length * (1.0 + 1e-9)):
+            continue
+        if m != i:
+            out[m, 0], out[m, 1], out[m, 2], out[m, 3] = out[i, 0], out[i, 1], out[i, 2], out[i, 3]
+        m += 1
+    if m == 0:
+        return 0, 0.0, 0.0
+    return m, nx, ny

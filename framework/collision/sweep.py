@@ -40,7 +40,7 @@ from __future__ import annotations
 import math
 from typing import cast
 
-from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
+from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment, Shape
 from ..validation import vector2
 from .capsule import capsule_first, core_points
 from .collide import collide
@@ -81,6 +81,10 @@ def time_of_impact(
     bx, by, br = pose("transform_b", transform_b)
     max_, may_ = vector2("motion_a", motion_a)
     mbx, mby = vector2("motion_b", motion_b)
+    if isinstance(shape_b, ChainSegment) and not isinstance(shape_a, ChainSegment):
+        # A chain segment's impact is worked with the segment first, whichever comes first.
+        hit = time_of_impact(shape_b, (bx, by, br), (mbx, mby), shape_a, (ax, ay, ar), (max_, may_))
+        return None if hit is None else Impact(hit.fraction, Vec2(-hit.normal.x + 0.0, -hit.normal.y + 0.0))
 
     contact = collide(shape_a, (ax, ay, ar), shape_b, (bx, by, br))
     if contact is not None:
@@ -107,6 +111,17 @@ def time_of_impact(
     # t_in < end, so the fraction is < 1. A t_in == 0 here means touching at the start and moving
     # in (or an overlap that collide's rounding missed): contact from the start.
     fraction = math.ldexp(t_in, k - j) if t_in > 0.0 else 0.0
+    if isinstance(shape_a, ChainSegment) and not isinstance(shape_b, Segment):
+        # A chain segment keeps the touches its one side and its joints allow (framework.collision.chain),
+        # judged where the two are at that moment.
+        from .chain import one_impact
+
+        at_a = (ax + max_ * fraction, ay + may_ * fraction, ar)
+        at_b = (bx + mbx * fraction, by + mby * fraction, br)
+        kept = one_impact(shape_a, at_a, shape_b, at_b, nx, ny)
+        if kept is None:
+            return None
+        nx, ny = kept
     return Impact(fraction + 0.0, Vec2(nx + 0.0, ny + 0.0))
 
 

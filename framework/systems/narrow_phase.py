@@ -11,6 +11,7 @@ import numpy as np
 
 from ..arrays import BoolArray, I64Array, IntpArray, distinct
 from ..collision import batch
+from ..collision.chain import chain_rule, deepest_below
 from ..collision.kinds import (
     BOXES,
     CAPSULES,
@@ -54,7 +55,72 @@ def pair_contacts(
     """Contacts of B (rows ``rb``) against A (rows ``ra``), in input order.
 
     ``remeasure``: the response measuring pairs it has just pushed apart; pairs then count
-    overlaps within rounding of touching as none, and box and polygon pairs skip their points."""
+    overlaps within rounding of touching as none, and box and polygon pairs skip their points.
+    A pair with a chain segment keeps what the chain's rules allow (:func:`chain_contacts`)."""
+    res = _pair_contacts(store, geom, ra, rb, counts, remeasure=remeasure)
+    if geom.chains:
+        res = chain_contacts(store, geom, ra, rb, res)
+    return res
+
+
+def chain_contacts(store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray,
+                   res: batch.ContactArrays) -> batch.ContactArrays:
+    """The contacts ``res`` of pairs ``(ra, rb)``, those with a chain segment passed through
+    :func:`framework.collision.chain.chain_rule` (one-sided; ghost vertices at the joints)."""
+    ca, cb = geom.is_chain[ra], geom.is_chain[rb]
+    m = np.flatnonzero(res.hit & (ca | cb))
+    if m.size == 0:
+        return res
+    first = ca[m]
+    seg, oth = np.where(first, ra[m], rb[m]), np.where(first, rb[m], ra[m])
+    sign = np.where(first, 1.0, -1.0)  # the kernel's normal from A toward B, times this: from the segment
+    hx, hy, cos, sin = geom.hx, geom.hy, geom.cos, geom.sin
+    ends = geom.world_poly[geom.poly_slot[seg]]
+    p1x, p1y = hx[seg] + ends[:, 0, 0], hy[seg] + ends[:, 0, 1]
+    p2x, p2y = hx[seg] + ends[:, 1, 0], hy[seg] + ends[:, 1, 1]
+    gl = geom.ghosts[seg]
+    c, s = cos[seg][:, None], sin[seg][:, None]
+    gx = hx[seg][:, None] + c * gl[:, :, 0] - s * gl[:, :, 1]
+    gy = hy[seg][:, None] + s * gl[:, :, 0] + c * gl[:, :, 1]
+    # The other body: its core (outline, centre or a capsule's ends) and radius, and its centre.
+    kind = store.kind[oth]
+    k = max(geom.K, 2)
+    vx, vy = np.zeros((m.size, k)), np.zeros((m.size, k))
+    count = np.ones(m.size, dtype=np.int64)
+    outl = np.flatnonzero((kind == KIND_AABB) | (kind == KIND_POLYGON) | (kind == KIND_SEGMENT))
+    if outl.size:
+        v, n = geom.outlines(store, oth[outl])
+        vx[outl, : v.shape[1]] = v[:, :, 0]
+        vy[outl, : v.shape[1]] = v[:, :, 1]
+        count[outl] = n
+    caps = np.flatnonzero(kind == KIND_CAPSULE)
+    if caps.size:
+        ux, uy = geom.cap_ux[oth[caps]], geom.cap_uy[oth[caps]]
+        vx[caps, 0], vy[caps, 0], vx[caps, 1], vy[caps, 1] = -ux, -uy, ux, uy
+        count[caps] = 2
+    vx += hx[oth][:, None]
+    vy += hy[oth][:, None]
+    radius = np.where((kind == KIND_CIRCLE) | (kind == KIND_CAPSULE), store.radius[oth], 0.0)
+    cx, cy = hx[oth], hy[oth]  # (its centre for the one-sided test: its hitbox origin)
+    ex, ey = p2x - p1x, p2y - p1y
+    ln = np.hypot(ex, ey)
+    low, sx, sy = deepest_below(vx, vy, count, radius, p1x, p1y, ey / ln, -ex / ln)
+    keep, nx, ny, depth, px, py = chain_rule(p1x, p1y, p2x, p2y, gx[:, 0], gy[:, 0], gx[:, 1], gy[:, 1], cx, cy,
+                                             sign * res.nx[m], sign * res.ny[m], res.depth[m], res.px[m],
+                                             res.py[m], low, sx, sy)
+    hit = res.hit.copy()
+    onx, ony, odepth, opx, opy = res.nx.copy(), res.ny.copy(), res.depth.copy(), res.px.copy(), res.py.copy()
+    hit[m] = keep
+    onx[m], ony[m] = np.where(keep, sign * nx, 0.0), np.where(keep, sign * ny, 0.0)
+    odepth[m], opx[m], opy[m] = np.where(keep, depth, 0.0), np.where(keep, px, 0.0), np.where(keep, py, 0.0)
+    return batch.ContactArrays(hit, onx, ony, odepth, opx, opy)
+
+
+def _pair_contacts(
+    store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray, counts: dict[str, int] | None = None,
+    *, remeasure: bool = False,
+) -> batch.ContactArrays:
+    """:func:`pair_contacts` of two-sided shapes (a chain segment is its segment here)."""
     P = ra.size
     if P == 0:
         return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))

@@ -51,6 +51,7 @@ from ..collision.soft_manifold import (
     UP,
     box_box,
     capsule_capsule,
+    chain_segment,
     circle_circle,
     polygon_circle,
     polygon_polygon,
@@ -58,7 +59,7 @@ from ..collision.soft_manifold import (
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
 
-__all__ = ["PARAMS", "SLOT", "internal_faces", "soft_step"]
+__all__ = ["CHAIN_KIND", "PARAMS", "SLOT", "internal_faces", "soft_step"]
 
 # The layout of the ``params`` float array (one argument instead of fourteen scalars).
 PARAMS = ("dt", "substeps", "gx", "gy", "slop", "speculative", "hertz", "damping", "push_speed",
@@ -69,6 +70,7 @@ PARAMS = ("dt", "substeps", "gx", "gy", "slop", "speculative", "hertz", "damping
 
 _DYNAMIC, _STATIC = 0, 2
 _AABB, _CIRCLE, _CAPSULE = 0, 1, 3
+CHAIN_KIND = _CHAIN = 5  # a chain segment (kernel_tables' code: the store's kind is a segment's)
 
 
 @njit(cache=True)
@@ -400,6 +402,12 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
             if k < 0:
                 k, nx, ny = polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, s_pair, out, faces[a],
                                             faces[b])
+        if kind[a] == _CHAIN or kind[b] == _CHAIN:  # one-sided, ghost vertices: what the chain keeps
+            g, o = (a, b) if kind[a] == _CHAIN else (b, a)
+            f = 1.0 if g == a else -1.0
+            k, nx, ny = chain_segment(wv, wn, lv, g, o, cnt[o], rr[o], wc[o, 0], wc[o, 1], k, f * nx, f * ny,
+                                      s_pair, out)
+            nx, ny = f * nx, f * ny
         low = 0.0
         if k > 0:
             low = out[0, 2]

@@ -45,9 +45,10 @@ from ..joints import (
     joint_components,
     joint_writes,
 )
+from ..shapes import ChainSegment
 from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT, STATIC
 from .soft_joints import JOINT_F, JOINT_IMP
-from .soft_kernel import PARAMS, SLOT, internal_faces, soft_step
+from .soft_kernel import CHAIN_KIND, PARAMS, SLOT, internal_faces, soft_step
 from .stage import PRIORITY, Stage
 
 __all__ = ["COMPILE_NOTICE", "SOFT_SETTINGS", "SoftStep", "kernel_tables"]
@@ -138,7 +139,9 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     :func:`~framework.systems.soft_kernel.soft_step`. Every hitbox is a rounded polygon about its
     hitbox origin (vertex count 0: no hitbox, or ``detection`` off): AABBs do not turn with the
     transform (their offset does); circles are one vertex, capsules their segment, segments their
-    two ends with radius 0 (Box2D's segment as a polygon of two points: each side a face).
+    two ends with radius 0 (Box2D's segment as a polygon of two points: each side a face); a chain
+    segment also its ghost vertices, in the vertex slots after its ends, and the shape kind
+    ``CHAIN_KIND``.
 
     ``off`` rows: the hitbox offset, then the centre of mass the soft step turns the body about
     (:attr:`~framework.components.Hitbox.mass_data`'s ``center``: a dynamic circle's or polygon's
@@ -167,6 +170,7 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
             inertia = hb._inertia if hb._inertia is not None else hb.effective_mass * polys[r].central_moment
             inv_inertia[r] = 0.0 if math.isinf(inertia) else 1.0 / inertia
     verts = np.zeros((n, K, 4))  # local vertices (x, y), then the edges' outward normals
+    chain: list[int] = []  # the rows of chain segments
     cnt = np.zeros(n, dtype=np.int64)
     rr = np.zeros(n)
     spin = np.ones(n, dtype=np.int64)
@@ -199,10 +203,15 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
             d = math.hypot(ex, ey)
             verts[r, :2] = ((x1, y1, ey / d, -ex / d), (x2, y2, -ey / d, ex / d))
             cnt[r] = 2
+            if isinstance(polys[r], ChainSegment):  # its ghosts after its ends (the kernel reads them there)
+                verts[r, 2, 0:2], verts[r, 3, 0:2] = polys[r].ghost1, polys[r].ghost2
+                chain.append(r)
     if not detection:
         cnt[:] = 0
     fprops = np.stack([store.inv_mass, inv_inertia, store.friction, store.restitution, store.bound, rr])
-    iprops = np.stack([store.body.astype(np.int64), store.kind.astype(np.int64), store.layer, store.mask,
+    kind = store.kind.astype(np.int64)
+    kind[chain] = CHAIN_KIND  # (the kernel's code of a chain segment)
+    iprops = np.stack([store.body.astype(np.int64), kind, store.layer, store.mask,
                        store.entity, store.sensor.astype(np.int64), store.one_way.astype(np.int64),
                        store.has_vel.astype(np.int64), cnt, spin])
     return fprops, iprops, off, verts
