@@ -25,6 +25,8 @@ Geometry: y is up; ``cells[row][col]`` has row 0 at the top, as drawn, so with `
 ``origin = (ox, oy)`` the cell ``(col, row)`` spans x in ``[ox + col * tile, ox + (col + 1) * tile]``
 and y in ``[oy + (H - row - 1) * tile, oy + (H - row) * tile]``. Pieces never span rows. With a
 dyadic tile size (32, 1, 0.5...) and origin every vertex and position is exact.
+
+Terrain drawn as lines in Tiled (polyline and polygon objects) becomes chains: :func:`tiled_chains`.
 """
 
 from __future__ import annotations
@@ -33,12 +35,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from .shapes import AABB, Polygon
-from .validation import InvalidValue, positive, vector2
+from .shapes import AABB, Chain, Polygon
+from .validation import InvalidValue, finite, positive, vector2
 
 __all__ = [
     "HEIGHTS", "MIRRORED", "SLOPES", "SLOPE_DOWN", "SLOPE_DOWN_HIGH", "SLOPE_DOWN_LOW", "SLOPE_UP",
-    "SLOPE_UP_HIGH", "SLOPE_UP_LOW", "SOLID", "STEP", "TERRAIN", "TerrainPiece", "terrain_pieces",
+    "SLOPE_UP_HIGH", "SLOPE_UP_LOW", "SOLID", "STEP", "TERRAIN", "TerrainPiece", "terrain_pieces", "tiled_chains",
 ]
 
 SOLID = "solid"
@@ -174,3 +176,62 @@ def _polygon_piece(run: list[str | None], col: int, row: int, t: float, ox: floa
     return TerrainPiece(shape, ox + (col + half_w) * t, bottom + half_h * t,
                         tuple((c, row) for c in range(col, col + n)),
                         (bottom + heights[0] * t, bottom + heights[-1] * t))
+
+
+# --- Tiled objects drawn as lines: chains -----------------------------------------------------------
+
+def tiled_chains(objects: object, map_height: float, scale: float = 1.0) -> list[Chain]:
+    """The polyline and polygon objects of a Tiled object layer as :class:`~framework.shapes.Chain`
+    terrain (other objects are left to the caller): ``objects`` is the layer's ``"objects"`` list
+    (or the layer itself, a dict with one) as Tiled's JSON gives it; ``map_height`` the map's height
+    in Tiled's pixels (``height * tileheight``): Tiled's y runs down from the map's top, the
+    chains' up from its bottom; every coordinate is then multiplied by ``scale`` (``1 / tile`` for
+    a world in tiles).
+
+    - A **polygon** is a closed loop of solid terrain: bodies meet it from outside, however it was
+      drawn (its points are put in counter-clockwise order, y up).
+    - A **polyline** is met from the side on the left of the way it was drawn, as it looks in
+      Tiled: ground drawn left to right is met from above, a ceiling is drawn right to left.
+
+    An object's ``x, y`` and ``rotation`` (degrees, clockwise as Tiled shows it, about ``x, y``)
+    place its points. Bad values (a missing or non-finite coordinate, fewer points than a chain
+    needs, two equal points in a row) raise :class:`ValueError` naming the object."""
+    scale = positive("tiled_chains scale", scale)
+    map_h = finite("tiled_chains map_height", map_height)
+    if isinstance(objects, dict):
+        objects = objects.get("objects", [])
+    if not isinstance(objects, list):
+        raise InvalidValue(f"tiled_chains needs a Tiled object layer or its 'objects' list, got {objects!r}")
+    chains = []
+    for i, obj in enumerate(objects):
+        if not isinstance(obj, dict):
+            raise InvalidValue(f"Tiled object {i} must be a JSON object, got {obj!r}")
+        loop = "polygon" in obj
+        raw = obj.get("polygon" if loop else "polyline")
+        if raw is None:
+            continue
+        label = f"Tiled {'polygon' if loop else 'polyline'} object {obj.get('id', i)!r}"
+        x, y = finite(f"{label} x", obj.get("x", 0.0)), finite(f"{label} y", obj.get("y", 0.0))
+        angle = math.radians(finite(f"{label} rotation", obj.get("rotation", 0.0)))
+        c, s = (1.0, 0.0) if angle == 0.0 else (math.cos(angle), math.sin(angle))
+        if not isinstance(raw, list):
+            raise InvalidValue(f"{label}: its points must be a list, got {raw!r}")
+        pts = []
+        for j, p in enumerate(raw):
+            if not isinstance(p, dict):
+                raise InvalidValue(f"{label}: point {j} must be an object with x and y, got {p!r}")
+            px, py = finite(f"{label} point {j} x", p.get("x")), finite(f"{label} point {j} y", p.get("y"))
+            # Tiled's frame (y down), turned about the object's position, then y up from the bottom.
+            tx, ty = x + c * px - s * py, y + s * px + c * py
+            pts.append((tx * scale, (map_h - ty) * scale))
+        if loop:
+            area2 = sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]))
+            if area2 < 0.0:
+                pts.reverse()  # counter-clockwise: solid inside, met from outside
+        else:
+            pts.reverse()  # met on the left of the way it was drawn (a chain is met on its right)
+        try:
+            chains.append(Chain(pts, loop=loop))
+        except InvalidValue as exc:
+            raise InvalidValue(f"{label}: {exc}") from None
+    return chains
