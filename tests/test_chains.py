@@ -251,3 +251,34 @@ def test_a_box_rests_in_a_loop_and_on_it(solver) -> None:
     assert hit.point == pytest.approx((12.0, 3.0), abs=1e-3)  # the top of the box on top
     hit = s.raycast((12, 1), (0, 1))  # from inside the solid block: through its top's back, to the box
     assert hit.entity == on_top and hit.point == pytest.approx((12.0, 2.0), abs=1e-3)
+
+
+def test_a_character_walks_a_chain_up_a_ramp_as_it_walks_tiles() -> None:
+    # docs/character.md's walk (flat ground at y = 32, a 45-degree ramp up to 64 over x 128..160),
+    # the ground drawn as one chain instead of tiles: the same path.
+    from framework.character import CharacterController
+
+    scene = Scene(gravity=(0.0, -1024.0))
+    spawn_chain(scene, Chain([(320, 64), (160, 64), (128, 32), (96, 32), (40, 32), (0, 32)]))
+    hero = scene.spawn(Transform(64.0, 46.0), Velocity(), Hitbox(AABB(24.0, 28.0), body="kinematic"),
+                       CharacterController(step_height=8.0))
+    ctrl, body, vel = scene.get(hero, CharacterController), scene.get(hero, Transform), scene.get(hero, Velocity)
+    path = []
+    for step in range(60):
+        vel.x = 128.0
+        scene.step(1 / 64)
+        if step % 10 == 9:
+            path.append((body.x, round(body.y - 14, 9), ctrl.on_floor, round(ctrl.floor_normal[1], 3)))
+    assert path == [(84.0, 32.0, True, 1.0), (104.0, 32.0, True, 1.0), (124.0, 40.0, True, 0.707),
+                    (144.0, 60.0, True, 0.707), (164.0, 64.0, True, 1.0), (184.0, 64.0, True, 1.0)]
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_a_fast_body_with_ccd_stops_on_a_chain_from_above_and_passes_from_below(solver) -> None:
+    s = Scene(solver="soft") if solver == "soft" else Scene()
+    spawn_chain(s, Chain([(4, 0), (0, 0), (-4, 0)]))
+    down = s.spawn(Transform(1, 3), Velocity(0, -600), Hitbox(Circle(0.25), ccd=True))  # 10 units a step
+    up = s.spawn(Transform(-1, -3), Velocity(0, 600), Hitbox(Circle(0.25), ccd=True))
+    s.step(1 / 60)
+    assert s.get(down, Transform).y == pytest.approx(0.25, abs=1e-2)
+    assert s.get(up, Transform).y == pytest.approx(7.0)
