@@ -36,7 +36,7 @@ from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
 from .frame import StepFrame, add_counters
 from .geometry import Geometry
 from .input import Input
-from .joints import Joint, JointBroken, JointReaction, check_joints, joint_components, remove_joints_of
+from .joints import Joint, JointBroken, JointReaction, breakable, check_joints, joint_components, remove_joints_of
 from .limits import MAX_COORD, check_motion, motion_within
 from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
@@ -685,9 +685,7 @@ class Scene:
         if not isinstance(stage, SoftStep):
             return []
         broken = []
-        for e, j in joint_components():
-            if j.break_force == math.inf and j.break_torque == math.inf:
-                continue
+        for e, j in breakable(joint_components()):
             fx, fy, torque = stage.reaction(e, j)
             if math.hypot(fx, fy) > j.break_force or abs(torque) > j.break_torque:
                 broken.append(JointBroken(e, j.a, j.b, j, Vec2(float(fx), float(fy)), float(torque)))

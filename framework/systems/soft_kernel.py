@@ -55,6 +55,7 @@ from ..collision.soft_manifold import (
     polygon_circle,
     polygon_polygon,
 )
+from ..compiled import leaf
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
 
@@ -123,7 +124,7 @@ def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
     return faces
 
 
-@njit(cache=True)
+@leaf
 def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
                   wc, wv, wn, lo, hi, reach):
     """World centres, vertices and normals of every hitbox (``cnt == 0``: none) and its bounds, widened by
@@ -260,7 +261,7 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
     return pairs
 
 
-@njit(cache=True)
+@leaf
 def _fat_overlap(fat, i, j):
     return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
 
@@ -774,7 +775,7 @@ def _anchors_from_centres(jint, jf, off, conv):
     return jf
 
 
-@njit(cache=True)
+@leaf
 def _from_centres(x, y, rot, off, conv, x_origin, y_origin, x0, y0, centre0):
     """Move the ``conv`` rows back from their centres of mass to their origins: the origin at the
     step's start plus the centre's motion since, less the centre's turn since (``R(rot) c`` now less
@@ -789,7 +790,7 @@ def _from_centres(x, y, rot, off, conv, x_origin, y_origin, x0, y0, centre0):
         y[r] = y_origin[r] + ((y[r] - y0[r]) - (ey - centre0[r, 1]))
 
 
-@njit(cache=True)
+@leaf
 def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, turning):
     """The velocities of A and B after the impulse ``(px, py)`` at their anchors (B takes it, A
     its opposite); ``turning``: the angular parts too."""
@@ -803,7 +804,7 @@ def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, tu
     return vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
     """Apply each point's accumulated impulses (Box2D's ``b2WarmStartContacts``)."""
     for c in range(nc):
@@ -821,7 +822,7 @@ def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
         vx[a], vy[a], w[a], vx[b], vy[b], w[b] = vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_bias, rotation, softness,
            inv_h, push):
     """One pass over the contacts (Box2D's ``b2SolveContact``): the normal impulses with soft
@@ -885,7 +886,7 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
             vx[b], vy[b], w[b] = vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
     """Bounce the points that approached faster than ``threshold`` and took an impulse (Box2D's
     ``b2ApplyRestitution``): the relative normal velocity becomes ``-e`` times the approach."""

@@ -235,7 +235,7 @@ class SoftStep(Stage):
         self._faces_key: tuple[int, int, int, bool] | None = None
         self._faces = np.zeros(0, dtype=np.int64)
         self._no_driven = np.zeros(0, dtype=np.bool_)
-        self._joint_key: tuple[Any, ...] | None = None  # what the packed joint tables were packed from
+        self._joint_key: tuple[Any, ...] = (None, None, None)  # what the packed joint tables were packed from
         self._joint_tables: tuple[np.ndarray, ...] = ()
         self.reset()
 
@@ -383,16 +383,22 @@ class SoftStep(Stage):
                 self.joints = (_NO_KEYS, _NO_IMP, _NO_JF)
             return _NO_JINT, _NO_JF, _NO_IMP, _NO_KEYS
         store = self.bodies.store
-        for _e, j in joints:
-            if j._frame is None:  # (added to the world by hand, not by the scene: measured now)
-                j.attach(store)
-        check_joints(joints, store, "soft")
-        key = (store.version, joint_writes(), [(e, id(j)) for e, j in joints])
-        if key != self._joint_key:  # (packed again only when a joint, its bodies or the rows changed)
+        key = (store.version, joint_writes(), joints)
+        if not (key[:2] == self._joint_key[:2] and joints is self._joint_key[2]):
+            for _e, j in joints:
+                if j._frame is None:  # (added to the world by hand, not by the scene: measured now)
+                    j.attach(store)
+            check_joints(joints, store, "soft")
+            key = (store.version, joint_writes(), joints)  # (attaching writes the anchors it measures)
+            # (packed again only when a joint, its bodies or the rows changed: joint_components
+            # answers with the same list while no component was added or removed)
             self._joint_tables = joint_tables(joints, store.row_of)
             self._joint_key = key
         jint, jf, keys, apart = self._joint_tables
-        if np.array_equal(keys, old_keys):
+        if keys is old_keys and jf is old_jf:  # (the same tables as last step: nothing changed)
+            imp = old_imp
+            changed = np.zeros(keys.size, dtype=bool)
+        elif np.array_equal(keys, old_keys):
             imp = old_imp
             changed = np.any(jf != old_jf, axis=1)
         else:
