@@ -12,9 +12,14 @@ its caller, who keeps them alive for the call.
 
 from __future__ import annotations
 
+from typing import Any
+
 from numba import njit
 
 __all__ = ["leaf"]
 
+# (``_nrt`` is numba's own switch for its reference counting; its type stubs do not list it)
+_LEAF_OPTIONS: dict[str, Any] = {"cache": True, "_nrt": False}
+
 #: ``@leaf``: compile (cached on disk) without reference counting. See the module docstring.
-leaf = njit(cache=True, _nrt=False)
+leaf = njit(**_LEAF_OPTIONS)
