@@ -565,7 +565,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
     not modified: new ones are returned. ``jint, jf, jimp``: the joints, their parameters and their
-    impulses from the last step (:mod:`framework.systems.soft_joints`; new impulses are returned);
+    impulses from the last step (:mod:`framework.systems.soft_joints`; new impulses are returned),
+    or three Nones for a scene without joints (then the joints' code is not compiled for it);
     ``apart``: the sorted keys of the pairs that do not collide (a joint's bodies). See the module
     docstring for the stages.
 
@@ -630,7 +631,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     if shifted:
         x_origin, y_origin = x.copy(), y.copy()
         off, bound, centre0 = _to_centres(x, y, rot, off, bound, conv)
-        if jint.shape[0]:
+        if jint is not None:
             jf = _anchors_from_centres(jint, jf, off, conv)
 
     # --- shapes, fat bounds and the broad phase ----------------------------------------------------
@@ -687,10 +688,9 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
         softness[q, 0], softness[q, 1], softness[q, 2] = _soft((2.0 if q & 1 else 1.0) * scale * hertz,
                                                                scale * zeta, h)
     push = params[_PUSH]
-    nj = jint.shape[0]  # (no joints: no calls and no copies, as before there were joints)
-    jp = jf
-    jsoft = softness[0]
-    if nj:
+    # (a scene without joints passes None: numba drops these branches, and compiles none of the
+    # joints' code for it)
+    if jint is not None:
         jp = prepare_joints(jint, jf, x, y, rot, moving, im, ii, h)
         jimp = jimp.copy()
         jsoft = np.empty(3)  # the joints' stiffness (Box2D's b2PrepareJoint: at most a quarter of the sub-step rate)
@@ -704,7 +704,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             if moving[r] and body[r] == _DYNAMIC and not driven[r]:
                 vx[r] += h * gx
                 vy[r] += h * gy
-        if nj:
+        if jint is not None:
             warm_start_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
         for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
@@ -721,7 +721,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
                             c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
                             mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
                             qc[r], qs[r] = c2 * mag, s2 * mag
-            if nj:
+            if jint is not None:
                 solve_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w, relax == 0, jsoft, h, inv_h)
             _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
                    inv_h, push)

@@ -62,7 +62,6 @@ SOFT_SETTINGS = {"slop": 0.005, "hertz": 30.0, "damping": 10.0, "push_speed": 3.
 # the store's columns the kernel reads (and writes: the pose and velocity), in its argument order
 _KERNEL_COLUMNS = ("x", "y", "rot", "vx", "vy", "w", "asleep")
 # a scene without joints passes these
-_NO_JINT = np.zeros((0, 3), dtype=np.int64)
 _NO_JF = np.zeros((0, len(JOINT_F)))
 _NO_IMP = np.zeros((0, len(JOINT_IMP)))
 _NO_KEYS = np.zeros(0, dtype=np.int64)
@@ -201,20 +200,21 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     return fprops, iprops, off, verts
 
 
-_COMPILED = False
+_COMPILED: set[bool] = set()  # the kernel's variants called in this process (True: with joints)
 COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 25 to 30 seconds; later runs load "
                   "it from numba's cache)")
 
 
-def _first_call(args: tuple[Any, ...]) -> tuple[Any, ...]:
-    """The kernel's first call in this process: if it has not returned within a second (numba is
-    compiling it, not loading it from its cache), say so on stderr, once."""
-    global _COMPILED
+def _first_call(args: tuple[Any, ...], variant: bool) -> tuple[Any, ...]:
+    """The kernel's first call in this process for scenes with joints (``variant``) or without:
+    if it has not returned within a second (numba is compiling it, not loading it from its cache),
+    say so on stderr, once. (The two are compiled apart: a scene without joints compiles none of
+    the joints' code.)"""
     try:
         with notice_if_slow(COMPILE_NOTICE):
             return soft_step(*args)
     finally:
-        _COMPILED = True
+        _COMPILED.add(variant)
 
 
 class SoftStep(Stage):
@@ -371,7 +371,7 @@ class SoftStep(Stage):
             self._settings_key = key
         return self._params
 
-    def _joints(self) -> tuple[np.ndarray, ...]:
+    def _joints(self) -> tuple[np.ndarray | None, ...]:
         """The kernel's joint arguments ``(jint, jf, jimp, apart)``: the joint components packed
         (checked again: game code may have written to them), last step's impulses matched by joint.
         A sleeping body is woken where its joint's other body moves, or the joint is new or changed
@@ -381,7 +381,7 @@ class SoftStep(Stage):
         if not joints:
             if old_keys.size:
                 self.joints = (_NO_KEYS, _NO_IMP, _NO_JF)
-            return _NO_JINT, _NO_JF, _NO_IMP, _NO_KEYS
+            return None, None, None, _NO_KEYS  # (the kernel's variant without joints)
         store = self.bodies.store
         key = (store.version, joint_writes(), joints)
         if not (key[:2] == self._joint_key[:2] and joints is self._joint_key[2]):
@@ -447,11 +447,13 @@ class SoftStep(Stage):
         joints = self._joints()
         args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
                 *joints)
-        out = soft_step(*args) if _COMPILED else _first_call(args)
+        jint = joints[0]
+        variant = jint is not None
+        out = soft_step(*args) if variant in _COMPILED else _first_call(args, variant)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info, jimp = out
-        if jimp.size:
+        if jint is not None:
             self.joints = (self.joints[0], jimp, self.joints[2])
-            ja, jb = joints[0][:, 1], joints[0][:, 2]
+            ja, jb = jint[:, 1], jint[:, 2]
             both = (ja >= 0) & (jb >= 0)
             frame.joined = (ja[both], jb[both])
         if "movement" in effects:
