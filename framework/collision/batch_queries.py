@@ -98,9 +98,9 @@ def _norm(x, y, m):  # pragma: no cover - compiled
 def hypot(x, y):  # pragma: no cover - compiled
     """``math.hypot(x, y)`` as CPython 3.11 computes it (the same bits)."""
     x, y = abs(x), abs(y)
+    if math.isinf(x) or math.isinf(y):
+        return math.inf
     m = x if x > y else y
-    if math.isinf(m):
-        return m
     if math.isnan(x) or math.isnan(y):
         return math.nan
     if m == 0.0:
