@@ -38,7 +38,7 @@ from .geometry import Geometry
 from .input import Input
 from .joints import Joint, JointBroken, JointReaction, breakable, check_joints, joint_components, remove_joints_of
 from .limits import MAX_COORD, check_motion, motion_within
-from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
+from .queries import ALL_LAYERS, Nearest, NearestMany, PointHits, RayHits, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
 from .shapes import Shape
 from .snapshot import Snapshot
@@ -677,6 +677,30 @@ class Scene:
         closest points: a :class:`~framework.collision.distance.Distance`."""
         self._activate()
         return self._queries.distance(entity_a, entity_b)
+
+    def query_points(self, points: Any, *, mask: int = ALL_LAYERS) -> PointHits:
+        """:meth:`query_point` of many points (an ``(n, 2)`` array) in one compiled pass: a
+        :class:`~framework.queries.PointHits`; point ``i``'s entities, sorted, are
+        ``hits.entities[hits.offsets[i]:hits.offsets[i + 1]]`` (``hits.of(i)``)."""
+        self._activate()
+        return self._queries.query_points(points, mask)
+
+    def nearest_many(self, points: Any, *, max_distance: float = math.inf, mask: int = ALL_LAYERS) -> NearestMany:
+        """:meth:`nearest` of many points (an ``(n, 2)`` array) in one compiled pass: a
+        :class:`~framework.queries.NearestMany` of arrays ``entity`` (-1 where no hitbox is within
+        ``max_distance``), ``distance`` (``inf`` there) and ``point``; the same floats as
+        ``nearest`` point by point."""
+        self._activate()
+        return self._queries.nearest_many(points, max_distance, mask)
+
+    def raycast_many(self, origins: Any, directions: Any, *, max_distance: float = math.inf,
+                     mask: int = ALL_LAYERS) -> RayHits:
+        """:meth:`raycast` of many rays (``(n, 2)`` arrays of origins and directions) in one
+        compiled pass: a :class:`~framework.queries.RayHits` of arrays ``entity`` (-1 for a miss),
+        ``distance`` (``inf`` for a miss), ``point`` and ``normal``; the same floats as
+        ``raycast`` ray by ray. Batched rays are not drawn by the debug overlay."""
+        self._activate()
+        return self._queries.raycast_many(origins, directions, max_distance, mask)
 
     def _break_joints(self) -> list[JointBroken]:
         """Remove the joints whose force or torque this step was above their ``break_force`` or
