@@ -81,9 +81,10 @@ class PointHits(NamedTuple):
 
 class NearestMany(NamedTuple):
     """The hitbox nearest each of ``n`` points (:meth:`SpatialQueries.nearest_many`): ``entity``
-    ``(n,)`` (-1 where none is within ``max_distance``), ``distance`` ``(n,)`` (0 inside; ``inf``
-    where none is) and ``point`` ``(n, 2)``, the hitbox's point nearest (the query point itself
-    where none is). Row ``i`` is ``nearest(points[i])``, float for float."""
+    ``(n,)`` (-1 where none is within ``max_distance``), ``distance`` ``(n,)`` (0 inside; -1
+    where none is: the contract's queries never answer inf) and ``point`` ``(n, 2)``, the
+    hitbox's point nearest (the query point itself where none is). Row ``i`` is
+    ``nearest(points[i])``, float for float."""
 
     entity: NDArray[np.int64]
     distance: NDArray[np.float64]
@@ -92,7 +93,7 @@ class NearestMany(NamedTuple):
 
 class RayHits(NamedTuple):
     """Where each of ``n`` rays first enters a hitbox (:meth:`SpatialQueries.raycast_many`):
-    ``entity`` ``(n,)`` (-1 for a miss), ``distance`` ``(n,)`` (``inf`` for a miss), ``point`` and
+    ``entity`` ``(n,)`` (-1 for a miss), ``distance`` ``(n,)`` (-1 for a miss), ``point`` and
     ``normal`` ``(n, 2)`` (zeros for a miss). Row ``i`` is ``raycast(origins[i], directions[i])``,
     float for float."""
 
@@ -368,7 +369,7 @@ class SpatialQueries:
 
     def nearest_many(self, points: object, max_distance: float = math.inf, mask: int = ALL_LAYERS) -> NearestMany:
         """:meth:`nearest` of each row of ``points`` (``(n, 2)``), in one compiled pass: a
-        :class:`NearestMany` (entity -1 and distance ``inf`` where no hitbox is within
+        :class:`NearestMany` (entity -1 and distance -1 where no hitbox is within
         ``max_distance``)."""
         pts = _xy_rows("points", points)
         md = _max_distance(max_distance)
@@ -379,12 +380,13 @@ class SpatialQueries:
             np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), md, store.kind, cols.kind, cols.sa,
             cols.sb, cols.local, cols.cnt, store.layer, store.entity, geom.minx, geom.miny, geom.maxx, geom.maxy,
             geom.hx, geom.hy, store.rot, m)
+        dist[ent < 0] = -1.0  # (a miss: never inf)
         return NearestMany(ent, dist, np.stack([bx, by], axis=1))
 
     def raycast_many(self, origins: object, directions: object, max_distance: float = math.inf,
                      mask: int = ALL_LAYERS) -> RayHits:
         """:meth:`raycast` of each ray ``origins[i]``, ``directions[i]`` (``(n, 2)`` each), in one
-        compiled pass: a :class:`RayHits` (entity -1 and distance ``inf`` for a miss). (ray, row)
+        compiled pass: a :class:`RayHits` (entity -1 and distance -1 for a miss). (ray, row)
         pairs the compiled float path leaves to exact arithmetic, and rays against capsules, are
         answered by :func:`~framework.collision.ray.raycast` itself."""
         o = _xy_rows("origins", origins)
@@ -423,6 +425,7 @@ class SpatialQueries:
                 ent[i], dist[i], rows[i] = e, hit.distance, r
                 hx[i], hy[i] = hit.point
                 nx[i], ny[i] = hit.normal
+        dist[ent < 0] = -1.0  # (a miss: never inf)
         return RayHits(ent, dist, np.stack([hx, hy], axis=1), np.stack([nx, ny], axis=1))
 
     def _contains(self, r: int, px: float, py: float) -> bool:

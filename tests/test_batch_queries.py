@@ -104,6 +104,7 @@ def test_points_and_nearest_equal_the_single_queries_and_brute_force(bodies, poi
         inside = s.query_points(points, mask=mask)
         near = s.nearest_many(points, max_distance=max_distance, mask=mask)
         assert inside.offsets.shape == (len(points) + 1,) and inside.offsets[0] == 0
+        assert np.isfinite(near.distance).all() and np.isfinite(near.point).all()  # (never inf, never NaN)
         for i, p in enumerate(points):
             single = s.query_point(*p, mask=mask)
             assert inside.of(i) == single
@@ -137,6 +138,7 @@ def test_rays_equal_the_single_queries_and_brute_force(bodies, rays, mask, max_d
         origins = [o for o, _ in rays]
         directions = [d for _, d in rays]
         hits = s.raycast_many(origins, directions, max_distance=max_distance, mask=mask)
+        assert all(np.isfinite(a).all() for a in (hits.distance, hits.point, hits.normal))  # (never inf or NaN)
         for i, (o, d) in enumerate(rays):
             got = _batch_ray(hits, i)
             assert got == _hit_tuple(s.raycast(o, d, max_distance=max_distance, mask=mask))
@@ -250,7 +252,7 @@ def test_rays_graze_hit_at_max_distance_and_start_inside():
         ]
         assert got[5][1] == math.hypot(4.0, 4.0) and got[6][3] == pytest.approx((0.0, 1.0), abs=1e-15)
         assert got == [_hit_tuple(s.raycast(*r)) for r in rays]
-        assert math.isinf(hits.distance[0]) and hits.point[0].tolist() == [0.0, 0.0]
+        assert hits.distance[0] == -1.0 and hits.point[0].tolist() == [0.0, 0.0]  # (a miss: never inf)
         # a hit at exactly max_distance counts; a hair short of it does not
         at = s.raycast_many([(-5.0, 0.0)], [(1.0, 0.0)], max_distance=4.0)
         short = s.raycast_many([(-5.0, 0.0)], [(1.0, 0.0)], max_distance=3.999999)
@@ -276,7 +278,7 @@ def test_nearest_far_away_ties_and_masks():
         masked = s.nearest_many([(-3.0, 0.0), (-3.0, 0.0)], mask=2, max_distance=7.0)
         assert _batch_near(masked, 0) == (c, 6.0, (3.0, 0.0))
         none = s.nearest_many([(-3.0, 0.0)], mask=2, max_distance=5.5)
-        assert none.entity.tolist() == [-1] and math.isinf(none.distance[0])
+        assert none.entity.tolist() == [-1] and none.distance[0] == -1.0  # (a miss: never inf)
         assert none.point.tolist() == [[-3.0, 0.0]]
 
 
