@@ -554,6 +554,7 @@ class Scene:
                     exc.add_note(f"step {self.frame + 1} failed after a system changed the scene's structure (a Hitbox "
                                  "or Velocity added or removed): the scene is left as the failure found it")
                 raise
+        store.end_undo()  # (the step stands: the static rows need no saving any more)
         self.broken_joints = self._break_joints()
         self.frame += 1
         self.time += dt
