@@ -6,7 +6,9 @@ Where each runs in a step (see :func:`install`)::
     movement          (framework: integrate velocities, gravity; moving platforms move)
     character         (framework: the player and the walkers move and slide with their
                        CharacterController: slopes, steps, riding platforms, one-way platforms)
-    ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide)
+    before response   weigh_on_bridges
+    ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide; or
+                       the soft step, with the bridges' joints)
     after response    sense_player -> sense_enemies -> fall_out -> animate -> follow_camera
     end of step       collision handlers: coins, spikes, enemies, checkpoints, the goal
 
@@ -18,6 +20,7 @@ else collision-related comes from the pipeline: its events (``scene.on_collision
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +35,7 @@ from .animations import animations
 from .components import (
     ONE_WAY,
     SOLID,
+    BridgePlank,
     Checkpoint,
     Coin,
     Enemy,
@@ -89,6 +93,8 @@ def level_flow(scene: Scene, dt: float) -> None:
     if state.pending_stage == 0:
         game.clear_level()
         state.pending_stage = 1
+        index = state.level_index + (1 if state.pending == "next" else 0)
+        game.use_solver_of(index)  # (when this step ends: a solver changes only between steps)
     else:
         index = state.level_index + (1 if state.pending == "next" else 0)
         state.pending = None
@@ -128,6 +134,33 @@ def swing_platforms(scene: Scene, dt: float) -> None:
     for _e, (rope, t, v) in scene.query(SwingRope, Transform, Velocity):
         v.x, v.y = (rope.swing.pivot[0] - t.x) / dt, (rope.swing.pivot[1] - t.y) / dt
         v.angular = (rope.swing.angle(rope.swing.time) - t.rotation) / dt
+
+
+def weigh_on_bridges(scene: Scene, dt: float) -> None:
+    """The player weighs on the bridge plank it stands on. The character controller moves the
+    player as a kinematic body, which presses on nothing; so after it has moved (and before the
+    soft step solves the bridge's hinges), the plank under its feet gets the impulse of the
+    player's weight over the step, ``push_mass * gravity * dt``, at the point under the feet (its
+    bottom middle): the bridge then carries the player as it would a weight of that mass hung
+    there, and sags under it (as :func:`.bridge.hang` says, tested)."""
+    planks = scene.query(BridgePlank)
+    if not planks or dt <= 0.0:
+        return
+    tu: Tuning = scene.resources[Tuning]
+    gx, gy = scene.gravity
+    jx, jy = tu.push_mass * gx * dt, tu.push_mass * gy * dt
+    for _e, (_p, t, hb, ctrl) in scene.query(Player, Transform, Hitbox, CharacterController):
+        floor = ctrl.floor_entity
+        if not ctrl.on_floor or floor is None or scene.try_get(floor, BridgePlank) is None:
+            continue
+        pt, pv, phb = scene.get(floor, Transform), scene.get(floor, Velocity), scene.get(floor, Hitbox)
+        mass, (cx, cy), inertia = phb.mass_data
+        c, s = math.cos(pt.rotation), math.sin(pt.rotation)
+        rx = t.x - (pt.x + c * cx - s * cy)  # from the plank's centre of mass to the feet
+        ry = t.y - hb.shape.height * 0.5 - (pt.y + s * cx + c * cy)
+        pv.x += jx / mass
+        pv.y += jy / mass
+        pv.angular += (rx * jy - ry * jx) / inertia
 
 
 def control_player(scene: Scene, dt: float) -> None:
@@ -367,6 +400,7 @@ def install(scene: Scene) -> None:
 
     for system in (level_flow, move_platforms, swing_platforms, control_player, walk_enemies):
         scene.add_system(system, before="movement")
+    scene.add_system(weigh_on_bridges, before="response")
     for system in (sense_player, sense_enemies, fall_out, animate, follow_camera):
         scene.add_system(system, after="response")
     scene.on_collision(P, Coin, on_coin)
