@@ -537,22 +537,39 @@ _WRITES = [0]  # joint parameters written, ever (see joint_writes)
 
 
 def joint_components() -> list[tuple[int, Joint]]:
-    """Every joint of the current esper world as ``(entity, joint)``, by entity then kind. A world
-    without joints answers from esper's table of component types (which drops a type when its last
-    component goes): four set look-ups, a fraction of a microsecond a step."""
+    """Every joint of the current esper world as ``(entity, joint)``, by entity then kind (a list
+    the caller must not change). A world without joints answers from esper's table of component
+    types (which drops a type when its last component goes): four set look-ups, a fraction of a
+    microsecond a step. Otherwise the answer is sorted again only when esper's lists of the joint
+    types are new ones (esper makes new lists after any component is added or removed): a step
+    asks three times, and sorting a hundred joints each time was a fifth of a chain's step."""
     if esper._components.keys().isdisjoint(_JOINT_SET):
         return []
+    lists = tuple(esper.get_component(cls) for cls in JOINT_TYPES)
+    seen, answer = _LISTED
+    if seen is not None and all(a is b for a, b in zip(lists, seen)):
+        return answer
     out: list[tuple[int, Joint]] = []
-    for cls in JOINT_TYPES:
-        out.extend(esper.get_component(cls))
+    for found in lists:
+        out.extend(found)
     if len(out) > 1:
         out.sort(key=lambda ej: (ej[0], ej[1].kind))
+    _LISTED[:] = [lists, out]  # (holding esper's lists: their identities cannot be reused)
     return out
+
+
+_LISTED: list = [None, []]  # esper's lists joint_components last read, and its answer
+_CLEAN: list = [None]  # what check_joints last passed: (joints, store, version, writes, solver)
 
 
 def check_joints(joints: list[tuple[int, Joint]], store: BodyStore, solver: str) -> None:
     """:class:`InvalidValue` naming the joint's entity if a joint is bad (a parameter written since,
-    a body gone or without a Hitbox), or if the scene's solver cannot solve joints."""
+    a body gone or without a Hitbox), or if the scene's solver cannot solve joints. The same list
+    of joints against the same bodies with nothing written since it passed passes at once."""
+    last = _CLEAN[0]
+    if (last is not None and last[0] is joints and last[1] is store and last[2] == store.version
+            and last[3] == _WRITES[0] and last[4] == solver):
+        return
     if joints and solver != "soft":
         e, j = joints[0]
         raise InvalidValue(f"entity {e} holds a {type(j).__name__}: joints need Scene(solver=\"soft\"); the exact "
@@ -567,6 +584,21 @@ def check_joints(joints: list[tuple[int, Joint]], store: BodyStore, solver: str)
         except InvalidValue as exc:
             raise InvalidValue(f"entity {e}: {exc}") from None
         j.__dict__["_checked"] = stamp
+    _CLEAN[0] = (joints, store, store.version, _WRITES[0], solver)
+
+
+def breakable(joints: list[tuple[int, Joint]]) -> list[tuple[int, Joint]]:
+    """The joints that may break (a finite ``break_force`` or ``break_torque``), found again only
+    when the list or a joint's parameters changed."""
+    last, answer = _BREAKABLE
+    if last is not None and last[0] is joints and last[1] == _WRITES[0]:
+        return answer
+    answer = [(e, j) for e, j in joints if j.break_force != math.inf or j.break_torque != math.inf]
+    _BREAKABLE[:] = [(joints, _WRITES[0]), answer]
+    return answer
+
+
+_BREAKABLE: list = [None, []]  # (the list and the writes breakable last read, its answer)
 
 
 def joint_writes() -> int:

@@ -4,6 +4,11 @@ Candidates come from one compiled pass over the hitboxes' bounds (the static has
 bounds test in scenes of more than :data:`~framework.collision.broad_phase.DIRECT_QUERY` rows);
 the exact answer from the collision functions of :mod:`framework.collision`. Rays
 cast during a step are logged in the step's frame for the debug overlay.
+
+The batch forms (:meth:`SpatialQueries.query_points`, :meth:`~SpatialQueries.nearest_many`,
+:meth:`~SpatialQueries.raycast_many`) answer many points or rays in one compiled pass
+(:mod:`framework.collision.batch_queries`) with the same answers, float for float, as the single
+queries asked one by one; batched rays are not logged for the overlay.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ from numpy.typing import NDArray
 
 from .casting import ShapeHit, cast_rows, shape_bounds, touch_point
 from .collision import batch, collide
+from .collision import batch_queries as bq
 from .collision.box_rows import rows_meeting
 from .collision.broad_phase import DIRECT_QUERY
 from .collision.distance import Distance, point_distance
@@ -25,12 +31,13 @@ from .collision.placement import check_shape
 from .collision.ray import closest_on_segment
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
-from .shapes import AABB, Capsule, Circle
+from .geometry import Geometry
+from .shapes import AABB, Capsule, Circle, Polygon
 from .store import STATIC
 from .systems.stage import Pipeline
 from .validation import InvalidValue, finite, vector2
 
-__all__ = ["ALL_LAYERS", "Nearest", "SceneHit", "ShapeHit", "SpatialQueries"]
+__all__ = ["ALL_LAYERS", "Nearest", "NearestMany", "PointHits", "RayHits", "SceneHit", "ShapeHit", "SpatialQueries"]
 
 ALL_LAYERS = 0xFFFFFFFF
 
@@ -51,6 +58,99 @@ class Nearest(NamedTuple):
     entity: int
     distance: float
     point: Vec2
+
+
+class PointHits(NamedTuple):
+    """Which entities hold each of ``n`` points (:meth:`SpatialQueries.query_points`), as two
+    arrays: point ``i``'s entities, sorted, are ``entities[offsets[i]:offsets[i + 1]]``
+    (``offsets`` has ``n + 1`` entries, the first 0). ``counts`` and :meth:`of` read them."""
+
+    offsets: NDArray[np.int64]
+    entities: NDArray[np.int64]
+
+    @property
+    def counts(self) -> NDArray[np.int64]:
+        """How many entities hold each point, ``(n,)``."""
+        return np.diff(self.offsets)
+
+    def of(self, i: int) -> list[int]:
+        """The entities holding point ``i``, sorted: ``query_point`` of that point."""
+        found: list[int] = self.entities[self.offsets[i]:self.offsets[i + 1]].tolist()
+        return found
+
+
+class NearestMany(NamedTuple):
+    """The hitbox nearest each of ``n`` points (:meth:`SpatialQueries.nearest_many`): ``entity``
+    ``(n,)`` (-1 where none is within ``max_distance``), ``distance`` ``(n,)`` (0 inside; -1
+    where none is: the contract's queries never answer inf) and ``point`` ``(n, 2)``, the
+    hitbox's point nearest (the query point itself where none is). Row ``i`` is
+    ``nearest(points[i])``, float for float."""
+
+    entity: NDArray[np.int64]
+    distance: NDArray[np.float64]
+    point: NDArray[np.float64]
+
+
+class RayHits(NamedTuple):
+    """Where each of ``n`` rays first enters a hitbox (:meth:`SpatialQueries.raycast_many`):
+    ``entity`` ``(n,)`` (-1 for a miss), ``distance`` ``(n,)`` (-1 for a miss), ``point`` and
+    ``normal`` ``(n, 2)`` (zeros for a miss). Row ``i`` is ``raycast(origins[i], directions[i])``,
+    float for float."""
+
+    entity: NDArray[np.int64]
+    distance: NDArray[np.float64]
+    point: NDArray[np.float64]
+    normal: NDArray[np.float64]
+
+
+def _xy_rows(name: str, value: object) -> NDArray[np.float64]:
+    """``value`` as an ``(n, 2)`` float64 array of finite values (a copy), or :class:`InvalidValue`
+    naming the bad row."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError):
+        raise InvalidValue(f"{name} must be an (n, 2) array of numbers, got {value!r}") from None
+    if a.size == 0 and a.ndim <= 2 and (a.ndim < 2 or a.shape[1] in (0, 2)):
+        return np.zeros((0, 2))
+    if a.dtype.kind not in "iuf":
+        raise InvalidValue(f"{name} must be an (n, 2) array of real numbers, got dtype {a.dtype} ({value!r:.80})")
+    if a.ndim != 2 or a.shape[1] != 2:
+        raise InvalidValue(f"{name} must be an (n, 2) array of x, y rows, got shape {a.shape}")
+    out = a.astype(np.float64)
+    bad = np.flatnonzero(~np.isfinite(out).all(axis=1))
+    if bad.size:
+        i = int(bad[0])
+        raise InvalidValue(f"{name}[{i}] must be finite, got {tuple(a[i].tolist())!r}")
+    return out
+
+
+def _mask_value(mask: object) -> np.int64:
+    if isinstance(mask, bool) or not isinstance(mask, (int, np.integer)) or not -2**63 <= int(mask) < 2**63:
+        raise InvalidValue(f"mask must be an int of 64 bits, got {mask!r}")
+    return np.int64(mask)
+
+
+def _max_distance(max_distance: object) -> float:
+    """As the single queries take it: a real >= 0 (inf allowed), else :class:`InvalidValue`."""
+    md = float(max_distance) if isinstance(max_distance, (int, float, np.floating, np.integer)) and not isinstance(
+        max_distance, bool) else math.nan
+    if not md >= 0.0:
+        raise InvalidValue(f"max_distance must be >= 0, got {max_distance!r}")
+    return md
+
+
+class _Shapes(NamedTuple):
+    """The hitboxes' shapes as columns for the batch kernels (framework.collision.batch_queries):
+    the kind of each row's live shape (-1: none), ``sa, sb`` (an AABB's half width and height, a
+    circle's radius, a capsule's radius and length), ``ext`` (the ray cast's local scale,
+    :func:`~framework.collision.ray.extent`), a polygon's points (``local``, ``cnt``)."""
+
+    kind: NDArray[np.int8]
+    sa: NDArray[np.float64]
+    sb: NDArray[np.float64]
+    ext: NDArray[np.float64]
+    local: NDArray[np.float64]
+    cnt: NDArray[np.int64]
 
 
 class SpatialQueries:
@@ -214,6 +314,119 @@ class SpatialQueries:
             poses.append((hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))))
         (sa, pa), (sb, pb) = poses
         return shape_distance(sa, pa, sb, pb)
+
+    # --- many at once (framework.collision.batch_queries) -------------------------------------
+
+    def _shapes(self) -> _Shapes:
+        """The live shapes as columns, cached until a structural change (rebuilt while a hitbox
+        edit waits for the next step, as the single queries read the edited shape at once)."""
+        store = self.bodies.store
+        cached: tuple[int, _Shapes] | None = getattr(self, "_shape_cols", None)
+        if cached is not None and cached[0] == store.version and not store.dirty_hitboxes:
+            return cached[1]
+        n = store.n
+        kind = np.full(n, -1, dtype=np.int8)
+        sa, sb, ext = np.zeros(n), np.zeros(n), np.zeros(n)
+        shapes = [None if hb is None else hb.shape for hb in store.hitboxes[:n]]
+        K = max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)])
+        local = np.zeros((n, K, 2))
+        cnt = np.zeros(n, dtype=np.int64)
+        for r, shape in enumerate(shapes):
+            if isinstance(shape, AABB):
+                kind[r], sa[r], sb[r], ext[r] = 0, shape.half_width, shape.half_height, max(shape.width, shape.height)
+            elif isinstance(shape, Circle):
+                kind[r], sa[r], ext[r] = 1, shape.radius, shape.radius
+            elif isinstance(shape, Capsule):
+                kind[r], sa[r], sb[r], ext[r] = 3, shape.radius, shape.length, shape.bounding_radius
+            elif isinstance(shape, Polygon):
+                kind[r], cnt[r] = 2, len(shape.points)
+                local[r, : cnt[r]] = shape.points
+                ext[r] = max(max(abs(x), abs(y)) for x, y in shape.points)
+        cols = _Shapes(kind, sa, sb, ext, local, cnt)
+        self._shape_cols = (store.version, cols)
+        return cols
+
+    def _prepare(self) -> Geometry:
+        """The geometry, current, as the single queries' candidate search leaves it."""
+        geom = self.bodies.ensure_geometry()
+        self.pipeline.frame.counters["rehashed"] = (self.pipeline.frame.counters.get("rehashed", 0)
+                                                    + self.bodies.sync_static())
+        return geom
+
+    def query_points(self, points: object, mask: int = ALL_LAYERS) -> PointHits:
+        """:meth:`query_point` of each row of ``points`` (``(n, 2)``), in one compiled pass: a
+        :class:`PointHits` (``offsets``, ``entities``; point ``i``'s sorted entities are
+        ``entities[offsets[i]:offsets[i + 1]]``)."""
+        pts = _xy_rows("points", points)
+        m = _mask_value(mask)
+        geom = self._prepare()
+        store, cols = self.bodies.store, self._shapes()
+        offsets, entities = bq.points_inside(
+            np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), store.kind, cols.kind, store.layer,
+            store.entity, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, cols.sa, geom.cap_ux,
+            geom.cap_uy, store.hw, store.hh, geom.world_poly, geom.poly_slot, geom.count, m, 2.0)
+        return PointHits(offsets, entities)
+
+    def nearest_many(self, points: object, max_distance: float = math.inf, mask: int = ALL_LAYERS) -> NearestMany:
+        """:meth:`nearest` of each row of ``points`` (``(n, 2)``), in one compiled pass: a
+        :class:`NearestMany` (entity -1 and distance -1 where no hitbox is within
+        ``max_distance``)."""
+        pts = _xy_rows("points", points)
+        md = _max_distance(max_distance)
+        m = _mask_value(mask)
+        geom = self._prepare()
+        store, cols = self.bodies.store, self._shapes()
+        ent, dist, bx, by = bq.nearest_points(
+            np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), md, store.kind, cols.kind, cols.sa,
+            cols.sb, cols.local, cols.cnt, store.layer, store.entity, geom.minx, geom.miny, geom.maxx, geom.maxy,
+            geom.hx, geom.hy, store.rot, m)
+        dist[ent < 0] = -1.0  # (a miss: never inf)
+        return NearestMany(ent, dist, np.stack([bx, by], axis=1))
+
+    def raycast_many(self, origins: object, directions: object, max_distance: float = math.inf,
+                     mask: int = ALL_LAYERS) -> RayHits:
+        """:meth:`raycast` of each ray ``origins[i]``, ``directions[i]`` (``(n, 2)`` each), in one
+        compiled pass: a :class:`RayHits` (entity -1 and distance -1 for a miss). (ray, row)
+        pairs the compiled float path leaves to exact arithmetic, and rays against capsules, are
+        answered by :func:`~framework.collision.ray.raycast` itself."""
+        o = _xy_rows("origins", origins)
+        d = _xy_rows("directions", directions)
+        if o.shape != d.shape:
+            raise InvalidValue(f"origins and directions must have the same shape, got {o.shape} and {d.shape}")
+        zero = np.flatnonzero((d[:, 0] == 0.0) & (d[:, 1] == 0.0))
+        if zero.size:
+            raise InvalidValue(f"directions[{int(zero[0])}] must not be zero, got {tuple(d[zero[0]].tolist())!r}")
+        md = _max_distance(max_distance)
+        m = _mask_value(mask)
+        geom = self._prepare()
+        store, cols = self.bodies.store, self._shapes()
+        ox, oy = np.ascontiguousarray(o[:, 0]), np.ascontiguousarray(o[:, 1])
+        if math.isfinite(md):
+            reach = np.full(ox.size, md)
+        elif store.n == 0:
+            reach = np.ones(ox.size)
+        else:  # _world_extent of each origin (the same float operations)
+            far = np.maximum.reduce([np.abs(float(geom.minx.min()) - ox), np.abs(float(geom.maxx.max()) - ox),
+                                     np.abs(float(geom.miny.min()) - oy), np.abs(float(geom.maxy.max()) - oy)])
+            reach = 2.0 * far + 1.0
+        ent, dist, hx, hy, nx, ny, rows, pending = bq.rays_first(
+            ox, oy, np.ascontiguousarray(d[:, 0]), np.ascontiguousarray(d[:, 1]), md, reach, store.kind, cols.kind,
+            cols.sa, cols.sb, cols.ext, cols.local, cols.cnt, store.layer, store.entity, geom.minx, geom.miny,
+            geom.maxx, geom.maxy, geom.hx, geom.hy, store.rot, m)
+        for i, r in pending.tolist():
+            hb = store.hitboxes[r]
+            assert hb is not None  # (rows with a kind have a hitbox)
+            hit = _raycast(hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
+                           (float(ox[i]), float(oy[i])), (float(d[i, 0]), float(d[i, 1])), md)
+            if hit is None:
+                continue
+            e = int(store.entity[r])
+            if ent[i] < 0 or (hit.distance, e, r) < (float(dist[i]), int(ent[i]), int(rows[i])):
+                ent[i], dist[i], rows[i] = e, hit.distance, r
+                hx[i], hy[i] = hit.point
+                nx[i], ny[i] = hit.normal
+        dist[ent < 0] = -1.0  # (a miss: never inf)
+        return RayHits(ent, dist, np.stack([hx, hy], axis=1), np.stack([nx, ny], axis=1))
 
     def _contains(self, r: int, px: float, py: float) -> bool:
         store, geom = self.bodies.store, self.bodies.geometry

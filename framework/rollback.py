@@ -6,8 +6,10 @@ back what the pipeline changes: every body's pose, velocity and sleep, the pairs
 tracks and the last step's frame (contacts, events, the solver's warm start), the soft step's
 candidate pairs and warm starts (kept by reference: its kernel never changes them in place), the
 sleeping stage's links, the character controllers' state, the step counter and clock; entities
-spawned during the step are removed and despawns it asked for are dropped. It costs a copy of eight
-columns a step (about 30 us at 10,000 bodies, about 1% of such a step). What game code did outside
+spawned during the step are removed and despawns it asked for are dropped. It costs a copy of the
+rows that are not static a step (about 30 us at 10,000 bodies, about 1% of such a step); a static
+row is saved only if it changes during the step (game code writes it, or a structural change), since
+the pipeline never moves one, so a level of 100,000 tiles adds nothing. What game code did outside
 the scene (its own components' fields, resources, files) is the game's: the scene cannot take that
 back.
 
@@ -25,28 +27,25 @@ import numpy as np
 from numba import njit
 
 from .character import CharacterController
+from .store import ROW_STATE, ROW_STRUCTURE
 
 __all__ = ["StepRollback"]
 
-_COLUMNS = ("x", "y", "rot", "vx", "vy", "w", "still", "asleep")
-_STRUCTURE = ("entity", "kind", "body", "has_vel")
 # the character controller's state, written by each step (its settings are the game's)
 _CONTROLLER_STATE = ("drop_through", "on_floor", "floor_normal", "floor_entity", "on_wall", "wall_normal",
                      "on_ceiling", "crushed")
 
 
-_KEPT = _STRUCTURE + _COLUMNS
-
-
 @njit(cache=True)
-def _keep(entity, kind, body, has_vel, x, y, rot, vx, vy, w, still, asleep):
-    """The columns (of one length, in :data:`_KEPT`'s order) as the rows of a new float array."""
-    n = x.size
-    out = np.empty((12, n))
-    for r in range(n):
-        out[0, r], out[1, r], out[2, r], out[3, r] = entity[r], kind[r], body[r], has_vel[r]
-        out[4, r], out[5, r], out[6, r], out[7, r], out[8, r], out[9, r] = x[r], y[r], rot[r], vx[r], vy[r], w[r]
-        out[10, r], out[11, r] = still[r], asleep[r]
+def _keep(rows, entity, kind, body, has_vel, x, y, rot, vx, vy, w, still, asleep):
+    """The ``rows`` of the columns (in :data:`~framework.store.ROW_STATE`'s order) as the rows of a
+    new float array, one column per row kept."""
+    out = np.empty((12, rows.size))
+    for k in range(rows.size):
+        r = rows[k]
+        out[0, k], out[1, k], out[2, k], out[3, k] = entity[r], kind[r], body[r], has_vel[r]
+        out[4, k], out[5, k], out[6, k], out[7, k], out[8, k], out[9, k] = x[r], y[r], rot[r], vx[r], vy[r], w[r]
+        out[10, k], out[11, k] = still[r], asleep[r]
     return out
 
 
@@ -55,12 +54,14 @@ class StepRollback:
 
     def __init__(self, scene: Any) -> None:
         store = scene.bodies.store
-        n = self.n = store.n
-        # the rows' structure (which entity, shape kind, body kind, whether it has a Velocity) and
-        # the columns a step changes, as the rows of one float array (every value of them is exact
-        # in a float), copied in one compiled pass
+        self.n = store.n
+        # every row that is not static, whole (structure and the columns a step changes), copied in
+        # one compiled pass; the static rows are saved by the store before their first change
+        # (BodyStore.begin_undo): the pipeline never moves them, so a level's tiles cost nothing
         c = store.cols
-        self.kept = _keep(*(c[name][:n] for name in _KEPT))
+        self.rows = store.active()[2]
+        self.kept = _keep(self.rows, *(c[name] for name in ROW_STATE))
+        store.begin_undo()
         self.frame = scene._pipeline.frame
         tracker = scene.tracker
         self.tracker = (tracker.active, tracker.keys)
@@ -79,11 +80,17 @@ class StepRollback:
         for e in [e for e in esper._entities if e >= self.next_entity]:
             scene._remove(e)  # spawned during the failed step
         store = scene.bodies.store
-        n, kept = self.n, self.kept
-        if store.n != n or not all(np.array_equal(store.cols[name][:n], kept[i]) for i, name in enumerate(_STRUCTURE)):
+        saved = store.end_undo()
+        c, rows, kept = store.cols, self.rows, self.kept
+        if store.n != self.n or not all(np.array_equal(c[name][rows], kept[i]) for i, name in enumerate(ROW_STRUCTURE)):
             return False
-        for i, name in enumerate(_COLUMNS, len(_STRUCTURE)):
-            store.cols[name][:n] = kept[i]
+        for r, values in saved.items():
+            if any(c[name][r] != values[i] for i, name in enumerate(ROW_STRUCTURE)):
+                return False
+        for i, name in enumerate(ROW_STATE[len(ROW_STRUCTURE):], len(ROW_STRUCTURE)):
+            c[name][rows] = kept[i]
+            for r, values in saved.items():
+                c[name][r] = values[i]
         store.motion += 1  # (caches keyed on motion look again)
         store.sleep_dirty = True
         store.written.clear()

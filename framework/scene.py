@@ -36,9 +36,9 @@ from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts
 from .frame import StepFrame, add_counters
 from .geometry import Geometry
 from .input import Input
-from .joints import Joint, JointBroken, JointReaction, check_joints, joint_components, remove_joints_of
+from .joints import Joint, JointBroken, JointReaction, breakable, check_joints, joint_components, remove_joints_of
 from .limits import MAX_COORD, check_motion, motion_within
-from .queries import ALL_LAYERS, Nearest, SceneHit, ShapeHit, SpatialQueries
+from .queries import ALL_LAYERS, Nearest, NearestMany, PointHits, RayHits, SceneHit, ShapeHit, SpatialQueries
 from .rollback import StepRollback
 from .shapes import Shape
 from .snapshot import Snapshot
@@ -92,7 +92,8 @@ class Scene:
     continuous detection and sleeping. Rendering is added when a renderer is attached.
     ``solver``: ``"exact"`` (the default: bodies rest at their exact heights, touching decided
     exactly) or ``"soft"`` (Box2D v3's soft step as one compiled call: several times faster, bodies
-    rest within a fraction of the linear slop, see docs/physics.md).
+    rest within a fraction of the linear slop, see docs/physics.md); settable between steps (see
+    :attr:`solver`).
     ``length_unit``: world units per metre; scales the soft solver's tolerances (its linear slop is
     0.005 metres, as Box2D's), so a game in pixels with 32 pixels a metre passes 32.
     """
@@ -134,6 +135,7 @@ class Scene:
         self._stepping = False
         self._dispatching = False  # collision handlers are running
         self._pending_despawn: list[int] = []
+        self._after_step: list[Callable[[Scene], Any]] = []  # called when the step under way ends
         esper.switch_world(self.world)
         self._stages = {stage.name: stage for stage in pipeline_stages(self._pipeline)}
         for stage in self._stages.values():
@@ -155,8 +157,68 @@ class Scene:
 
     @property
     def solver(self) -> str:
-        """The contact solver: ``"exact"`` or ``"soft"`` (see :class:`Scene`)."""
+        """The contact solver: ``"exact"`` or ``"soft"`` (see :class:`Scene`).
+
+        Settable between steps (a game whose levels need different solvers: a level with joints
+        the soft one, another the exact one's resting heights). Switching puts the scene's
+        pipeline in the state a new scene of that solver starts from, keeping the bodies (poses,
+        velocities), entities, components, systems, handlers, resources, clock and step counter:
+        the other solver's stages replace this one's, each solver's own state is dropped (the
+        exact solver's pair tracking and warm starts, the soft step's candidate pairs, contact and
+        joint impulses), the last step's frame is forgotten (``scene.events`` and
+        ``scene.contacts`` read empty until the next step) and every body is woken. So pairs that
+        touch across the switch are reported ``started`` again by the next step, and no ``ended``
+        for pairs the old solver was tracking: switch with nothing touching for unbroken events.
+        Setting the solver it has already changes nothing. Refused with :class:`InvalidValue`
+        (the scene unchanged) for an unknown solver, and during a step (from a system or a
+        collision handler: use :meth:`after_step` to switch when the step ends)."""
         return self._pipeline.solver
+
+    @solver.setter
+    def solver(self, solver: str) -> None:
+        self._activate()
+        if self._stepping:
+            raise InvalidValue(f"Scene solver cannot change during a step (asked for {solver!r} from a system or a "
+                               "collision handler): set it between steps, or from scene.after_step(...)")
+        if not isinstance(solver, str) or solver not in SOLVERS:
+            raise InvalidValue(f"Scene solver must be one of {SOLVERS}, got {solver!r}")
+        pipeline = self._pipeline
+        if solver == pipeline.solver:
+            return
+        for stage in self._stages.values():
+            if stage in esper._processors:
+                unregister(stage)
+        pipeline.solver = solver
+        pipeline.frame = StepFrame(counters={})
+        self._totals = None
+        # Fresh stages, as a new scene's: the solvers' own (and the sleeping stage, whose links the
+        # solver made); the character and render stages keep theirs (the controllers' state is
+        # the components', the renderer the scene's).
+        fresh = {stage.name: stage for stage in pipeline_stages(pipeline)}
+        for name in list(self._stages):
+            if self._stages[name].solver is not None or name == "sleeping":
+                self._stages[name] = fresh[name]
+        store = self.bodies.store
+        if store.n:
+            store.wake(np.arange(store.n))
+        for stage in self._stages.values():
+            if stage.solver in (None, solver):
+                esper.add_processor(stage, stage.priority)
+
+    def after_step(self, call: Callable[[Scene], Any]) -> None:
+        """Call ``call(scene)`` when the step under way ends (after its sub-steps, handlers and
+        despawns; the step counter and clock moved on), between steps: for what only between
+        steps may be done, such as setting :attr:`solver` from a system. Calls run in the order
+        asked for; one that raises stops the rest, and the step (complete) raises its exception
+        with a note. A step that fails (and is undone) drops them. Outside a step, ``call(scene)``
+        runs now."""
+        if not callable(call):
+            raise InvalidValue(f"after_step takes a callable as call(scene), got {call!r}")
+        self._activate()
+        if self._stepping:
+            self._after_step.append(call)
+        else:
+            call(self)
 
     @property
     def gravity(self) -> tuple[float, float]:
@@ -548,18 +610,28 @@ class Scene:
                         add_counters(total, self.counters)
                     self._totals = (events, total)
             except Exception as exc:
+                self._after_step = []  # (the step is undone: what it asked for with it)
                 if before.restore(self):
                     exc.add_note(f"step {self.frame + 1} failed and was undone: the scene is as it was before it")
                 else:
                     exc.add_note(f"step {self.frame + 1} failed after a system changed the scene's structure (a Hitbox "
                                  "or Velocity added or removed): the scene is left as the failure found it")
                 raise
+        store.end_undo()  # (the step stands: the static rows need no saving any more)
         self.broken_joints = self._break_joints()
         self.frame += 1
         self.time += dt
         inp = self.resources.get(Input)
         if inp is not None:
             inp.end_step()
+        calls, self._after_step = self._after_step, []
+        for call in calls:
+            try:
+                call(self)
+            except Exception as exc:
+                exc.add_note(f"raised by {call!r}, called by scene.after_step at the end of step {self.frame} (the "
+                             "step is complete; later after_step calls were not made)")
+                raise
         try:
             # A bad value written by a collision handler (after the step's physics was done, and
             # kept): reported now, by the step that made it. (The pipeline's own values were
@@ -678,6 +750,30 @@ class Scene:
         self._activate()
         return self._queries.distance(entity_a, entity_b)
 
+    def query_points(self, points: Any, *, mask: int = ALL_LAYERS) -> PointHits:
+        """:meth:`query_point` of many points (an ``(n, 2)`` array) in one compiled pass: a
+        :class:`~framework.queries.PointHits`; point ``i``'s entities, sorted, are
+        ``hits.entities[hits.offsets[i]:hits.offsets[i + 1]]`` (``hits.of(i)``)."""
+        self._activate()
+        return self._queries.query_points(points, mask)
+
+    def nearest_many(self, points: Any, *, max_distance: float = math.inf, mask: int = ALL_LAYERS) -> NearestMany:
+        """:meth:`nearest` of many points (an ``(n, 2)`` array) in one compiled pass: a
+        :class:`~framework.queries.NearestMany` of arrays ``entity`` (-1 where no hitbox is within
+        ``max_distance``), ``distance`` (``inf`` there) and ``point``; the same floats as
+        ``nearest`` point by point."""
+        self._activate()
+        return self._queries.nearest_many(points, max_distance, mask)
+
+    def raycast_many(self, origins: Any, directions: Any, *, max_distance: float = math.inf,
+                     mask: int = ALL_LAYERS) -> RayHits:
+        """:meth:`raycast` of many rays (``(n, 2)`` arrays of origins and directions) in one
+        compiled pass: a :class:`~framework.queries.RayHits` of arrays ``entity`` (-1 for a miss),
+        ``distance`` (``inf`` for a miss), ``point`` and ``normal``; the same floats as
+        ``raycast`` ray by ray. Batched rays are not drawn by the debug overlay."""
+        self._activate()
+        return self._queries.raycast_many(origins, directions, max_distance, mask)
+
     def _break_joints(self) -> list[JointBroken]:
         """Remove the joints whose force or torque this step was above their ``break_force`` or
         ``break_torque`` (and their entities, if that was all they held); what broke, by entity."""
@@ -685,9 +781,7 @@ class Scene:
         if not isinstance(stage, SoftStep):
             return []
         broken = []
-        for e, j in joint_components():
-            if j.break_force == math.inf and j.break_torque == math.inf:
-                continue
+        for e, j in breakable(joint_components()):
             fx, fy, torque = stage.reaction(e, j)
             if math.hypot(fx, fy) > j.break_force or abs(torque) > j.break_torque:
                 broken.append(JointBroken(e, j.a, j.b, j, Vec2(float(fx), float(fy)), float(torque)))

@@ -26,8 +26,8 @@ from .limits import MAX_COORD, check_hitbox_limits, check_position, rows_sound
 from .shapes import AABB, Capsule, Circle, Segment
 from .validation import InvalidValue
 
-__all__ = ["BodyStore", "KIND_AABB", "KIND_CAPSULE", "KIND_CIRCLE", "KIND_POLYGON", "KIND_NONE", "KIND_SEGMENT",
-           "as_selector"]
+__all__ = ["ROW_STATE", "ROW_STRUCTURE", "BodyStore", "KIND_AABB", "KIND_CAPSULE", "KIND_CIRCLE", "KIND_POLYGON",
+           "KIND_NONE", "KIND_SEGMENT", "as_selector"]
 
 BODY_CODES = {Body.DYNAMIC: 0, Body.KINEMATIC: 1, Body.STATIC: 2}
 DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
@@ -46,6 +46,11 @@ _INTS = {
     "look": np.int64,  # stamp of the row's last change a renderer must look at (Visual, hitbox shape, new row)
 }
 _BOOLS = ("has_vel", "sensor", "ccd", "one_way", "asleep")
+#: What a step may change in a row (framework.rollback keeps it): the row's structure (entity, shape
+#: kind, body kind, whether it has a Velocity; compared, not put back), then its pose, velocity and
+#: rest (put back). Every value of them is exact in a float.
+ROW_STRUCTURE = ("entity", "kind", "body", "has_vel")
+ROW_STATE = ROW_STRUCTURE + ("x", "y", "rot", "vx", "vy", "w", "still", "asleep")
 _FIELD_NAMES = {
     "x": "Transform.x", "y": "Transform.y", "rot": "Transform.rotation",
     "vx": "Velocity.x", "vy": "Velocity.y", "w": "Velocity.angular",
@@ -129,6 +134,10 @@ class BodyStore:
         self.looks = 0  # the last stamp given to a row's ``look`` column
         self._lookup = np.full(1, -1, dtype=np.int64)  # entity id -> row (rows_of)
         self._lookup_version = -1
+        # A step that may be undone (framework.rollback) keeps every row that is not static; a
+        # static row is saved here before its first change during the step (rows below _undo_n).
+        self._undo: dict[int, NDArray[np.float64]] | None = None
+        self._undo_n = 0
 
     # --- change flags and the rows that can move ---------------------------------------------
 
@@ -307,6 +316,9 @@ class BodyStore:
     def remove(self, entity: int, components: tuple[Any, ...]) -> None:
         row = self.row_of[entity]
         last = self.n - 1
+        if self._undo is not None:
+            self._before_change(row)
+            self._before_change(last)
         if self.cols["body"][row] == STATIC and self.cols["kind"][row] >= 0:
             self.static_dirty = True
         if self.cols["asleep"][row]:
@@ -349,6 +361,8 @@ class BodyStore:
     def set_velocity(self, entity: int, velocity: Velocity | None) -> None:
         """Give the row ``velocity``'s values (or none); unbind the old Velocity first."""
         row = self.row_of[entity]
+        if self._undo is not None:
+            self._before_change(row)
         c = self.cols
         for col in ("vx", "vy", "w"):  # values the old Velocity held, reported no more
             self.bad.pop((entity, col), None)
@@ -364,6 +378,8 @@ class BodyStore:
 
     def set_hitbox(self, entity: int, hitbox: Hitbox | None) -> None:
         row = self.row_of[entity]
+        if self._undo is not None:
+            self._before_change(row)
         old = self.hitboxes[row]
         if old is not None and old is not hitbox:
             self.unbind(entity, old)
@@ -424,6 +440,26 @@ class BodyStore:
         c["friction"][row] = NO_FRICTION if hb._friction is None else hb._friction
         c["inv_inertia"][row] = _inverse_inertia(hb)
 
+    # --- a step that may be undone (framework.rollback) --------------------------------------
+
+    def begin_undo(self) -> None:
+        """From now on, save each static row (of the rows there are now) before its first change:
+        the rollback of a step keeps the rows that are not static whole, and a static row changes
+        only when game code writes it or the scene's structure changes (the pipeline never moves
+        one), so a level of 100,000 tiles costs nothing to keep."""
+        self._undo, self._undo_n = {}, self.n
+
+    def end_undo(self) -> dict[int, NDArray[np.float64]]:
+        """Stop saving; the static rows saved, each as its :data:`ROW_STATE` values."""
+        saved, self._undo = self._undo or {}, None
+        return saved
+
+    def _before_change(self, row: int) -> None:
+        undo = self._undo
+        if undo is not None and row < self._undo_n and row not in undo and self.cols["body"][row] == STATIC:
+            c = self.cols
+            undo[row] = np.array([c[name][row] for name in ROW_STATE], dtype=np.float64)
+
     # --- component views -------------------------------------------------------------------
 
     def read(self, entity: int, col: str) -> Any:
@@ -444,6 +480,8 @@ class BodyStore:
 
     def write(self, entity: int, col: str, value: object) -> None:
         row = self.row_of[entity]
+        if self._undo is not None:
+            self._before_change(row)
         self.writes += 1
         self.written.add(entity)
         if self.cols["asleep"][row] or self.cols["still"][row]:
@@ -533,6 +571,8 @@ class BodyStore:
         changed = self.dirty_hitboxes
         for e in changed:
             row = self.row_of[e]
+            if self._undo is not None:
+                self._before_change(row)
             hb = cast(Hitbox, self.hitboxes[row])  # (the row of an edited hitbox holds it)
             try:
                 for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction", "inertia",

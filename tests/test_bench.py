@@ -28,7 +28,7 @@ from shapely.geometry import Polygon as ShapelyPolygon  # noqa: E402
 
 def tiny_perf(**kw):
     args = dict(sizes=(48, 96), rounds={48: 3, 96: 3}, tiles=300, tile_bodies=48, brute_sizes=(48,),
-                check_up_to=96, progress=False)
+                check_up_to=96, progress=False, queries=30, query_rounds=1, query_bodies=40)
     args.update(kw)
     return perf.run_perf(**args)
 
@@ -167,6 +167,18 @@ def test_rope_rows_measure_its_stretch():
         assert 0.0 < row["rel_error"] <= row["max_stretch"] < 0.1, row  # a few percent at most, never negative
 
 
+@pytest.mark.parametrize("case", ["offset-spin", "offset-throw"])
+def test_centre_of_mass_rows_soft_turns_about_it_exact_about_the_origin(case):
+    """The accuracy report's centre-of-mass case (issue 38): the soft solver keeps the centre of a
+    spinning offset box on its exact path to rounding; the exact solver turns it about its origin,
+    so the centre swings round it, a full diameter (2 x the offset 1) off in a turn."""
+    soft = acc.run_mass(case, "soft")
+    exact = acc.run_mass(case, "substeps-1")
+    assert soft["scenario"] == "mass" and list(soft) == acc.ROW_KEYS and soft["expected"] == 0.0
+    assert soft["measured"] < 1e-9 and soft["rel_error"] == soft["measured"] / acc.MASS_OFFSET
+    assert exact["measured"] == pytest.approx(2.0 * acc.MASS_OFFSET, rel=1e-3)
+
+
 def test_resting_stack_metrics_have_the_documented_keys():
     row = acc.run_rest("stack", "response-iterations-4", steps=20)
     assert row["max_depth"] >= 0.0 and row["jitter"] >= 0.0 and row["snags"] is None
@@ -224,6 +236,28 @@ def test_perf_report_has_the_documented_columns_and_json():
     assert all(c["ok"] for c in report["checks"])
     assert "boxes-48+tiles-300" in perf.text_report(report)
     assert "| scene" in perf.markdown(report, "python -m framework.bench perf", "images/perf.png")
+    queries = report["queries"]
+    assert [q["query"].split(" ")[0] for q in queries] == ["query_points", "nearest_many", "nearest_many",
+                                                            "raycast_many", "raycast_many"]
+    for q in queries:
+        assert {k for k, _, _ in perf.QUERY_COLUMNS} <= set(q) and q["queries"] == 30 and q["speedup"] > 0.0
+    assert "loop/batch" in perf.text_report(report) and "### Batch queries" in perf.markdown(report, "c", None)
+
+
+def test_perf_query_check_fails_loudly(monkeypatch):
+    """A batch answer that differs from the single queries' stops the benchmark."""
+    from framework.scene import Scene
+
+    real = Scene.nearest_many
+
+    def one_off(self, points, **kw):
+        res = real(self, points, **kw)
+        res.distance[0] += 1e-9
+        return res
+
+    monkeypatch.setattr(Scene, "nearest_many", one_off)
+    with pytest.raises(perf.QueryMismatch, match="nearest_many"):
+        perf.run_queries(20, bodies=30, tiles=10, rounds=1)
 
 
 def test_perf_without_pymunk_has_null_columns(monkeypatch, tmp_path):

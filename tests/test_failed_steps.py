@@ -109,6 +109,83 @@ def test_a_failed_step_removes_what_it_spawned_and_drops_the_despawns_it_asked_f
         assert state_hash(s) == before and sorted(s.entities) == entities and s.exists(4)
 
 
+def test_a_failed_step_puts_back_the_static_bodies_a_system_moved():
+    """The rollback keeps the rows that are not static whole and saves a static row only on its
+    first change during the step: a system that moves a wall (twice) and a static floor, then
+    fails, leaves them where they were, and the scene goes on as one that never tried."""
+    s, twin = _busy(), _busy()
+    try:
+        _hashes(s, 12)
+        _hashes(twin, 12)
+        before = state_hash(s)
+        wall, floor = 2, 1  # (a wall and the floor: static)
+        x0 = s.get(wall, Transform).x
+
+        def shove(scene, dt):
+            t = scene.get(wall, Transform)
+            t.x += 0.5
+            t.x += 0.25  # (a second write of the same row: the first saved value stands)
+            scene.get(floor, Transform).rotation = 0.125
+            raise RuntimeError("after shoving")
+
+        s.add_system(shove, after="movement")
+        with pytest.raises(RuntimeError, match="after shoving") as info:
+            s.step(DT)
+        assert "undone" in info.value.__notes__[-1]
+        assert state_hash(s) == before
+        assert s.get(wall, Transform).x == x0 and s.get(floor, Transform).rotation == 0.0
+        s.remove_system(shove)
+        assert _hashes(s, 20) == _hashes(twin, 20)
+    finally:
+        s.close()
+        twin.close()
+
+
+def test_a_static_body_changed_by_a_step_that_stands_is_not_put_back_later():
+    """A static body moved by a system in a step that succeeds stays moved, also when a later
+    step fails (it is saved again from where it is then)."""
+    s = _busy()
+    with s:
+        wall = 2
+        x0 = s.get(wall, Transform).x
+
+        def nudge(scene, dt):
+            scene.get(wall, Transform).x += 0.5
+
+        s.add_system(nudge, after="movement")
+        s.step(DT)
+        s.remove_system(nudge)
+        assert s.get(wall, Transform).x == x0 + 0.5
+        before = state_hash(s)
+
+        def nudge_and_fail(scene, dt):
+            scene.get(wall, Transform).x += 1.0
+            raise RuntimeError("no")
+
+        s.add_system(nudge_and_fail, after="movement")
+        with pytest.raises(RuntimeError):
+            s.step(DT)
+        assert s.get(wall, Transform).x == x0 + 0.5 and state_hash(s) == before
+
+
+def test_a_failed_step_that_took_a_static_body_s_hitbox_is_left_as_it_found_it():
+    """A structural change of a static row during a failed step (its Hitbox removed) cannot be
+    put back: the scene says so, as for a moving body's."""
+    s = _busy()
+    with s:
+        _hashes(s, 5)
+        wall = 2
+
+        def strip(scene, dt):
+            scene.remove_component(wall, Hitbox)
+            raise RuntimeError("stripped")
+
+        s.add_system(strip, after="movement")
+        with pytest.raises(RuntimeError, match="stripped") as info:
+            s.step(DT)
+        assert "left as the failure found it" in info.value.__notes__[-1]
+
+
 def test_a_failed_sub_step_undoes_the_whole_step():
     s = _busy()
     s.substeps = 4

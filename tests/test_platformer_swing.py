@@ -285,7 +285,7 @@ def test_bad_text_swings_are_level_errors(text, problem):
 
 def test_the_swings_level_has_three_swings_over_pits_a_checkpoint_and_a_goal():
     level = load_level(builtin_levels()[3])
-    assert level.name == "Swings" and len(builtin_levels()) == 4
+    assert level.name == "Swings" and len(builtin_levels()) == 5
     swings = level.of_kind("swing")
     assert len(swings) == 3 and len(level.of_kind("checkpoint")) == 1 and len(level.of_kind("goal")) == 1
     ground = len(level.tiles) - 1

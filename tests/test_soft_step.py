@@ -502,13 +502,17 @@ def test_a_first_step_that_compiles_says_so_once_and_a_quick_one_says_nothing(mo
         return "out"
 
     monkeypatch.setattr(ss, "soft_step", slow)
-    monkeypatch.setattr(ss, "_COMPILED", False)
-    assert ss._first_call((1, 2)) == "out"
+    monkeypatch.setattr(ss, "_COMPILED", set())
+    assert ss._first_call((1, 2), False) == "out"
     assert ss.COMPILE_NOTICE in capsys.readouterr().err
-    assert ss._COMPILED
-    monkeypatch.setattr(ss, "_COMPILED", False)
+    assert ss._COMPILED == {False}
+    # the variant for scenes with joints is compiled apart: its first call says so too
+    assert ss._first_call((1, 2), True) == "out"
+    assert ss.COMPILE_NOTICE in capsys.readouterr().err
+    assert ss._COMPILED == {False, True}
+    monkeypatch.setattr(ss, "_COMPILED", set())
     monkeypatch.setattr(ss, "soft_step", lambda *args: "quick")
-    assert ss._first_call((1, 2)) == "quick"
+    assert ss._first_call((1, 2), False) == "quick"
     assert capsys.readouterr().err == ""
 
 

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass
 
 __all__ = [
-    "ALL", "Checkpoint", "Coin", "ENEMY", "Enemy", "GameState", "Goal", "Hazard", "LevelPiece",
+    "ALL", "BridgePlank", "Checkpoint", "Coin", "ENEMY", "Enemy", "GameState", "Goal", "Hazard", "LevelPiece",
     "MovingPlatform", "ONE_WAY", "PICKUP", "PLAYER", "Player", "SOLID", "SwingRope", "SwingingPlatform", "Tuning",
 ]
 
@@ -47,7 +47,8 @@ class Tuning:
     barrel_radius: float = 0.375   # tiles
     prop_friction: float = 0.6     # crates and barrels
     step_height: float = 0.3       # tiles: the player and walkers walk up steps this high
-    push_mass: float = 1.0         # the player pushes crates and barrels as a body of this mass
+    push_mass: float = 1.0         # the player pushes crates and barrels, and weighs on bridges, as a body of this mass
+    plank_mass: float = 0.25       # a bridge plank's (a bridge's ``mass`` property overrides it)
 
 
 @dataclass
@@ -119,6 +120,16 @@ class SwingRope:
     turned with it."""
 
     swing: SwingingPlatform
+
+
+@dataclass
+class BridgePlank:
+    """Plank ``index`` (from the left, 0 to ``planks - 1``) of a rope bridge: a dynamic board hinged
+    to its neighbours (the end ones to the anchors) by ``RevoluteJoint``s. Whoever stands on it
+    weighs on it (:func:`.systems.weigh_on_bridges`)."""
+
+    index: int
+    planks: int
 
 
 @dataclass

@@ -8,7 +8,10 @@
 
 The scene stays the same object for the whole run (a window runner holds it); levels are swapped
 inside it by despawning one level's entities and spawning the next one's (see
-:func:`.systems.level_flow`).
+:func:`.systems.level_flow`). A level that asks for another contact solver (``Level.solver``: a
+level with a rope bridge needs the soft one, whose joints hinge its planks) gets it: the scene
+switches solver between the two steps of the level change (``Scene.solver`` is settable between
+steps), and back to the game's own for a level that asks for none.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ import math
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
+from framework import AABB, Circle, Hitbox, Polygon, RevoluteJoint, Scene, Transform, Velocity
 from framework.character import CharacterController
 from framework.components import Visual
 from framework.input import Input
@@ -25,6 +28,7 @@ from framework.tiles import SLOPES, STEP, terrain_pieces
 
 from . import systems
 from .animations import SHEETS, animations
+from .bridge import hang, plank_length
 from .components import (
     ALL,
     ENEMY,
@@ -33,6 +37,7 @@ from .components import (
     PICKUP,
     PLAYER,
     SOLID,
+    BridgePlank,
     Checkpoint,
     Coin,
     Enemy,
@@ -47,7 +52,7 @@ from .components import (
     Tuning,
 )
 from .demo import Autoplay
-from .levels import Level, builtin_levels, load_level
+from .levels import Level, bridge_planks, builtin_levels, load_level
 
 __all__ = ["DT", "Game", "COLORS"]
 
@@ -56,6 +61,7 @@ COLORS = {
     "solid": (86, 98, 128), "oneway": (176, 134, 82), "spikes": (226, 70, 70), "player": (84, 176, 255),
     "enemy": (196, 84, 164), "coin": (255, 212, 64), "goal": (90, 224, 120), "checkpoint": (150, 150, 150),
     "platform": (214, 170, 96), "crate": (168, 112, 64), "barrel": (120, 84, 52), "rope": (150, 120, 80),
+    "plank": (186, 140, 86),
 }
 PROP_MASK = SOLID | ONE_WAY | PLAYER | ENEMY  # crates and barrels: solid to everything that moves
 PLAYER_MASK = SOLID | ONE_WAY | ENEMY | PICKUP | HAZARD
@@ -68,7 +74,8 @@ IMAGES = {name: Path(__file__).with_name("images") / f"{name}.png" for name in (
 class Game:
     """A run of the platformer over ``levels`` (paths or :class:`Level` objects; default: the
     shipped ones), in a new scene unless one is given. ``autoplay``: scripted input (see
-    :mod:`.demo`) instead of the keyboard's."""
+    :mod:`.demo`) instead of the keyboard's. The scene's solver when the game is made is the
+    game's own (:attr:`solver`): the levels that ask for none are played with it."""
 
     def __init__(
         self, levels: Sequence[Level | str | Path] | None = None, *, tuning: Tuning | None = None,
@@ -82,6 +89,8 @@ class Game:
             raise ValueError("Game needs at least one level")
         self.tuning = tuning or Tuning()
         self.scene = scene if scene is not None else Scene()
+        #: the contact solver of the levels that ask for none (``Level.solver`` None): the scene's
+        self.solver = self.scene.solver
         self.state = GameState(view=view)
         self.scene.resources[GameState] = self.state
         self.scene.resources[Tuning] = self.tuning
@@ -106,10 +115,25 @@ class Game:
                 scene.despawn(e)
         self.state.player = None
 
+    def solver_of(self, index: int) -> str:
+        """The contact solver level ``index`` is played with: the one it asks for, else the game's."""
+        return self.levels[index].solver or self.solver
+
+    def use_solver_of(self, index: int) -> None:
+        """Switch the scene to level ``index``'s solver: now between steps, or when the step under
+        way ends (``Scene.after_step``); nothing if it has it."""
+        want = self.solver_of(index)
+        if self.scene.solver != want:
+            self.scene.after_step(lambda scene: setattr(scene, "solver", want))
+
     def spawn_level(self, index: int) -> None:
-        """Spawn level ``index``: its tiles, objects and the player at its start."""
+        """Spawn level ``index``: its tiles, objects and the player at its start, in a scene running
+        the level's solver (switched here between steps; during a step, the scene must have it
+        already, as :func:`.systems.level_flow` sees to: else ``InvalidValue``, nothing spawned)."""
         if not 0 <= index < len(self.levels):
             raise ValueError(f"no level {index}: the game has {len(self.levels)}")
+        if self.scene.solver != self.solver_of(index):
+            self.scene.solver = self.solver_of(index)
         if self.state.player is not None:
             self.clear_level()
         level = self.levels[index]
@@ -184,6 +208,8 @@ class Game:
                 self._platform(obj, t, piece)
             elif obj.kind == "swing":
                 self._swing(obj, t, piece)
+            elif obj.kind == "bridge":
+                self._bridge(obj, t, piece)
             elif obj.kind == "crate":
                 s = tu.crate_size * t
                 piece("crate", Transform(obj.x, obj.bottom + s * 0.5), Velocity(), Hitbox(
@@ -251,6 +277,36 @@ class Game:
         rope = Polygon([(-1.0, -swing.length + hh), (1.0, -swing.length + hh), (1.0, 0.0), (-1.0, 0.0)])
         piece("rope", Transform(*swing.pivot, theta), Velocity(), Hitbox(
             rope, body="kinematic", sensor=True, layer=0, mask=0), SwingRope(swing), Visual(COLORS["rope"], z=0))
+
+    def _bridge(self, obj, t: float, piece) -> None:
+        """A rope bridge (:mod:`.bridge`): ``planks`` dynamic planks (``Polygon`` boxes: they turn)
+        hinged end to end by ``RevoluteJoint``s, the end ones to the anchors, spawned where the
+        statics hang them (so the bridge starts at rest). The rectangle's left and right edges are
+        the anchors, its top the deck's top there and its height the sag at rest; the hinges are on
+        the planks' middle line, half a plank's thickness below the deck's top. A plank's layer is
+        ``SOLID`` and its mask 0: the player and the walkers stand on it (their controllers block
+        on its layer), and it meets nothing in the solver (not the ground at its ends, not the
+        player, whose weight it takes from :func:`.systems.weigh_on_bridges`)."""
+        planks = bridge_planks(obj, t)
+        thickness = float(obj.props.get("thickness", 0.25)) * t
+        mass = float(obj.props.get("mass", self.tuning.plank_mass))
+        top = obj.y + obj.height * 0.5
+        left, right = (obj.x - obj.width * 0.5, top - thickness * 0.5), (obj.x + obj.width * 0.5, top - thickness * 0.5)
+        length = plank_length(obj.width, obj.height, planks)
+        hinges = hang(left, right, planks, length, [1.0] * (planks - 1))
+        box = Polygon.box(length, thickness)
+        bodies = []
+        for i in range(planks):
+            (x0, y0), (x1, y1) = hinges[i], hinges[i + 1]
+            bodies.append(piece("plank", Transform((x0 + x1) * 0.5, (y0 + y1) * 0.5, math.atan2(y1 - y0, x1 - x0)),
+                                Velocity(), Hitbox(box, layer=SOLID, mask=0, mass=mass), BridgePlank(i, planks),
+                                Visual(COLORS["plank"], z=1)))
+        # (the joints go with their planks when the level is left: no LevelPiece of their own)
+        scene = self.scene
+        scene.spawn(RevoluteJoint(bodies[0], None, hinges[0]))
+        for i in range(planks - 1):
+            scene.spawn(RevoluteJoint(bodies[i], bodies[i + 1], hinges[i + 1]))
+        scene.spawn(RevoluteJoint(bodies[-1], None, hinges[-1]))
 
     def _autoplay(self, scene: Scene, dt: float) -> None:
         playing = self.state.player is not None and self.state.pending is None

@@ -18,6 +18,8 @@ list of :class:`LevelObject` in world coordinates (y up, units of the map's pixe
     ~  the cells a moving platform sweeps: to its right, left, above or below (one side)
     S  swing: a run of S (an odd number of cells) is its board at rest, half a tile thick, one-way
     o  a swing's pivot, straight above the middle of its board (only empty cells or objects between)
+    =  rope bridge: a run of = (2 cells or more) is hung between its ends, the deck's top at the
+       run's top at both ends, sagging to the run's bottom in the middle (one tile), a plank a cell
 
 Lines starting with ``;`` are comments; short rows are padded with empty cells.
 
@@ -33,15 +35,24 @@ tiles are ignored. Layers named ``background`` or ``decoration`` (or ``kind`` = 
 ignored. Layer ``data`` may
 be a plain array or base64 (uncompressed, zlib or gzip). One object layer (or more) holds
 objects whose ``type``/``class`` (or ``name``) is ``player``, ``coin``, ``enemy``, ``goal``,
-``checkpoint``, ``platform``, ``swing``, ``spikes``, ``crate`` or ``barrel``; points and rectangles both
-work. Properties:
+``checkpoint``, ``platform``, ``swing``, ``bridge``, ``spikes``, ``crate`` or ``barrel``; points and
+rectangles both work. Properties:
 ``platform``: ``dx``, ``dy`` (travel in tiles, y up), ``speed`` (tiles/s), ``one_way`` (bool);
 ``swing`` (a rectangle: its board at rest, hanging straight below the pivot): ``length`` (tiles
 from the pivot down to the board's centre, > 0; required), ``angle`` (the largest swing, degrees,
 0 < angle < 90; default 30), ``period`` (s, > 0; default the pendulum's, 2 pi sqrt(length /
 gravity), gravity in tiles/s^2 from the game's ``Tuning``), ``phase`` (degrees; default 0: the
 swing starts at rest position going right), ``one_way`` (bool, default true);
+``bridge`` (a rectangle: its left and right edges are the anchors, its top the deck's top there,
+its bottom the deck's top in the middle at rest: the height is the sag): ``planks`` (an integer >=
+2; default one a tile of width), ``thickness`` (tiles, > 0, less than a plank's length; default
+0.25), ``mass`` (each plank's, > 0; default the game's ``Tuning.plank_mass``);
 ``enemy``: ``speed`` (tiles/s), ``direction`` (-1 left, 1 right).
+
+The map's ``solver`` property (``exact`` or ``soft``) is the contact solver the game runs the level
+with (``Level.solver``); without it, ``soft`` if the level has a bridge (its hinges are joints,
+which only the soft solver solves), else none asked for (the game's own). A bridge in a level that
+asks for ``exact`` is an error.
 
 A malformed file raises :class:`LevelError`, a ``ValueError`` whose message starts with the
 file's name and says what is wrong.
@@ -68,7 +79,9 @@ __all__ = [
 LEVEL_DIR = Path(__file__).with_name("levels")
 # The order gives the tile ids of the tileset ``to_tmj`` writes: new kinds go at the end.
 TILE_KINDS = ("solid", "oneway", "spikes", *terrain.SLOPES, terrain.STEP)
-OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel", "swing")
+OBJECT_KINDS = ("player", "coin", "enemy", "goal", "checkpoint", "platform", "spikes", "crate", "barrel", "swing",
+                "bridge")
+SOLVERS = ("exact", "soft")  # what a level may ask for (framework.scene.SOLVERS)
 DECORATION = ("background", "decoration")
 DEFAULT_TILE = 32.0
 
@@ -133,6 +146,8 @@ class Level:
     height: int
     tiles: list[list[str | None]]
     objects: list[LevelObject]
+    #: the contact solver the level is played with (``"exact"`` or ``"soft"``); ``None``: the game's
+    solver: str | None = None
 
     @property
     def size(self) -> tuple[float, float]:
@@ -182,12 +197,21 @@ class Level:
                     fail(f"platform at ({o.x:g}, {o.y:g}): speed must be > 0")
             if o.kind == "swing":
                 _check_swing(o, fail)
+            if o.kind == "bridge":
+                _check_bridge(o, self.tile, fail)
             if o.kind == "enemy":
                 if not _is_number(o.props.get("speed", 2.0)) or not float(o.props.get("speed", 2.0)) >= 0:
                     fail(f"enemy at ({o.x:g}, {o.y:g}): speed must be a number >= 0")
                 if o.props.get("direction", -1) not in (-1, 1):
                     fail(f"enemy at ({o.x:g}, {o.y:g}): direction must be -1 or 1, "
                          f"got {_show(o.props.get('direction'))}")
+        if self.solver is not None and (not isinstance(self.solver, str) or self.solver not in SOLVERS):
+            fail(f"solver must be one of {', '.join(SOLVERS)}, got {_show(self.solver)}")
+        if self.of_kind("bridge"):
+            if self.solver == "exact":
+                fail("the level has a bridge, whose hinges are joints, which only the soft solver solves: "
+                     "solver must be soft (or not given), got 'exact'")
+            self.solver = "soft"
         return self
 
 
@@ -211,6 +235,37 @@ def _check_swing(o: LevelObject, fail: Fail) -> None:
         fail(f"{where}: period must be > 0 seconds, got {_show(o.props['period'])}")
     if not isinstance(o.props.get("one_way", True), bool):
         fail(f"{where}: one_way must be true or false, got {_show(o.props['one_way'])}")
+
+
+def _check_bridge(o: LevelObject, tile: float, fail: Fail) -> None:
+    """A bridge: a rectangle (anchors at its left and right edges, the deck's top at its top there;
+    its height the sag); ``planks`` (an int >= 2), ``thickness`` (tiles) and ``mass`` (each
+    plank's), all optional. The planks must be longer than thick."""
+    from .bridge import plank_length
+
+    where = f"bridge at ({o.x:g}, {o.y:g})"
+    if o.width <= 0 or o.height <= 0:
+        fail(f"{where} needs a rectangle: its width the span between the anchors, its height the sag "
+             f"(width and height > 0), got {o.width:g} x {o.height:g}")
+    planks = o.props.get("planks", bridge_planks(o, tile))
+    if isinstance(planks, bool) or not isinstance(planks, int) or planks < 2:
+        fail(f"{where}: planks must be an integer >= 2, got {_show(planks)}")
+    for key in ("thickness", "mass"):
+        if key in o.props and not _is_number(o.props[key]):
+            fail(f"{where}: {key} must be a number, got {_show(o.props[key])}")
+        if key in o.props and not float(o.props[key]) > 0:
+            fail(f"{where}: {key} must be > 0, got {_show(o.props[key])}")
+    thickness = float(o.props.get("thickness", 0.25)) * tile
+    length = plank_length(o.width, o.height, planks)
+    if not thickness < length:
+        fail(f"{where}: thickness must be less than a plank's length ({length / tile:.4g} tiles for {planks} "
+             f"planks), got {_show(o.props.get('thickness', 0.25))}")
+
+
+def bridge_planks(o: LevelObject, tile: float) -> int:
+    """A bridge's plank count: its ``planks`` property, else one a tile of its width (at least 2)."""
+    planks = o.props.get("planks")
+    return planks if isinstance(planks, int) and not isinstance(planks, bool) else max(2, round(o.width / tile))
 
 
 def _is_number(v: object) -> bool:
@@ -273,7 +328,7 @@ def parse_text(
     height = len(grid)
     tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
     objects: list[LevelObject] = []
-    known = set(_TEXT_TILES) | set(_TEXT_OBJECTS) | set(_TEXT_EMPTY) | {"M", "~", "S", "o"}
+    known = set(_TEXT_TILES) | set(_TEXT_OBJECTS) | set(_TEXT_EMPTY) | {"M", "~", "S", "o", "="}
 
     def center(col: int, row: int) -> tuple[float, float]:
         return (col + 0.5) * tile, (height - row - 0.5) * tile
@@ -290,6 +345,7 @@ def parse_text(
                 objects.append(LevelObject(_TEXT_OBJECTS[ch], x, y, tile, tile))
     objects.extend(_text_platforms(grid, tile, fail))
     objects.extend(_text_swings(grid, tile, fail))
+    objects.extend(_text_bridges(grid, tile, fail))
     return Level(name or Path(source).stem, source, float(tile), width, height, tiles, objects).validate()
 
 
@@ -386,6 +442,20 @@ def _text_swings(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
     return out
 
 
+def _text_bridges(grid: list[str], tile: float, fail: Fail) -> list[LevelObject]:
+    """Bridges: a run of ``=`` (2 cells or more) is hung between the run's outer edges, the deck's
+    top at the run's top at both ends and sagging to the run's bottom in the middle: the rectangle
+    of its cells. One plank a cell."""
+    height = len(grid)
+    out = []
+    for row, start, col in _runs(grid, "="):
+        if col - start < 2:
+            fail(f"bridge at line {row + 1}, column {start + 1} is one cell long: a bridge needs 2 or more '='")
+        out.append(LevelObject("bridge", (start + col) * 0.5 * tile, (height - row - 0.5) * tile, (col - start) * tile,
+                               tile))
+    return out
+
+
 # --- Tiled maps ------------------------------------------------------------------------------------
 
 
@@ -472,8 +542,9 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
             continue
         else:
             fail(f"{where}: unknown layer type {_show(ltype)}")
-    title = _props(data, fail, "map").get("title") or name or Path(source).stem
-    return Level(_text(title), source, float(tw), width, height, tiles, objects).validate()
+    map_props = _props(data, fail, "map")
+    title = map_props.get("title") or name or Path(source).stem
+    return Level(_text(title), source, float(tw), width, height, tiles, objects, map_props.get("solver")).validate()
 
 
 def _flat_layers(layers: list, fail: Fail, limits: LevelLimits) -> list[dict]:
@@ -699,7 +770,8 @@ def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
         "renderorder": "right-down", "infinite": False, "compressionlevel": -1,
         "width": level.width, "height": level.height, "tilewidth": int(t), "tileheight": int(t),
         "nextlayerid": 3, "nextobjectid": len(objs) + 1,
-        "properties": [{"name": "title", "type": "string", "value": title or level.name}],
+        "properties": [{"name": "title", "type": "string", "value": title or level.name},
+                       *([{"name": "solver", "type": "string", "value": level.solver}] if level.solver else [])],
         "tilesets": [tileset],
         "layers": [
             {"type": "tilelayer", "id": 1, "name": "tiles", "x": 0, "y": 0, "width": level.width,

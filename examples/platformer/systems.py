@@ -6,8 +6,11 @@ Where each runs in a step (see :func:`install`)::
     movement          (framework: integrate velocities, gravity; moving platforms move)
     character         (framework: the player and the walkers move and slide with their
                        CharacterController: slopes, steps, riding platforms, one-way platforms)
-    ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide)
-    after response    sense_player -> sense_enemies -> fall_out -> animate -> follow_camera
+    before response   weigh_on_bridges
+    ccd .. response   (framework: sweep, broad phase, contacts and events, push-out and slide; or
+                       the soft step, with the bridges' joints)
+    after response    stand_on_bridges -> sense_player -> sense_enemies -> fall_out -> animate ->
+                      follow_camera
     end of step       collision handlers: coins, spikes, enemies, checkpoints, the goal
 
 The game's own movement code is input -> the velocity wanted: the framework's character
@@ -18,6 +21,7 @@ else collision-related comes from the pipeline: its events (``scene.on_collision
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +36,7 @@ from .animations import animations
 from .components import (
     ONE_WAY,
     SOLID,
+    BridgePlank,
     Checkpoint,
     Coin,
     Enemy,
@@ -89,6 +94,8 @@ def level_flow(scene: Scene, dt: float) -> None:
     if state.pending_stage == 0:
         game.clear_level()
         state.pending_stage = 1
+        index = state.level_index + (1 if state.pending == "next" else 0)
+        game.use_solver_of(index)  # (when this step ends: a solver changes only between steps)
     else:
         index = state.level_index + (1 if state.pending == "next" else 0)
         state.pending = None
@@ -128,6 +135,75 @@ def swing_platforms(scene: Scene, dt: float) -> None:
     for _e, (rope, t, v) in scene.query(SwingRope, Transform, Velocity):
         v.x, v.y = (rope.swing.pivot[0] - t.x) / dt, (rope.swing.pivot[1] - t.y) / dt
         v.angular = (rope.swing.angle(rope.swing.time) - t.rotation) / dt
+
+
+def weigh_on_bridges(scene: Scene, dt: float) -> None:
+    """The player weighs on the bridge plank it stands on. The character controller moves the
+    player as a kinematic body, which presses on nothing; so after it has moved (and before the
+    soft step solves the bridge's hinges), the plank under its feet gets the impulse of the
+    player's weight over the step, ``push_mass * gravity * dt``, at the point under the feet (its
+    bottom middle): the bridge then carries the player as it would a weight of that mass hung
+    there, and sags under it (as :func:`.bridge.hang` says, tested)."""
+    planks = scene.query(BridgePlank)
+    if not planks or dt <= 0.0:
+        return
+    tu: Tuning = scene.resources[Tuning]
+    gx, gy = scene.gravity
+    jx, jy = tu.push_mass * gx * dt, tu.push_mass * gy * dt
+    for _e, (_p, t, hb, ctrl) in scene.query(Player, Transform, Hitbox, CharacterController):
+        floor = ctrl.floor_entity
+        if not ctrl.on_floor or floor is None or scene.try_get(floor, BridgePlank) is None:
+            continue
+        pt, pv, phb = scene.get(floor, Transform), scene.get(floor, Velocity), scene.get(floor, Hitbox)
+        mass, (cx, cy), inertia = phb.mass_data
+        c, s = math.cos(pt.rotation), math.sin(pt.rotation)
+        rx = t.x - (pt.x + c * cx - s * cy)  # from the plank's centre of mass to the feet
+        ry = t.y - hb.shape.height * 0.5 - (pt.y + s * cx + c * cy)
+        pv.x += jx / mass
+        pv.y += jy / mass
+        pv.angular += (rx * jy - ry * jx) / inertia
+
+
+def stand_on_bridges(scene: Scene, dt: float) -> None:
+    """Keep the player standing on the bridge deck under it. The character controller stood it on
+    a plank, then the soft step moved the planks on: their hinges and the player's weight changed
+    their velocity from the one the controller rode by, so the deck may now be a little below the
+    feet, or above them, in them (where two planks meet in them at once, pushed out of one into the
+    other, the controller would find the player crushed). So here the player is moved straight up
+    or down onto the deck: its feet, the bottom of its box, a hair (2**-20 tile) above the highest
+    point of the planks' top faces under it. Not if that move would put it into anything (the
+    ground at a bridge's end, a ceiling): then the controller sees to it next step as to any floor
+    that moved."""
+    planks = scene.query(BridgePlank)
+    if not planks:
+        return
+    tile = _tile(scene)
+    for _e, (_p, t, hb, ctrl) in scene.query(Player, Transform, Hitbox, CharacterController):
+        floor = ctrl.floor_entity
+        if not ctrl.on_floor or floor is None or scene.try_get(floor, BridgePlank) is None:
+            continue
+        w, h = hb.shape.width, hb.shape.height
+        x0, x1, feet = t.x - 0.5 * w, t.x + 0.5 * w, t.y - 0.5 * h
+        top = None
+        for e, _plank in planks:
+            # its top face, corner to corner; the highest of it over the feet is at an end of
+            # the part of it over them (it is straight)
+            pt, box = scene.get(e, Transform), scene.get(e, Hitbox).shape
+            hl, ht = max(px for px, _py in box.points), max(py for _px, py in box.points)  # (a centred box)
+            c, s = math.cos(pt.rotation), math.sin(pt.rotation)
+            (ax, ay), (bx, by) = sorted((pt.x + c * dx - s * ht, pt.y + s * dx + c * ht) for dx in (-hl, hl))
+            lo, hi = max(ax, x0), min(bx, x1)
+            if lo > hi or bx == ax:
+                continue
+            for x in (lo, hi):
+                y = ay + (by - ay) * (x - ax) / (bx - ax)
+                top = y if top is None else max(top, y)
+        if top is None:
+            continue
+        dy = top + 2.0**-20 * tile - feet
+        if dy == 0.0 or scene.query_shape(hb.shape, (t.x, t.y + dy), mask=ctrl.solid_mask or hb.mask):
+            continue
+        t.y += dy
 
 
 def control_player(scene: Scene, dt: float) -> None:
@@ -367,7 +443,8 @@ def install(scene: Scene) -> None:
 
     for system in (level_flow, move_platforms, swing_platforms, control_player, walk_enemies):
         scene.add_system(system, before="movement")
-    for system in (sense_player, sense_enemies, fall_out, animate, follow_camera):
+    scene.add_system(weigh_on_bridges, before="response")
+    for system in (stand_on_bridges, sense_player, sense_enemies, fall_out, animate, follow_camera):
         scene.add_system(system, after="response")
     scene.on_collision(P, Coin, on_coin)
     scene.on_collision(P, Hazard, on_hazard, kinds=("started", "ongoing"))

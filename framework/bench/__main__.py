@@ -84,7 +84,8 @@ def main(argv: list[str] | None = None) -> int:
         report = perf.run_perf(sizes=sizes, rounds=rounds, tiles=perf.TILES if args.tiles is None else args.tiles,
                               tile_bodies=tile_bodies, brute_sizes=cfg["brute_sizes"] if args.sizes is None else
                               (min(sizes),), check_up_to=max(small, default=min(sizes)), progress=progress,
-                              quick=args.quick)
+                              quick=args.quick, query_rounds=3 if args.quick else 10,
+                              **({} if args.sizes is None else {"queries": 100, "query_bodies": min(sizes)}))
     elif args.benchmark == "render":
         from . import render
 

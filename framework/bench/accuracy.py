@@ -70,6 +70,18 @@ Scenarios (each has an exact reference, so every error is measured, not judged b
   rope's 5; ``max_stretch``: the largest over the run. Modes ``soft`` and ``soft-substeps-N``
   (the scene's ``substeps``: N soft steps, of the solver's own 4 sub-steps each, a step).
 
+- **mass** (the centre of mass, issue 38): a box 1 x 0.5 whose centre is 1 from its hitbox origin
+  (``Polygon`` points (0.5, -0.25) to (1.5, 0.25)), mass 1. ``offset-spin``: spinning at one turn a
+  second, no gravity, for 2 s; exact answer: its centre of mass stays where it is.
+  ``offset-throw``: thrown at (3, 6) spinning as fast, gravity 20, for 1 s; exact answer: its
+  centre of mass moves as a twin's that does not spin (the same box centred on its origin, thrown
+  alike in the same scene: the integrator's own error, the same for both, is left out).
+  ``measured``: the largest distance of the centre of mass from the exact answer over the run;
+  ``rel_error``: that over the offset (1). The soft solver
+  turns a body about its centre of mass, as Box2D and pymunk do; the exact solver turns it about
+  its hitbox origin (documented in docs/physics.md), so there the centre swings round the origin.
+  Modes ``substeps-1`` (the exact solver's default) and ``soft``.
+
 Sleeping is off in every scene (except ``default-sleeping``) so the solver is measured, not the
 sleep. ``ms_per_step``: median over the steps of every repeated run, timed in the same process
 (the scene's whole step, for the scenario's scene). All scenes use ``dt = 1/60`` s, gravity
@@ -98,9 +110,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BULLET_MODES", "CONTROLLER_CASES", "CONTROLLER_MODES", "CRATE_MODES", "REST_MODES", "BALL_MODES",
-    "FRICTION_CASES", "FRICTION_MODES", "JOINT_CASES", "JOINT_MODES", "ROW_KEYS",
+    "FRICTION_CASES", "FRICTION_MODES", "JOINT_CASES", "JOINT_MODES", "MASS_CASES", "MASS_MODES", "ROW_KEYS",
     "analytic_bullet_toi", "bullet_lanes", "crate_placements", "crates_overlap_exact", "markdown", "run_accuracy",
     "pendulum_period", "run_ball", "run_bullets", "run_controller", "run_crates", "run_friction", "run_joint",
+    "run_mass",
     "run_rest", "text_report",
 ]
 
@@ -124,8 +137,10 @@ CONTROLLER_CASES = ("slope-45-up", "slope-45-down", "slope-2:1-up", "slope-2:1-d
 CONTROLLER_MODES = ("substeps-1", "substeps-4")
 JOINT_CASES = ("pendulum-distance", "pendulum-revolute", "rope-20-hanging", "rope-20-swinging")
 JOINT_MODES = ("soft", "soft-substeps-2", "soft-substeps-4")  # (the exact solver refuses joints)
+MASS_CASES = ("offset-spin", "offset-throw")
+MASS_MODES = ("substeps-1", "soft")
 SCENARIOS = ("bullet", "crate", "stack", "character", "character-walk", "crowd", "ball", "friction", "controller",
-             "joints")
+             "joints", "mass")
 DEFAULT_MODES = {"discrete", "response-iterations-4", "substeps-1", "default-sleeping"}
 
 FULL: dict[str, Any] = {"lanes": 128, "crates": 10_000, "rest_steps": 600, "ball_steps": 1_000, "runs": 3,
@@ -683,6 +698,58 @@ def _rope_run(case: str, mode: str, steps: int) -> tuple[list[float], dict[str, 
         scene.close()
 
 
+# --- the centre of mass ---------------------------------------------------------------------------------
+
+MASS_OFFSET = 1.0  # the box's centre from its hitbox origin
+MASS_SPIN = 2.0 * math.pi  # rad/s: a turn a second
+MASS_THROW = (3.0, 6.0)
+
+
+def run_mass(case: str, mode: str, runs: int = 1) -> dict[str, Any]:
+    """One centre-of-mass case (see the module's docstring) in one mode; the row."""
+    times: list[float] = []
+    worst = 0.0
+    steps = 0
+    for _ in range(runs):
+        ms, worst, steps = _mass_run(case, mode)
+        times += ms
+    return _row("mass", mode, case=case, ms_per_step=median(times), samples=1, measured=worst, expected=0.0,
+                rel_error=worst / MASS_OFFSET, steps=steps)
+
+
+def _mass_run(case: str, mode: str) -> tuple[list[float], float, int]:
+    """The spinning offset box, and 100 to its right a twin that does not spin, its box centred
+    on its origin: the same centre of mass, thrown alike. The exact answer (the centre of mass
+    moves as if the body did not turn) is the twin's path, so the integrator's own error (the same
+    for both) is not counted, only how the turn moves the centre."""
+    throw = case == "offset-throw"
+    g = -GRAVITY[1] if throw else 0.0
+    scene = _scene_for(mode, gravity=(0.0, -g))
+    try:
+        c, hh, apart = MASS_OFFSET, 0.25, 100.0
+        box = Polygon([(c - 0.5, -hh), (c + 0.5, -hh), (c + 0.5, hh), (c - 0.5, hh)])
+        vx, vy = MASS_THROW if throw else (0.0, 0.0)
+        # (Velocity is the centre of mass's in the soft solver, the origin's in the exact one: the
+        # same numbers given to both, as a game would)
+        e = scene.spawn(Transform(0.0, 0.0), Velocity(vx, vy, MASS_SPIN), Hitbox(box, mass=1.0))
+        twin = scene.spawn(Transform(c + apart, 0.0), Velocity(vx, vy), Hitbox(Polygon.box(1.0, 2 * hh), mass=1.0))
+        cx, cy = scene.get(e, Hitbox).mass_data.center
+        t, tt = scene.get(e, Transform), scene.get(twin, Transform)
+        steps = int(round((1.0 if throw else 2.0) / DT))
+        drift = np.zeros(steps)
+
+        def after(k: int) -> None:
+            cs, sn = math.cos(t.rotation), math.sin(t.rotation)
+            x = t.x + cs * cx - sn * cy
+            y = t.y + sn * cx + cs * cy
+            drift[k] = math.hypot(x - (tt.x - apart), y - tt.y)
+
+        times = _timed_steps(scene, steps, after=after)
+        return times, float(drift.max()), steps
+    finally:
+        scene.close()
+
+
 # --- the character controller -------------------------------------------------------------------------
 
 WALK = 6.0  # units/s: 0.1 a step
@@ -838,6 +905,10 @@ def run_accuracy(config: dict[str, Any] | None = None, progress: bool = True, qu
             for mode in JOINT_MODES:
                 jobs.append((f"joints {case} {mode}", partial(run_joint, case, mode, cfg["pendulum_periods"],
                                                              cfg["rope_steps"], cfg["runs"])))
+    if "mass" in want:
+        for case in MASS_CASES:
+            for mode in MASS_MODES:
+                jobs.append((f"mass {case} {mode}", partial(run_mass, case, mode, cfg["runs"])))
     rows = []
     with Progress(len(jobs), "accuracy", enabled=progress) as bar:
         for name, job in jobs:
@@ -890,6 +961,10 @@ TABLES: dict[str, tuple[str, list[Column]]] = {
                 ("expected", "exact", "g7"), ("rel_error", "relative error (rope: stretch)", "sci"),
                 ("max_stretch", "largest stretch, of the length", "sci"),
                 ("apex_drop", "swing lost over the run", "sci")]),
+    "mass": (f"The centre of mass of a box whose centre is {MASS_OFFSET:g} from its origin, spinning a turn a "
+             "second (free, and thrown under g = 20)",
+             [("case", "case", "str"), *_COMMON, ("measured", "centre of mass off its exact path, largest", "sci"),
+              ("rel_error", "of the offset", "sci")]),
 }
 
 

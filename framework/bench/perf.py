@@ -17,6 +17,12 @@ ratios hold; each figure is the median over the rounds.
 Before timing, on the small sizes, the pipeline's candidate pairs are checked against
 :func:`~framework.collision.broad_phase.brute_force_pairs` on the same bounds (with and without
 overlapping static tiles); a mismatch raises :class:`PairMismatch`.
+
+Batch queries (:func:`run_queries`): a scene of every shape kind (boxes, circles, capsules,
+polygons, turned) over a floor of unit tiles; ``Scene.query_points``, ``nearest_many`` and
+``raycast_many`` of 1,000 random points or rays, timed interleaved against the same queries asked
+one by one (``query_point``, ``nearest``, ``raycast`` in a Python loop). Their answers are checked
+equal first (a mismatch raises :class:`QueryMismatch`).
 """
 
 from __future__ import annotations
@@ -53,8 +59,9 @@ if TYPE_CHECKING:
     from ..scene import Scene
 
 __all__ = [
-    "COLUMNS", "EFFECTS", "PairMismatch", "Workload", "brute_detection", "build_pymunk", "build_scene",
-    "check_pairs", "goals", "make_boxes", "markdown", "run_perf", "text_report", "with_tiles",
+    "COLUMNS", "EFFECTS", "PairMismatch", "QUERY_COLUMNS", "QueryMismatch", "Workload", "brute_detection",
+    "build_pymunk", "build_scene", "check_pairs", "goals", "make_boxes", "markdown", "query_scene", "run_perf",
+    "run_queries", "text_report", "with_tiles",
 ]
 
 EFFECTS = ("movement", "detection", "events", "response")
@@ -91,6 +98,10 @@ ROW_KEYS = [k for k, _, _ in COLUMNS] + ["pairs_per_body", "cell_size", "rounds"
 
 class PairMismatch(AssertionError):
     """The pipeline's candidate pairs differ from the brute-force pairs on the same bounds."""
+
+
+class QueryMismatch(AssertionError):
+    """A batch query's answers differ from the single queries' asked one by one."""
 
 
 # --- the workload -------------------------------------------------------------------------------------
@@ -378,6 +389,105 @@ def _brute_row(label: str, n: int, brute: Task, hash_row: dict[str, Any]) -> dic
     }
 
 
+# --- batch queries against a loop of single queries ----------------------------------------------------
+
+#: The columns of the batch-query rows: (key, header, format).
+QUERY_COLUMNS: list[Column] = [
+    ("query", "query", "str"),
+    ("queries", "queries", "int"),
+    ("bodies", "bodies", "int"),
+    ("batch_ms", "batch ms", "ms"),
+    ("loop_ms", "loop ms", "ms"),
+    ("speedup", "loop/batch", "ratio"),
+    ("batch_us_per_query", "us/query", "ms"),
+]
+
+
+def query_scene(bodies: int = 1_000, tiles: int = 400, seed: int = 0) -> Scene:
+    """A scene of ``bodies`` hitboxes of every kind (boxes, circles, capsules, polygons), turned, over a
+    floor of ``tiles`` unit tiles, all static (what a game queries between steps)."""
+    from ..scene import Scene
+    from ..shapes import Capsule, Circle, Polygon
+
+    rng = np.random.default_rng(seed)
+    side = math.sqrt(bodies) * 6.0
+    hexagon = Polygon([(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)])
+    shapes = [AABB(2.0, 1.0), Circle(0.75), Capsule(0.4, 1.5), hexagon, Polygon.box(2.0, 0.5)]
+    scene = Scene()
+    for k in range(bodies):
+        x, y = rng.uniform(0.0, side, 2)
+        scene.spawn(Transform(float(x), float(y), float(rng.uniform(0.0, 2.0 * math.pi))),
+                    Hitbox(shapes[k % len(shapes)], body="static", layer=1 + k % 2))
+    for k in range(tiles):
+        scene.spawn(Transform(-0.5 * tiles + k + 0.5 + 0.5 * side, -1.5), Hitbox(AABB(1.0, 1.0), body="static"))
+    scene.step(DT)
+    return scene
+
+
+def _same(batch: Any, loop: list[Any]) -> bool:
+    """Whether a batch answer (PointHits, NearestMany or RayHits) equals the single answers."""
+    if hasattr(batch, "offsets"):
+        return all(batch.of(i) == one for i, one in enumerate(loop))
+    for i, one in enumerate(loop):
+        if one is None:
+            if batch.entity[i] != -1:
+                return False
+            continue
+        got = [int(batch.entity[i]), float(batch.distance[i]), tuple(batch.point[i].tolist())]
+        want = [one.entity, one.distance, tuple(one.point)]
+        if hasattr(batch, "normal"):
+            got.append(tuple(batch.normal[i].tolist()))
+            want.append(tuple(one.normal))
+        if got != want:
+            return False
+    return True
+
+
+def run_queries(queries: int = 1_000, bodies: int = 1_000, tiles: int = 400, rounds: int = 10, seed: int = 0,
+                loop_sample: int = 200, bar: Progress | None = None) -> list[dict[str, Any]]:
+    """Time each batch query against a Python loop of the single query (interleaved rounds); rows of
+    :data:`QUERY_COLUMNS`. The loop asks the first ``loop_sample`` queries only (a loop of 1,000
+    unbounded ``nearest`` takes seconds) and its time is scaled to all of them (it is linear:
+    each query is asked on its own). The answers are compared first, on the loop's queries:
+    :class:`QueryMismatch` if they differ."""
+    scene = query_scene(bodies, tiles, seed)
+    rng = np.random.default_rng(seed + 1)
+    side = math.sqrt(bodies) * 6.0
+    pts = rng.uniform(-2.0, side + 2.0, (queries, 2))
+    dirs = rng.normal(size=(queries, 2))
+    k = min(queries, loop_sample)
+    plist = [tuple(p) for p in pts[:k].tolist()]
+    dlist = [tuple(d) for d in dirs[:k].tolist()]
+    reach = side / 4.0
+    cases: list[tuple[str, Callable[[], Any], Callable[[], Any]]] = [
+        ("query_points", lambda: scene.query_points(pts), lambda: [scene.query_point(*p) for p in plist]),
+        ("nearest_many", lambda: scene.nearest_many(pts), lambda: [scene.nearest(p) for p in plist]),
+        ("nearest_many (max_distance 2)", lambda: scene.nearest_many(pts, max_distance=2.0),
+         lambda: [scene.nearest(p, max_distance=2.0) for p in plist]),
+        (f"raycast_many (max_distance {reach:.0f})", lambda: scene.raycast_many(pts, dirs, max_distance=reach),
+         lambda: [scene.raycast(p, d, max_distance=reach) for p, d in zip(plist, dlist)]),
+        ("raycast_many", lambda: scene.raycast_many(pts, dirs),
+         lambda: [scene.raycast(p, d) for p, d in zip(plist, dlist)]),
+    ]
+    tasks = []
+    for name, batch, loop in cases:
+        if not _same(batch(), loop()):
+            scene.close()
+            raise QueryMismatch(f"{name}: the batch's answers differ from the single queries' one by one")
+        tasks += [Task(f"{name}/batch", batch), Task(f"{name}/loop", loop)]
+    run_interleaved(tasks, rounds, warmup=1, bar=bar)
+    scene.close()
+    by = {t.name: t for t in tasks}
+    rows = []
+    for name, _, _ in cases:
+        b = cast(float, median(by[f"{name}/batch"].ms))
+        lp = cast(float, median(by[f"{name}/loop"].ms)) * queries / k
+        rows.append({"query": name, "queries": queries, "bodies": bodies + tiles, "batch_ms": b, "loop_ms": lp,
+                     "speedup": lp / b if b else None, "batch_us_per_query": b / queries * 1000.0,
+                     "loop_sample": k})
+    return rows
+
+
 def run_perf(
     sizes: tuple[int, ...] = FULL["sizes"],
     rounds: dict[int, int] | None = None,
@@ -388,17 +498,22 @@ def run_perf(
     seed: int = 0,
     progress: bool = True,
     quick: bool = False,
+    queries: int = 1_000,
+    query_rounds: int = 10,
+    query_bodies: int = 1_000,
 ) -> dict[str, Any]:
     """Run the benchmark; return the report (``rows``, ``goals``, ``checks``, ``workload``, ``machine``).
 
     ``tile_bodies``: the movers of the platformer-scale level (``None``: no tiles rows); its rows are
     timed in the same rounds as the plain scene of that size. Any size works (tests use tiny ones).
+    ``queries``: how many points or rays each batch query of :func:`run_queries` asks (0: none), in
+    ``query_rounds`` rounds over a scene of ``query_bodies`` bodies.
     """
     pymunk = optional_module("pymunk")
     rounds = dict(rounds or {})
     sizes = tuple(sorted(set(sizes) | ({tile_bodies} if tile_bodies else set())))
     groups: list[tuple[int, int]] = [(n, rounds.get(n, 20)) for n in sizes]
-    total = sum(r for _, r in groups) + len(sizes)
+    total = sum(r for _, r in groups) + len(sizes) + (query_rounds if queries else 0)
     checks: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
     with Progress(total, "perf", enabled=progress) as bar:
@@ -436,6 +551,11 @@ def run_perf(
             for c in (ctx, ctx_t):
                 if c is not None:
                     c["scene"].close()
+        query_rows: list[dict[str, Any]] = []
+        if queries:
+            bar.task(f"batch queries ({queries:,} each)")
+            query_rows = run_queries(queries, bodies=query_bodies, tiles=min(400, query_bodies), rounds=query_rounds,
+                                     seed=seed, bar=bar)
     report = {
         "benchmark": "perf",
         "quick": quick,
@@ -447,9 +567,12 @@ def run_perf(
             "seed": seed, "warmup": WARMUP,
             "brute_force": "brute_force_pairs + the AABB narrow kernel (detection only)",
             "floor": "SpatialHash.pairs alone on the same bounds and cell size",
+            "queries": "query_scene(1,000 bodies of every kind + 400 tiles); 1,000 random points / rays per batch "
+                       "against a Python loop of the single query (answers checked equal first)",
         },
         "rows": rows,
         "checks": checks,
+        "queries": query_rows,
     }
     report["goals"] = goals(rows)
     return report
@@ -532,6 +655,17 @@ def notes(report: dict[str, Any]) -> list[str]:
     return out
 
 
+def _query_lines(report: dict[str, Any]) -> list[str]:
+    rows = report.get("queries") or []
+    if not rows:
+        return []
+    return ["", format_table(rows, QUERY_COLUMNS), "",
+            f"Batch queries: each answers {rows[0]['queries']:,} points or rays over {rows[0]['bodies']:,} hitboxes in "
+            "one compiled pass; loop ms is the same queries asked one by one in Python (timed on the first "
+            f"{rows[0]['loop_sample']:,} and scaled; their answers equal, checked before timing); loop/batch is the "
+            "speed-up."]
+
+
 def text_report(report: dict[str, Any]) -> str:
     m = report["machine"]
     lines = [
@@ -547,6 +681,7 @@ def text_report(report: dict[str, Any]) -> str:
         "pair checks (pipeline == brute_force_pairs): "
         + ", ".join(f"{c['bodies']} moving + {c['static']} static: ok" for c in report["checks"]),
         *notes(report),
+        *_query_lines(report),
     ]
     if m["pymunk"] is None:
         lines.append("pymunk is not installed (pip install 'framework[bench]'): its columns are empty.")
@@ -572,6 +707,8 @@ def markdown(report: dict[str, Any], command: str, plot: str | None) -> str:
                                               for c in report["checks"]) + ": all equal.",
         "",
         *(f"- {n}" for n in notes(report)),
+        *(["", "### Batch queries against a loop of single queries", ""] + _query_lines(report)[1:]
+          if report.get("queries") else []),
     ]
     if plot:
         parts += ["", f"![ms per step against N, log-log, and the per-stage split]({plot})"]

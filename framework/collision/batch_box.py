@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from ..compiled import leaf
 from .batch_common import F64, ContactArrays, columns, finish, frame, sum_leading
 from .batch_point import overlap_point
 from .collide import POINT_TOL
@@ -240,7 +241,7 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
 
 
 
-@njit(cache=True)
+@leaf
 def _two_sum_1(a, b):  # pragma: no cover - compiled
     """:func:`_two_sum` of two floats."""
     s = a + b
@@ -248,7 +249,7 @@ def _two_sum_1(a, b):  # pragma: no cover - compiled
     return s, (a - (s - bb)) + (b - bb)
 
 
-@njit(cache=True)
+@leaf
 def _less_1(dh, dl, rh, rl):  # pragma: no cover - compiled
     """:func:`_less` of one row (``np.sign``'s 0 at 0 kept)."""
     adh = abs(dh)
@@ -256,7 +257,7 @@ def _less_1(dh, dl, rh, rl):  # pragma: no cover - compiled
     return adh < rh or (adh == rh and sign * dl < rl)
 
 
-@njit(cache=True)
+@leaf
 def _dd_overlap_1(dh, dl, rh, rl):  # pragma: no cover - compiled
     """:func:`_dd_overlap` of one row."""
     sgn = -1.0 if dh < 0.0 else 1.0

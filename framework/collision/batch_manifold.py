@@ -20,12 +20,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..compiled import leaf
 from .kinds import KIND_AABB
 
 __all__ = ["pair_manifolds"]
 
 
-@njit(cache=True)
+@leaf
 def _outline(r, kind, hx, hy, hw, hh, slot, world_poly, count, out):
     """Row ``r``'s outline in world coordinates, counter-clockwise, into ``out``; its vertex count."""
     if kind[r] == KIND_AABB:
@@ -43,7 +44,7 @@ def _outline(r, kind, hx, hy, hw, hh, slot, world_poly, count, out):
     return m
 
 
-@njit(cache=True)
+@leaf
 def _face_normal(p, m, i):
     j = i + 1 if i + 1 < m else 0
     ex, ey = p[j, 0] - p[i, 0], p[j, 1] - p[i, 1]
@@ -51,7 +52,7 @@ def _face_normal(p, m, i):
     return ey / length, -ex / length
 
 
-@njit(cache=True)
+@leaf
 def _facing(p, m, nx, ny):
     best, along = 0, -np.inf
     for i in range(m):

@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..compiled import leaf
+
 __all__ = ["holds", "rows_meeting", "rows_within"]
 
 
@@ -28,7 +30,7 @@ def rows_meeting(kind, minx, miny, maxx, maxy, x0, y0, x1, y1):  # pragma: no co
     return out[:m]
 
 
-@njit(cache=True)
+@leaf
 def holds(keys, key):  # pragma: no cover - compiled
     """Whether the sorted ``keys`` hold ``key`` (a binary search; the soft step's pair and joint
     filters use it too)."""

@@ -38,6 +38,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from ..compiled import leaf
 from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .exact import BAND, TINY, Offset, float_approx, ratio_approx, rounded_exact
 from .ray import closest_on_segment
@@ -108,7 +109,7 @@ def capsule_first(a: Capsule, pose_a: tuple[float, float, float], b: Capsule,
 
 # --- the compiled core -----------------------------------------------------------------------------
 
-@njit(cache=True)
+@leaf
 def _folded_x(nx, ny):
     if ny < -DIR_TOL or (abs(ny) <= DIR_TOL and nx < 0.0):
         return -nx
@@ -165,12 +166,12 @@ def _pick(cd, cx, cy, m, size):
 _on_segment = njit(cache=True)(closest_on_segment)
 
 
-@njit(cache=True)
+@leaf
 def _n_edges(nb):
     return nb if nb >= 3 else 1
 
 
-@njit(cache=True)
+@leaf
 def _pair_points(i, a0x, a0y, a1x, a1y, qx, qy, nb):
     """Closest points ``(pa, pb)`` of pair ``i``: ``i < 2 E``: A's end ``i // E`` and B's edge
     ``i % E`` (E edges: a point's one "edge" is the point, a segment's is the segment); then B's
@@ -187,7 +188,7 @@ def _pair_points(i, a0x, a0y, a1x, a1y, qx, qy, nb):
     return cx, cy, qx[j], qy[j]
 
 
-@njit(cache=True)
+@leaf
 def _closest(a0x, a0y, a1x, a1y, qx, qy, nb):
     """The pair of closest points of the cores (first of the nearest): ``(i, distance)``."""
     best, bi = np.inf, 0
@@ -199,7 +200,7 @@ def _closest(a0x, a0y, a1x, a1y, qx, qy, nb):
     return bi, best
 
 
-@njit(cache=True)
+@leaf
 def _axes(a0x, a0y, a1x, a1y, bx, by, nb, dx, dy, rsum, f, cd, cx, cy):
     """The separating axes of the cores (A's segment's normal and direction, the vertical, B's
     faces): fills the push-out candidates ``(overlap / |u| + R, f u / |u|)`` both ways; returns
@@ -244,7 +245,7 @@ def _axes(a0x, a0y, a1x, a1y, bx, by, nb, dx, dy, rsum, f, cd, cx, cy):
     return m, sat
 
 
-@njit(cache=True)
+@leaf
 def _inside_point(a0x, a0y, a1x, a1y, qx, qy, nb):
     """A point of both cores, which meet (up to rounding)."""
     if nb == 1:
@@ -283,7 +284,7 @@ def _inside_point(a0x, a0y, a1x, a1y, qx, qy, nb):
     return 0.5 * (pax + pbx), 0.5 * (pay + pby)
 
 
-@njit(cache=True)
+@leaf
 def _apart_contact(i, dist, depth, a0x, a0y, a1x, a1y, qx, qy, nb, ra, rb, f, out):
     """The contact of cores apart whose closest points are pair ``i``, ``dist`` > 0 apart (the
     normal times ``f``)."""

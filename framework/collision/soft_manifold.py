@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from ..compiled import leaf
 
 __all__ = ["DOWN", "LEFT", "RIGHT", "UP", "box_box", "capsule_capsule", "chain_segment", "circle_circle", "face_bit",
            "polygon_circle", "polygon_polygon"]
@@ -47,7 +47,7 @@ _EPS = 1.1920929e-07  # Box2D's FLT_EPSILON, the scale of "safely outside"
 LEFT, RIGHT, DOWN, UP = 1, 2, 4, 8  # a static box's faces, by the direction a body leaves it through them
 
 
-@njit(cache=True)
+@leaf
 def face_bit(vx, vy):
     """The face of a box that the direction ``(vx, vy)`` leaves it through (its dominant axis)."""
     if abs(vx) >= abs(vy):
@@ -55,7 +55,7 @@ def face_bit(vx, vy):
     return UP if vy > 0.0 else DOWN
 
 
-@njit(cache=True)
+@leaf
 def circle_circle(ax, ay, ra, bx, by, rb, speculative, out):
     """Two circles (centres, radii)."""
     dx, dy = bx - ax, by - ay
@@ -74,7 +74,7 @@ def circle_circle(ax, ay, ra, bx, by, rb, speculative, out):
     return 1, nx, ny
 
 
-@njit(cache=True)
+@leaf
 def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out, fa=0, fb=0):
     """Two axis-aligned boxes (centres, half extents; internal ``faces`` bits ``fa``, ``fb``): what
     :func:`polygon_polygon` gives them, in a few operations (the common case of boxes that never
@@ -117,7 +117,7 @@ def box_box(ax, ay, aw, ah, bx, by, bw, bh, speculative, out, fa=0, fb=0):
     return 2, 0.0, sgn
 
 
-@njit(cache=True)
+@leaf
 def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out, fa=0):
     """Polygon A (world vertices ``V[a, :count]``, normals ``N[a]``, rounding ``ra``, internal
     ``faces`` bits ``fa``) and circle B."""
@@ -171,7 +171,7 @@ def polygon_circle(V, N, a, count, ra, cx, cy, rb, speculative, out, fa=0):
     return 1, nx, ny
 
 
-@njit(cache=True)
+@leaf
 def _max_separation(V, N, p1, c1, p2, c2, f1, f2):
     """The edge of polygon 1 whose normal separates the two the most and that separation, among the
     edges that leave no box through an internal face (``f1``, ``f2``: the polygons' ``faces`` bits;
@@ -190,7 +190,7 @@ def _max_separation(V, N, p1, c1, p2, c2, f1, f2):
     return best, best_sep, sep_all
 
 
-@njit(cache=True)
+@leaf
 def _internal_corner(N, p, c, i, f):
     """Whether vertex ``i`` of polygon ``p`` (``c`` vertices, ``faces`` bits ``f``) ends an internal face."""
     if f == 0:
@@ -199,7 +199,7 @@ def _internal_corner(N, p, c, i, f):
     return (f & face_bit(N[p, i0, 0], N[p, i0, 1])) != 0 or (f & face_bit(N[p, i, 0], N[p, i, 1])) != 0
 
 
-@njit(cache=True)
+@leaf
 def _incident_edge(nx, ny, N, p2, c2):
     """The edge of polygon 2 most anti-parallel to the reference normal."""
     best, low = 0, 1e300
@@ -210,7 +210,7 @@ def _incident_edge(nx, ny, N, p2, c2):
     return best
 
 
-@njit(cache=True)
+@leaf
 def _segment_fractions(p1x, p1y, q1x, q1y, p2x, p2y, q2x, q2y):
     """Box2D's ``b2SegmentDistance``: the fractions along segments 1 and 2 of their closest points."""
     d1x, d1y, d2x, d2y = q1x - p1x, q1y - p1y, q2x - p2x, q2y - p2y
@@ -241,7 +241,7 @@ def _segment_fractions(p1x, p1y, q1x, q1y, p2x, p2y, q2x, q2y):
     return f1, f2
 
 
-@njit(cache=True)
+@leaf
 def _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out):
     """Box2D's ``b2ClipPolygons``: reference edge ``e1`` of polygon 1, incident edge ``e2`` of
     polygon 2; ``flip``: polygon 1 is B (the normal is turned to point from A to B)."""
@@ -283,7 +283,7 @@ def _clip(V, N, p1, c1, r1, e1, p2, c2, r2, e2, flip, out):
     return 2, -nx, -ny
 
 
-@njit(cache=True)
+@leaf
 def _segments_cross(V, a, b):
     """Whether the segments of rows ``a`` and ``b`` cross (each one's ends on either side of the
     other's line, by the signs of the orientations: closest points then lie at no distance, up
@@ -297,7 +297,7 @@ def _segments_cross(V, a, b):
     return o1 * o2 < 0.0 and o3 * o4 < 0.0
 
 
-@njit(cache=True)
+@leaf
 def capsule_capsule(V, a, ra, b, rb, speculative, out):
     """Two capsules (rows ``a``, ``b`` of ``V``: their segments' ends; radii): one point, between
     the closest points of the two segments (as Box2D's ``b2CollideCapsules`` where the segments are
@@ -325,7 +325,7 @@ def capsule_capsule(V, a, ra, b, rb, speculative, out):
     return 1, nx, ny
 
 
-@njit(cache=True)
+@leaf
 def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out, fa=0, fb=0):
     """Two rounded polygons (world vertices, normals, counts, radii, internal ``faces`` bits),
     ``slop``: Box2D's linear slop. Returns ``(count, nx, ny)``; points beyond ``speculative`` apart
@@ -388,13 +388,13 @@ _SIN_TOL = 0.01
 _SAME = 1e-12
 
 
-@njit(cache=True)
+@leaf
 def _unit2(x, y):
     ln = math.sqrt(x * x + y * y)
     return x / ln, y / ln
 
 
-@njit(cache=True)
+@leaf
 def chain_segment(V, N, L, g, o, count, ro, cx, cy, k, nx, ny, speculative, out):
     """What chain segment ``g`` (world ends ``V[g, 0:2]``; local ends and ghosts ``L[g, 0:4]``) keeps of
     its manifold with body ``o`` (``count`` world vertices ``V[o]``, normals ``N[o]``, radius ``ro``,
@@ -481,7 +481,7 @@ def chain_segment(V, N, L, g, o, count, ro, cx, cy, k, nx, ny, speculative, out)
     return _own_points(out, m, p1x, p1y, u1x, u1y, length, convex1, convex2, n1x, n1y)
 
 
-@njit(cache=True)
+@leaf
 def _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny):
     """The manifold's points that this segment owns: a point at or beyond a joint where the chain
     runs on straight or bends inward is the neighbour's (at the joint itself, the segment that ends

@@ -29,6 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import leaf
 from .softness import soft
 
 __all__ = ["JOINT_F", "JOINT_IMP", "prepare_joints", "solve_joints", "warm_start_joints"]
@@ -132,7 +133,7 @@ def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
     return jp
 
 
-@njit(cache=True)
+@leaf
 def _unit(x, y):
     """``(x, y)`` normalised; (0, 0) for a vector too short to have a direction (``b2Normalize``)."""
     d = math.sqrt(x * x + y * y)
@@ -141,7 +142,7 @@ def _unit(x, y):
     return x / d, y / d
 
 
-@njit(cache=True)
+@leaf
 def _state(r, x, y, x0, y0, qc, qs, rot, vx, vy, w):
     """A body's motion since the step began (dx, dy, turn cos, sin), angle and velocity; the
     world's (row -1) is still."""
@@ -150,14 +151,14 @@ def _state(r, x, y, x0, y0, qc, qs, rot, vx, vy, w):
     return x[r] - x0[r], y[r] - y0[r], qc[r], qs[r], rot[r], vx[r], vy[r], w[r]
 
 
-@njit(cache=True)
+@leaf
 def _store(r, m, i, vxr, vyr, wr, vx, vy, w):
     """Write a body's new velocity (a body that takes no impulse keeps its own)."""
     if r >= 0 and (m > 0.0 or i > 0.0):
         vx[r], vy[r], w[r] = vxr, vyr, wr
 
 
-@njit(cache=True)
+@leaf
 def warm_start_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
     """Apply each joint's accumulated impulses (Box2D's ``b2WarmStart*Joint``)."""
     for j in range(jint.shape[0]):
@@ -205,7 +206,7 @@ def warm_start_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w):
         _store(b, mb, ib, vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px + ang), vx, vy, w)
 
 
-@njit(cache=True)
+@leaf
 def solve_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w, use_bias, csoft, h, inv_h):
     """One pass over the joints (Box2D's ``b2Solve*Joint``): with the bias that pulls them back
     together (``use_bias``; ``csoft``: the joints' softness) or without it (the relax)."""
@@ -251,7 +252,7 @@ def solve_joints(jint, jf, jp, imp, x, y, x0, y0, qc, qs, rot, vx, vy, w, use_bi
         _store(b, mb, ib, vbx, vby, wb, vx, vy, w)
 
 
-@njit(cache=True)
+@leaf
 def _axial(s, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb):
     """The velocities after the impulse ``s`` along the axis ``(ux, uy)`` at the anchors."""
     px, py = s * ux, s * uy
@@ -259,7 +260,7 @@ def _axial(s, ux, uy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby
             vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px))
 
 
-@njit(cache=True)
+@leaf
 def _limit(c, cdot, mass, old, use_bias, csoft, inv_h):
     """A one-sided limit's new accumulated impulse (>= 0), ``c >= 0`` where it is kept: ahead of
     it, speculative (close the gap, no more); past it, soft (with the bias) or rigid."""
@@ -271,7 +272,7 @@ def _limit(c, cdot, mass, old, use_bias, csoft, inv_h):
     return max(old - ms * mass * (cdot + bias) - isc * old, 0.0)
 
 
-@njit(cache=True)
+@leaf
 def _distance(jf, jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias,
               csoft, h, inv_h):
     """Box2D's ``b2SolveDistanceJoint``: a spring toward the length (``hertz > 0``) and the
@@ -314,7 +315,7 @@ def _distance(jf, jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, v
     return vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, bias_rate, ms, isc):
     """The point-to-point row of the revolute and weld joints (Box2D's 2x2 block): the anchors'
     relative velocity, plus ``bias_rate`` times their separation, to zero."""
@@ -334,7 +335,7 @@ def _point(jp, imp, j, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa,
             vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px))
 
 
-@njit(cache=True)
+@leaf
 def _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
               use_bias, csoft, h, inv_h):
     """Box2D's ``b2SolveRevoluteJoint``: the spring (``hertz > 0``: toward the angle it was made
@@ -373,7 +374,7 @@ def _revolute(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib,
                   isc)
 
 
-@njit(cache=True)
+@leaf
 def _along(s, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb):
     """The velocities after the impulse ``s`` along a slide's axis ``(ux, uy)`` (B takes it, A its
     opposite; ``a1``, ``a2``: the turning arms, Box2D's crosses of ``d + rA`` and ``rB`` with it)."""
@@ -381,7 +382,7 @@ def _along(s, ux, uy, a1, a2, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb):
             vbx + mb * s * ux, vby + mb * s * uy, wb + ib * s * a2)
 
 
-@njit(cache=True)
+@leaf
 def _slide_limits(jf, imp, j, slide, ux, uy, a1, a2, mass, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias, csoft,
                   inv_h):
     """The lower and upper limits of a slide (prismatic and wheel joints) at ``slide`` along the axis."""
@@ -400,7 +401,7 @@ def _slide_limits(jf, imp, j, slide, ux, uy, a1, a2, mass, ma, ia, mb, ib, vax, 
     return vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb,
                use_bias, csoft, h, inv_h):
     """Box2D's ``b2SolvePrismaticJoint``: the spring along the axis ``(ux, uy)`` (``hertz > 0``:
@@ -451,7 +452,7 @@ def _prismatic(jf, jp, imp, j, angle, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia
             vbx + mb * p1 * nx, vby + mb * p1 * ny, wb + ib * lb)
 
 
-@njit(cache=True)
+@leaf
 def _wheel(jf, jp, imp, j, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias,
            csoft, h, inv_h):
     """Box2D's ``b2SolveWheelJoint``: the motor's turn, the suspension spring along the axis
@@ -486,7 +487,7 @@ def _wheel(jf, jp, imp, j, ux, uy, dx, dy, rax, ray, rbx, rby, ma, ia, mb, ib, v
             vbx + mb * s * nx, vby + mb * s * ny, wb + ib * s * s2)
 
 
-@njit(cache=True)
+@leaf
 def _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, use_bias,
           csoft):
     """Box2D's ``b2SolveWeldJoint`` (not block solved): the relative angle, then the shared point;
@@ -506,7 +507,7 @@ def _weld(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax
                   isc)
 
 
-@njit(cache=True)
+@leaf
 def _mouse(jf, jp, imp, j, sx, sy, rbx, rby, mb, ib, vbx, vby, wb, h):
     """Box2D's ``b2SolveMouseJoint``: damp the body's turn a little, then pull its anchor toward the
     target (a spring, always biased), the accumulated impulse at most ``max_force * h``."""
@@ -531,7 +532,7 @@ def _mouse(jf, jp, imp, j, sx, sy, rbx, rby, mb, ib, vbx, vby, wb, h):
     return vbx + mb * px, vby + mb * py, wb + ib * (rbx * py - rby * px)
 
 
-@njit(cache=True)
+@leaf
 def _unwind(angle):
     """``angle`` brought into [-pi, pi) by whole turns."""
     if -math.pi <= angle < math.pi:
@@ -539,7 +540,7 @@ def _unwind(angle):
     return angle - 2.0 * math.pi * math.floor((angle + math.pi) / (2.0 * math.pi))
 
 
-@njit(cache=True)
+@leaf
 def _motor(jf, jp, imp, j, angle, sx, sy, rax, ray, rbx, rby, ma, ia, mb, ib, vax, vay, wa, vbx, vby, wb, h, inv_h):
     """Box2D's ``b2SolveMotorJoint``: the relative turn, then the point, each driven toward its
     target at ``correction`` of the error a sub-step (``angle``: b's turn relative to a's less the

@@ -56,6 +56,7 @@ from ..collision.soft_manifold import (
     polygon_circle,
     polygon_polygon,
 )
+from ..compiled import leaf
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
 
@@ -125,7 +126,7 @@ def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
     return faces
 
 
-@njit(cache=True)
+@leaf
 def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
                   wc, wv, wn, lo, hi, reach):
     """World centres, vertices and normals of every hitbox (``cnt == 0``: none) and its bounds, widened by
@@ -262,7 +263,7 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
     return pairs
 
 
-@njit(cache=True)
+@leaf
 def _fat_overlap(fat, i, j):
     return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
 
@@ -572,7 +573,8 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
     not modified: new ones are returned. ``jint, jf, jimp``: the joints, their parameters and their
-    impulses from the last step (:mod:`framework.systems.soft_joints`; new impulses are returned);
+    impulses from the last step (:mod:`framework.systems.soft_joints`; new impulses are returned),
+    or three Nones for a scene without joints (then the joints' code is not compiled for it);
     ``apart``: the sorted keys of the pairs that do not collide (a joint's bodies). See the module
     docstring for the stages.
 
@@ -637,7 +639,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     if shifted:
         x_origin, y_origin = x.copy(), y.copy()
         off, bound, centre0 = _to_centres(x, y, rot, off, bound, conv)
-        if jint.shape[0]:
+        if jint is not None:
             jf = _anchors_from_centres(jint, jf, off, conv)
 
     # --- shapes, fat bounds and the broad phase ----------------------------------------------------
@@ -694,10 +696,9 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
         softness[q, 0], softness[q, 1], softness[q, 2] = _soft((2.0 if q & 1 else 1.0) * scale * hertz,
                                                                scale * zeta, h)
     push = params[_PUSH]
-    nj = jint.shape[0]  # (no joints: no calls and no copies, as before there were joints)
-    jp = jf
-    jsoft = softness[0]
-    if nj:
+    # (a scene without joints passes None: numba drops these branches, and compiles none of the
+    # joints' code for it)
+    if jint is not None:
         jp = prepare_joints(jint, jf, x, y, rot, moving, im, ii, h)
         jimp = jimp.copy()
         jsoft = np.empty(3)  # the joints' stiffness (Box2D's b2PrepareJoint: at most a quarter of the sub-step rate)
@@ -711,7 +712,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             if moving[r] and body[r] == _DYNAMIC and not driven[r]:
                 vx[r] += h * gx
                 vy[r] += h * gy
-        if nj:
+        if jint is not None:
             warm_start_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w)
         _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii)
         for relax in range(2):  # solve (with the soft push), integrate positions, relax (without)
@@ -728,7 +729,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
                             c2, s2 = qc[r] - hw * qs[r], qs[r] + hw * qc[r]
                             mag = 1.0 / math.sqrt(c2 * c2 + s2 * s2)
                             qc[r], qs[r] = c2 * mag, s2 * mag
-            if nj:
+            if jint is not None:
                 solve_joints(jint, jf, jp, jimp, x, y, x0, y0, qc, qs, rot, vx, vy, w, relax == 0, jsoft, h, inv_h)
             _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, relax == 0, rotation, softness,
                    inv_h, push)
@@ -782,7 +783,7 @@ def _anchors_from_centres(jint, jf, off, conv):
     return jf
 
 
-@njit(cache=True)
+@leaf
 def _from_centres(x, y, rot, off, conv, x_origin, y_origin, x0, y0, centre0):
     """Move the ``conv`` rows back from their centres of mass to their origins: the origin at the
     step's start plus the centre's motion since, less the centre's turn since (``R(rot) c`` now less
@@ -797,7 +798,7 @@ def _from_centres(x, y, rot, off, conv, x_origin, y_origin, x0, y0, centre0):
         y[r] = y_origin[r] + ((y[r] - y0[r]) - (ey - centre0[r, 1]))
 
 
-@njit(cache=True)
+@leaf
 def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, turning):
     """The velocities of A and B after the impulse ``(px, py)`` at their anchors (B takes it, A
     its opposite); ``turning``: the angular parts too."""
@@ -811,7 +812,7 @@ def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, tu
     return vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
     """Apply each point's accumulated impulses (Box2D's ``b2WarmStartContacts``)."""
     for c in range(nc):
@@ -829,7 +830,7 @@ def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
         vx[a], vy[a], w[a], vx[b], vy[b], w[b] = vax, vay, wa, vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_bias, rotation, softness,
            inv_h, push):
     """One pass over the contacts (Box2D's ``b2SolveContact``): the normal impulses with soft
@@ -893,7 +894,7 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
             vx[b], vy[b], w[b] = vbx, vby, wb
 
 
-@njit(cache=True)
+@leaf
 def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
     """Bounce the points that approached faster than ``threshold`` and took an impulse (Box2D's
     ``b2ApplyRestitution``): the relative normal velocity becomes ``-e`` times the approach."""

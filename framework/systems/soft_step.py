@@ -63,7 +63,6 @@ SOFT_SETTINGS = {"slop": 0.005, "hertz": 30.0, "damping": 10.0, "push_speed": 3.
 # the store's columns the kernel reads (and writes: the pose and velocity), in its argument order
 _KERNEL_COLUMNS = ("x", "y", "rot", "vx", "vy", "w", "asleep")
 # a scene without joints passes these
-_NO_JINT = np.zeros((0, 3), dtype=np.int64)
 _NO_JF = np.zeros((0, len(JOINT_F)))
 _NO_IMP = np.zeros((0, len(JOINT_IMP)))
 _NO_KEYS = np.zeros(0, dtype=np.int64)
@@ -217,20 +216,21 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     return fprops, iprops, off, verts
 
 
-_COMPILED = False
+_COMPILED: set[bool] = set()  # the kernel's variants called in this process (True: with joints)
 COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 25 to 30 seconds; later runs load "
                   "it from numba's cache)")
 
 
-def _first_call(args: tuple[Any, ...]) -> tuple[Any, ...]:
-    """The kernel's first call in this process: if it has not returned within a second (numba is
-    compiling it, not loading it from its cache), say so on stderr, once."""
-    global _COMPILED
+def _first_call(args: tuple[Any, ...], variant: bool) -> tuple[Any, ...]:
+    """The kernel's first call in this process for scenes with joints (``variant``) or without:
+    if it has not returned within a second (numba is compiling it, not loading it from its cache),
+    say so on stderr, once. (The two are compiled apart: a scene without joints compiles none of
+    the joints' code.)"""
     try:
         with notice_if_slow(COMPILE_NOTICE):
             return soft_step(*args)
     finally:
-        _COMPILED = True
+        _COMPILED.add(variant)
 
 
 class SoftStep(Stage):
@@ -251,7 +251,7 @@ class SoftStep(Stage):
         self._faces_key: tuple[int, int, int, bool] | None = None
         self._faces = np.zeros(0, dtype=np.int64)
         self._no_driven = np.zeros(0, dtype=np.bool_)
-        self._joint_key: tuple[Any, ...] | None = None  # what the packed joint tables were packed from
+        self._joint_key: tuple[Any, ...] = (None, None, None)  # what the packed joint tables were packed from
         self._joint_tables: tuple[np.ndarray, ...] = ()
         self.reset()
 
@@ -387,7 +387,7 @@ class SoftStep(Stage):
             self._settings_key = key
         return self._params
 
-    def _joints(self) -> tuple[np.ndarray, ...]:
+    def _joints(self) -> tuple[np.ndarray | None, ...]:
         """The kernel's joint arguments ``(jint, jf, jimp, apart)``: the joint components packed
         (checked again: game code may have written to them), last step's impulses matched by joint.
         A sleeping body is woken where its joint's other body moves, or the joint is new or changed
@@ -397,18 +397,24 @@ class SoftStep(Stage):
         if not joints:
             if old_keys.size:
                 self.joints = (_NO_KEYS, _NO_IMP, _NO_JF)
-            return _NO_JINT, _NO_JF, _NO_IMP, _NO_KEYS
+            return None, None, None, _NO_KEYS  # (the kernel's variant without joints)
         store = self.bodies.store
-        for _e, j in joints:
-            if j._frame is None:  # (added to the world by hand, not by the scene: measured now)
-                j.attach(store)
-        check_joints(joints, store, "soft")
-        key = (store.version, joint_writes(), [(e, id(j)) for e, j in joints])
-        if key != self._joint_key:  # (packed again only when a joint, its bodies or the rows changed)
+        key = (store.version, joint_writes(), joints)
+        if not (key[:2] == self._joint_key[:2] and joints is self._joint_key[2]):
+            for _e, j in joints:
+                if j._frame is None:  # (added to the world by hand, not by the scene: measured now)
+                    j.attach(store)
+            check_joints(joints, store, "soft")
+            key = (store.version, joint_writes(), joints)  # (attaching writes the anchors it measures)
+            # (packed again only when a joint, its bodies or the rows changed: joint_components
+            # answers with the same list while no component was added or removed)
             self._joint_tables = joint_tables(joints, store.row_of)
             self._joint_key = key
         jint, jf, keys, apart = self._joint_tables
-        if np.array_equal(keys, old_keys):
+        if keys is old_keys and jf is old_jf:  # (the same tables as last step: nothing changed)
+            imp = old_imp
+            changed = np.zeros(keys.size, dtype=bool)
+        elif np.array_equal(keys, old_keys):
             imp = old_imp
             changed = np.any(jf != old_jf, axis=1)
         else:
@@ -457,11 +463,13 @@ class SoftStep(Stage):
         joints = self._joints()
         args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
                 *joints)
-        out = soft_step(*args) if _COMPILED else _first_call(args)
+        jint = joints[0]
+        variant = jint is not None
+        out = soft_step(*args) if variant in _COMPILED else _first_call(args, variant)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info, jimp = out
-        if jimp.size:
+        if jint is not None:
             self.joints = (self.joints[0], jimp, self.joints[2])
-            ja, jb = joints[0][:, 1], joints[0][:, 2]
+            ja, jb = jint[:, 1], jint[:, 2]
             both = (ja >= 0) & (jb >= 0)
             frame.joined = (ja[both], jb[both])
         if "movement" in effects:

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from ..compiled import leaf
 
 __all__ = ["soft"]
 
 
-@njit(cache=True)
+@leaf
 def soft(hertz, zeta, h):
     """(bias rate, mass scale, impulse scale) of a soft constraint."""
     if hertz == 0.0:

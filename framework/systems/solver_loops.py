@@ -43,11 +43,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..compiled import leaf
+
 __all__ = ["solve_positions", "solve_positions_rigid", "solve_velocities", "solve_velocities_rigid", "supported",
            "warm_start"]
 
 
-@njit(cache=True)
+@leaf
 def _within(change, share, sign, ex, ey, nx, ny, reach):
     """``change`` limited so that a body now ``(ex, ey)`` from where the call began, moving by
     ``sign * share * change`` along ``(nx, ny)``, stays within ``reach`` of it."""
@@ -67,7 +69,7 @@ def _within(change, share, sign, ex, ey, nx, ny, reach):
     return t / (sign * share)
 
 
-@njit(cache=True)
+@leaf
 def _kept_within(change, share, sign, ex, ey, nx, ny, reach):
     """:func:`_within`, returning ``change`` itself where it is not limited (with shares that are
     not 0, 1/2 or 1, ``t / (sign * share)`` rounds off ``change``, which read as held back)."""
@@ -214,7 +216,7 @@ def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx,
     return passes
 
 
-@njit(cache=True)
+@leaf
 def _stop_sliding(i, ia, ib, nx, ny, limit, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, timpulse, vx, vy, w,
                   tolerance):
     """Friction's update of contact ``i`` in :func:`solve_velocities` (a function of its own, off
@@ -236,7 +238,7 @@ def _stop_sliding(i, ia, ib, nx, ny, limit, tshare_a, tshare_b, turn_a, turn_b, 
     return abs(change) > tolerance
 
 
-@njit(cache=True)
+@leaf
 def _left(order, a, b, moved, last, dirty):
     """After the last pass: the contacts of bodies that moved in it are still to look at."""
     for k in range(order.size):
