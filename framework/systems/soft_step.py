@@ -217,8 +217,8 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
 
 
 _COMPILED: set[bool] = set()  # the kernel's variants called in this process (True: with joints)
-COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 25 to 30 seconds; later runs load "
-                  "it from numba's cache)")
+COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 20 to 30 seconds, and again "
+                  "for the first scene with joints; later runs load it from numba's cache)")
 
 
 def _first_call(args: tuple[Any, ...], variant: bool) -> tuple[Any, ...]:
