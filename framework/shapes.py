@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from .validation import InvalidValue, finite, positive
 
@@ -390,12 +390,7 @@ class Chain:
     def __init__(self, points: Iterable[Sequence[float]], loop: bool = False) -> None:
         if not isinstance(loop, bool):
             raise InvalidValue(f"Chain loop must be True or False, got {loop!r}")
-        if isinstance(points, (str, bytes)):
-            raise InvalidValue(f"Chain points must be a sequence of (x, y) pairs, got {points!r}")
-        try:
-            raw = list(points)
-        except TypeError:
-            raise InvalidValue(f"Chain points must be a sequence of (x, y) pairs, got {points!r}") from None
+        raw = _listed(points, "Chain")
         pts = [_point(f"Chain point {i}", p) for i, p in enumerate(raw)]
         if loop and len(pts) > 1 and pts[0] == pts[-1]:
             pts.pop()  # a loop given closed
@@ -520,14 +515,20 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
     return tuple(res[start:] + res[:start])
 
 
+def _listed(points: Any, what: str) -> list[Any]:
+    """``points`` as a list (text is not a sequence of points), or :class:`InvalidValue` saying
+    ``what``'s points must be (x, y) pairs."""
+    if isinstance(points, (str, bytes)):
+        raise InvalidValue(f"{what} points must be a sequence of (x, y) pairs, got {points!r}")
+    try:
+        return list(points)
+    except TypeError:
+        raise InvalidValue(f"{what} points must be a sequence of (x, y) pairs, got {points!r}") from None
+
+
 def _read_points(points: Iterable[Sequence[float]]) -> tuple[list[tuple[float, float]], str]:
     """The points as finite float pairs (-0.0 made 0.0), and how to show the argument in errors."""
-    if isinstance(points, (str, bytes)):
-        raise InvalidValue(f"Polygon points must be a sequence of (x, y) pairs, got {points!r}")
-    try:
-        raw = list(points)
-    except TypeError:
-        raise InvalidValue(f"Polygon points must be a sequence of (x, y) pairs, got {points!r}") from None
+    raw = _listed(points, "Polygon")
     # Name the bad value as the caller wrote it (a tuple stays a tuple); a one-shot iterator is
     # shown as the list of what it gave.
     shown = repr(points) if hasattr(points, "__len__") and hasattr(points, "__getitem__") else repr(raw)

@@ -38,6 +38,7 @@ from numba import njit
 
 from .exact import BAND
 from .pieces import TIE
+from .ray import closest_on_segment
 from .tiebreak import DIR_TOL
 
 __all__ = ["hypot", "nearest_points", "points_inside", "rays_first"]
@@ -117,19 +118,7 @@ def hypot(x, y):  # pragma: no cover - compiled
     return _norm(x, y, m)
 
 
-@njit(cache=True)
-def _closest_on_segment(px, py, s0x, s0y, s1x, s1y):  # pragma: no cover - compiled
-    """framework.collision.ray.closest_on_segment."""
-    ex, ey = s1x - s0x, s1y - s0y
-    e2 = ex * ex + ey * ey
-    if e2 == 0.0:
-        return s0x, s0y
-    t = ((px - s0x) * ex + (py - s0y) * ey) / e2
-    if t <= 0.0:
-        return s0x, s0y
-    if t >= 1.0:
-        return s1x, s1y
-    return s0x + t * ex, s0y + t * ey
+_closest_on_segment = njit(cache=True)(closest_on_segment)  # (the single queries' own arithmetic, compiled)
 
 
 @njit(cache=True)
