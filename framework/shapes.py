@@ -232,15 +232,7 @@ class Polygon(Shape):
 
     @property
     def second_moment(self) -> float:
-        # Each edge and the origin span a triangle; summed with the sign of their winding (the
-        # points are counter-clockwise), they give the polygon's integrals of 1 and x^2 + y^2.
-        pts = self.points
-        twice_area, moment = [], []
-        for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]):
-            cross = x0 * y1 - x1 * y0
-            twice_area.append(cross)
-            moment.append(cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1))
-        return math.fsum(moment) / (6.0 * math.fsum(twice_area))
+        return _origin_moment(self.points)  # (the points are counter-clockwise)
 
     @property
     def centroid(self) -> tuple[float, float]:
@@ -268,13 +260,7 @@ class Polygon(Shape):
     def central_moment(self) -> float:
         # The origin formula of second_moment, on the outline moved so its centroid is the origin.
         cx, cy = self.centroid
-        pts = [(x - cx, y - cy) for x, y in self.points]
-        twice_area, moment = [], []
-        for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]):
-            cross = x0 * y1 - x1 * y0
-            twice_area.append(cross)
-            moment.append(cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1))
-        return math.fsum(moment) / (6.0 * math.fsum(twice_area))
+        return _origin_moment([(x - cx, y - cy) for x, y in self.points])
 
     def __len__(self) -> int:
         return len(self.points)
@@ -513,6 +499,18 @@ def _normalise_outline(points: Iterable[Sequence[float]]) -> tuple[tuple[float, 
         res.reverse()
     start = min(range(len(res)), key=lambda i: (res[i][1], res[i][0]))
     return tuple(res[start:] + res[:start])
+
+
+def _origin_moment(pts: Sequence[tuple[float, float]]) -> float:
+    """A counter-clockwise outline's second moment about the origin, per unit area: each edge and
+    the origin span a triangle; summed with the sign of their winding, they give the integrals of
+    1 and x^2 + y^2."""
+    twice_area, moment = [], []
+    for (x0, y0), (x1, y1) in zip(pts, [*pts[1:], *pts[:1]]):
+        cross = x0 * y1 - x1 * y0
+        twice_area.append(cross)
+        moment.append(cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1))
+    return math.fsum(moment) / (6.0 * math.fsum(twice_area))
 
 
 def _listed(points: Any, what: str) -> list[Any]:

@@ -53,6 +53,19 @@ def _face_normal(p, m, i):
 
 
 @leaf
+def _clip(s0, s1, lo, hi):
+    """The part ``[lo, hi]`` (fractions along the incident face, v0 to v1) left inside one side
+    plane, ``s0`` and ``s1`` the heights of v0 and v1 inside it: ``(empty, lo, hi)``."""
+    if s0 < 0.0 and s1 < 0.0:
+        return True, lo, hi
+    if s0 < 0.0:
+        lo = max(lo, s0 / (s0 - s1))
+    elif s1 < 0.0:
+        hi = min(hi, s0 / (s0 - s1))
+    return False, lo, hi
+
+
+@leaf
 def _facing(p, m, nx, ny):
     best, along = 0, -np.inf
     for i in range(m):
@@ -103,28 +116,16 @@ def pair_manifolds(ra, rb, nx, ny, margin, kind, hx, hy, hw, hh, slot, world_pol
                 s1 = (ref[i, 0] - v1x) * -ux + (ref[i, 1] - v1y) * -uy
                 t0 = (ref[i1, 0] - v0x) * ux + (ref[i1, 1] - v0y) * uy
                 t1 = (ref[i1, 0] - v1x) * ux + (ref[i1, 1] - v1y) * uy
-                if (s0 < 0.0 and s1 < 0.0) or (t0 < 0.0 and t1 < 0.0):
-                    empty = True
-                    break
-                if s0 < 0.0:
-                    lo = max(lo, s0 / (s0 - s1))
-                elif s1 < 0.0:
-                    hi = min(hi, s0 / (s0 - s1))
-                if t0 < 0.0:
-                    lo = max(lo, t0 / (t0 - t1))
-                elif t1 < 0.0:
-                    hi = min(hi, t0 / (t0 - t1))
-                continue
-            kx, ky = _face_normal(ref, mr, k)
-            s0 = (ref[k, 0] - v0x) * kx + (ref[k, 1] - v0y) * ky  # >= 0: v0 inside face k
-            s1 = (ref[k, 0] - v1x) * kx + (ref[k, 1] - v1y) * ky
-            if s0 < 0.0 and s1 < 0.0:
-                empty = True
+                empty, lo, hi = _clip(s0, s1, lo, hi)
+                if not empty:
+                    empty, lo, hi = _clip(t0, t1, lo, hi)
+            else:
+                kx, ky = _face_normal(ref, mr, k)
+                s0 = (ref[k, 0] - v0x) * kx + (ref[k, 1] - v0y) * ky  # >= 0: v0 inside face k
+                s1 = (ref[k, 0] - v1x) * kx + (ref[k, 1] - v1y) * ky
+                empty, lo, hi = _clip(s0, s1, lo, hi)
+            if empty:
                 break
-            if s0 < 0.0:
-                lo = max(lo, s0 / (s0 - s1))
-            elif s1 < 0.0:
-                hi = min(hi, s0 / (s0 - s1))
         if empty or lo > hi:
             # (a deep overlap, the incident face beside the reference face: B's deepest vertex
             # along the normal, with the overlap of the two shapes' projections on it)
