@@ -8,6 +8,7 @@ cached until the static set changes.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from .arrays import F64Array, I64Array, IntpArray
 from .shapes import Capsule, ChainSegment, Polygon, Segment
@@ -49,6 +50,61 @@ def widen_down(v: F64Array, out: F64Array | None = None) -> F64Array:
 def widen_up(v: F64Array, out: F64Array | None = None) -> F64Array:
     """``v`` raised by one or two ulps (see :func:`widen_down`)."""
     return np.add(v, _ulp_step(v), out=out)
+
+
+@njit(cache=True)
+def _place(rows, x, y, ox, oy, kind, hw, hh, radius, cos, sin, local, slot, world_poly, cap_half, cap_ux, cap_uy, hx,
+           hy, minx, maxx, miny, maxy, has_offset):  # pragma: no cover - compiled
+    """Origins and bounds of ``rows`` from their poses, with ``cos``/``sin`` of their rotations
+    already current: an offset hitbox's origin is its position plus the offset turned; a polygon's
+    or segment's outline is turned into ``world_poly`` (about the hitbox origin, padded vertices
+    included) and bounds it; a capsule's half segment ``(0, h)`` turned, grown by the radius;
+    a box or circle is its origin -+ its half extents. Each bound is then widened by one or two
+    ulps (:func:`widen_down`, :func:`widen_up`): the same arithmetic, so the same bits."""
+    for i in range(rows.size):
+        r = rows[i]
+        px, py = x[r], y[r]
+        if has_offset:
+            if ox[r] != 0.0 or oy[r] != 0.0:
+                co, so = cos[r], sin[r]
+                px = px + (co * ox[r] - so * oy[r])
+                py = py + (so * ox[r] + co * oy[r])
+            hx[r], hy[r] = px, py
+        k = kind[r]
+        if k == KIND_POLYGON or k == KIND_SEGMENT:
+            s = slot[r]
+            cc, ss = cos[r], sin[r]
+            lo_x = hi_x = lo_y = hi_y = 0.0
+            for j in range(local.shape[1]):
+                wx = cc * local[r, j, 0] - ss * local[r, j, 1]
+                wy = ss * local[r, j, 0] + cc * local[r, j, 1]
+                world_poly[s, j, 0], world_poly[s, j, 1] = wx, wy
+                if j == 0 or wx < lo_x:
+                    lo_x = wx
+                if j == 0 or wx > hi_x:
+                    hi_x = wx
+                if j == 0 or wy < lo_y:
+                    lo_y = wy
+                if j == 0 or wy > hi_y:
+                    hi_y = wy
+            lx, hx_, ly, hy_ = px + lo_x, px + hi_x, py + lo_y, py + hi_y
+        elif k == KIND_CAPSULE:
+            h = cap_half[r]
+            ux, uy = -(sin[r] * h), cos[r] * h
+            cap_ux[r], cap_uy[r] = ux, uy
+            ex, ey = abs(ux) + radius[r], abs(uy) + radius[r]
+            lx, hx_, ly, hy_ = px - ex, px + ex, py - ey, py + ey
+        else:
+            lx, hx_, ly, hy_ = px - hw[r], px + hw[r], py - hh[r], py + hh[r]
+        minx[r], maxx[r] = lx - _ulp(lx), hx_ + _ulp(hx_)
+        miny[r], maxy[r] = ly - _ulp(ly), hy_ + _ulp(hy_)
+
+
+@njit(cache=True)
+def _ulp(v):  # pragma: no cover - compiled
+    """:func:`_ulp_step` of one float (NaN stays NaN, as ``np.maximum`` keeps it)."""
+    step = abs(v) * 2.0**-52
+    return _TINY if step < _TINY else step
 
 
 class Geometry:
@@ -152,84 +208,42 @@ class Geometry:
         self.miny[row], self.maxy[row] = _down(lo_y), _up(hi_y)
 
     def _compute(self, store: BodyStore, rows: IntpArray, full: bool, sel: slice | IntpArray | None = None) -> None:
-        """Origins and bounds of ``rows`` (``sel``: the same rows as a slice, if they are one run)."""
-        n = store.n
+        """Origins and bounds of ``rows`` (``sel``: the same rows as a slice, if they are one run):
+        the sines and cosines of the rows whose rotation matters by numpy, the rest in one
+        compiled pass (:func:`_place`; a step's few moving rows took some thirty numpy calls)."""
+        n, c = store.n, store.cols
         if sel is None:
             sel = slice(0, n) if full else rows
-        x, y, rot = store.x, store.y, store.rot
-        ox, oy = store.ox, store.oy
         if full:
             self.cos, self.sin = np.ones(n), np.zeros(n)
-            self.has_offset = bool(ox.any() or oy.any())
+            self.has_offset = bool(store.ox.any() or store.oy.any())
             self.minx, self.maxx, self.miny, self.maxy = (np.zeros(n) for _ in range(4))
             self.poly_slot = np.full(n, -1, dtype=np.int64)
             self.poly_slot[self.poly_rows] = np.arange(self.poly_rows.size)
             self.world_poly = np.zeros((self.poly_rows.size, self.K, 2))
             self.cap_ux, self.cap_uy = np.zeros(n), self.cap_half.copy()
             if self.has_offset:
-                self.hx, self.hy = x.copy(), y.copy()
-        offset = rows[(ox[sel] != 0.0) | (oy[sel] != 0.0)] if self.has_offset else rows[:0]
-        if not self.poly_rows.size:
-            polys = rows[:0]
-        elif self.segments:
-            polys = rows[(store.kind[sel] == KIND_POLYGON) | (store.kind[sel] == KIND_SEGMENT)]
-        else:
-            polys = rows[store.kind[sel] == KIND_POLYGON]
-        caps = rows[store.kind[sel] == KIND_CAPSULE] if self.cap_rows.size else rows[:0]
+                self.hx, self.hy = store.x.copy(), store.y.copy()
+            rows = np.arange(n)
+        hx = getattr(self, "hx", None)
+        if not self.has_offset and (hx is None or hx.base is not c["x"] or hx.size != n):
+            self.hx, self.hy = store.x, store.y  # (the columns themselves: origins are positions)
         # Rotations matter only to polygons, capsules and offset hitboxes (AABBs and circles ignore
         # them).
-        turned = np.union1d(polys, offset) if offset.size else polys
-        if caps.size:
-            turned = np.union1d(turned, caps)
-        if turned.size:
-            self.cos[turned], self.sin[turned] = np.cos(rot[turned]), np.sin(rot[turned])
-        if self.has_offset:
-            self.hx[sel], self.hy[sel] = x[sel], y[sel]
-            if offset.size:
-                co, so = self.cos[offset], self.sin[offset]
-                self.hx[offset] += co * ox[offset] - so * oy[offset]
-                self.hy[offset] += so * ox[offset] + co * oy[offset]
-        else:
-            self.hx, self.hy = x, y
-        hx, hy = self.hx[sel], self.hy[sel]
-        ex, ey = store.hw[sel], store.hh[sel]
-        view = isinstance(sel, slice)  # write through views, no temporaries
-        for lo, hi, h, e in ((self.minx, self.maxx, hx, ex), (self.miny, self.maxy, hy, ey)):
-            if view:
-                np.subtract(h, e, out=lo[sel])
-                np.add(h, e, out=hi[sel])
-            else:
-                lo[sel], hi[sel] = h - e, h + e
-        if polys.size:
-            loc = self.local[polys]
-            cc, ss = self.cos[polys, None], self.sin[polys, None]
-            wx = cc * loc[:, :, 0] - ss * loc[:, :, 1]
-            wy = ss * loc[:, :, 0] + cc * loc[:, :, 1]
-            self.world_poly[self.poly_slot[polys]] = np.stack([wx, wy], axis=-1)  # about the hitbox origin
-            self.minx[polys] = self.hx[polys] + wx.min(axis=1)
-            self.maxx[polys] = self.hx[polys] + wx.max(axis=1)
-            self.miny[polys] = self.hy[polys] + wy.min(axis=1)
-            self.maxy[polys] = self.hy[polys] + wy.max(axis=1)
-        if caps.size:
-            # The half segment (0, h) turned; the bounds: its ends, pushed out by the radius.
-            h, r = self.cap_half[caps], store.radius[caps]
-            ux, uy = -(self.sin[caps] * h), self.cos[caps] * h
-            self.cap_ux[caps], self.cap_uy[caps] = ux, uy
-            ex, ey = np.abs(ux) + r, np.abs(uy) + r
-            self.minx[caps], self.maxx[caps] = self.hx[caps] - ex, self.hx[caps] + ex
-            self.miny[caps], self.maxy[caps] = self.hy[caps] - ey, self.hy[caps] + ey
-        # Widen by an ulp or two: a bound is a rounded sum, so two shapes overlapping by less than
-        # the rounding (boxes stacked at non-dyadic heights) could have strictly disjoint bounds
-        # and never reach the (exact) narrow phase. The broad phase may now also pair shapes that
-        # merely touch; the narrow phase drops those.
-        with np.errstate(over="ignore", invalid="ignore"):  # inf stays inf, NaN stays NaN
-            for lo, hi in ((self.minx, self.maxx), (self.miny, self.maxy)):
-                if view:
-                    widen_down(lo[sel], out=lo[sel])
-                    widen_up(hi[sel], out=hi[sel])
-                else:
-                    lo[sel] = widen_down(lo[sel])
-                    hi[sel] = widen_up(hi[sel])
+        if self.poly_rows.size or self.cap_rows.size or self.has_offset:
+            kind = c["kind"][sel]
+            turned = (kind == KIND_POLYGON) | (kind == KIND_SEGMENT) | (kind == KIND_CAPSULE)
+            if self.has_offset:
+                turned |= (c["ox"][sel] != 0.0) | (c["oy"][sel] != 0.0)
+            turned_rows = rows[turned]
+            if turned_rows.size:
+                rot = c["rot"][turned_rows]
+                self.cos[turned_rows], self.sin[turned_rows] = np.cos(rot), np.sin(rot)
+        # (the columns whole: the pass reads only ``rows``, all below n)
+        _place(np.ascontiguousarray(rows, dtype=np.int64), c["x"], c["y"], c["ox"], c["oy"], c["kind"], c["hw"],
+               c["hh"], c["radius"], self.cos, self.sin, self.local, self.poly_slot, self.world_poly, self.cap_half,
+               self.cap_ux, self.cap_uy, self.hx, self.hy, self.minx, self.maxx, self.miny, self.maxy,
+               self.has_offset)
 
     def outlines(self, store: BodyStore, rows: IntpArray) -> tuple[F64Array, I64Array]:
         """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows (a

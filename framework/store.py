@@ -129,7 +129,7 @@ class BodyStore:
         self.version = 0  # bumped on every structural change (rows, kinds, body types)
         self._friction_seen = (-1, False)  # (version, whether a hitbox gives friction then)
         self.wakes = 0  # bumped whenever a sleeping row wakes
-        self.writes = 0  # bumped by every write from game code (component views)
+        self.writes = 0  # bumped by every write from game code to a pose (Transform views; velocities move no bound)
         self.motion = 0  # bumped by every move the pipeline makes (move_by_velocity, place)
         self.looks = 0  # the last stamp given to a row's ``look`` column
         self._lookup = np.full(1, -1, dtype=np.int64)  # entity id -> row (rows_of)
@@ -482,7 +482,8 @@ class BodyStore:
         row = self.row_of[entity]
         if self._undo is not None:
             self._before_change(row)
-        self.writes += 1
+        if col in ("x", "y", "rot"):
+            self.writes += 1
         self.written.add(entity)
         if self.cols["asleep"][row] or self.cols["still"][row]:
             self.wake(row)
