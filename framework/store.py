@@ -17,6 +17,7 @@ from numbers import Real
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON, KIND_SEGMENT
@@ -55,6 +56,18 @@ _FIELD_NAMES = {
     "x": "Transform.x", "y": "Transform.y", "rot": "Transform.rotation",
     "vx": "Velocity.x", "vy": "Velocity.y", "w": "Velocity.angular",
 }
+
+
+@njit(cache=True)
+def _move_rows(rows, x, y, rot, vx, vy, w, dt):  # pragma: no cover - compiled
+    """:meth:`BodyStore.move_by_velocity`'s arithmetic, row by row (a rotation only where ``w``
+    is not 0: adding 0 would turn a rotation of -0.0 into 0.0)."""
+    for i in range(rows.size):
+        r = rows[i]
+        x[r] += vx[r] * dt
+        y[r] += vy[r] * dt
+        if w[r] != 0.0:
+            rot[r] += w[r] * dt
 
 
 def as_selector(rows: NDArray[np.intp]) -> slice | NDArray[np.intp]:
@@ -250,12 +263,7 @@ class BodyStore:
         """``x += vx dt``, ``y += vy dt`` and ``rot += w dt`` over ``rows`` (``sel``: the same rows,
         as a slice where they are one run, so the column reads are views, not gathers)."""
         c = self.cols
-        c["x"][sel] += c["vx"][sel] * dt
-        c["y"][sel] += c["vy"][sel] * dt
-        w = c["w"][sel]
-        spinning = w != 0.0
-        if spinning.any():
-            c["rot"][rows[spinning]] += w[spinning] * dt
+        _move_rows(rows, c["x"], c["y"], c["rot"], c["vx"], c["vy"], c["w"], dt)
         self.motion += 1
 
     def place(

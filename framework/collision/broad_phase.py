@@ -228,8 +228,11 @@ class SpatialHash:
     def enter_few(self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike) -> None:
         """Take up to :data:`SMALL` moving bodies as a :meth:`pairs` call does (for the queries
         and the overlay's cells), without pairing them: the caller paired them itself
-        (:func:`direct_pairs`)."""
-        self._enter(as_bounds(minx, miny, maxx, maxy), ids, None)
+        (:func:`direct_pairs`), from the geometry's bounds (float64 columns, never inverted: not
+        checked again here, a step's broad phase calls this every step)."""
+        f64 = np.float64
+        self._enter((np.asarray(minx, f64), np.asarray(miny, f64), np.asarray(maxx, f64), np.asarray(maxy, f64)),
+                    ids, None)
 
     def _enter(self, b: Bounds, ids: ArrayLike, strips: StripSweep | None) -> None:
         """Take the moving bodies of a step: swept into ``strips``, or (None) kept as they are,
