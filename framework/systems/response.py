@@ -19,15 +19,18 @@ import numpy as np
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray
 from ..collision import batch
 from ..collision.kinds import KIND_AABB, KIND_CIRCLE
-from ..events import pair_keys, sorted_find, sorted_member
+from ..events import pair_keys, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..geometry import Geometry
 from ..store import STATIC
+from .gather import gather
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Pairs, Solve
 from .stage import Stage
 from .turning import manifold_points
+
+_NO_IDS = np.zeros(0, dtype=np.int64)
 
 __all__ = ["Response"]
 
@@ -82,118 +85,32 @@ class Response(Stage):
     # --- which contacts ----------------------------------------------------------------------
 
     def _gather(self, frame: StepFrame) -> Contacts:
-        """This step's contacts (with last step's push and impulse where the pair was acted on),
-        plus last step's pairs that no longer overlap but are still close (both bodies still
-        there, with hitboxes whose layers meet)."""
-        store, bodies = self.bodies.store, self.bodies
+        """This step's contacts (with last step's push and impulse where the pair was acted on;
+        two boxes along the axis they came together on), plus last step's pairs that no longer
+        overlap but are still close (both bodies still there, with hitboxes whose layers meet,
+        still facing each other): one compiled pass, :func:`~framework.systems.gather.gather`
+        (its docstring says why each rule)."""
+        store = self.bodies.store
         c = frame.contacts
-        sa, sb, snx, sny, spush, simp, ssep, stpush, stimp = frame.support
-        now_keys, kept_keys = pair_keys(c.a, c.b), pair_keys(sa, sb)
-        push0, impulse0 = np.zeros(c.a.size), np.zeros(c.a.size)
-        tpush0, timpulse0 = np.zeros(c.a.size), np.zeros(c.a.size)
-        if kept_keys.size:  # the warm start of the pairs found again
-            at, found = sorted_find(now_keys, kept_keys)
-            push0[found], impulse0[found] = spush[at[found]], simp[at[found]]
-            if stpush.any() or stimp.any():  # (friction acted last step)
-                tpush0[found], timpulse0[found] = stpush[at[found]], stimp[at[found]]
-        old = np.flatnonzero(~sorted_member(kept_keys, now_keys))
-        sra, srb = bodies.rows_of(sa[old]), bodies.rows_of(sb[old])
-        live = (sra >= 0) & (srb >= 0)
-        ok = np.flatnonzero(live)
-        live[ok] = (store.kind[sra[ok]] >= 0) & (store.kind[srb[ok]] >= 0) & filter_layers(store, sra[ok], srb[ok])
-        old, sra, srb = old[live], sra[live], srb[live]
-        snx, sny = snx.copy(), sny.copy()
-        gaps = self._support_gaps(frame, sra, srb, snx[old], sny[old]) - ssep[old]
-        self._rolling_gaps(sra, srb, old, snx, sny, gaps)
-        margin = KEEP_GAP * np.minimum(store.bound[sra], store.bound[srb])
-        near = (gaps >= -margin) & self._facing(sra, srb, snx[old], sny[old], margin)
-        old, sra, srb, gaps = old[near], sra[near], srb[near], gaps[near]
-        cat = np.concatenate
-        nx, ny, depth = self._entry_axes(frame, frame.contact_rows[0], frame.contact_rows[1], c.nx, c.ny, c.depth)
-        return Contacts(
-            cat([frame.contact_rows[0], sra]), cat([frame.contact_rows[1], srb]), cat([c.a, sa[old]]),
-            cat([c.b, sb[old]]), cat([nx, snx[old]]), cat([ny, sny[old]]), cat([depth, gaps]),
-            np.arange(c.a.size + old.size) < c.a.size, cat([push0, spush[old]]), cat([impulse0, simp[old]]),
-            cat([tpush0, stpush[old]]), cat([timpulse0, stimp[old]]), cat([c.px, np.zeros(old.size)]),
-            cat([c.py, np.zeros(old.size)]))
-
-    def _rolling_gaps(self, ra: IntpArray, rb: IntpArray, old: IntpArray, nx: F64Array, ny: F64Array,
-                      gaps: F64Array) -> None:
-        """Kept pairs of two circles of which friction rolls one: their normal (in ``nx, ny`` at
-        ``old``) and gap (in ``gaps``, as a depth) where they stand now.
-
-        Elsewhere a kept pair keeps last step's normal, and its gap is the step's motion along it.
-        Between two circles that is a plane tangent to the lower one: a circle rolling over the
-        top of another rode that plane at the height of the top, kept while their bounds still
-        faced each other (a diameter of travel), and rolling on a level plane costs nothing: in a
-        pile of 80 rolling circles (issue 33 item 5a) balls rolled on such planes at up to 0.5
-        units/s, 0.12 clear of the circle under them. (Not yet for circles that do not turn: the
-        frictionless half-boxes crowd of test_solver, seed 0, then rests at 34 s instead of
-        within 30.)"""
-        store = self.bodies.store
-        if not ("friction" in self.pipeline.effects and "rotation" in self.pipeline.effects):
-            return
-        circles = (store.kind[ra] == KIND_CIRCLE) & (store.kind[rb] == KIND_CIRCLE)
-        turns = (store.inv_inertia[ra] > 0.0) | (store.inv_inertia[rb] > 0.0)
-        i = np.flatnonzero(circles & turns)
-        if i.size == 0:
-            return
-        i = i[store.pair_friction(ra[i], rb[i]) > 0.0]
+        ra, rb = frame.contact_rows
+        n = store.n
+        if ra.size and (int(ra.max()) >= n or int(rb.max()) >= n):
+            raise IndexError(f"a contact's row is beyond the store's {n} rows (a body removed during the step)")
         geom = self.bodies.ensure_geometry()
-        a, b = ra[i], rb[i]
-        dx, dy = geom.hx[b] - geom.hx[a], geom.hy[b] - geom.hy[a]
-        dist = np.hypot(dx, dy)
-        ok = dist > 0.0
-        i, a, b, dx, dy, dist = i[ok], a[ok], b[ok], dx[ok], dy[ok], dist[ok]
-        nx[old[i]], ny[old[i]] = dx / dist, dy / dist
-        gaps[i] = np.minimum(store.radius[a] + store.radius[b] - dist, 0.0)
-
-    def _entry_axes(self, frame: StepFrame, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array,
-                    depth: F64Array) -> tuple[F64Array, F64Array, F64Array]:
-        """The solve's normals and depths of this step's contacts between two AABBs: along the
-        axis the pair came together on this step, where that is not the axis of least overlap.
-
-        The least overlap (the contract's push-out) forgets how the boxes met. A box falling into a
-        gap a hair narrower than itself overlaps its neighbours' top corners by the step's fall
-        vertically and by the hair sideways: pushed out sideways, it wedged the row apart against
-        the walls and sank into the gap, and a crowd came to rest with rows overlapping by 0.02
-        (issue 33). So where, at the step's start, the two boxes overlapped along one axis and
-        were apart or touching along the other (within a millionth of their size), the contact
-        is along that other axis; apart along both (a corner approach), along the axis on which
-        they met last; overlapping along both, the least overlap as before. The events keep the
-        contract's normal; only the solve's changes."""
-        store = self.bodies.store
-        boxes = np.flatnonzero((store.kind[ra] == KIND_AABB) & (store.kind[rb] == KIND_AABB))
-        a, b = ra[boxes], rb[boxes]
-        ma, mb = self._moved(frame, a), self._moved(frame, b)
-        if boxes.size == 0 or ma is None or mb is None:
-            return nx, ny, depth
-        geom = self.bodies.ensure_geometry()
-        wx, wy = store.hw[a] + store.hw[b], store.hh[a] + store.hh[b]
-        # centre offsets (b - a) now and at the step's start (the hitboxes moved with their bodies)
-        cx, cy = geom.hx[b] - geom.hx[a], geom.hy[b] - geom.hy[a]
-        cx0, cy0 = cx - (mb[0] - ma[0]), cy - (mb[1] - ma[1])
-        ox, oy = wx - np.abs(cx), wy - np.abs(cy)  # overlaps now (> 0 along both: they overlap)
-        ox0, oy0 = wx - np.abs(cx0), wy - np.abs(cy0)  # ... and at the start (<= 0: apart)
-        hair = 1e-6 * np.minimum(wx, wy)
-        apart_x, apart_y = ox0 <= hair, oy0 <= hair
-        # apart along both: the axis whose gap closed later in the step (vertical on a tie)
-        late_x = (-ox0) * np.maximum(oy - oy0, 0.0) > (-oy0) * np.maximum(ox - ox0, 0.0)
-        along_x = np.where(apart_x & apart_y, late_x, apart_x & ~apart_y)
-        along_y = np.where(apart_x & apart_y, ~late_x, apart_y & ~apart_x)
-        was_x = np.abs(nx[boxes]) > np.abs(ny[boxes])
-        to_x, to_y = along_x & ~was_x & (ox > 0.0), along_y & was_x & (oy > 0.0)
-        if not (to_x.any() or to_y.any()):
-            return nx, ny, depth
-        nx, ny, depth = nx.copy(), ny.copy(), depth.copy()
-        # (b's side of a: where it was at the start, else where it is)
-        side_x = np.where(np.where(cx0 != 0.0, cx0, cx) < 0.0, -1.0, 1.0)
-        side_y = np.where(np.where(cy0 != 0.0, cy0, cy) < 0.0, -1.0, 1.0)
-        i = boxes[to_x]
-        nx[i], ny[i], depth[i] = side_x[to_x], 0.0, ox[to_x]
-        i = boxes[to_y]
-        nx[i], ny[i], depth[i] = 0.0, side_y[to_y], oy[to_y]
-        return nx, ny, depth
+        store.rows_of(_NO_IDS)  # (the entity -> row table, current)
+        col = store.cols
+        i64, f64 = np.int64, np.float64
+        sa, sb, snx, sny, spush, simp, ssep, stpush, stimp = (
+            np.asarray(v, dtype=i64 if k < 2 else f64) for k, v in enumerate(frame.support))
+        effects = self.pipeline.effects
+        out = gather(
+            np.asarray(c.a, dtype=i64), np.asarray(c.b, dtype=i64), c.nx, c.ny, c.depth, c.px, c.py,
+            np.asarray(ra, dtype=i64), np.asarray(rb, dtype=i64), sa, sb, snx, sny, spush, simp, ssep, stpush, stimp,
+            store._lookup, col["kind"], col["layer"], col["mask"], store.layers_all_meet(), col["bound"],
+            col["radius"], col["inv_inertia"], col["friction"], col["hw"], col["hh"], col["x"], col["y"],
+            frame.start_x, frame.start_y, geom.hx, geom.hy, geom.minx, geom.miny, geom.maxx, geom.maxy,
+            "friction" in effects and "rotation" in effects, KEEP_GAP, KIND_AABB, KIND_CIRCLE)
+        return Contacts(*out)
 
     def _solid(self, frame: StepFrame, cs: Contacts) -> BoolArray:
         """Mask of the contacts the response acts on."""
@@ -208,15 +125,6 @@ class Response(Stage):
             solid &= ~one_way | self._lands_on_one_way(frame, cs)
         return solid
 
-    def _facing(self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, margin: F64Array) -> BoolArray:
-        """Mask of the kept pairs whose bodies still face each other across their contact: their
-        bounds meet when grown by ``margin`` along the normal only (a box whose support slid away
-        sideways is no longer held by it, however small the gap along the normal)."""
-        geom = self.bodies.ensure_geometry()
-        gx, gy = margin * np.abs(nx), margin * np.abs(ny)
-        return ((geom.minx[ra] - gx < geom.maxx[rb]) & (geom.minx[rb] - gx < geom.maxx[ra])
-                & (geom.miny[ra] - gy < geom.maxy[rb]) & (geom.miny[rb] - gy < geom.maxy[ra]))
-
     def _moved(self, frame: StepFrame, rows: IntpArray) -> tuple[F64Array, F64Array] | None:
         """How far each of ``rows`` has moved since the step began, or None if one was spawned
         during the step (it has no start)."""
@@ -224,17 +132,6 @@ class Response(Stage):
         if rows.size and sx.size <= int(rows.max()):
             return None
         return store.x[rows] - sx[rows], store.y[rows] - sy[rows]
-
-    def _support_gaps(self, frame: StepFrame, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array) -> F64Array:
-        """How far the step's movement took last step's pairs apart along their normal, as a depth
-        (<= 0; the caller subtracts the gap they ended last step with): a pair that fell together
-        stays where it was (and is pushed apart again if a push below makes them overlap), one
-        flying apart starts this much farther from touching."""
-        ma, mb = self._moved(frame, ra), self._moved(frame, rb)
-        if ra.size == 0 or ma is None or mb is None:
-            return np.zeros(ra.size)
-        gap = (mb[0] - ma[0]) * nx + (mb[1] - ma[1]) * ny
-        return np.minimum(-gap, 0.0)
 
     def _lands_on_one_way(self, frame: StepFrame, cs: Contacts) -> BoolArray:
         """Mask of contacts a one-way platform takes: the other body comes from above (the
