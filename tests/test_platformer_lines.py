@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from examples.platformer import Game
-from examples.platformer.components import LevelPiece
+from examples.platformer.components import Enemy, LevelPiece
 from examples.platformer.levels import LevelError, TerrainLine, load_level, parse_tmj, to_tmj
 from examples.platformer.terrain import fill_pieces, grass_strips, triangulate
 from framework import Hitbox, Transform, Velocity
@@ -220,6 +220,23 @@ def test_the_player_jumps_onto_the_slope_and_onto_the_rock() -> None:
     roof = 160.0 + 16.0 * (1.0 - abs(x - 896.0) / 64.0)  # the roof at the player's centre...
     assert g.player_state.grounded and 832 < x < 960
     assert feet(g.scene, g.player) >= roof - 1e-9 and feet(g.scene, g.player) < 176.0 + 1e-9  # ... on it
+
+
+def test_a_walker_walks_over_the_hill_onto_the_tiles_and_turns_at_the_ledge() -> None:
+    d = _tmj()
+    _objects(d).append({"id": 30, "type": "enemy", "x": 720.0, "y": 300.0, "width": 0, "height": 0, "point": True,
+                        "properties": [{"name": "direction", "type": "int", "value": -1}]})
+    g = Game([parse_tmj(d, "walker.tmj")])
+    xs = []
+    for k in range(780):
+        g.step(set())
+        ((e, (en, t)),) = g.scene.query(Enemy, Transform)
+        xs.append(t.x)
+        if k >= 30:  # (it starts in the air)
+            assert_on_floor(g.scene, e)
+            if t.x > 256:
+                assert 0.0 <= feet(g.scene, e) - _under(t.x) <= 1e-9  # (as wide as the player)
+    assert min(xs) < 32 and en.direction == 1 and xs[-1] > min(xs) + 2 * T  # up, over, down, back
 
 
 @pytest.mark.parametrize("solver", ["exact", "soft"])
