@@ -34,6 +34,7 @@ GROUND = (70, 80, 108)
 GROUND_DARK = (56, 64, 88)
 GRASS = (104, 190, 92)
 GRASS_DARK = (70, 150, 70)
+GRASS_LIGHT = (150, 220, 130)  # the light line along the grass's top
 PLANK = (184, 138, 84)
 PLANK_DARK = (128, 90, 52)
 SPIKE = (226, 70, 70)
@@ -65,7 +66,7 @@ def ground(top: bool) -> NDArray[np.uint8]:
         for col in range(TILE):
             img[: depth[col], col, :3] = GRASS
             img[depth[col] - 1, col, :3] = GRASS_DARK
-        img[0, :, :3] = (150, 220, 130)
+        img[0, :, :3] = GRASS_LIGHT
     return img
 
 
@@ -86,7 +87,7 @@ def slope(kind: str) -> NDArray[np.uint8]:
     grass = (below > 0.0) & (below <= depth)
     img[grass, :3] = GRASS
     img[grass & (below > depth - 1.0 * stretch), :3] = GRASS_DARK
-    img[(below > 0.0) & (below <= 1.0 * stretch), :3] = (150, 220, 130)
+    img[(below > 0.0) & (below <= 1.0 * stretch), :3] = GRASS_LIGHT
     return img
 
 

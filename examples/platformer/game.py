@@ -26,6 +26,7 @@ from framework.components import Visual
 from framework.input import Input
 from framework.tiles import SLOPES, STEP, terrain_pieces
 
+from . import art as art_colors
 from . import systems
 from .animations import SHEETS, animations
 from .bridge import hang, plank_length
@@ -52,7 +53,8 @@ from .components import (
     Tuning,
 )
 from .demo import Autoplay
-from .levels import Level, bridge_planks, builtin_levels, load_level
+from .levels import Level, TerrainLine, bridge_planks, builtin_levels, load_level
+from .terrain import DARK_DEPTH, GRASS_DEPTH, LIGHT_DEPTH, fill_pieces, grass_strips
 
 __all__ = ["DT", "Game", "COLORS"]
 
@@ -176,6 +178,8 @@ class Game:
                 image = "ground_top" if kind == "solid" else kind
                 # (a slope piece's cells all hold a tile)
                 piece("slope", Transform(*level.cell_center(col, row)), Visual(image=str(IMAGES[image]), z=0))  # type: ignore[index]
+        for line in level.terrain:  # drawn as lines: a chain, and pieces that draw the ground
+            self._terrain(line, t, piece, art)
         for row, cells in enumerate(level.tiles):
             for col, kind in enumerate(cells):
                 x, y = level.cell_center(col, row)
@@ -235,6 +239,29 @@ class Game:
                                               push_mass=tu.push_mass),
                           Player(), moving("idle", "player", 4))
         systems.follow_camera(scene, 0.0)
+
+    @staticmethod
+    def _terrain(line: TerrainLine, t: float, piece, art: bool) -> None:
+        """Terrain drawn as a line (:class:`.levels.TerrainLine`): its chain, one static segment a
+        body (solid from outside, no catching at joints), and the pieces that draw it
+        (:mod:`.terrain`): the ground's fill, and with the art, grass along its top."""
+        for seg in line.chain().segments:
+            piece("chain", Transform(0.0, 0.0), Hitbox(seg, body="static", layer=SOLID))
+        looks = [(fill_pieces(line), art_colors.GROUND if art else COLORS["solid"], 0)]
+        if art:
+            light, grass, dark = LIGHT_DEPTH * t, GRASS_DEPTH * t, (GRASS_DEPTH - DARK_DEPTH) * t
+            looks += [(grass_strips(line, 0.0, light), art_colors.GRASS_LIGHT, 1),
+                      (grass_strips(line, light, dark), art_colors.GRASS, 1),
+                      (grass_strips(line, dark, grass), art_colors.GRASS_DARK, 1)]
+        for outlines, color, z in looks:
+            for pts in outlines:
+                x0, y0 = pts[0]  # (the piece's place: its first corner)
+                try:
+                    shape = Polygon([(x - x0, y - y0) for x, y in pts])
+                except ValueError:
+                    continue  # too thin to draw (a sliver under a near-vertical edge)
+                piece("terrain", Transform(x0, y0), Hitbox(shape, body="static", sensor=True, layer=0, mask=0),
+                      Visual(color, z=z))
 
     @staticmethod
     def _spikes(x: float, bottom: float, width: float, piece) -> None:

@@ -49,6 +49,14 @@ its bottom the deck's top in the middle at rest: the height is the sag): ``plank
 0.25), ``mass`` (each plank's, > 0; default the game's ``Tuning.plank_mass``);
 ``enemy``: ``speed`` (tiles/s), ``direction`` (-1 left, 1 right).
 
+**Terrain drawn as lines** (:class:`TerrainLine`): a Tiled **polyline** object (its type empty or
+``terrain``) is the surface of the ground: everything below it, down to the map's bottom, is solid
+and drawn as ground, whichever way it was drawn. It must run one way across the map (its x never
+turning back: steep and vertical drops are fine), so draw an overhang, a ceiling or a floating block
+as a **polygon** object, which is a solid block of any outline (not crossing itself). Both become
+chains (:func:`framework.tiles.tiled_chains`, :class:`framework.shapes.Chain`): one-sided segments
+met from outside the solid, without catching at joints. Tiled's object ``rotation`` is honoured.
+
 The map's ``solver`` property (``exact`` or ``soft``) is the contact solver the game runs the level
 with (``Level.solver``); without it, ``soft`` if the level has a bridge (its hinges are joints,
 which only the soft solver solves), else none asked for (the game's own). A bridge in a level that
@@ -70,9 +78,10 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from framework import tiles as terrain
+from framework.shapes import Chain
 
 __all__ = [
-    "DEFAULT_LIMITS", "LEVEL_DIR", "Level", "LevelError", "LevelLimits", "LevelObject", "builtin_levels",
+    "DEFAULT_LIMITS", "LEVEL_DIR", "Level", "LevelError", "LevelLimits", "LevelObject", "TerrainLine", "builtin_levels",
     "load_level", "parse_text", "parse_tmj", "to_tmj", "dump_tmj",
 ]
 
@@ -112,6 +121,8 @@ class LevelLimits:
     max_tiles: int = 4_000_000          # width x height (2,000 x 2,000)
     max_objects: int = 100_000
     max_layers: int = 1_000
+    max_points: int = 100_000           # the points of every terrain line (polyline, polygon) together
+    max_polygon_points: int = 1_000     # one polygon's (drawing it takes time quadratic in them)
 
 
 DEFAULT_LIMITS = LevelLimits()
@@ -134,6 +145,39 @@ class LevelObject:
         return self.y - self.height * 0.5
 
 
+@dataclass(frozen=True)
+class TerrainLine:
+    """Terrain drawn as a line (a Tiled polyline or polygon object), in world coordinates (y up).
+
+    - ``loop`` false (a polyline): ``points`` is the ground's surface, left to right (x never
+      decreasing); the ground is everything below it down to the map's bottom (y = 0).
+    - ``loop`` true (a polygon): ``points`` is the outline of a solid block (the loader gives it
+      counter-clockwise; either winding is the same block).
+
+    :meth:`outline` is the solid's outline either way, :meth:`chain` its collision chain."""
+
+    points: tuple[tuple[float, float], ...]
+    loop: bool = False
+    #: where it came from, for messages (e.g. ``"polyline object 7"``)
+    label: str = field(default="", compare=False)
+
+    def outline(self) -> list[tuple[float, float]]:
+        """The solid's outline, counter-clockwise (y up): a polygon's points; a polyline's surface
+        closed down to the map's bottom (its ends' feet, unless an end is on the bottom already)."""
+        if self.loop:
+            pts = list(self.points)
+            area2 = sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]))
+            return pts if area2 >= 0.0 else pts[::-1]
+        pts = list(self.points)
+        (x0, y0), (x1, y1) = pts[0], pts[-1]
+        feet = [(x1, 0.0)] * (y1 != 0.0) + [(x0, 0.0)] * (y0 != 0.0)
+        return [*reversed(pts), *reversed(feet)]  # right to left along the top, then the feet left to right
+
+    def chain(self) -> Chain:
+        """The collision chain: a loop round :meth:`outline`, met from outside."""
+        return Chain(self.outline(), loop=True)
+
+
 @dataclass
 class Level:
     """A loaded level: ``tiles[row][col]`` is a kind from ``TILE_KINDS`` or ``None``, row 0 at the
@@ -148,6 +192,8 @@ class Level:
     objects: list[LevelObject]
     #: the contact solver the level is played with (``"exact"`` or ``"soft"``); ``None``: the game's
     solver: str | None = None
+    #: terrain drawn as lines (Tiled polylines and polygons), beside the tiles
+    terrain: list[TerrainLine] = field(default_factory=list)
 
     @property
     def size(self) -> tuple[float, float]:
@@ -205,6 +251,13 @@ class Level:
                 if o.props.get("direction", -1) not in (-1, 1):
                     fail(f"enemy at ({o.x:g}, {o.y:g}): direction must be -1 or 1, "
                          f"got {_show(o.props.get('direction'))}")
+        for i, line in enumerate(self.terrain):
+            _check_terrain(line, i, w, h, self.tile, fail)
+        start = players[0]
+        for line in self.terrain:
+            if _inside(line.outline(), start.x, start.bottom + 0.5 * self.tile):
+                fail(f"the player start at ({start.x:g}, {start.bottom:g}) is inside the ground of "
+                     f"{line.label or 'a terrain line'}: put it above the surface")
         if self.solver is not None and (not isinstance(self.solver, str) or self.solver not in SOLVERS):
             fail(f"solver must be one of {', '.join(SOLVERS)}, got {_show(self.solver)}")
         if self.of_kind("bridge"):
@@ -213,6 +266,43 @@ class Level:
                      "solver must be soft (or not given), got 'exact'")
             self.solver = "soft"
         return self
+
+
+def _check_terrain(line: TerrainLine, i: int, w: float, h: float, tile: float, fail: Fail) -> None:
+    """A terrain line: inside the map, a chain (no two equal points in a row...), and a polyline
+    running left to right, never turning back."""
+    if not isinstance(line, TerrainLine):
+        fail(f"terrain {i + 1} must be a TerrainLine, got {_show(line)}")
+    what = line.label or f"terrain {'polygon' if line.loop else 'polyline'} {i + 1}"
+    eps = 1e-9 * tile
+    for x, y in line.points:
+        if not (-eps <= x <= w + eps and -eps <= y <= h + eps):
+            fail(f"{what}: point ({x:g}, {y:g}) lies outside the map (0..{w:g}, 0..{h:g})")
+    if not line.loop:
+        xs = [p[0] for p in line.points]
+        back = next((j for j in range(1, len(xs)) if xs[j] < xs[j - 1] - eps), None)
+        if back is not None or not xs[-1] > xs[0]:
+            where = f"turns back at point {back}" if back is not None else "does not run across the map"
+            fail(f"{what} {where}: a polyline is the surface of the ground below it and must run one way "
+                 "across the map (steep and vertical drops are fine); draw an overhang, a ceiling or a "
+                 "floating block as a polygon")
+    try:
+        line.chain()
+        if line.loop:
+            from .terrain import triangulate
+
+            triangulate(line.outline())  # (what draws it: a polygon must not cross itself)
+    except ValueError as exc:
+        fail(f"{what}: {exc}")
+
+
+def _inside(outline: list[tuple[float, float]], x: float, y: float) -> bool:
+    """Whether ``(x, y)`` is inside the polygon ``outline`` (even-odd rule)."""
+    inside = False
+    for (x0, y0), (x1, y1) in zip(outline, outline[1:] + outline[:1]):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
 
 
 def _check_swing(o: LevelObject, fail: Fail) -> None:
@@ -501,6 +591,8 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
     gid_kinds = _tileset_kinds(data.get("tilesets", []), fail)
     tiles: list[list[str | None]] = [[None] * width for _ in range(height)]
     objects: list[LevelObject] = []
+    lines: list[TerrainLine] = []
+    points = 0
     map_h = float(height * th)
     for layer in layers:
         lname = _text(layer.get("name", ""))
@@ -537,14 +629,26 @@ def parse_tmj(data: Any, source: str = "<tmj>", *, name: str | None = None,
             if len(objects) + len(objs) > limits.max_objects:
                 fail(f"{where}: more than {limits.max_objects} objects (LevelLimits.max_objects)")
             for obj in objs:
-                objects.append(_tmj_object(obj, map_h, fail, where))
+                if isinstance(obj, dict) and ("polyline" in obj or "polygon" in obj):
+                    drawn = obj.get("polygon", obj.get("polyline"))
+                    points += len(drawn) if isinstance(drawn, list) else 0
+                    if points > limits.max_points:
+                        fail(f"{where}: more than {limits.max_points} points of polylines and polygons "
+                             "(LevelLimits.max_points)")
+                    if "polygon" in obj and isinstance(drawn, list) and len(drawn) > limits.max_polygon_points:
+                        fail(f"{where}: polygon object {_text(obj.get('id', '?'))} has {len(drawn)} points, more than "
+                             f"{limits.max_polygon_points} (LevelLimits.max_polygon_points)")
+                    lines.append(_tmj_line(obj, map_h, fail, where))
+                else:
+                    objects.append(_tmj_object(obj, map_h, fail, where))
         elif ltype in ("imagelayer",):
             continue
         else:
             fail(f"{where}: unknown layer type {_show(ltype)}")
     map_props = _props(data, fail, "map")
     title = map_props.get("title") or name or Path(source).stem
-    return Level(_text(title), source, float(tw), width, height, tiles, objects, map_props.get("solver")).validate()
+    return Level(_text(title), source, float(tw), width, height, tiles, objects, map_props.get("solver"),
+                 lines).validate()
 
 
 def _flat_layers(layers: list, fail: Fail, limits: LevelLimits) -> list[dict]:
@@ -683,6 +787,26 @@ def _tmj_object(obj: Any, map_h: float, fail: Fail, where: str) -> LevelObject:
     return LevelObject(kind, cx, cy, w, h, _props(obj, fail, label))
 
 
+def _tmj_line(obj: dict, map_h: float, fail: Fail, where: str) -> TerrainLine:
+    """A polyline or polygon object as a :class:`TerrainLine` (a polyline put left to right)."""
+    loop = "polygon" in obj
+    label = f"{'polygon' if loop else 'polyline'} object {_text(obj.get('id', '?'))}"
+    kind = _text(obj.get("type") or obj.get("class") or "").lower()
+    if kind not in ("", "terrain"):
+        fail(f"{where}: {label}: polylines and polygons are terrain; its type must be empty or 'terrain', "
+             f"got {_show(kind)}")
+    if not isinstance(obj.get("polygon" if loop else "polyline"), list):
+        fail(f"{where}: {label}: its points must be a list, got {_show(obj.get('polygon' if loop else 'polyline'))}")
+    try:
+        (chain,) = terrain.tiled_chains([obj], map_h)
+    except ValueError as exc:
+        fail(f"{where}: {exc}")
+    pts = chain.points
+    if not loop and pts[-1][0] < pts[0][0]:
+        pts = pts[::-1]  # left to right, whichever way it was drawn
+    return TerrainLine(tuple(pts), loop, label)
+
+
 # --- loading and writing ---------------------------------------------------------------------------
 
 
@@ -763,6 +887,10 @@ def to_tmj(level: Level, title: str | None = None) -> dict[str, Any]:
                 for k, v in sorted(o.props.items())
             ]
         objs.append(entry)
+    for line in level.terrain:  # at the object layer's origin, the points in Tiled's frame (y down)
+        points = [{"x": x, "y": map_h - y} for x, y in line.points]
+        objs.append({"id": len(objs) + 1, "name": "", "type": "terrain", "rotation": 0, "visible": True, "x": 0,
+                     "y": 0, "polygon" if line.loop else "polyline": points})
     sloped = any(k in terrain.SLOPES or k == terrain.STEP for row in level.tiles for k in row)
     tileset = _tileset(t, len(TILE_KINDS) if sloped else _BASIC_KINDS)
     return {

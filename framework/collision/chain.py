@@ -21,9 +21,13 @@ contact (Box2D v3's ``b2CollideChainSegmentAndPolygon``, and its Gauss-map class
     pushed out along the segment's normal by its depth below the segment's line, never sideways
     out of the joint. This is what keeps a box sliding along a chain from catching on a joint.
 
-A contact whose normal already is ``n1`` is kept as it is. Every function works on numpy arrays,
-one value per contact (the scalar queries pass arrays of one), so the scalar queries and the
-scenes' kernels give the same answers.
+A contact whose normal already is ``n1`` is kept as it is.
+
+The rule is stated once, in :func:`chain_verdict`, a compiled leaf function
+(:data:`framework.compiled.leaf`) that every path calls: the scalar queries (:func:`one_contact`,
+:func:`one_impact`), the exact solver's narrow phase (:func:`chain_rule`, row by row) and the soft
+step's manifolds (:func:`framework.collision.soft_manifold.chain_segment`). What each does with
+the verdict (a contact's depth and point, a manifold's points) stays with it.
 """
 
 from __future__ import annotations
@@ -33,10 +37,11 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from ..compiled import leaf
 from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Shape
 
-__all__ = ["CONVEX_TOL", "SIN_TOL", "chain_rule", "chain_world", "classify", "core_world", "deepest_below",
-           "one_contact", "one_impact", "one_sided_ray"]
+__all__ = ["CONVEX_TOL", "KEEP", "PASS", "SIN_TOL", "SKIP", "SNAP", "chain_rule", "chain_verdict", "chain_world",
+           "classify", "core_world", "deepest_below", "one_contact", "one_impact", "one_sided_ray"]
 
 F = NDArray[np.float64]
 
@@ -93,51 +98,94 @@ def deepest_below(vx: F, vy: F, count: NDArray[np.int64], radius: F, p1x: F, p1y
     return low, vx[rows, j] - n1x * radius, vy[rows, j] - n1y * radius
 
 
-def _unit(x: F, y: F) -> tuple[F, F]:
-    ln = np.hypot(x, y)
-    return x / ln, y / ln
+# What the rule leaves of a contact (:func:`chain_verdict`).
+KEEP, PASS, SKIP, SNAP = 0, 1, 2, 3
 
 
-def chain_rule(p1x: F, p1y: F, p2x: F, p2y: F, g1x: F, g1y: F, g2x: F, g2y: F, cx: F, cy: F, nx: F, ny: F,
-               depth: F, px: F, py: F, low: F, sx: F, sy: F) -> tuple[NDArray[np.bool_], F, F, F, F, F]:
-    """The contacts of chain segments (module docstring): per row, the segment ``p1 -> p2`` and its
-    ghosts, the body's centre ``(cx, cy)``, the two-sided contact (normal ``(nx, ny)`` from the
-    segment toward the body, ``depth``, point) and the body's least height above the segment's line
-    with its point there (:func:`deepest_below`). Returns ``(keep, nx, ny, depth, px, py)``."""
-    passes, skip, snap, n1x, n1y = classify(p1x, p1y, p2x, p2y, g1x, g1y, g2x, g2y, cx, cy, nx, ny)
-    snap_depth = -low
-    keep = ~passes & ~skip & (~snap | (snap_depth > 0.0))
-    nx, ny = np.where(snap, n1x, nx), np.where(snap, n1y, ny)
-    depth = np.where(snap, snap_depth, depth)
-    px = np.where(snap, sx + 0.5 * snap_depth * n1x, px)
-    py = np.where(snap, sy + 0.5 * snap_depth * n1y, py)
-    return keep, nx + 0.0, ny + 0.0, depth, px, py
+@leaf
+def chain_verdict(p1x, p1y, p2x, p2y, u0x, u0y, u1x, u1y, u2x, u2y, cx, cy, nx, ny):
+    """The chain's rule (module docstring), once for every solver and query: the segment
+    ``p1 -> p2``, the unit directions ``u0`` (ghost 1 -> ``p1``), ``u1`` (``p1 -> p2``) and ``u2``
+    (``p2`` -> ghost 2), the body's centre ``(cx, cy)`` and the two-sided contact's normal
+    ``(nx, ny)`` from the segment toward the body. Returns ``(verdict, convex1, convex2)``: the
+    verdict is :data:`PASS` (the body is behind: no contact), :data:`SKIP` (the neighbour owns the
+    normal), :data:`SNAP` (push out along the segment's normal ``(u1y, -u1x)`` instead) or
+    :data:`KEEP`; ``convex1``, ``convex2``: whether the joints at ``p1`` and ``p2`` turn outward.
 
-
-def classify(p1x: F, p1y: F, p2x: F, p2y: F, g1x: F, g1y: F, g2x: F, g2y: F, cx: F, cy: F, nx: F,
-             ny: F) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.bool_], F, F]:
-    """Per contact of a chain segment (normal ``(nx, ny)`` from it toward the body, whose centre is
-    ``(cx, cy)``): ``(passes, skip, snap, n1x, n1y)``: the body passes (it is behind), the normal is
-    the neighbour's, the normal is to be snapped to the segment's normal ``n1`` (module
-    docstring)."""
-    u1x, u1y = _unit(p2x - p1x, p2y - p1y)
+    Each caller measures the directions its own way (the exact path with ``hypot``, as numpy's
+    ``np.hypot``; the soft step with ``sqrt(x * x + y * y)``, as Box2D's ``b2Normalize``), so
+    neither's answers changed when the two statements of the rule became this one."""
     n1x, n1y = u1y, -u1x
-    u0x, u0y = _unit(p1x - g1x, p1y - g1y)
-    u2x, u2y = _unit(g2x - p2x, g2y - p2y)
     n0x, n0y = u0y, -u0x
     n2x, n2y = u2y, -u2x
     convex1 = u0x * u1y - u0y * u1x >= CONVEX_TOL
     convex2 = u1x * u2y - u1y * u2x >= CONVEX_TOL
     behind1 = n1x * (cx - p1x) + n1y * (cy - p1y) < 0.0
-    behind0 = ~convex1 | (n0x * (cx - p1x) + n0y * (cy - p1y) < 0.0)
-    behind2 = ~convex2 | (n2x * (cx - p2x) + n2y * (cy - p2y) < 0.0)
-    passes = behind1 & behind0 & behind2
-    same = (np.abs(nx - n1x) <= SAME_NORMAL) & (np.abs(ny - n1y) <= SAME_NORMAL)
-    tail = nx * u1x + ny * u1y <= 0.0
-    skip = np.where(tail, convex1 & (nx * n0y - ny * n0x > SIN_TOL), convex2 & (n2x * ny - n2y * nx > SIN_TOL))
-    snap = ~same & np.where(tail, ~convex1, ~convex2)
-    skip &= ~same
-    return passes, skip, snap, n1x, n1y
+    behind0 = (not convex1) or n0x * (cx - p1x) + n0y * (cy - p1y) < 0.0
+    behind2 = (not convex2) or n2x * (cx - p2x) + n2y * (cy - p2y) < 0.0
+    if behind1 and behind0 and behind2:
+        return PASS, convex1, convex2  # one-sided: the body comes from behind
+    if abs(nx - n1x) <= SAME_NORMAL and abs(ny - n1y) <= SAME_NORMAL:
+        return KEEP, convex1, convex2  # already the segment's normal
+    if nx * u1x + ny * u1y <= 0.0:  # toward p1
+        if not convex1:
+            return SNAP, convex1, convex2
+        return (SKIP if nx * n0y - ny * n0x > SIN_TOL else KEEP), convex1, convex2
+    if not convex2:
+        return SNAP, convex1, convex2
+    return (SKIP if n2x * ny - n2y * nx > SIN_TOL else KEEP), convex1, convex2
+
+
+@leaf
+def _unit(x, y):
+    # (numba's math.hypot is the C library's, as numpy's np.hypot: the same bits)
+    ln = math.hypot(x, y)
+    return x / ln, y / ln
+
+
+@leaf
+def classify(p1x, p1y, p2x, p2y, g1x, g1y, g2x, g2y, cx, cy, nx, ny):
+    """:func:`chain_verdict` of a contact of the segment ``p1 -> p2`` with ghosts ``g1``, ``g2``
+    (world coordinates), the body's centre ``(cx, cy)`` and the normal ``(nx, ny)`` from the
+    segment toward the body: ``(verdict, n1x, n1y)``, ``n1`` the segment's unit normal."""
+    u1x, u1y = _unit(p2x - p1x, p2y - p1y)
+    u0x, u0y = _unit(p1x - g1x, p1y - g1y)
+    u2x, u2y = _unit(g2x - p2x, g2y - p2y)
+    verdict, _, _ = chain_verdict(p1x, p1y, p2x, p2y, u0x, u0y, u1x, u1y, u2x, u2y, cx, cy, nx, ny)
+    return verdict, u1y, -u1x
+
+
+@leaf
+def _chain_rows(p1x, p1y, p2x, p2y, g1x, g1y, g2x, g2y, cx, cy, nx, ny, depth, px, py, low, sx, sy,
+                keep, onx, ony, odepth, opx, opy):
+    """:func:`chain_rule`, row by row, into ``keep, onx, ony, odepth, opx, opy``."""
+    for i in range(p1x.shape[0]):
+        verdict, n1x, n1y = classify(p1x[i], p1y[i], p2x[i], p2y[i], g1x[i], g1y[i], g2x[i], g2y[i], cx[i], cy[i],
+                                     nx[i], ny[i])
+        if verdict == SNAP:  # out along the segment's normal, by the body's depth below its line
+            d = -low[i]
+            keep[i] = d > 0.0
+            onx[i], ony[i], odepth[i] = n1x + 0.0, n1y + 0.0, d
+            opx[i], opy[i] = sx[i] + 0.5 * d * n1x, sy[i] + 0.5 * d * n1y
+        else:
+            keep[i] = verdict == KEEP
+            onx[i], ony[i], odepth[i], opx[i], opy[i] = nx[i] + 0.0, ny[i] + 0.0, depth[i], px[i], py[i]
+
+
+def chain_rule(p1x: F, p1y: F, p2x: F, p2y: F, g1x: F, g1y: F, g2x: F, g2y: F, cx: F, cy: F, nx: F, ny: F,
+               depth: F, px: F, py: F, low: F, sx: F, sy: F) -> tuple[NDArray[np.bool_], F, F, F, F, F]:
+    """The contacts of chain segments (module docstring; :func:`chain_verdict` per row): per row,
+    the segment ``p1 -> p2`` and its ghosts, the body's centre ``(cx, cy)``, the two-sided contact
+    (normal ``(nx, ny)`` from the segment toward the body, ``depth``, point) and the body's least
+    height above the segment's line with its point there (:func:`deepest_below`). Returns
+    ``(keep, nx, ny, depth, px, py)``."""
+    n = p1x.shape[0]
+    keep = np.empty(n, dtype=np.bool_)
+    onx, ony, odepth, opx, opy = (np.empty(n) for _ in range(5))
+    rows = [np.ascontiguousarray(a, dtype=np.float64) for a in
+            (p1x, p1y, p2x, p2y, g1x, g1y, g2x, g2y, cx, cy, nx, ny, depth, px, py, low, sx, sy)]
+    _chain_rows(*rows, keep, onx, ony, odepth, opx, opy)
+    return keep, onx, ony, odepth, opx, opy
 
 
 def one_contact(seg: ChainSegment, pose_s: tuple[float, float, float], other: Shape,
@@ -148,9 +196,10 @@ def one_contact(seg: ChainSegment, pose_s: tuple[float, float, float], other: Sh
     seg_w = chain_world(seg, *pose_s)
     pts, r, (cx, cy) = core_world(other, *pose_o)
     p1x, p1y, p2x, p2y = seg_w[:4]
-    u1x, u1y = _unit(np.array([p2x - p1x]), np.array([p2y - p1y]))
+    u1x, u1y = _unit(p2x - p1x, p2y - p1y)
     low, sx, sy = deepest_below(np.array([[p[0] for p in pts]]), np.array([[p[1] for p in pts]]),
-                                np.array([len(pts)]), np.array([r]), np.array([p1x]), np.array([p1y]), u1y, -u1x)
+                                np.array([len(pts)]), np.array([r]), np.array([p1x]), np.array([p1y]),
+                                np.array([u1y]), np.array([-u1x]))
     a = [np.array([v]) for v in (*seg_w, cx, cy, nx, ny, depth, px, py)]
     keep, nx_, ny_, d_, px_, py_ = chain_rule(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], a[8], a[9], a[10],
                                               a[11], a[12], a[13], a[14], low, sx, sy)
@@ -179,10 +228,9 @@ def one_impact(seg: ChainSegment, pose_s: tuple[float, float, float], other: Sha
     segment's normal."""
     seg_w = chain_world(seg, *pose_s)
     _, _, (cx, cy) = core_world(other, *pose_o)
-    a = [np.array([v]) for v in (*seg_w, cx, cy, nx, ny)]
-    passes, skip, snap, n1x, n1y = classify(*a)
-    if passes[0] or skip[0]:
+    verdict, n1x, n1y = classify(*seg_w, cx, cy, nx, ny)
+    if verdict == PASS or verdict == SKIP:
         return None
-    if snap[0]:
-        return float(n1x[0]) + 0.0, float(n1y[0]) + 0.0
+    if verdict == SNAP:
+        return n1x + 0.0, n1y + 0.0
     return nx, ny

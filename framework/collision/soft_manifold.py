@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 
 from ..compiled import leaf
+from .chain import KEEP, PASS, SKIP, chain_verdict
 
 __all__ = ["DOWN", "LEFT", "RIGHT", "UP", "box_box", "capsule_capsule", "chain_segment", "circle_circle", "face_bit",
            "polygon_circle", "polygon_polygon"]
@@ -382,12 +383,6 @@ def polygon_polygon(V, N, a, ca, ra, b, cb, rb, slop, speculative, out, fa=0, fb
     return k, nx, ny
 
 
-# framework.collision.chain's tolerances (Box2D's convexTol and sinTol) and its "same normal".
-_CONVEX_TOL = 0.01
-_SIN_TOL = 0.01
-_SAME = 1e-12
-
-
 @leaf
 def _unit2(x, y):
     ln = math.sqrt(x * x + y * y)
@@ -399,8 +394,9 @@ def chain_segment(V, N, L, g, o, count, ro, cx, cy, k, nx, ny, speculative, out)
     """What chain segment ``g`` (world ends ``V[g, 0:2]``; local ends and ghosts ``L[g, 0:4]``) keeps of
     its manifold with body ``o`` (``count`` world vertices ``V[o]``, normals ``N[o]``, radius ``ro``,
     hitbox origin ``(cx, cy)``): ``k`` points in ``out`` and the normal ``(nx, ny)`` from ``g`` toward
-    ``o``. Returns ``(count, nx, ny)``, the normal from ``g`` toward ``o``
-    (:func:`framework.collision.chain.classify`'s rules)."""
+    ``o``. Returns ``(count, nx, ny)``, the normal from ``g`` toward ``o``. The rule is
+    :func:`framework.collision.chain.chain_verdict` (its directions measured here as Box2D does,
+    ``sqrt(x * x + y * y)``); what a kept or snapped manifold's points are is this function's."""
     if k <= 0:
         return k, nx, ny
     p1x, p1y, p2x, p2y = V[g, 0, 0], V[g, 0, 1], V[g, 1, 0], V[g, 1, 1]
@@ -417,26 +413,11 @@ def chain_segment(V, N, L, g, o, count, ro, cx, cy, k, nx, ny, speculative, out)
     n1x, n1y = u1y, -u1x
     u0x, u0y = _unit2(p1x - g1x, p1y - g1y)
     u2x, u2y = _unit2(g2x - p2x, g2y - p2y)
-    n0x, n0y = u0y, -u0x
-    n2x, n2y = u2y, -u2x
-    convex1 = u0x * u1y - u0y * u1x >= _CONVEX_TOL
-    convex2 = u1x * u2y - u1y * u2x >= _CONVEX_TOL
-    behind1 = n1x * (cx - p1x) + n1y * (cy - p1y) < 0.0
-    behind0 = (not convex1) or n0x * (cx - p1x) + n0y * (cy - p1y) < 0.0
-    behind2 = (not convex2) or n2x * (cx - p2x) + n2y * (cy - p2y) < 0.0
-    if behind1 and behind0 and behind2:
-        return 0, 0.0, 0.0  # one-sided: the body comes from behind
+    verdict, convex1, convex2 = chain_verdict(p1x, p1y, p2x, p2y, u0x, u0y, u1x, u1y, u2x, u2y, cx, cy, nx, ny)
+    if verdict == PASS or verdict == SKIP:
+        return 0, 0.0, 0.0  # the body comes from behind, or the neighbour owns the normal
     length = math.sqrt(wex * wex + wey * wey)
-    if abs(nx - n1x) <= _SAME and abs(ny - n1y) <= _SAME:
-        return _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny)
-    if nx * u1x + ny * u1y <= 0.0:  # toward p1
-        if convex1:
-            if nx * n0y - ny * n0x > _SIN_TOL:
-                return 0, 0.0, 0.0  # the neighbour's
-            return _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny)
-    elif convex2:
-        if n2x * ny - n2y * nx > _SIN_TOL:
-            return 0, 0.0, 0.0
+    if verdict == KEEP:
         return _own_points(out, k, p1x, p1y, u1x, u1y, length, convex1, convex2, nx, ny)
     # Snapped: along the segment's normal, the body's incident edge clipped to the segment.
     if count == 1:
