@@ -277,6 +277,8 @@ class BodyStore:
     # --- columns ---------------------------------------------------------------------------
 
     def __getattr__(self, name: str) -> NDArray[Any]:  # (a column of any of the dtypes above)
+        # (the columns are properties, :func:`_live_rows`; this serves them while an object is
+        # being rebuilt without its class's help, and says which name is missing otherwise)
         cols = self.__dict__.get("cols")
         if cols is not None and name in cols:
             return cols[name][: self.__dict__["n"]]
@@ -598,6 +600,22 @@ class BodyStore:
             self.version += 1
             self.static_dirty = True
         return changed
+
+
+def _live_rows(name: str) -> property:
+    """The live rows of one column, ``cols[name][:n]``, as a property: found by the class's own
+    lookup (``__getattr__`` runs only after a failed lookup has raised, which cost a column read
+    0.76 us; the exact step reads a hundred to three hundred of them)."""
+
+    def rows(self: BodyStore) -> NDArray[Any]:
+        return self.cols[name][: self.n]
+
+    return property(rows, doc=f"The live rows of the ``{name}`` column.")
+
+
+if not TYPE_CHECKING:  # (mypy reads the declarations in the class)
+    for _name in (*_FLOATS, *_INTS, *_BOOLS):
+        setattr(BodyStore, _name, _live_rows(_name))
 
 
 _MISSING = object()
