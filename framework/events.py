@@ -42,12 +42,20 @@ class CollisionEvent(NamedTuple):
     normal: Vec2  # unit, from a toward b
     depth: float
     point: Vec2
+    part_a: int = 0  # which shape of a touched: 0 its Hitbox, i its Parts' i-th (a body of several shapes)
+    part_b: int = 0
 
     def flipped(self) -> CollisionEvent:
-        """The same event seen from ``b``: entities swapped, normal negated."""
+        """The same event seen from ``b``: entities (and parts) swapped, normal negated."""
         return CollisionEvent(
-            self.kind, self.b, self.a, Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0), self.depth, self.point
+            self.kind, self.b, self.a, Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0), self.depth, self.point,
+            self.part_b, self.part_a,
         )
+
+    def __repr__(self) -> str:  # (the parts only where a body of several shapes touched: part 0 is the Hitbox)
+        parts = f", part_a={self.part_a!r}, part_b={self.part_b!r}" if self.part_a or self.part_b else ""
+        return (f"CollisionEvent(kind={self.kind!r}, a={self.a!r}, b={self.b!r}, normal={self.normal!r}, "
+                f"depth={self.depth!r}, point={self.point!r}{parts})")
 
 
 class StepContacts(NamedTuple):
@@ -134,18 +142,28 @@ class PairTracker:
 
 
 def to_events(
-    contacts: StepContacts, started: NDArray[np.bool_], ongoing: NDArray[np.bool_], ended: StepContacts
+    contacts: StepContacts, started: NDArray[np.bool_], ongoing: NDArray[np.bool_], ended: StepContacts,
+    parts: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
+    ended_parts: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
 ) -> list[CollisionEvent]:
-    """Event records, sorted by pair (a, b), then ended before started before ongoing."""
+    """Event records, sorted by pair (a, b), then ended before started before ongoing (``parts``,
+    ``ended_parts``: which shape of each body touched, beside ``contacts`` and ``ended``; None:
+    part 0 of each)."""
     out: list[tuple[int, int, int, CollisionEvent]] = []
-    for group, kind, order in ((ended, ENDED, 0), (contacts, None, 1)):
+    for group, kind, order, shapes in ((ended, ENDED, 0, ended_parts), (contacts, None, 1, parts)):
         if len(group.a) == 0:
             continue
         cols = [arr.tolist() for arr in group]
         st = started.tolist() if kind is None else None
-        for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
-            k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
-            out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py))))
+        if shapes is None:
+            for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
+                k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
+                out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py))))
+        else:
+            pa, pb = shapes[0].tolist(), shapes[1].tolist()
+            for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
+                k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
+                out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py), pa[i], pb[i])))
     out.sort(key=lambda t: (t[0], t[1], t[2]))
     return [t[3] for t in out]
 
