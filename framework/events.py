@@ -25,7 +25,7 @@ from .entities import is_value_type
 from .shapes import Shape
 from .validation import InvalidValue
 
-__all__ = ["CollisionEvent", "CollisionHandlers", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_find",
+__all__ = ["CollisionEvent", "CollisionHandlers", "PartEvent", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_find",
            "sorted_member", "sorted_members"]
 
 STARTED: Literal["started"] = "started"
@@ -42,20 +42,46 @@ class CollisionEvent(NamedTuple):
     normal: Vec2  # unit, from a toward b
     depth: float
     point: Vec2
-    part_a: int = 0  # which shape of a touched: 0 its Hitbox, i its Parts' i-th (a body of several shapes)
-    part_b: int = 0
+    # Which shape of each body touched: 0 its Hitbox, i the i-th of its Parts (a body of several
+    # shapes). Not fields: an event stays a tuple of six; a compound body's events are PartEvents.
+    part_a = 0
+    part_b = 0
 
     def flipped(self) -> CollisionEvent:
         """The same event seen from ``b``: entities (and parts) swapped, normal negated."""
-        return CollisionEvent(
-            self.kind, self.b, self.a, Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0), self.depth, self.point,
-            self.part_b, self.part_a,
-        )
+        normal = Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0)
+        if self.part_a or self.part_b:
+            return PartEvent(self.kind, self.b, self.a, normal, self.depth, self.point, self.part_b, self.part_a)
+        return CollisionEvent(self.kind, self.b, self.a, normal, self.depth, self.point)
 
-    def __repr__(self) -> str:  # (the parts only where a body of several shapes touched: part 0 is the Hitbox)
-        parts = f", part_a={self.part_a!r}, part_b={self.part_b!r}" if self.part_a or self.part_b else ""
-        return (f"CollisionEvent(kind={self.kind!r}, a={self.a!r}, b={self.b!r}, normal={self.normal!r}, "
-                f"depth={self.depth!r}, point={self.point!r}{parts})")
+
+class PartEvent(CollisionEvent):
+    """A :class:`CollisionEvent` where a body of several shapes (:class:`~framework.components.Parts`)
+    touched with one of its other shapes: the same six fields, and ``part_a``, ``part_b``, which
+    shape of ``a`` and of ``b`` (0: the entity's Hitbox; i: the i-th of its Parts). Equal to another
+    event when the six fields and the parts are."""
+
+    part_a: int
+    part_b: int
+
+    def __new__(cls, kind: Literal["started", "ongoing", "ended"], a: int, b: int, normal: Vec2, depth: float,
+                point: Vec2, part_a: int = 0, part_b: int = 0) -> PartEvent:
+        self = super().__new__(cls, kind, a, b, normal, depth, point)
+        self.part_a, self.part_b = part_a, part_b
+        return self
+
+    def __eq__(self, other: object) -> bool:
+        return tuple.__eq__(self, other) is True and (
+            getattr(other, "part_a", 0), getattr(other, "part_b", 0)) == (self.part_a, self.part_b)
+
+    def __ne__(self, other: object) -> bool:
+        return not self == other
+
+    __hash__ = tuple.__hash__
+
+    def __repr__(self) -> str:
+        return (f"PartEvent(kind={self.kind!r}, a={self.a!r}, b={self.b!r}, normal={self.normal!r}, "
+                f"depth={self.depth!r}, point={self.point!r}, part_a={self.part_a!r}, part_b={self.part_b!r})")
 
 
 class StepContacts(NamedTuple):
@@ -163,7 +189,9 @@ def to_events(
             pa, pb = shapes[0].tolist(), shapes[1].tolist()
             for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
                 k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
-                out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py), pa[i], pb[i])))
+                ev = (PartEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py), pa[i], pb[i]) if pa[i] or pb[i] else
+                      CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py)))
+                out.append((a, b, order, ev))
     out.sort(key=lambda t: (t[0], t[1], t[2]))
     return [t[3] for t in out]
 
