@@ -22,7 +22,8 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
 __all__ = [
     "AABB", "Body", "Camera", "Capsule", "Chain", "ChainSegment", "CharacterController", "Circle", "CollisionEvent",
     "Contact", "DistanceJoint",
-    "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Parts", "Polygon", "PrismaticJoint",
+    "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Parts", "Polygon",
+    "PrismaticJoint",
     "RayHit",
     "Renderer", "RevoluteJoint", "Segment",
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",

@@ -25,8 +25,8 @@ from .entities import is_value_type
 from .shapes import Shape
 from .validation import InvalidValue
 
-__all__ = ["CollisionEvent", "CollisionHandlers", "PartEvent", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_find",
-           "sorted_member", "sorted_members"]
+__all__ = ["CollisionEvent", "CollisionHandlers", "PartEvent", "PairTracker", "STARTED", "ONGOING", "ENDED",
+           "sorted_find", "sorted_member", "sorted_members"]
 
 STARTED: Literal["started"] = "started"
 ONGOING: Literal["ongoing"] = "ongoing"
@@ -42,10 +42,18 @@ class CollisionEvent(NamedTuple):
     normal: Vec2  # unit, from a toward b
     depth: float
     point: Vec2
+
     # Which shape of each body touched: 0 its Hitbox, i the i-th of its Parts (a body of several
     # shapes). Not fields: an event stays a tuple of six; a compound body's events are PartEvents.
-    part_a = 0
-    part_b = 0
+    @property
+    def part_a(self) -> int:
+        """Which shape of ``a`` touched: 0, its Hitbox (a :class:`PartEvent` names its Parts)."""
+        return 0
+
+    @property
+    def part_b(self) -> int:
+        """Which shape of ``b`` touched: 0, its Hitbox (a :class:`PartEvent` names its Parts)."""
+        return 0
 
     def flipped(self) -> CollisionEvent:
         """The same event seen from ``b``: entities (and parts) swapped, normal negated."""
@@ -61,14 +69,23 @@ class PartEvent(CollisionEvent):
     shape of ``a`` and of ``b`` (0: the entity's Hitbox; i: the i-th of its Parts). Equal to another
     event when the six fields and the parts are."""
 
-    part_a: int
-    part_b: int
+    _parts: tuple[int, int]
 
     def __new__(cls, kind: Literal["started", "ongoing", "ended"], a: int, b: int, normal: Vec2, depth: float,
                 point: Vec2, part_a: int = 0, part_b: int = 0) -> PartEvent:
         self = super().__new__(cls, kind, a, b, normal, depth, point)
-        self.part_a, self.part_b = part_a, part_b
+        self._parts = (part_a, part_b)
         return self
+
+    @property
+    def part_a(self) -> int:
+        """Which shape of ``a`` touched: 0 its Hitbox, i the i-th of its Parts."""
+        return self._parts[0]
+
+    @property
+    def part_b(self) -> int:
+        """Which shape of ``b`` touched: 0 its Hitbox, i the i-th of its Parts."""
+        return self._parts[1]
 
     def __eq__(self, other: object) -> bool:
         return tuple.__eq__(self, other) is True and (

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..character import CharacterController
 from ..compile_notice import notice_if_slow
+from ..components import Body, body_mass_data
 from ..events import StepContacts
 from ..frame import StepFrame
 from ..joints import (
@@ -45,7 +46,6 @@ from ..joints import (
     joint_components,
     joint_writes,
 )
-from ..components import Body, body_mass_data
 from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment
 from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT, NO_FRICTION, STATIC
 from ..validation import InvalidValue
@@ -328,15 +328,17 @@ def _by_entity(cols: tuple[np.ndarray, ...], contacts: StepContacts) -> tuple[tu
     sorted by entities, then parts."""
     ea, eb = contacts.a, contacts.b
     swap = ea > eb
-    cols = list(cols)
+    out = list(cols)
     if swap.any():
-        for i in range(0, 4 if len(cols) >= 4 else 2, 2):
-            cols[i], cols[i + 1] = np.where(swap, cols[i + 1], cols[i]), np.where(swap, cols[i], cols[i + 1])
-        contacts = StepContacts(np.where(swap, eb, ea), np.where(swap, ea, eb), np.where(swap, 0.0 - contacts.nx, contacts.nx),
-                                np.where(swap, 0.0 - contacts.ny, contacts.ny), contacts.depth, contacts.px, contacts.py)
-    pa, pb = (cols[2], cols[3]) if len(cols) >= 4 else (cols[0], cols[1])
+        for i in range(0, 4 if len(out) >= 4 else 2, 2):
+            out[i], out[i + 1] = np.where(swap, out[i + 1], out[i]), np.where(swap, out[i], out[i + 1])
+        contacts = StepContacts(np.where(swap, eb, ea), np.where(swap, ea, eb),
+                                np.where(swap, 0.0 - contacts.nx, contacts.nx),
+                                np.where(swap, 0.0 - contacts.ny, contacts.ny), contacts.depth, contacts.px,
+                                contacts.py)
+    pa, pb = (out[2], out[3]) if len(out) >= 4 else (out[0], out[1])
     order = np.lexsort((pb, pa, contacts.b, contacts.a))
-    return tuple(c[order] for c in cols), contacts.take(order)
+    return tuple(c[order] for c in out), contacts.take(order)
 
 
 _COMPILED: set[bool] = set()  # the kernel's variants called in this process (True: with joints)
