@@ -360,3 +360,25 @@ def test_a_snapshot_keeps_the_parts_and_continues_bit_for_bit():
     scene.get(e, Parts)[0].friction = -2.0
     with pytest.raises(InvalidValue, match="part 1"):
         scene.step(DT)
+
+
+def test_the_debug_overlay_outlines_every_part_posed_by_its_body():
+    from framework.render.overlay import OVERLAY_COLORS, _part_segments
+
+    scene = Scene(solver="soft")
+    e = scene.spawn(Transform(1.0, 2.0, math.pi / 2), Velocity(), Hitbox(Polygon.box(1, 1)),
+                    Parts([Hitbox(Polygon.box(1.0, 0.5), offset=(2.0, 0.0)), Hitbox(AABB(1.0, 0.5), offset=(0.0, 1.0),
+                                                                                  sensor=True)]))
+    (ends, colors), = _part_segments(scene.store)
+    assert ends.shape == (8, 4)
+    # the box part turned a quarter: its centre at (1, 2) + R(90) (2, 0) = (1, 4), 0.5 wide, 1 high
+    xs, ys = ends[:4, 0], ends[:4, 1]
+    assert xs.min() == pytest.approx(0.75) and xs.max() == pytest.approx(1.25)
+    assert ys.min() == pytest.approx(3.5) and ys.max() == pytest.approx(4.5)
+    # the AABB part: its offset turns, its box does not: centre (0, 2), 1 wide, 0.5 high
+    xs, ys = ends[4:, 0], ends[4:, 1]
+    assert xs.min() == pytest.approx(-0.5) and xs.max() == pytest.approx(0.5)
+    assert ys.min() == pytest.approx(1.75) and ys.max() == pytest.approx(2.25)
+    assert [tuple(c) for c in colors] == [OVERLAY_COLORS["dynamic"]] * 4 + [OVERLAY_COLORS["sensor"]] * 4
+    scene.despawn(e)
+    assert _part_segments(scene.store) == []
