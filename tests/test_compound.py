@@ -382,3 +382,54 @@ def test_the_debug_overlay_outlines_every_part_posed_by_its_body():
     assert [tuple(c) for c in colors] == [OVERLAY_COLORS["dynamic"]] * 4 + [OVERLAY_COLORS["sensor"]] * 4
     scene.despawn(e)
     assert _part_segments(scene.store) == []
+
+
+# --- queries -----------------------------------------------------------------------------------
+
+def _query_scene() -> tuple[Scene, int, int]:
+    """A compound body at (0, 0) turned a quarter: its Hitbox a 1 x 1 box, its part a circle of
+    radius 0.5 whose offset (2, 0) the turn puts at (0, 2); and a plain box at (5, 0)."""
+    scene = Scene(solver="soft")
+    e = scene.spawn(Transform(0.0, 0.0, math.pi / 2), Velocity(), Hitbox(Polygon.box(1, 1)),
+                    Parts([Hitbox(Circle(0.5), offset=(2.0, 0.0), layer=2)]))
+    plain = scene.spawn(Transform(5.0, 0.0), Hitbox(AABB(1, 1), body="static"))
+    return scene, e, plain
+
+
+def test_rays_and_point_queries_meet_the_parts_and_name_the_entity():
+    scene, e, plain = _query_scene()
+    hit = scene.raycast((-3.0, 2.0), (1.0, 0.0))  # only the part lies on this line
+    assert hit is not None and hit.entity == e
+    assert hit.distance == pytest.approx(2.5) and hit.point.y == pytest.approx(2.0)
+    assert scene.raycast((-3.0, 2.0), (1.0, 0.0), mask=1) is None  # the part's layer is 2
+    # a ray through both shapes: the entity once, where it first enters the body
+    hits = scene.raycast_all((0.0, 5.0), (0.0, -1.0))
+    assert [h.entity for h in hits] == [e] and hits[0].distance == pytest.approx(2.5)
+    assert scene.query_point(0.0, 2.25) == [e]
+    assert scene.query_point(0.0, 1.25) == []
+    assert scene.query_box(-0.1, 2.3, 0.1, 2.4) == [e]
+    assert scene.query_shape(Circle(0.25), (0.6, 2.0)) == [e]
+    near = scene.nearest((0.0, 3.5))
+    assert near is not None and near.entity == e and near.distance == pytest.approx(1.0)
+    assert scene.distance(plain, e).distance == pytest.approx(4.0)  # its box is nearer than its circle (4.24)
+    above = scene.spawn(Transform(0.0, 5.0), Hitbox(AABB(1, 1), body="static"))
+    assert scene.distance(e, above).distance == pytest.approx(2.0)  # its circle (top at 2.5) is nearer
+    cast = scene.shape_cast(Circle(0.25), (-3.0, 2.0), (3.0, 2.0))
+    assert cast is not None and cast.entity == e and cast.fraction == pytest.approx(2.25 / 6)
+    assert cast.normal.x == pytest.approx(-1.0)
+    assert scene.shape_cast(Circle(0.25), (-3.0, 2.0), (3.0, 2.0), ignore=[e]) is None
+
+
+def test_the_batch_queries_answer_the_parts_as_the_single_ones():
+    scene, e, plain = _query_scene()
+    pts = [(0.0, 2.25), (0.0, 1.25), (5.0, 0.0), (0.0, 0.0)]
+    hits = scene.query_points(pts)
+    assert [hits.of(i) for i in range(len(pts))] == [scene.query_point(*p) for p in pts]
+    near = scene.nearest_many(pts)
+    for i, p in enumerate(pts):
+        one = scene.nearest(p)
+        assert one is not None and (near.entity[i], near.distance[i]) == (one.entity, one.distance)
+    rays = scene.raycast_many([(-3.0, 2.0), (-3.0, 0.0), (-3.0, 9.0)], [(1.0, 0.0)] * 3)
+    assert rays.entity.tolist() == [e, e, -1]
+    assert rays.distance.tolist()[:2] == [scene.raycast((-3.0, 2.0), (1.0, 0.0)).distance,  # type: ignore[union-attr]
+                                          scene.raycast((-3.0, 0.0), (1.0, 0.0)).distance]  # type: ignore[union-attr]
