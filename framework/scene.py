@@ -668,6 +668,7 @@ class Scene:
         from .systems.soft_step import MAX_COMPOUND_ENTITY
 
         store = self.bodies.store
+        characters = esper.get_component(CharacterController) if "character" in self.effects else []
         for e in sorted(store.parts):
             parts = store.parts[e]
             hb = store.hitboxes[store.row_of[e]]
@@ -684,6 +685,11 @@ class Scene:
             if esper.has_component(e, CharacterController):
                 raise InvalidValue(f"entity {e} is a character (CharacterController) with Parts: the character "
                                    "controller moves bodies of one shape; remove its Parts")
+            if characters and any(not part.sensor for part in parts.hitboxes):
+                raise InvalidValue(f"entity {e} is a body of several shapes (Parts) in a scene with characters "
+                                   f"(entity {characters[0][0]}): the character controller does not see the parts of "
+                                   "compound bodies yet (it would walk through them); make its parts sensors, or the "
+                                   "body one shape")
             if e >= MAX_COMPOUND_ENTITY:
                 raise InvalidValue(f"entity {e} has Parts: compound bodies take entity ids below "
                                    f"{MAX_COMPOUND_ENTITY} (2**24)")
