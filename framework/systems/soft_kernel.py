@@ -580,8 +580,13 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     :func:`framework.systems.soft_step.kernel_tables`; an array argument costs about 0.3 us to pass):
     ``fprops`` (inverse mass, inverse inertia, friction, restitution, bounding radius, rounding
     radius), ``iprops`` (body kind, shape kind, layer, mask, entity, sensor, one-way, has a
-    velocity, vertex count, turns with the body), ``off`` (hitbox offsets) and ``verts`` (each
-    row's local vertices, then normals); ``faces``: each row's internal faces (:func:`internal_faces`).
+    velocity, vertex count, turns with the body, then the owner, key id and part number of each
+    shape row), ``off`` (hitbox offsets) and ``verts`` (each row's local vertices, then normals);
+    ``faces``: each row's internal faces (:func:`internal_faces`). The pose and velocity columns
+    are the bodies'; the tables may hold more rows than they, the shape rows of compound bodies'
+    other parts, each posed by its owner body row and acting on it (its contacts' impulses go to
+    the owner; two shapes of one owner never pair); without compound bodies each row is its own
+    owner and the step is what it was before they existed, bit for bit.
     ``driven``: rows a character controller moved this step (they are not moved again, and take
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
@@ -593,9 +598,10 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
 
     Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp)`` (few objects: each
     array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
-    slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
-    entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
-    (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
+    slots for the next step; the pairs touching now (``touch_i`` rows: body row a, body row b,
+    entity a, entity b, started, part a, part b; ``touch_f`` rows: nx, ny, depth, px, py), the pairs
+    that stopped touching (``end_i`` rows: key id a, key id b, the entities but for parts, see
+    ``soft_step.part_ids``; ``end_f``: their last contact); ``info``: whether the pairs
     were found again, how many contacts the solver used, how many bodies sleep (before this step's
     wakes), then the rows of the sleepers to wake; the joints' impulses."""
     inv_mass, inv_inertia, friction, restitution, bound, rr = fprops[0], fprops[1], fprops[2], fprops[3], fprops[4], \
