@@ -171,7 +171,8 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     inv_inertia = store.inv_inertia
     bodies = store.body[:n].tolist()
     for r, k in enumerate(kinds):
-        if (k == KIND_CIRCLE or k == KIND_POLYGON) and bodies[r] == DYNAMIC and store.entity[r] not in store.parts:
+        if (k == KIND_CIRCLE or k == KIND_POLYGON) and bodies[r] == DYNAMIC and not (
+                compound and int(store.entity[r]) in store.parts):  # (a compound body's: the whole body's, below)
             hb = store.hitboxes[r]
             gx, gy = polys[r].centroid
             cx, cy = float(store.ox[r]) + gx, float(store.oy[r]) + gy
