@@ -489,3 +489,45 @@ def test_a_file_snapshot_keeps_the_parts(tmp_path):
     for _ in range(40):
         other.step(DT)
     assert _pose(other) == _pose(scene)
+
+
+def test_an_event_between_parts_names_both_with_the_normal_from_a_to_b():
+    # (in the solver's pair table a part's key comes after every entity's own: the pair is found
+    # as (b's Hitbox, a's part) and named as events name pairs, a < b, the normal turned round)
+    scene = Scene(gravity=(0.0, 0.0), solver="soft")
+    left = scene.spawn(Transform(-2.0, 0.0), Velocity(2.0, 0.0), Hitbox(Polygon.box(1, 1)),
+                       Parts([Hitbox(Circle(0.5), offset=(1.0, 0.0))]))
+    right = scene.spawn(Transform(1.0, 0.0), Velocity(), Hitbox(Polygon.box(1, 1)))
+    first = None
+    for _ in range(30):
+        scene.step(DT)
+        first = first or next((ev for ev in scene.events if ev.kind == "started"), None)
+    assert first is not None
+    assert (first.a, first.b, first.part_a, first.part_b) == (left, right, 1, 0)
+    assert first.normal.x == pytest.approx(1.0)  # from the left body's head toward the right box
+    contacts = scene.contacts
+    assert contacts.a.tolist() == [left] and contacts.b.tolist() == [right] and contacts.nx[0] > 0.0
+    # and two parts: each names its own
+    scene = Scene(gravity=(0.0, 0.0), solver="soft")
+    a = scene.spawn(Transform(-2.0, 0.0), Velocity(2.0, 0.0), Hitbox(Polygon.box(1, 1)),
+                    Parts([Hitbox(Circle(0.25), offset=(0.0, 2.0)), Hitbox(Circle(0.5), offset=(1.0, 0.0))]))
+    b = scene.spawn(Transform(2.0, 0.0), Velocity(-2.0, 0.0), Hitbox(Polygon.box(1, 1)),
+                    Parts([Hitbox(Circle(0.5), offset=(-1.0, 0.0))]))
+    seen = set()
+    for _ in range(30):
+        scene.step(DT)
+        seen |= {(ev.a, ev.b, ev.part_a, ev.part_b) for ev in scene.events if ev.kind == "started"}
+    assert (a, b, 2, 1) in seen
+
+
+def test_a_scene_without_compound_bodies_gives_the_kernel_its_rows_as_before():
+    from framework.systems.soft_step import kernel_tables
+
+    scene, e = _scene_with_compound()
+    scene.remove_component(e, Parts)
+    store = scene.store
+    fprops, iprops, off, verts = kernel_tables(store)
+    n = store.n
+    assert fprops.shape[1] == iprops.shape[1] == off.shape[0] == verts.shape[0] == n
+    assert iprops[10].tolist() == list(range(n)) and iprops[11].tolist() == store.entity.tolist()
+    assert iprops[12].tolist() == [0] * n
