@@ -13,7 +13,7 @@ import esper
 
 from .components import Body, Hitbox, Parts, Transform, Velocity, check_component
 from .limits import check_hitbox_limits, check_position
-from .shapes import Shape
+from .shapes import ChainSegment, Shape
 from .sprites import Animation, Frame
 from .store import BodyStore
 from .validation import InvalidValue
@@ -141,6 +141,9 @@ def check_parts(parts: Parts, hitbox: Hitbox | None) -> None:
             check_hitbox_limits(part)
         except InvalidValue as exc:
             raise InvalidValue(f"Parts: part {i}: {exc}") from None
+        if isinstance(part.shape, ChainSegment):
+            raise InvalidValue(f"Parts: part {i} is a chain segment: a chain's segments are bodies of their own "
+                               "(framework.chains.spawn_chain); a plain Segment may be a part")
         if part is hitbox or part._store is not None:
             raise InvalidValue(f"Parts: part {i} is a Hitbox that belongs to an entity already; give each its own")
         if hitbox is not None and part.body is not hitbox.body:

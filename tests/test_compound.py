@@ -124,7 +124,14 @@ def test_parts_refuse_what_is_not_a_list_of_new_hitboxes():
         scene.spawn(Transform(0, 0), Parts([Hitbox(Circle(1))]))
     with pytest.raises(InvalidValue, match="part 1 is body='static'"):
         scene.spawn(Transform(0, 0), Velocity(), Hitbox(Circle(1)), Parts([Hitbox(Circle(1), body="static")]))
+    from framework import Chain, Segment
+
+    ground = Chain([(2.0, 0.0), (1.0, 0.0), (0.0, 0.0)]).segments[0]
+    with pytest.raises(InvalidValue, match="part 1 is a chain segment"):
+        scene.spawn(Transform(0, 0), Hitbox(AABB(1, 1), body="static"), Parts([Hitbox(ground, body="static")]))
     assert scene.entities == []
+    scene.spawn(Transform(0, 0), Hitbox(AABB(1, 1), body="static"),
+                Parts([Hitbox(Segment((0.0, 0.0), (2.0, 0.0)), body="static")]))  # a plain segment: fine
 
 
 def _scene_with_compound(solver: str = "soft") -> tuple[Scene, int]:
