@@ -538,3 +538,29 @@ def test_a_scene_without_compound_bodies_gives_the_kernel_its_rows_as_before():
     assert fprops.shape[1] == iprops.shape[1] == off.shape[0] == verts.shape[0] == n
     assert iprops[10].tolist() == list(range(n)) and iprops[11].tolist() == store.entity.tolist()
     assert iprops[12].tolist() == [0] * n
+
+
+def test_a_failed_step_of_a_compound_scene_is_undone_and_the_scene_goes_on_as_its_twin():
+    scene, e = _l_body_on_ledge(-0.2)
+    twin, _ = _l_body_on_ledge(-0.2)
+    for _ in range(15):
+        scene.step(DT)
+        twin.step(DT)
+    fail = [True]
+
+    def once(s, dt):  # a game system that fails in the next step, after the physics moved everything
+        if fail:
+            fail.clear()
+            s.get(e, Parts)[0].friction = 0.1  # (an edit the undone step must forget too)
+            raise RuntimeError("a game system failed")
+
+    scene.add_system(once, after="response")
+    before = _pose(scene)
+    with pytest.raises(RuntimeError, match="a game system failed"):
+        scene.step(DT)
+    assert _pose(scene) == before
+    scene.get(e, Parts)[0].friction = 0.6  # (what it was: the game's edit is its own to undo)
+    for _ in range(30):
+        scene.step(DT)
+        twin.step(DT)
+        assert _pose(scene) == _pose(twin)
