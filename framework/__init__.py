@@ -5,7 +5,7 @@ Importing it (and running scenes without a renderer) never imports pyglet's GL m
 
 from typing import TYPE_CHECKING, Any
 
-from .components import Body, Hitbox, MassData, Transform, Velocity, Visual
+from .components import Body, Hitbox, MassData, Parts, Transform, Velocity, Visual, body_mass_data
 from .shapes import AABB, Capsule, Chain, ChainSegment, Circle, Polygon, Segment, Shape
 from .text import Text
 from .validation import InvalidValue
@@ -22,11 +22,12 @@ if TYPE_CHECKING:  # the names loaded on first use (see __getattr__), as type ch
 __all__ = [
     "AABB", "Body", "Camera", "Capsule", "Chain", "ChainSegment", "CharacterController", "Circle", "CollisionEvent",
     "Contact", "DistanceJoint",
-    "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Polygon", "PrismaticJoint",
+    "Hitbox", "Impact", "Input", "InvalidValue", "MassData", "MotorJoint", "MouseJoint", "Parts", "Polygon",
+    "PrismaticJoint",
     "RayHit",
     "Renderer", "RevoluteJoint", "Segment",
     "STAGES", "Scene", "SceneClosed", "SceneHit", "Shape", "Text", "Transform", "Vec2", "Velocity", "Visual",
-    "WeldJoint", "WheelJoint", "collide", "run", "screenshot",
+    "WeldJoint", "WheelJoint", "body_mass_data", "collide", "run", "screenshot",
 ]
 __version__ = "0.2.0"
 

@@ -13,7 +13,9 @@ a scene, a component keeps its own values.
 
 from __future__ import annotations
 
+import math
 import os
+from collections.abc import Iterable, Iterator
 from enum import Enum
 from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
@@ -24,7 +26,7 @@ from .validation import InvalidValue, finite, vector2
 if TYPE_CHECKING:
     from .store import BodyStore
 
-__all__ = ["Body", "Hitbox", "MassData", "Transform", "Velocity", "Visual"]
+__all__ = ["MAX_PARTS", "Body", "Hitbox", "MassData", "Parts", "Transform", "Velocity", "Visual", "body_mass_data"]
 
 
 class _Columns:
@@ -314,6 +316,112 @@ class Hitbox:
     def __repr__(self) -> str:
         inner = ", ".join(f"{f}={object.__getattribute__(self, '_' + f)!r}" for f in _HITBOX_FIELDS)
         return f"Hitbox({inner})"
+
+
+#: The most parts a :class:`Parts` holds (a body's shapes are numbered 0, its Hitbox, to 63).
+MAX_PARTS = 63
+
+
+class Parts:
+    """More shapes of an entity's body, beside its :class:`Hitbox`: a body of several shapes (a
+    character with a head circle and a body box, an L-shaped crate, a car's chassis).
+
+    ``Parts([Hitbox(Circle(0.5), offset=(0, 1)), Hitbox(Polygon.box(0.5, 2), offset=(0.75, 0.75))])``:
+    each part is a Hitbox of its own, with its own shape, ``offset`` (in the entity's frame, turning
+    with it), material (``friction``, ``restitution``), ``mass`` or ``density``, ``inertia`` (about its
+    own centre of mass), ``layer``, ``mask``, ``sensor`` and ``one_way``. Its ``body`` must be the
+    entity's Hitbox's (a static compound body gives every part ``body="static"``). The entity's shapes
+    are numbered: 0 its Hitbox, 1, 2, ... these parts in order; collision events name them
+    (``CollisionEvent.part_a``, ``part_b``). Shapes of one body never collide with each other.
+
+    The body's mass is the sum of its shapes' masses, its centre of mass theirs together, its
+    moment of inertia about that centre the sum of each shape's about its own centre plus
+    ``m d^2`` for the distance ``d`` between the two (the parallel-axis theorem):
+    :func:`body_mass_data`, ``scene.mass_data(entity)``. A compound body turns when all its shapes
+    are circles or polygons and none has ``inertia=math.inf`` (an AABB never turns, a capsule is
+    turned only by the game).
+
+    Only the soft solver (``Scene(solver="soft")``) takes compound bodies: the exact solver and the
+    character controller refuse them (an :class:`InvalidValue` naming the entity, at the step's
+    checks, before anything changes). The parts are fixed when the Parts is made (a tuple); a part's
+    fields may be edited in a scene, as a Hitbox's (checked at the next step)."""
+
+    __slots__ = ("hitboxes", "_store", "_entity")
+    hitboxes: tuple[Hitbox, ...]
+    _store: BodyStore | None
+    _entity: int
+
+    def __init__(self, hitboxes: Iterable[Hitbox]) -> None:
+        if isinstance(hitboxes, Hitbox):
+            raise InvalidValue("Parts takes a list of Hitboxes, got one Hitbox: write Parts([hitbox])")
+        try:
+            items = tuple(hitboxes)
+        except TypeError:
+            raise InvalidValue(f"Parts takes a list of Hitboxes, got {hitboxes!r}") from None
+        if not 1 <= len(items) <= MAX_PARTS:
+            raise InvalidValue(f"Parts takes 1 to {MAX_PARTS} Hitboxes, got {len(items)}")
+        for i, hb in enumerate(items):
+            if not isinstance(hb, Hitbox):
+                raise InvalidValue(f"Parts: part {i + 1} must be a Hitbox, got {hb!r}")
+        if len({id(hb) for hb in items}) != len(items):
+            raise InvalidValue("Parts: the same Hitbox object is given twice; give each part its own")
+        object.__setattr__(self, "hitboxes", items)
+        object.__setattr__(self, "_store", None)
+        object.__setattr__(self, "_entity", -1)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError("Parts is fixed when made: replace the component (scene.add_component) to change "
+                             "the shapes, or edit a part's fields")
+
+    def __len__(self) -> int:
+        return len(self.hitboxes)
+
+    def __iter__(self) -> Iterator[Hitbox]:
+        return iter(self.hitboxes)
+
+    def __getitem__(self, i: int) -> Hitbox:
+        return self.hitboxes[i]
+
+    def __getstate__(self) -> dict[str, Any]:  # pickling (snapshots)
+        return {name: object.__getattribute__(self, name) for name in Parts.__slots__}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
+
+    def mass_data(self, hitbox: Hitbox) -> MassData:
+        """The mass data of the body made of ``hitbox`` (the entity's) and these parts:
+        :func:`body_mass_data`."""
+        return body_mass_data(hitbox, self)
+
+    def __repr__(self) -> str:
+        return f"Parts({list(self.hitboxes)!r})"
+
+
+def body_mass_data(hitbox: Hitbox, parts: Parts | Iterable[Hitbox] | None = None) -> MassData:
+    """The mass data (:class:`MassData`) of a body made of ``hitbox`` and ``parts`` (none: the
+    hitbox's own, :attr:`Hitbox.mass_data`). Mass: the sum of the shapes' masses; centre: the
+    mass-weighted mean of their centres (in the entity's frame); inertia about that centre: each
+    shape's inertia about its own centre plus its mass times its centre's squared distance from the
+    body's (the parallel-axis theorem). A shape of infinite mass makes the body immovable: mass and
+    inertia ``math.inf``, centre the mean of the infinite shapes' centres; a shape with
+    ``inertia=math.inf`` keeps the body from turning (inertia ``math.inf``)."""
+    if parts is None:
+        return hitbox.mass_data
+    datas = [hitbox.mass_data] + [hb.mass_data for hb in parts]
+    infinite = [d for d in datas if math.isinf(d.mass)]
+    if infinite:
+        k = len(infinite)
+        cx = sum(d.center[0] for d in infinite) / k
+        cy = sum(d.center[1] for d in infinite) / k
+        return MassData(math.inf, (cx, cy), math.inf)
+    mass = math.fsum(d.mass for d in datas)
+    cx = math.fsum(d.mass * d.center[0] for d in datas) / mass
+    cy = math.fsum(d.mass * d.center[1] for d in datas) / mass
+    if any(math.isinf(d.inertia) for d in datas):
+        return MassData(mass, (cx, cy), math.inf)
+    inertia = math.fsum(d.inertia + d.mass * ((d.center[0] - cx) ** 2 + (d.center[1] - cy) ** 2) for d in datas)
+    return MassData(mass, (cx, cy), inertia)
 
 
 def check_hitbox_field(name: str, value: object) -> Any:

@@ -11,14 +11,14 @@ from typing import Any
 
 import esper
 
-from .components import Body, Hitbox, Transform, Velocity, check_component
+from .components import Body, Hitbox, Parts, Transform, Velocity, check_component
 from .limits import check_hitbox_limits, check_position
-from .shapes import Shape
+from .shapes import ChainSegment, Shape
 from .sprites import Animation, Frame
 from .store import BodyStore
 from .validation import InvalidValue
 
-__all__ = ["MissingComponent", "check_added_component", "check_is_component", "spawn_components"]
+__all__ = ["MissingComponent", "check_added_component", "check_is_component", "check_parts", "spawn_components"]
 
 # Modules whose types are values, not components: Python's built-in types (str, int, float, bool,
 # bytes, tuple, list, dict, set, None, functions, modules, ...), the standard library's numbers and
@@ -121,7 +121,34 @@ def spawn_components(components: tuple[Any, ...]) -> tuple[Any, Any, Any]:
         check_position(t.x, t.y)
     if h is not None:
         check_hitbox_limits(h)
+    parts = kinds.get(Parts)
+    if parts is not None:
+        if h is None:
+            raise InvalidValue("an entity with Parts needs a Hitbox (its part 0, that gives the body its kind)")
+        check_parts(parts, h)
     return t, v, h
+
+
+def check_parts(parts: Parts, hitbox: Hitbox | None) -> None:
+    """Refuse a :class:`~framework.components.Parts` an entity whose Hitbox is ``hitbox`` cannot
+    take: a part with a bad field, beyond the scene's limits, already another entity's, or whose
+    body kind is not the Hitbox's. Normalises the parts' fields in place, as spawning a Hitbox does."""
+    if parts._store is not None:
+        raise InvalidValue(f"{parts!r} already belongs to an entity; give each entity its own")
+    for i, part in enumerate(parts.hitboxes, start=1):
+        try:
+            check_component(part)
+            check_hitbox_limits(part)
+        except InvalidValue as exc:
+            raise InvalidValue(f"Parts: part {i}: {exc}") from None
+        if isinstance(part.shape, ChainSegment):
+            raise InvalidValue(f"Parts: part {i} is a chain segment: a chain's segments are bodies of their own "
+                               "(framework.chains.spawn_chain); a plain Segment may be a part")
+        if part is hitbox or part._store is not None:
+            raise InvalidValue(f"Parts: part {i} is a Hitbox that belongs to an entity already; give each its own")
+        if hitbox is not None and part.body is not hitbox.body:
+            raise InvalidValue(f"Parts: part {i} is body={part.body.value!r}, the entity's Hitbox "
+                               f"body={hitbox.body.value!r}: the shapes of one body are of one kind")
 
 
 def check_added_component(store: BodyStore, entity: int, component: Any) -> None:
@@ -136,6 +163,14 @@ def check_added_component(store: BodyStore, entity: int, component: Any) -> None
     if isinstance(component, Hitbox):
         try:
             check_hitbox_limits(component)
+        except InvalidValue as exc:
+            raise InvalidValue(f"entity {entity}: {exc}") from None
+    if isinstance(component, Parts):
+        hb = esper.try_component(entity, Hitbox)
+        if entity not in store.row_of or hb is None:
+            raise InvalidValue(f"entity {entity}: Parts need a Hitbox (and a Transform) on the entity first")
+        try:
+            check_parts(component, hb)
         except InvalidValue as exc:
             raise InvalidValue(f"entity {entity}: {exc}") from None
     if isinstance(component, (Velocity, Hitbox)):

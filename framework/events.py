@@ -25,8 +25,8 @@ from .entities import is_value_type
 from .shapes import Shape
 from .validation import InvalidValue
 
-__all__ = ["CollisionEvent", "CollisionHandlers", "PairTracker", "STARTED", "ONGOING", "ENDED", "sorted_find",
-           "sorted_member", "sorted_members"]
+__all__ = ["CollisionEvent", "CollisionHandlers", "PartEvent", "PairTracker", "STARTED", "ONGOING", "ENDED",
+           "sorted_find", "sorted_member", "sorted_members"]
 
 STARTED: Literal["started"] = "started"
 ONGOING: Literal["ongoing"] = "ongoing"
@@ -43,11 +43,62 @@ class CollisionEvent(NamedTuple):
     depth: float
     point: Vec2
 
+    # Which shape of each body touched: 0 its Hitbox, i the i-th of its Parts (a body of several
+    # shapes). Not fields: an event stays a tuple of six; a compound body's events are PartEvents.
+    @property
+    def part_a(self) -> int:
+        """Which shape of ``a`` touched: 0, its Hitbox (a :class:`PartEvent` names its Parts)."""
+        return 0
+
+    @property
+    def part_b(self) -> int:
+        """Which shape of ``b`` touched: 0, its Hitbox (a :class:`PartEvent` names its Parts)."""
+        return 0
+
     def flipped(self) -> CollisionEvent:
-        """The same event seen from ``b``: entities swapped, normal negated."""
-        return CollisionEvent(
-            self.kind, self.b, self.a, Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0), self.depth, self.point
-        )
+        """The same event seen from ``b``: entities (and parts) swapped, normal negated."""
+        normal = Vec2(-self.normal.x + 0.0, -self.normal.y + 0.0)
+        if self.part_a or self.part_b:
+            return PartEvent(self.kind, self.b, self.a, normal, self.depth, self.point, self.part_b, self.part_a)
+        return CollisionEvent(self.kind, self.b, self.a, normal, self.depth, self.point)
+
+
+class PartEvent(CollisionEvent):
+    """A :class:`CollisionEvent` where a body of several shapes (:class:`~framework.components.Parts`)
+    touched with one of its other shapes: the same six fields, and ``part_a``, ``part_b``, which
+    shape of ``a`` and of ``b`` (0: the entity's Hitbox; i: the i-th of its Parts). Equal to another
+    event when the six fields and the parts are."""
+
+    _parts: tuple[int, int]
+
+    def __new__(cls, kind: Literal["started", "ongoing", "ended"], a: int, b: int, normal: Vec2, depth: float,
+                point: Vec2, part_a: int = 0, part_b: int = 0) -> PartEvent:
+        self = super().__new__(cls, kind, a, b, normal, depth, point)
+        self._parts = (part_a, part_b)
+        return self
+
+    @property
+    def part_a(self) -> int:
+        """Which shape of ``a`` touched: 0 its Hitbox, i the i-th of its Parts."""
+        return self._parts[0]
+
+    @property
+    def part_b(self) -> int:
+        """Which shape of ``b`` touched: 0 its Hitbox, i the i-th of its Parts."""
+        return self._parts[1]
+
+    def __eq__(self, other: object) -> bool:
+        return tuple.__eq__(self, other) is True and (
+            getattr(other, "part_a", 0), getattr(other, "part_b", 0)) == (self.part_a, self.part_b)
+
+    def __ne__(self, other: object) -> bool:
+        return not self == other
+
+    __hash__ = tuple.__hash__
+
+    def __repr__(self) -> str:
+        return (f"PartEvent(kind={self.kind!r}, a={self.a!r}, b={self.b!r}, normal={self.normal!r}, "
+                f"depth={self.depth!r}, point={self.point!r}, part_a={self.part_a!r}, part_b={self.part_b!r})")
 
 
 class StepContacts(NamedTuple):
@@ -134,18 +185,30 @@ class PairTracker:
 
 
 def to_events(
-    contacts: StepContacts, started: NDArray[np.bool_], ongoing: NDArray[np.bool_], ended: StepContacts
+    contacts: StepContacts, started: NDArray[np.bool_], ongoing: NDArray[np.bool_], ended: StepContacts,
+    parts: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
+    ended_parts: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None,
 ) -> list[CollisionEvent]:
-    """Event records, sorted by pair (a, b), then ended before started before ongoing."""
+    """Event records, sorted by pair (a, b), then ended before started before ongoing (``parts``,
+    ``ended_parts``: which shape of each body touched, beside ``contacts`` and ``ended``; None:
+    part 0 of each)."""
     out: list[tuple[int, int, int, CollisionEvent]] = []
-    for group, kind, order in ((ended, ENDED, 0), (contacts, None, 1)):
+    for group, kind, order, shapes in ((ended, ENDED, 0, ended_parts), (contacts, None, 1, parts)):
         if len(group.a) == 0:
             continue
         cols = [arr.tolist() for arr in group]
         st = started.tolist() if kind is None else None
-        for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
-            k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
-            out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py))))
+        if shapes is None:
+            for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
+                k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
+                out.append((a, b, order, CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py))))
+        else:
+            pa, pb = shapes[0].tolist(), shapes[1].tolist()
+            for i, (a, b, nx, ny, depth, px, py) in enumerate(zip(*cols)):
+                k = kind if kind is not None else (STARTED if st[i] else ONGOING)  # type: ignore[index]
+                ev = (PartEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py), pa[i], pb[i]) if pa[i] or pb[i] else
+                      CollisionEvent(k, a, b, Vec2(nx, ny), depth, Vec2(px, py)))
+                out.append((a, b, order, ev))
     out.sort(key=lambda t: (t[0], t[1], t[2]))
     return [t[3] for t in out]
 

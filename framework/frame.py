@@ -85,6 +85,10 @@ class StepFrame:
     contact_rows: tuple[_I, _I] = (_INTS, _INTS)
     started: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     ended: StepContacts = field(default_factory=StepContacts.empty)
+    # which shape of each body touched (the soft step, in a scene with compound bodies; else None:
+    # every shape is part 0): (part a, part b) beside ``contacts`` and beside ``ended``
+    parts: tuple[_I, _I] | None = None
+    ended_parts: tuple[_I, _I] | None = None
     # response: the contacts applied (a, b, nx, ny, pushed) and the pairs acted on, kept for the next
     # step with their push, impulse, the gap they ended with and their friction's tangential push
     # and impulse (a, b, nx, ny, push, impulse, gap, tangent push, tangent impulse)
@@ -106,6 +110,7 @@ class StepFrame:
         resting pairs)."""
         return StepFrame(dt=dt, render=render, pairs=self.pairs, contacts=self.contacts,
                          contact_rows=self.contact_rows, started=self.started, ended=self.ended,
+                         parts=self.parts, ended_parts=self.ended_parts,
                          resolved=self.resolved, support=self.support, points=self.points,
                          _events=self._events)
 
@@ -114,5 +119,6 @@ class StepFrame:
         """The frame's collision events (made on first use), sorted by pair: ended, then started
         or ongoing."""
         if self._events is None:
-            self._events = to_events(self.contacts, self.started, ~self.started, self.ended)
+            self._events = to_events(self.contacts, self.started, ~self.started, self.ended, self.parts,
+                                     self.ended_parts)
         return self._events

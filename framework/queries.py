@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .casting import ShapeHit, cast_rows, shape_bounds, touch_point
-from .collision import batch, collide
+from .collision import batch, collide, time_of_impact
 from .collision import batch_queries as bq
 from .collision.box_rows import rows_meeting
 from .collision.broad_phase import DIRECT_QUERY
@@ -178,6 +178,25 @@ class SpatialQueries:
         hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)
         return np.concatenate([st, mv[hit]])
 
+    def _parts(self, mask: int) -> list[tuple[int, Any, tuple[float, float, float]]]:
+        """The other shapes of the compound bodies (:class:`~framework.components.Parts`) whose
+        layer meets ``mask``: ``(entity, part hitbox, its pose (x, y, rotation))``, by entity then
+        part. A query answers a body's parts as its Hitbox, by its entity; compound bodies are few,
+        so their parts are tested one by one, without the broad phase."""
+        store = self.bodies.store
+        out = []
+        for e, parts in sorted(store.parts.items()):
+            r = store.row_of[e]
+            if store.hitboxes[r] is None:  # (refused by the step: not a body)
+                continue
+            x, y, rot = float(store.x[r]), float(store.y[r]), float(store.rot[r])
+            c, s = math.cos(rot), math.sin(rot)
+            for hb in parts.hitboxes:
+                if hb.layer & mask:
+                    ox, oy = hb.offset
+                    out.append((e, hb, (x + c * ox - s * oy, y + s * ox + c * oy, rot)))
+        return out
+
     def _mask_ok(self, rows: NDArray[np.intp], mask: int) -> NDArray[np.intp]:
         keep: NDArray[np.bool_] = (self.bodies.store.layer[rows] & mask) != 0  # (numpy types `!=` as Any)
         return rows[keep]
@@ -206,6 +225,15 @@ class SpatialQueries:
                            (ox, oy), (dx, dy), md)
             if hit is not None:
                 hits.append(SceneHit(int(store.entity[r]), *hit))
+        if store.parts:  # a compound body: where the ray first enters any of its shapes
+            for e, part, pose in self._parts(int(mask)):
+                hit = _raycast(part.shape, pose, (ox, oy), (dx, dy), md)
+                if hit is not None:
+                    hits.append(SceneHit(e, *hit))
+            first: dict[int, SceneHit] = {}
+            for h in sorted(hits, key=lambda h: h.distance):
+                first.setdefault(h.entity, h)
+            hits = list(first.values())
         hits.sort(key=lambda h: (h.distance, h.entity))
         self.pipeline.frame.ray_log.append(((ox, oy), (ex, ey), hits[0] if hits else None))
         return hits
@@ -229,6 +257,11 @@ class SpatialQueries:
             return ~np.isin(store.entity[rows], skip_entities)
 
         hit = cast_rows(self, shape, x0, y0, rot, mx, my, mask=mask, skip=skip if skip_entities.size else None)
+        if store.parts:
+            part_hit = self._cast_parts(shape, x0, y0, rot, mx, my, int(mask), set(skip_entities.tolist()))
+            if part_hit is not None and (hit is None or (part_hit.fraction, part_hit.entity)
+                                         < (hit[1], int(store.entity[hit[0]]))):
+                return part_hit
         if hit is None:
             return None
         r, fraction, nx, ny = hit
@@ -243,6 +276,27 @@ class SpatialQueries:
         at = (x0 + mx * fraction, y0 + my * fraction, rot)
         other = store.hitboxes[r].shape  # type: ignore[union-attr]  # (a row hit has a hitbox)
         return ShapeHit(entity, fraction, touch_point(shape, at, other, pose_b, -nx, -ny), Vec2(nx, ny))
+
+    def _cast_parts(self, shape: Any, x0: float, y0: float, rot: float, mx: float, my: float, mask: int,
+                    skip: set[int]) -> ShapeHit | None:
+        """The first part of a compound body ``shape`` would enter (sensors and ``skip``-ped
+        entities passed through), as :meth:`shape_cast` answers; by time of impact, then entity."""
+        best: ShapeHit | None = None
+        for e, part, pose in self._parts(mask):
+            if part.sensor or e in skip:
+                continue
+            impact = time_of_impact(shape, (x0, y0, rot), (mx, my), part.shape, pose)
+            if impact is None or (best is not None and (impact.fraction, e) >= (best.fraction, best.entity)):
+                continue
+            nx, ny = -impact.normal.x + 0.0, -impact.normal.y + 0.0  # (facing the cast shape)
+            if impact.fraction == 0.0:
+                contact = collide(shape, (x0, y0, rot), part.shape, pose)
+                if contact is not None:
+                    best = ShapeHit(e, 0.0, contact.point, Vec2(nx, ny))
+                    continue
+            at = (x0 + mx * impact.fraction, y0 + my * impact.fraction, rot)
+            best = ShapeHit(e, impact.fraction, touch_point(shape, at, part.shape, pose, -nx, -ny), Vec2(nx, ny))
+        return best
 
     def _world_extent(self, ox: float, oy: float) -> float:
         g = self.bodies.ensure_geometry()
@@ -264,7 +318,11 @@ class SpatialQueries:
         """Entities whose hitbox contains the point (closed: a point on the boundary counts)."""
         px, py = finite("x", x), finite("y", y)
         rows = self._mask_ok(self._candidate_rows(px - 1e-9, py - 1e-9, px + 1e-9, py + 1e-9), mask)
-        return sorted(int(self.bodies.store.entity[r]) for r in rows.tolist() if self._contains(r, px, py))
+        found = {int(self.bodies.store.entity[r]) for r in rows.tolist() if self._contains(r, px, py)}
+        if self.bodies.store.parts:
+            found |= {e for e, part, pose in self._parts(int(mask))
+                      if point_distance(part.shape, *pose, px, py)[0] == 0.0}
+        return sorted(found)
 
     def query_shape(self, shape: Any, position: tuple[float, float], rotation: float = 0.0,
                     mask: int = ALL_LAYERS) -> list[int]:
@@ -298,6 +356,10 @@ class SpatialQueries:
             e = int(store.entity[r])
             if d <= md and (best is None or (d, e) < (best.distance, best.entity)):
                 best = Nearest(e, d, at)
+        for e, part, pose in self._parts(int(mask)) if store.parts else ():
+            d, at = point_distance(part.shape, *pose, px, py)
+            if d <= md and (best is None or (d, e) < (best.distance, best.entity)):
+                best = Nearest(e, d, at)
         return best
 
     def distance(self, entity_a: int, entity_b: int) -> Distance:
@@ -313,7 +375,20 @@ class SpatialQueries:
                 raise InvalidValue(f"{name} must be an entity with a Hitbox, got {e!r}")
             poses.append((hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r]))))
         (sa, pa), (sb, pb) = poses
-        return shape_distance(sa, pa, sb, pb)
+        if not store.parts or not ({entity_a, entity_b} & store.parts.keys()):
+            return shape_distance(sa, pa, sb, pb)
+        # a compound body: the nearest of its shapes (the first of equals, Hitbox first)
+        shapes = self._parts(ALL_LAYERS)
+        of_a = [(sa, pa)] + [(p.shape, pose) for e, p, pose in shapes if e == entity_a]
+        of_b = [(sb, pb)] + [(p.shape, pose) for e, p, pose in shapes if e == entity_b]
+        best: Distance | None = None
+        for shape_a, pose_a in of_a:
+            for shape_b, pose_b in of_b:
+                d = shape_distance(shape_a, pose_a, shape_b, pose_b)
+                if best is None or d.distance < best.distance:
+                    best = d
+        assert best is not None
+        return best
 
     # --- many at once (framework.collision.batch_queries) -------------------------------------
 
@@ -361,6 +436,10 @@ class SpatialQueries:
         m = _mask_value(mask)
         geom = self._prepare()
         store, cols = self.bodies.store, self._shapes()
+        if store.parts:  # (compound bodies: the single queries, point by point)
+            found = [self.query_point(float(px), float(py), int(m)) for px, py in pts.tolist()]
+            offsets = np.concatenate([[0], np.cumsum([len(f) for f in found])]).astype(np.int64)
+            return PointHits(offsets, np.array([e for f in found for e in f], dtype=np.int64))
         offsets, entities = bq.points_inside(
             np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), store.kind, cols.kind, store.layer,
             store.entity, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, cols.sa, geom.cap_ux,
@@ -376,6 +455,12 @@ class SpatialQueries:
         m = _mask_value(mask)
         geom = self._prepare()
         store, cols = self.bodies.store, self._shapes()
+        if store.parts:  # (compound bodies: the single queries, point by point)
+            near = [self.nearest((float(px), float(py)), md, int(m)) for px, py in pts.tolist()]
+            return NearestMany(np.array([-1 if h is None else h.entity for h in near], dtype=np.int64),
+                               np.array([-1.0 if h is None else h.distance for h in near]),
+                               np.array([(px, py) if h is None else tuple(h.point) for h, (px, py) in
+                                         zip(near, pts.tolist())], dtype=np.float64).reshape(-1, 2))
         ent, dist, bx, by = bq.nearest_points(
             np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), md, store.kind, cols.kind, cols.sa,
             cols.sb, cols.local, cols.cnt, store.layer, store.entity, geom.minx, geom.miny, geom.maxx, geom.maxy,
@@ -400,6 +485,16 @@ class SpatialQueries:
         m = _mask_value(mask)
         geom = self._prepare()
         store, cols = self.bodies.store, self._shapes()
+        if store.parts:  # (compound bodies: the single queries, ray by ray; not logged for the overlay)
+            log = self.pipeline.frame.ray_log
+            logged = len(log)
+            first = [self.raycast_all((a, b), (c, d_), md, int(m)) for (a, b), (c, d_) in zip(o.tolist(), d.tolist())]
+            del log[logged:]
+            hits = [f[0] if f else None for f in first]
+            return RayHits(np.array([-1 if h is None else h.entity for h in hits], dtype=np.int64),
+                           np.array([-1.0 if h is None else h.distance for h in hits]),
+                           np.array([(0.0, 0.0) if h is None else tuple(h.point) for h in hits]).reshape(-1, 2),
+                           np.array([(0.0, 0.0) if h is None else tuple(h.normal) for h in hits]).reshape(-1, 2))
         ox, oy = np.ascontiguousarray(o[:, 0]), np.ascontiguousarray(o[:, 1])
         if math.isfinite(md):
             reach = np.full(ox.size, md)
@@ -459,9 +554,15 @@ class SpatialQueries:
         rows = self._mask_ok(self._candidate_rows(*box), mask)
         store, geom = self.bodies.store, self.bodies.geometry
         check_shape("shape", shape)
+        found: set[int] = self._overlapping_parts(shape, center, int(mask)) if store.parts else set()
         if rows.size == 0:
-            return []
+            return sorted(found)
         shapes_b = [store.hitboxes[r].shape for r in rows.tolist()]
         poses_b = list(zip(geom.hx[rows].tolist(), geom.hy[rows].tolist(), store.rot[rows].tolist()))
         res = batch.collide_many([shape] * rows.size, [center] * rows.size, shapes_b, poses_b)
-        return sorted(int(e) for e in store.entity[rows[res.hit]])
+        return sorted(found | {int(e) for e in store.entity[rows[res.hit]]})
+
+    def _overlapping_parts(self, shape: Any, center: tuple[float, float] | tuple[float, float, float],
+                           mask: int) -> set[int]:
+        """The compound bodies one of whose parts overlaps ``shape`` at ``center``."""
+        return {e for e, part, pose in self._parts(mask) if collide(shape, center, part.shape, pose) is not None}

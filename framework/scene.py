@@ -29,7 +29,7 @@ from .collision.broad_phase import SpatialHash
 from .collision.distance import Distance
 from .collision.results import Vec2
 from .compile_notice import FIRST_STEP_NOTICE, notice_if_slow
-from .components import Hitbox, Transform, Velocity, Visual
+from .components import Hitbox, MassData, Parts, Transform, Velocity, Visual, body_mass_data
 from .effects import DEFAULT_EFFECTS, EFFECTS, resolve_effects
 from .entities import MissingComponent, check_added_component, spawn_components
 from .events import CollisionEvent, CollisionHandlers, PairTracker, StepContacts, pair_parts
@@ -345,7 +345,9 @@ class Scene:
         if t is not None:
             self.bodies.store.add(entity, t, v, h)
         for comp in components:
-            if isinstance(comp, CharacterController):
+            if isinstance(comp, Parts):
+                self.bodies.store.set_parts(entity, comp)
+            elif isinstance(comp, CharacterController):
                 comp.bind(entity)
             elif isinstance(comp, Visual):
                 comp._bind(self.bodies.store if t is not None else None, entity, self.time)
@@ -438,6 +440,8 @@ class Scene:
             store.set_velocity(entity, component)
         elif isinstance(component, Hitbox):
             store.set_hitbox(entity, component)
+        elif isinstance(component, Parts):
+            store.set_parts(entity, component)
 
     def remove_component(self, entity: int, component_type: type) -> Any:
         """Remove and return ``entity``'s ``component_type`` component; it keeps its values."""
@@ -457,6 +461,8 @@ class Scene:
             store.set_velocity(entity, None)
         elif component_type is Hitbox and entity in store.row_of:
             store.set_hitbox(entity, None)
+        elif component_type is Parts and entity in store.row_of:
+            store.set_parts(entity, None)
         elif component_type is Visual:
             store.unbind(entity, comp)
             store.visual_changed(entity)
@@ -576,6 +582,8 @@ class Scene:
         dt = positive("dt", dt)
         store = self.bodies.store
         store.check()
+        if store.parts:
+            self._check_compound()
         joints = joint_components()
         if joints:
             check_joints(joints, store, self.solver)
@@ -652,6 +660,47 @@ class Scene:
                 first.add_note(f"{len(errors) - 1} other collision handler call(s) raised in step {self.frame} "
                                f"too: {others}{more}")
             raise first
+
+    def _check_compound(self) -> None:
+        """Refuse to step a scene whose compound bodies (entities with :class:`Parts`) it cannot
+        take: only the soft solver does, not for a character (the controller moves one shape), and
+        a body's shapes need its Hitbox and are of its kind. Changes nothing."""
+        from .systems.soft_step import MAX_COMPOUND_ENTITY
+
+        store = self.bodies.store
+        characters = esper.get_component(CharacterController) if "character" in self.effects else []
+        for e in sorted(store.parts):
+            parts = store.parts[e]
+            hb = store.hitboxes[store.row_of[e]]
+            if self.solver != "soft":
+                raise InvalidValue(f"entity {e} is a body of several shapes (Parts): the {self.solver} solver does not "
+                                   "take them; use Scene(solver='soft'), or remove its Parts")
+            if hb is None:
+                raise InvalidValue(f"entity {e} has Parts but no Hitbox: its Hitbox is its part 0 (give it one, or "
+                                   "remove its Parts)")
+            for i, part in enumerate(parts.hitboxes, start=1):
+                if part.body is not hb.body:
+                    raise InvalidValue(f"entity {e}: Parts: part {i} is body={part.body!r}, its Hitbox "
+                                       f"body={hb.body!r}: the shapes of one body are of one kind")
+            if esper.has_component(e, CharacterController):
+                raise InvalidValue(f"entity {e} is a character (CharacterController) with Parts: the character "
+                                   "controller moves bodies of one shape; remove its Parts")
+            if characters and any(not part.sensor for part in parts.hitboxes):
+                raise InvalidValue(f"entity {e} is a body of several shapes (Parts) in a scene with characters "
+                                   f"(entity {characters[0][0]}): the character controller does not see the parts of "
+                                   "compound bodies yet (it would walk through them); make its parts sensors, or the "
+                                   "body one shape")
+            if e >= MAX_COMPOUND_ENTITY:
+                raise InvalidValue(f"entity {e} has Parts: compound bodies take entity ids below "
+                                   f"{MAX_COMPOUND_ENTITY} (2**24)")
+
+    def mass_data(self, entity: int) -> MassData:
+        """The mass data of ``entity``'s body (:class:`MassData`: mass, centre of mass in the
+        entity's frame, moment of inertia about it): its Hitbox's, or with its :class:`Parts`, the
+        whole body's (:func:`~framework.components.body_mass_data`). :class:`MissingComponent` if it
+        has no Hitbox."""
+        hb = self.get(entity, Hitbox)
+        return body_mass_data(hb, self.try_get(entity, Parts))
 
     def _substep(self, dt: float, render: bool, checked: bool, errors: list[Exception], where: str) -> None:
         """One pass of the pipeline (``checked``: the store was just checked, nothing ran since).

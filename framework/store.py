@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from numbers import Real
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numba import njit
@@ -22,7 +22,17 @@ from numpy.typing import NDArray
 
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON, KIND_SEGMENT
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
-from .components import Body, Hitbox, Transform, Velocity, Visual, check_hitbox_field, check_mass_and_density
+from .components import (
+    Body,
+    Hitbox,
+    Parts,
+    Transform,
+    Velocity,
+    Visual,
+    check_component,
+    check_hitbox_field,
+    check_mass_and_density,
+)
 from .limits import MAX_COORD, check_hitbox_limits, check_position, rows_sound
 from .shapes import AABB, Capsule, Circle, Segment
 from .validation import InvalidValue
@@ -127,6 +137,9 @@ class BodyStore:
         self.shapes: list[Any] = []
         self.bad: dict[tuple[int, str], object] = {}
         self.dirty_hitboxes: set[int] = set()
+        # The other shapes of compound bodies (framework.components.Parts), by entity: the soft step
+        # poses them from their entity's row (framework.systems.soft_step.kernel_tables).
+        self.parts: dict[int, Parts] = {}
         self.static_epoch = 0  # bumped whenever static_dirty is set
         self.sleep_epoch = 0  # bumped whenever sleep_dirty is set
         self.static_dirty = True  # the static set or a static body changed: re-hash the statics
@@ -335,6 +348,8 @@ class BodyStore:
             self.sleep_dirty = True
         for comp in components:
             self.unbind(entity, comp)
+        if entity in self.parts:
+            self.unbind(entity, self.parts.pop(entity))
         del self.row_of[entity]
         for key in [k for k in self.bad if k[0] == entity]:
             del self.bad[key]
@@ -358,6 +373,10 @@ class BodyStore:
             comp._store = None
         elif isinstance(comp, (Hitbox, Visual)) and comp._store is self:
             object.__setattr__(comp, "_store", None)
+        elif isinstance(comp, Parts) and comp._store is self:
+            object.__setattr__(comp, "_store", None)
+            for hb in comp.hitboxes:
+                object.__setattr__(hb, "_store", None)
 
     def visual_changed(self, entity: int) -> None:
         """Stamp ``entity``'s row (if it has one) as changed for renderers: its Visual was edited,
@@ -400,6 +419,29 @@ class BodyStore:
         if hitbox is not None:
             object.__setattr__(hitbox, "_store", self)
             object.__setattr__(hitbox, "_entity", entity)
+        self.version += 1
+
+    def set_parts(self, entity: int, parts: Parts | None) -> None:
+        """Give ``entity`` (a row) the other shapes ``parts`` of a compound body, or none; the old
+        ones are unbound. Their hitboxes are bound to the entity: an edit of a part's field is
+        checked and applied at the next step, as the entity's Hitbox's."""
+        row = self.row_of[entity]
+        if self._undo is not None:
+            self._before_change(row)
+        old = self.parts.pop(entity, None)
+        if old is not None and old is not parts:
+            self.unbind(entity, old)
+        if parts is not None:
+            self.parts[entity] = parts
+            object.__setattr__(parts, "_store", self)
+            object.__setattr__(parts, "_entity", entity)
+            for hb in parts.hitboxes:
+                object.__setattr__(hb, "_store", self)
+                object.__setattr__(hb, "_entity", entity)
+        self.static_dirty = True
+        self.wake(row)
+        self.looks += 1  # (renderers draw every part: look again)
+        self.cols["look"][row] = self.looks
         self.version += 1
 
     def _set_hitbox_row(self, row: int, hb: Hitbox | None) -> None:
@@ -551,7 +593,8 @@ class BodyStore:
                         problems.append((e, col, float(self.cols[col][row])))
         for e in sorted(self.dirty_hitboxes):
             hb = self.hitboxes[self.row_of[e]]
-            assert hb is not None
+            if hb is None:  # (a part of a body without a Hitbox: the scene's checks refuse it)
+                continue
             for name in _HITBOX_FIELD_NAMES:
                 try:
                     value = check_hitbox_field(name, object.__getattribute__(hb, "_" + name))
@@ -565,6 +608,15 @@ class BodyStore:
                 check_hitbox_limits(hb)
             except InvalidValue as exc:
                 raise InvalidValue(f"entity {e}: {exc}") from None
+            parts = self.parts.get(e)
+            for i, part in enumerate(parts.hitboxes if parts is not None else ()):
+                try:
+                    for name in _HITBOX_FIELD_NAMES:
+                        check_hitbox_field(name, object.__getattribute__(part, "_" + name))
+                    check_mass_and_density(part)
+                    check_hitbox_limits(part)
+                except InvalidValue as exc:
+                    raise InvalidValue(f"entity {e}: part {i + 1}: {exc}") from None
         if problems:
             e, col, v = min(problems, key=lambda p: (p[0], p[1]))
             raise InvalidValue(f"entity {e}: {_FIELD_NAMES[col]} must be a finite number, got {v!r}")
@@ -584,7 +636,9 @@ class BodyStore:
             row = self.row_of[e]
             if self._undo is not None:
                 self._before_change(row)
-            hb = cast(Hitbox, self.hitboxes[row])  # (the row of an edited hitbox holds it)
+            hb = self.hitboxes[row]
+            if hb is None:  # (a part edited on an entity whose Hitbox was removed: refused by the scene's checks)
+                continue
             try:
                 for name in ("offset", "layer", "mask", "body", "mass", "restitution", "friction", "inertia",
                              "density"):
@@ -593,6 +647,9 @@ class BodyStore:
                 check_mass_and_density(hb)
             except InvalidValue as err:
                 raise InvalidValue(f"entity {e}: {err}") from None
+            parts = self.parts.get(e)
+            for part in parts.hitboxes if parts is not None else ():
+                check_component(part)  # (checked above: normalises its fields in place)
             self._set_hitbox_row(row, hb)
         self.dirty_hitboxes = set()
         if changed:

@@ -398,7 +398,8 @@ def test_candidate_pairs_kept_between_steps_are_those_a_full_sweep_finds():
         s.step(1 / 60)
         cnt = stage._kernel_tables[1][8]  # (iprops: the vertex counts)
         fixed = (store.body == 2) | ~store.has_vel
-        full = _candidate_pairs(stage.fat, cnt, fixed, store.layer, store.mask, True, store.entity)
+        full = _candidate_pairs(stage.fat, cnt, fixed, store.layer, store.mask, True, store.entity,
+                                np.arange(store.n))
         assert np.array_equal(full, stage.pairs)
         # (pairs that changed without a full sweep: the incremental update ran)
         incremental += s.counters["rehashed"] == 0 and not np.array_equal(before, stage.pairs)

@@ -38,7 +38,9 @@ import pyglet
 from pyglet import gl
 from pyglet.graphics import Batch, Group
 
+from ..components import Body
 from ..events import pair_keys, sorted_find
+from ..shapes import AABB
 from ..store import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT
 
 __all__ = ["HUD_FONT_SIZE", "HUD_LINE_PX", "OVERLAY_COLORS", "DebugOverlay", "wrap_figures"]
@@ -172,6 +174,37 @@ def _outline_segments(store: Any, geometry: Any, rows: np.ndarray) -> list[Segme
         seg_colors = np.broadcast_to(colors[capsules][:, None, :], segs.shape[:2] + (4,))
         out.append((segs.reshape(-1, 4), seg_colors.reshape(-1, 4)))
     return out
+
+
+def _part_segments(store: Any) -> list[Segments]:
+    """The outlines of the other shapes of compound bodies (:class:`~framework.components.Parts`),
+    each posed by its entity's transform (its offset turning with it; an AABB's box never turns) and
+    coloured as its body (a sensor part as a sensor). Every compound body's, seen or not: they are
+    few, and a part may reach into view from a body that is not."""
+    if not store.parts:
+        return []
+    from .drawables import fill_outline
+
+    names = {Body.DYNAMIC: "dynamic", Body.KINEMATIC: "kinematic", Body.STATIC: "static"}
+    ends: list[tuple[float, float, float, float]] = []
+    colors: list[tuple[int, ...]] = []
+    for e, parts in sorted(store.parts.items()):
+        row = store.row_of[e]
+        x, y, rot = float(store.x[row]), float(store.y[row]), float(store.rot[row])
+        c, s = math.cos(rot), math.sin(rot)
+        for hb in parts.hitboxes:
+            ox, oy = hb.offset
+            hx, hy = x + c * ox - s * oy, y + s * ox + c * oy
+            turn = (1.0, 0.0) if isinstance(hb.shape, AABB) else (c, s)
+            pts = [(hx + turn[0] * px - turn[1] * py, hy + turn[1] * px + turn[0] * py)
+                   for px, py in fill_outline(hb.shape)]
+            color = OVERLAY_COLORS["asleep" if store.asleep[row] else "sensor" if hb.sensor else names[hb.body]]
+            closed = len(pts) > 2
+            for i in range(len(pts) if closed else 1):
+                (ax, ay), (bx, by) = pts[i], pts[(i + 1) % len(pts)]
+                ends.append((ax, ay, bx, by))
+                colors.append(tuple(color))
+    return [_segments(ends, np.array(colors, dtype=np.uint8).reshape(-1, 4))]
 
 
 def _velocity_segments(store: Any, rows: np.ndarray) -> list[Segments]:
@@ -375,6 +408,7 @@ class DebugOverlay:
         parts: list[Segments] = []
         parts += _cell_segments(bodies.hash, renderer.camera.view_box())
         parts += _outline_segments(store, geometry, rows[store.kind[rows] >= 0])
+        parts += _part_segments(store)
         parts += _velocity_segments(store, rows)
         parts += _swept_path_segments(frame.swept_paths)
         parts += _ray_segments(frame.ray_log, NORMAL_PX / zoom)

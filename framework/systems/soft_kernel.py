@@ -128,43 +128,44 @@ def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
 
 @leaf
 def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
-                  wc, wv, wn, lo, hi, reach):
+                  wc, wv, wn, lo, hi, reach, owner):
     """World centres, vertices and normals of every hitbox (``cnt == 0``: none) and its bounds, widened by
-    ``margin0`` and swept by the body's motion this step; ``reach``: how far the body may move."""
-    n = x.size
+    ``margin0`` and swept by the body's motion this step; ``reach``: how far the body may move. The
+    shape rows are posed by their ``owner`` body rows (a row of its own but for a compound body's parts)."""
     g = (abs(gx) + abs(gy)) * dt * dt
-    for r in range(n):
-        k = cnt[r]
+    for q in range(cnt.size):
+        k = cnt[q]
         if k == 0:
             continue
+        r = owner[q]
         c, s = math.cos(rot[r]), math.sin(rot[r])
-        ox, oy = off[r, 0], off[r, 1]
+        ox, oy = off[q, 0], off[q, 1]
         hx, hy = x[r] + c * ox - s * oy, y[r] + s * ox + c * oy
-        wc[r, 0], wc[r, 1] = hx, hy
-        if not spin[r]:
+        wc[q, 0], wc[q, 1] = hx, hy
+        if not spin[q]:
             c, s = 1.0, 0.0
         mnx, mny, mxx, mxy = 1e300, 1e300, -1e300, -1e300
         for i in range(k):
-            px, py = lv[r, i, 0], lv[r, i, 1]
+            px, py = lv[q, i, 0], lv[q, i, 1]
             qx, qy = hx + c * px - s * py, hy + s * px + c * py
-            wv[r, i, 0], wv[r, i, 1] = qx, qy
-            wn[r, i, 0] = c * ln[r, i, 0] - s * ln[r, i, 1]
-            wn[r, i, 1] = s * ln[r, i, 0] + c * ln[r, i, 1]
+            wv[q, i, 0], wv[q, i, 1] = qx, qy
+            wn[q, i, 0] = c * ln[q, i, 0] - s * ln[q, i, 1]
+            wn[q, i, 1] = s * ln[q, i, 0] + c * ln[q, i, 1]
             mnx, mxx = min(mnx, qx), max(mxx, qx)
             mny, mxy = min(mny, qy), max(mxy, qy)
-        rad = rr[r] + margin0
+        rad = rr[q] + margin0
         mnx, mny, mxx, mxy = mnx - rad, mny - rad, mxx + rad, mxy + rad
         m = 0.0
         if moving[r] and not driven[r]:
             ex, ey = vx[r] * dt, vy[r] * dt
-            m = abs(ex) + abs(ey) + abs(w[r]) * bound[r] * dt + g
-            turn = abs(w[r]) * bound[r] * dt + g
+            m = abs(ex) + abs(ey) + abs(w[r]) * bound[q] * dt + g
+            turn = abs(w[r]) * bound[q] * dt + g
             mnx += min(ex, 0.0) - turn
             mxx += max(ex, 0.0) + turn
             mny += min(ey, 0.0) - turn
             mxy += max(ey, 0.0) + turn
-        lo[r, 0], lo[r, 1], hi[r, 0], hi[r, 1] = mnx, mny, mxx, mxy
-        reach[r] = m
+        lo[q, 0], lo[q, 1], hi[q, 0], hi[q, 1] = mnx, mny, mxx, mxy
+        reach[q] = m
 
 
 @njit(cache=True)
@@ -213,10 +214,11 @@ def _float_keys(v):
 
 
 @njit(cache=True)
-def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
+def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity, owner):
     """Sort-and-sweep along x over the fat bounds: the pairs of rows whose fat bounds overlap
-    (never two fixed ones; layers that meet), as rows ``(a, b, key)`` with ``entity[a] < entity[b]``
-    and ``key = entity[a] << 32 | entity[b]``, sorted by key."""
+    (never two fixed ones, never two shapes of one ``owner`` body; layers that meet), as rows
+    ``(a, b, key)`` with ``entity[a] < entity[b]`` and ``key = entity[a] << 32 | entity[b]``, sorted
+    by key (``entity``: the shape rows' key ids, a body's entity for its own row)."""
     n = fat.shape[0]
     xs = np.empty(n)
     for i in range(n):
@@ -235,7 +237,7 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity):
             j = order[jj]
             if fat[j, 0] > xmax:
                 break
-            if cnt[j] == 0 or (fixed[i] and fixed[j]):
+            if cnt[j] == 0 or (fixed[i] and fixed[j]) or owner[i] == owner[j]:
                 continue
             if fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3]:
                 continue
@@ -269,7 +271,7 @@ def _fat_overlap(fat, i, j):
 
 
 @njit(cache=True)
-def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs):
+def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs, owner):
     """The candidate pairs after the ``moved`` rows took new fat bounds: exactly what
     :func:`_candidate_pairs` would find (pairs of unmoved rows keep their overlap), at the cost of a
     pass over the pairs and one over the rows per moved row."""
@@ -290,7 +292,7 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
         if not moved[e] or cnt[e] == 0:
             continue
         for j in range(n):
-            if j == e or cnt[j] == 0 or (moved[j] and j < e) or (fixed[e] and fixed[j]):
+            if owner[j] == owner[e] or cnt[j] == 0 or (moved[j] and j < e) or (fixed[e] and fixed[j]):
                 continue
             if not _fat_overlap(fat, e, j):
                 continue
@@ -360,13 +362,15 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 
 @njit(cache=True)
 def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction, kind, cnt, rr, sensor,
-                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii, apart):
+                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity):
     """The manifold of every candidate pair, and the contacts the solver uses, prepared (anchors, effective
     masses, warm starts from the pair's slot by feature id): ``(nc, ci, cf, cp, tnow, evd)``, see
     :func:`soft_step`; a pair whose bodies both rest keeps its state (``tnow`` -1); a pair whose key is
-    in ``apart`` (sorted: the bodies of a joint) never touches."""
+    in ``apart`` (sorted: the bodies of a joint) never touches. The pairs are of shape rows; the
+    solver's bodies are their ``owner`` rows (``ci`` columns 2, 3)."""
     m = pairs.shape[0]
-    ci = np.empty((m, 2), dtype=np.int64)  # the contact's pair slot, points the solver uses
+    compound = owner.size != moving.size  # (shape rows beyond the body rows: parts of compound bodies)
+    ci = np.empty((m, 4), dtype=np.int64)  # the contact's pair slot, points the solver uses, its two bodies
     cf = np.empty((m, 5))  # nx, ny, friction, restitution, stiff (against an idle body)
     cp = np.empty((m, 2, 13))
     tnow = np.zeros(m, dtype=np.int8)  # in contact now: 1 yes, 0 no, -1 not measured (keeps its state)
@@ -374,16 +378,22 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
     out = np.empty((2, 4))
     nc = np.int64(0)  # (not the literal 0: the solver's functions would compile twice, for it and for int64)
     for p in range(m):
-        a, b = pairs[p, 0], pairs[p, 1]
+        a, b = pairs[p, 0], pairs[p, 1]  # shape rows
+        ba, bb = owner[a], owner[b]  # their bodies' rows
         was = slots[p, _TOUCH] != 0.0
-        if not moving[a] and not moving[b]:  # asleep (or still): keeps what it had
+        if not moving[ba] and not moving[bb]:  # asleep (or still): keeps what it had
             tnow[p] = -1
             slots[p, _NP] = 0.0
             continue
-        if apart.size and holds(apart, pairs[p, 2]):  # joined, not colliding
-            tnow[p] = 0
-            slots[p, _NP] = 0.0
-            continue
+        if apart.size:  # joined, not colliding (``apart``: keys of entities)
+            key = pairs[p, 2]
+            if compound:
+                ea, eb = min(entity[a], entity[b]), max(entity[a], entity[b])
+                key = (ea << 32) | eb
+            if holds(apart, key):
+                tnow[p] = 0
+                slots[p, _NP] = 0.0
+                continue
         s_pair = spec + reach[a] + reach[b] if response else 0.0
         if kind[a] == _AABB and kind[b] == _AABB:  # the common case, inline (an AABB's corner 2: its half extents)
             k, nx, ny = box_box(wc[a, 0], wc[a, 1], lv[a, 2, 0], lv[a, 2, 1], wc[b, 0], wc[b, 1], lv[b, 2, 0],
@@ -424,7 +434,7 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
         if use and (one_way[a] or one_way[b]):
             up = ny if one_way[a] else -ny  # the normal from the platform to the other body
             use = up > 0.5 and low > -4.0 * slop
-        if use and im[a] == 0.0 and im[b] == 0.0 and ii[a] == 0.0 and ii[b] == 0.0:
+        if use and im[ba] == 0.0 and im[bb] == 0.0 and ii[ba] == 0.0 and ii[bb] == 0.0:
             use = False
         if not use:
             slots[p, _NP] = 0.0
@@ -444,7 +454,7 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
             paired = 2.0
         else:
             paired = 0.0
-        ci[nc, 0], ci[nc, 1] = p, k
+        ci[nc, 0], ci[nc, 1], ci[nc, 2], ci[nc, 3] = p, k, ba, bb
         fa, fb = friction[a], friction[b]
         mu = 0.0
         if use_friction:
@@ -458,9 +468,10 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
         cf[nc, 3] = max(restitution[a], restitution[b])
         # the softness to use: 0 between moving bodies, 1 against an idle one (stiffer), + 2 for a
         # row standing for two points
-        cf[nc, 4] = (1.0 if (not moving[a] or not moving[b]) else 0.0) + paired
+        cf[nc, 4] = (1.0 if (not moving[ba] or not moving[bb]) else 0.0) + paired
         tx, ty = ny, -nx  # Box2D's right perp
         old_np = int(slots[p, _NP])
+        a, b = ba, bb  # (from here on, the bodies)
         for j in range(k):
             px, py = out[j, 0], out[j, 1]
             ax_, ay_ = px - x[a], py - y[a]
@@ -489,7 +500,7 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
 
 @njit(cache=True)
 def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving, ended_keys, ended_f, n_end,
-            rebuilt, sleepers):
+            rebuilt, sleepers, owner, part):
     """Store the impulses in the pairs' slots and report which pairs are in contact: ``(touch_i,
     touch_f, end_i, end_f, info)``, see :func:`soft_step`."""
     m = pairs.shape[0]
@@ -518,6 +529,7 @@ def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
                     slots[p, _NX + q] = evd[p, q]
                 a, b = pairs[p, 0], pairs[p, 1]
                 if not (sensor[a] or sensor[b]):  # a sleeper an awake body touches wakes
+                    a, b = owner[a], owner[b]
                     if asleep[a] and moving[b]:
                         wake[a] = True
                     if asleep[b] and moving[a]:
@@ -529,13 +541,14 @@ def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
             n_end += 1
         slots[p, _TOUCH] = 1.0 if touching else 0.0
     # the touching pairs, as the frame's contact columns
-    touch_i = np.empty((5, n_touch), dtype=np.int64)
+    touch_i = np.empty((7, n_touch), dtype=np.int64)
     touch_f = np.empty((5, n_touch))
     for i in range(n_touch):
         p = touching_idx[i]
         a, b = pairs[p, 0], pairs[p, 1]
-        touch_i[0, i], touch_i[1, i], touch_i[2, i], touch_i[3, i] = a, b, entity[a], entity[b]
+        touch_i[0, i], touch_i[1, i], touch_i[2, i], touch_i[3, i] = owner[a], owner[b], entity[a], entity[b]
         touch_i[4, i] = 1 if started[i] else 0
+        touch_i[5, i], touch_i[6, i] = part[a], part[b]
         for q in range(5):
             touch_f[q, i] = slots[p, _NX + q]
     end_i = np.empty((2, n_end), dtype=np.int64)
@@ -567,8 +580,13 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     :func:`framework.systems.soft_step.kernel_tables`; an array argument costs about 0.3 us to pass):
     ``fprops`` (inverse mass, inverse inertia, friction, restitution, bounding radius, rounding
     radius), ``iprops`` (body kind, shape kind, layer, mask, entity, sensor, one-way, has a
-    velocity, vertex count, turns with the body), ``off`` (hitbox offsets) and ``verts`` (each
-    row's local vertices, then normals); ``faces``: each row's internal faces (:func:`internal_faces`).
+    velocity, vertex count, turns with the body, then the owner, key id and part number of each
+    shape row), ``off`` (hitbox offsets) and ``verts`` (each row's local vertices, then normals);
+    ``faces``: each row's internal faces (:func:`internal_faces`). The pose and velocity columns
+    are the bodies'; the tables may hold more rows than they, the shape rows of compound bodies'
+    other parts, each posed by its owner body row and acting on it (its contacts' impulses go to
+    the owner; two shapes of one owner never pair); without compound bodies each row is its own
+    owner and the step is what it was before they existed, bit for bit.
     ``driven``: rows a character controller moved this step (they are not moved again, and take
     no impulse); ``fat``: each row's fat bounds; ``pairs, slots``: the candidate pairs kept from the last step
     (rows a, b and key) and their slots (``rebuild``: the rows changed, find them again); these are
@@ -580,22 +598,25 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
 
     Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp)`` (few objects: each
     array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
-    slots for the next step; the pairs touching now (``touch_i`` rows: row a, row b, entity a,
-    entity b, started; ``touch_f`` rows: nx, ny, depth, px, py), the pairs that stopped touching
-    (``end_i`` rows: entity a, entity b; ``end_f``: their last contact); ``info``: whether the pairs
+    slots for the next step; the pairs touching now (``touch_i`` rows: body row a, body row b,
+    entity a, entity b, started, part a, part b; ``touch_f`` rows: nx, ny, depth, px, py), the pairs
+    that stopped touching (``end_i`` rows: key id a, key id b, the entities but for parts, see
+    ``soft_step.part_ids``; ``end_f``: their last contact); ``info``: whether the pairs
     were found again, how many contacts the solver used, how many bodies sleep (before this step's
     wakes), then the rows of the sleepers to wake; the joints' impulses."""
     inv_mass, inv_inertia, friction, restitution, bound, rr = fprops[0], fprops[1], fprops[2], fprops[3], fprops[4], \
         fprops[5]
     body, kind, layer, mask, entity = iprops[0], iprops[1], iprops[2], iprops[3], iprops[4]
     sensor, one_way, has_vel, cnt, spin = iprops[5], iprops[6], iprops[7], iprops[8], iprops[9]
+    owner, sid, part = iprops[10], iprops[11], iprops[12]
     lv, ln = verts[:, :, 0:2], verts[:, :, 2:4]
     dt = params[_DT]
     nsub = int(params[_SUB])
     gx, gy = params[_GX], params[_GY]
     slop, spec = params[_SLOP], params[_SPEC]
     response, rotation, use_friction = params[_RESPONSE] != 0.0, params[_ROT] != 0.0, params[_FRIC] != 0.0
-    n = x.size
+    n = x.size  # the bodies' rows; then, in compound scenes, the shape rows of their other parts
+    ns = cnt.size
     K = lv.shape[1]
 
     # --- bodies: who moves, who takes impulses ----------------------------------------------
@@ -638,51 +659,56 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
             shifted = True
     if shifted:
         x_origin, y_origin = x.copy(), y.copy()
-        off, bound, centre0 = _to_centres(x, y, rot, off, bound, conv)
+        off, bound, centre0 = _to_centres(x, y, rot, off, bound, conv, owner)
         if jint is not None:
             jf = _anchors_from_centres(jint, jf, off, conv)
 
     # --- shapes, fat bounds and the broad phase ----------------------------------------------------
-    wc = np.empty((n, 2))
-    wv = np.empty((n, K, 2))
-    wn = np.empty((n, K, 2))
-    lo = np.empty((n, 2))
-    hi = np.empty((n, 2))
-    reach = np.zeros(n)
+    wc = np.empty((ns, 2))
+    wv = np.empty((ns, K, 2))
+    wn = np.empty((ns, K, 2))
+    lo = np.empty((ns, 2))
+    hi = np.empty((ns, 2))
+    reach = np.zeros(ns)
     margin0 = 0.5 * spec if response else 0.0
     _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, spin, bound, dt, gx, gy, margin0,
-                  wc, wv, wn, lo, hi, reach)
+                  wc, wv, wn, lo, hi, reach, owner)
+    fixed_s = fixed  # each shape row's body is fixed
+    if ns != n:
+        fixed_s = np.empty(ns, dtype=np.bool_)
+        for q in range(ns):
+            fixed_s[q] = fixed[owner[q]]
     fat_margin = params[_FAT]
     fat = fat.copy()  # (the step's inputs stay as they were: a failed step is undone by keeping them)
     slots = slots.copy()
-    moved = np.zeros(n, dtype=np.bool_)  # left its fat bounds (or the rows changed): new fat bounds
+    moved = np.zeros(ns, dtype=np.bool_)  # left its fat bounds (or the rows changed): new fat bounds
     n_moved = 0
-    for r in range(n):
+    for r in range(ns):
         if cnt[r] == 0:
             continue
         inside = (lo[r, 0] >= fat[r, 0] and lo[r, 1] >= fat[r, 1] and hi[r, 0] <= fat[r, 2]
                   and hi[r, 1] <= fat[r, 3])
         if rebuild or not inside:
-            e = 0.0 if fixed[r] else fat_margin
+            e = 0.0 if fixed_s[r] else fat_margin
             fat[r, 0], fat[r, 1], fat[r, 2], fat[r, 3] = lo[r, 0] - e, lo[r, 1] - e, hi[r, 0] + e, hi[r, 1] + e
             moved[r] = True
             n_moved += 1
     n_end = np.int64(0)
     ended_keys = np.empty(pairs.shape[0], dtype=np.int64)
     ended_f = np.empty((pairs.shape[0], 5))
-    rebuilt = rebuild or 8 * n_moved > n
+    rebuilt = rebuild or 8 * n_moved > ns
     if rebuilt or n_moved:
         if rebuilt:  # everything again: sort and sweep
-            new = _candidate_pairs(fat, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity)
+            new = _candidate_pairs(fat, cnt, fixed_s, layer, mask, params[_LAYERS] != 0.0, sid, owner)
         else:  # a few bodies left their fat bounds: only their pairs change
-            new = _moved_pairs(fat, moved, cnt, fixed, layer, mask, params[_LAYERS] != 0.0, entity, pairs)
+            new = _moved_pairs(fat, moved, cnt, fixed_s, layer, mask, params[_LAYERS] != 0.0, sid, pairs, owner)
         slots, n_end = _merge_slots(pairs[:, 2], slots, new[:, 2], ended_keys, ended_f)
         pairs = new
 
     # --- narrow phase: manifolds -> contacts, prepared ---------------------------------------------
     nc, ci, cf, cp, tnow, evd = _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction,
                                               kind, cnt, rr, sensor, one_way, friction, restitution, faces, wc, lv,
-                                              wv, wn, x, y, vx, vy, w, im, ii, apart)
+                                              wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity)
 
     # --- sub-steps ------------------------------------------------------------------------------
     h = dt / nsub if nsub > 0 else 0.0
@@ -739,16 +765,18 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
 
     # --- store the impulses in the slots; which pairs are in contact ----------------------------
     touch_i, touch_f, end_i, end_f, info = _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
-                                                   ended_keys, ended_f, n_end, rebuilt, sleepers)
+                                                   ended_keys, ended_f, n_end, rebuilt, sleepers, owner, part)
     return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp
 
 
 @njit(cache=True)
-def _to_centres(x, y, rot, off, bound, conv):
+def _to_centres(x, y, rot, off, bound, conv, owner):
     """Move the ``conv`` rows' positions from their origins to their centres of mass (``off``
     columns 2, 3, in the body's frame): returns copies of ``off`` and ``bound`` for the step, the
     hitbox offsets measured from the centres and the reach of each hitbox about them, and each
-    centre turned into the world at the step's start (``R(rot) c``)."""
+    centre turned into the world at the step's start (``R(rot) c``). The shape rows of a compound
+    body's other parts (after the body rows, posed by their ``owner``) have their offsets measured
+    from their body's centre too (their reach already holds it: see ``kernel_tables``)."""
     n = x.size
     off = off.copy()
     bound = bound.copy()
@@ -764,6 +792,11 @@ def _to_centres(x, y, rot, off, bound, conv):
         off[r, 0] -= cx
         off[r, 1] -= cy
         bound[r] += math.sqrt(off[r, 0] * off[r, 0] + off[r, 1] * off[r, 1])
+    for q in range(n, owner.size):
+        r = owner[q]
+        if conv[r]:
+            off[q, 0] -= off[r, 2]
+            off[q, 1] -= off[r, 3]
     return off, bound, centre0
 
 
@@ -816,8 +849,7 @@ def _push(px, py, ma, ia, mb, ib, ax, ay, bx, by, vax, vay, wa, vbx, vby, wb, tu
 def _warm_start(nc, ci, cf, cp, pairs, vx, vy, w, im, ii):
     """Apply each point's accumulated impulses (Box2D's ``b2WarmStartContacts``)."""
     for c in range(nc):
-        p = ci[c, 0]
-        a, b = pairs[p, 0], pairs[p, 1]
+        a, b = ci[c, 2], ci[c, 3]
         nx, ny = cf[c, 0], cf[c, 1]
         tx, ty = ny, -nx
         vax, vay, wa, vbx, vby, wb = vx[a], vy[a], w[a], vx[b], vy[b], w[b]
@@ -836,9 +868,8 @@ def _solve(nc, ci, cf, cp, pairs, x, y, x0, y0, qc, qs, vx, vy, w, im, ii, use_b
     """One pass over the contacts (Box2D's ``b2SolveContact``): the normal impulses with soft
     constraints (``use_bias``) or rigid ones without bias (the relax), then friction."""
     for c in range(nc):
-        p = ci[c, 0]
         k = ci[c, 1]
-        a, b = pairs[p, 0], pairs[p, 1]
+        a, b = ci[c, 2], ci[c, 3]
         mA, iA, mB, iB = im[a], ii[a], im[b], ii[b]
         vax, vay, wa = vx[a], vy[a], w[a]
         vbx, vby, wb = vx[b], vy[b], w[b]
@@ -902,8 +933,7 @@ def _restitution(nc, ci, cf, cp, pairs, vx, vy, w, im, ii, threshold):
         e = cf[c, 3]
         if e == 0.0:
             continue
-        p = ci[c, 0]
-        a, b = pairs[p, 0], pairs[p, 1]
+        a, b = ci[c, 2], ci[c, 3]
         nx, ny = cf[c, 0], cf[c, 1]
         vax, vay, wa, vbx, vby, wb = vx[a], vy[a], w[a], vx[b], vy[b], w[b]
         for j in range(ci[c, 1]):

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..character import CharacterController
 from ..compile_notice import notice_if_slow
+from ..components import Body, body_mass_data
 from ..events import StepContacts
 from ..frame import StepFrame
 from ..joints import (
@@ -45,8 +46,9 @@ from ..joints import (
     joint_components,
     joint_writes,
 )
-from ..shapes import ChainSegment
-from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT, STATIC
+from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment
+from ..store import DYNAMIC, KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT, NO_FRICTION, STATIC
+from ..validation import InvalidValue
 from .soft_joints import JOINT_F, JOINT_IMP
 from .soft_kernel import CHAIN_KIND, PARAMS, SLOT, internal_faces, soft_step
 from .stage import PRIORITY, Stage
@@ -147,17 +149,30 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     whose centre is not its entity's origin; (0, 0) for every other row, which turns about its
     origin as before: a kinematic body, as in Box2D; a capsule and an AABB, which contacts do not
     turn). Such a body's inverse inertia (``fprops`` row 1) is about that centre: the store's
-    column holds the exact solver's, about the origin."""
+    column holds the exact solver's, about the origin.
+
+    ``iprops`` rows 10 to 12: each shape row's owner (the body row that poses it and takes its
+    contacts' impulses), its key id (the pairs' keys are made of these: a body's entity for its own
+    row) and its part number (0: the entity's Hitbox). A compound body
+    (:class:`~framework.components.Parts`) has a shape row for each of its other parts after the
+    store's rows (:func:`_part_rows`): its own row takes the whole body's mass, inertia and centre of
+    mass. Without compound bodies there are none, and rows 10 to 12 are ``arange(n)``, the
+    entities and zeros: the kernel does exactly what it did before they existed."""
     n = store.n
     polys = [store.shapes[r] for r in range(n)]
     kinds = store.kind[:n].tolist()
-    K = max([4] + [len(s.points) for s, k in zip(polys, kinds) if k == KIND_POLYGON])
+    compound = [(store.row_of[e], parts) for e, parts in sorted(store.parts.items())
+                if store.hitboxes[store.row_of[e]] is not None]
+    part_shapes = [hb._shape for _r, parts in compound for hb in parts.hitboxes]
+    K = max([4] + [len(s.points) for s, k in zip(polys, kinds) if k == KIND_POLYGON]
+            + [len(s.points) for s in part_shapes if isinstance(s, Polygon)])
     off = np.zeros((n, 4))
     off[:, 0], off[:, 1] = store.ox, store.oy
     inv_inertia = store.inv_inertia
     bodies = store.body[:n].tolist()
     for r, k in enumerate(kinds):
-        if (k == KIND_CIRCLE or k == KIND_POLYGON) and bodies[r] == DYNAMIC:
+        if (k == KIND_CIRCLE or k == KIND_POLYGON) and bodies[r] == DYNAMIC and not (
+                compound and int(store.entity[r]) in store.parts):  # (a compound body's: the whole body's, below)
             hb = store.hitboxes[r]
             gx, gy = polys[r].centroid
             cx, cy = float(store.ox[r]) + gx, float(store.oy[r]) + gy
@@ -212,8 +227,119 @@ def kernel_tables(store, detection: bool = True) -> tuple[np.ndarray, ...]:
     kind[chain] = CHAIN_KIND  # (the kernel's code of a chain segment)
     iprops = np.stack([store.body.astype(np.int64), kind, store.layer, store.mask,
                        store.entity, store.sensor.astype(np.int64), store.one_way.astype(np.int64),
-                       store.has_vel.astype(np.int64), cnt, spin])
+                       store.has_vel.astype(np.int64), cnt, spin, np.arange(n, dtype=np.int64),
+                       store.entity.astype(np.int64), np.zeros(n, dtype=np.int64)])
+    if compound:
+        fprops, iprops, off, verts = _part_rows(store, compound, fprops, iprops, off, verts)
+        if not detection:
+            iprops[8, n:] = 0
     return fprops, iprops, off, verts
+
+
+#: A part's key id (``kernel_tables``' ``iprops`` row 11): ``PART_BASE + (entity << 6) + part``, above
+#: every entity's own (an entity's key id is the entity): the pairs' keys stay unique and sorted.
+PART_BASE = 1 << 30
+#: Compound bodies take entity ids below this (their parts' key ids must stay below 2**31).
+MAX_COMPOUND_ENTITY = 1 << 24
+
+
+def part_ids(sids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The entities and part numbers of shape rows' key ids (``iprops`` row 11)."""
+    sids = np.asarray(sids, dtype=np.int64)
+    is_part = sids >= PART_BASE
+    rest = sids - PART_BASE
+    return np.where(is_part, rest >> 6, sids), np.where(is_part, rest & 63, 0)
+
+
+def _shape_row(shape: Any, vrow: np.ndarray) -> tuple[int, int, float, int]:
+    """A part's shape as the kernel reads it (as ``kernel_tables`` packs a row's): its kind code,
+    vertex count, rounding radius and whether it turns with its body; its local vertices and the
+    edges' outward normals written into ``vrow``."""
+    if isinstance(shape, AABB):
+        hw, hh = shape.width * 0.5, shape.height * 0.5
+        vrow[:4, 0:2] = ((-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh))
+        vrow[:4, 2:4] = ((0.0, -1.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0))
+        return KIND_AABB, 4, 0.0, 0
+    if isinstance(shape, Circle):
+        return KIND_CIRCLE, 1, shape.radius, 1
+    if isinstance(shape, Capsule):
+        h = shape.half_length
+        vrow[:2, 0:2] = ((0.0, -h), (0.0, h))
+        vrow[:2, 2:4] = ((1.0, 0.0), (-1.0, 0.0))
+        return KIND_CAPSULE, 2, shape.radius, 1
+    if isinstance(shape, Segment):
+        (x1, y1), (x2, y2) = shape.a, shape.b
+        ex, ey = x2 - x1, y2 - y1
+        d = math.hypot(ex, ey)
+        vrow[:2] = ((x1, y1, ey / d, -ex / d), (x2, y2, -ey / d, ex / d))
+        if isinstance(shape, ChainSegment):
+            raise InvalidValue("a chain segment cannot be a part of a compound body (spawn_chain spawns a body each)")
+        return KIND_SEGMENT, 2, 0.0, 1
+    pts = shape.points
+    m = len(pts)
+    for i in range(m):
+        (x1, y1), (x2, y2) = pts[i], pts[(i + 1) % m]
+        ex, ey = x2 - x1, y2 - y1
+        d = math.hypot(ex, ey)
+        vrow[i] = (x1, y1, ey / d, -ex / d)
+    return KIND_POLYGON, m, 0.0, 1
+
+
+def _part_rows(store, compound: list[tuple[int, Any]], fprops: np.ndarray, iprops: np.ndarray, off: np.ndarray,
+               verts: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``kernel_tables``' tables with a shape row for each part of the ``compound`` bodies (their
+    rows, their Parts) appended, and each such body's own row given the whole body's inverse mass,
+    inverse inertia about its centre of mass, and that centre (``off`` columns 2, 3)."""
+    n = store.n
+    m = sum(len(parts) for _r, parts in compound)
+    fprops = np.concatenate([fprops, np.zeros((fprops.shape[0], m))], axis=1)
+    iprops = np.concatenate([iprops, np.zeros((iprops.shape[0], m), dtype=np.int64)], axis=1)
+    off = np.concatenate([off, np.zeros((m, 4))])
+    verts = np.concatenate([verts, np.zeros((m, verts.shape[1], 4))])
+    q = n
+    for r, parts in compound:
+        hb = store.hitboxes[r]
+        e = int(store.entity[r])
+        data = body_mass_data(hb, parts)
+        cx, cy = data.center
+        dynamic = hb._body is Body.DYNAMIC
+        turns = dynamic and all(isinstance(h._shape, (Circle, Polygon)) for h in (hb, *parts.hitboxes))
+        fprops[0, r] = 1.0 / data.mass if dynamic else 0.0
+        fprops[1, r] = 1.0 / data.inertia if turns and not math.isinf(data.inertia) else 0.0
+        off[r, 2], off[r, 3] = (cx, cy) if dynamic else (0.0, 0.0)
+        for i, part in enumerate(parts.hitboxes, start=1):
+            shape = part._shape
+            kind, cnt, radius, spin = _shape_row(shape, verts[q])
+            ox, oy = part._offset
+            reach = max(math.hypot(ox, oy), math.hypot(ox - off[r, 2], oy - off[r, 3]))
+            fprops[2, q] = NO_FRICTION if part._friction is None else part._friction
+            fprops[3, q] = part._restitution
+            fprops[4, q] = shape.bounding_radius + reach  # (its reach about its body's turning point)
+            fprops[5, q] = radius
+            iprops[:, q] = (iprops[0, r], kind, part._layer, part._mask, e, int(part._sensor), int(part._one_way),
+                            iprops[7, r], cnt, spin, r, PART_BASE + (e << 6) + i, i)
+            off[q, 0], off[q, 1] = ox, oy
+            q += 1
+    return fprops, iprops, off, verts
+
+
+def _by_entity(cols: tuple[np.ndarray, ...], contacts: StepContacts) -> tuple[tuple[np.ndarray, ...], StepContacts]:
+    """A compound scene's contacts (and ``cols`` beside them: rows then parts, as pairs, then any
+    other) named as events name pairs: smaller entity first (swapped where not, normal negated),
+    sorted by entities, then parts."""
+    ea, eb = contacts.a, contacts.b
+    swap = ea > eb
+    out = list(cols)
+    if swap.any():
+        for i in range(0, 4 if len(out) >= 4 else 2, 2):
+            out[i], out[i + 1] = np.where(swap, out[i + 1], out[i]), np.where(swap, out[i], out[i + 1])
+        contacts = StepContacts(np.where(swap, eb, ea), np.where(swap, ea, eb),
+                                np.where(swap, 0.0 - contacts.nx, contacts.nx),
+                                np.where(swap, 0.0 - contacts.ny, contacts.ny), contacts.depth, contacts.px,
+                                contacts.py)
+    pa, pb = (out[2], out[3]) if len(out) >= 4 else (out[0], out[1])
+    order = np.lexsort((pb, pa, contacts.b, contacts.a))
+    return tuple(c[order] for c in out), contacts.take(order)
 
 
 _COMPILED: set[bool] = set()  # the kernel's variants called in this process (True: with joints)
@@ -349,9 +475,11 @@ class SoftStep(Stage):
             eligible = ((store.kind[:n] == KIND_AABB) & (store.body[:n] == STATIC) & ~store.sensor[:n]
                         & ~store.one_way[:n])
             c = store.cols
-            half = np.ascontiguousarray(verts[:, 2, 0:2])  # an AABB's corner 2: its half extents
-            self._faces = internal_faces(c["x"][:n], c["y"][:n], c["rot"][:n], off, half, iprops[8], eligible,
-                                         iprops[2], iprops[3])
+            half = np.ascontiguousarray(verts[:n, 2, 0:2])  # an AABB's corner 2: its half extents
+            self._faces = internal_faces(c["x"][:n], c["y"][:n], c["rot"][:n], off[:n], half, iprops[8, :n],
+                                         eligible, iprops[2, :n], iprops[3, :n])
+            if iprops.shape[1] > n:  # (the parts of compound bodies: no internal faces)
+                self._faces = np.concatenate([self._faces, np.zeros(iprops.shape[1] - n, dtype=np.int64)])
             self._faces_key = key
         return self._faces
 
@@ -457,11 +585,12 @@ class SoftStep(Stage):
             frame.start_x, frame.start_y = c["x"][:n].copy(), c["y"][:n].copy()
         key = (store.version, store.n, "detection" in effects)
         rebuild = key != self._pairs_key
+        tables = self._tables()
         if rebuild:
-            self.fat = np.zeros((store.n, 4))
+            self.fat = np.zeros((tables[-2].shape[0], 4))  # (a row per shape: a compound body's parts too)
             self._pairs_key = key
         joints = self._joints()
-        args = (self._settings(frame), *self._tables(), self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
+        args = (self._settings(frame), *tables, self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
                 *joints)
         jint = joints[0]
         variant = jint is not None
@@ -474,10 +603,17 @@ class SoftStep(Stage):
             frame.joined = (ja[both], jb[both])
         if "movement" in effects:
             store.motion += 1
-        ra, rb, ea, eb, started = touch_i
-        frame.contacts = StepContacts(ea, eb, *touch_f)
+        ra, rb, ea, eb, started, pa, pb = touch_i
+        contacts = StepContacts(ea, eb, *touch_f)
+        ended = StepContacts(end_i[0], end_i[1], *end_f)
+        frame.parts = frame.ended_parts = None
+        if store.parts or (end_i.size and int(end_i.max()) >= PART_BASE):  # compound bodies: name the parts
+            (ra, rb, pa, pb, started), contacts = _by_entity((ra, rb, pa, pb, started), contacts)
+            (ea_, pea), (eb_, peb) = part_ids(end_i[0]), part_ids(end_i[1])
+            (pea, peb), ended = _by_entity((pea, peb), StepContacts(ea_, eb_, *end_f))
+            frame.parts, frame.ended_parts = (pa, pb), (pea, peb)
+        frame.contacts, frame.ended = contacts, ended
         frame.contact_rows, frame.started = (ra, rb), started.astype(bool)
-        frame.ended = StepContacts(end_i[0], end_i[1], *end_f)
         frame._events = None
         if info.size > 3:
             store.wake(info[3:])
