@@ -32,7 +32,7 @@ from .collision.ray import closest_on_segment
 from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
 from .geometry import Geometry
-from .shapes import AABB, Capsule, Circle, Polygon
+from .shapes import AABB, Capsule, Circle, Polygon, Segment
 from .store import STATIC
 from .systems.stage import Pipeline
 from .validation import InvalidValue, finite, vector2
@@ -219,12 +219,20 @@ class SpatialQueries:
         rows = self._mask_ok(rows, mask)
         hits = []
         geom, store = self.bodies.geometry, self.bodies.store
-        for r in rows.tolist():
-            hb = store.hitboxes[r]
-            hit = _raycast(hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
-                           (ox, oy), (dx, dy), md)
-            if hit is not None:
-                hits.append(SceneHit(int(store.entity[r]), *hit))
+        if rows.size:  # one compiled pass (the float path of raycast, the same bits); raycast itself
+            # for what it leaves to exact arithmetic (a graze, a corner) and for capsules
+            cols = self._shapes()
+            found = bq.ray_rows(np.ascontiguousarray(rows, dtype=np.int64), ox, oy, dx, dy, md, cols.kind, cols.sa,
+                                cols.sb, cols.ext, cols.local, cols.cnt, geom.hx, geom.hy, store.rot)
+            for r, (status, dist, px, py, nx, ny) in zip(rows.tolist(), found.tolist()):
+                if status > 0.0:
+                    hits.append(SceneHit(int(store.entity[r]), dist, Vec2(px, py), Vec2(nx, ny)))
+                elif status < 0.0:
+                    hb = store.hitboxes[r]
+                    hit = _raycast(hb.shape, (float(geom.hx[r]), float(geom.hy[r]), float(store.rot[r])),
+                                   (ox, oy), (dx, dy), md)
+                    if hit is not None:
+                        hits.append(SceneHit(int(store.entity[r]), *hit))
         if store.parts:  # a compound body: where the ray first enters any of its shapes
             for e, part, pose in self._parts(int(mask)):
                 hit = _raycast(part.shape, pose, (ox, oy), (dx, dy), md)
@@ -417,6 +425,10 @@ class SpatialQueries:
                 kind[r], cnt[r] = 2, len(shape.points)
                 local[r, : cnt[r]] = shape.points
                 ext[r] = max(max(abs(x), abs(y)) for x, y in shape.points)
+            elif isinstance(shape, Segment):  # (its two ends; a chain segment's one side: rays ask raycast)
+                kind[r], cnt[r] = 4, 2
+                local[r, :2] = (shape.a, shape.b)
+                ext[r] = max(abs(shape.a[0]), abs(shape.a[1]), abs(shape.b[0]), abs(shape.b[1]))
         cols = _Shapes(kind, sa, sb, ext, local, cnt)
         self._shape_cols = (store.version, cols)
         return cols

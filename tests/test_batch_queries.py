@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from framework import AABB, Capsule, Circle, Hitbox, Polygon, Scene, Transform
+from framework import AABB, Capsule, Chain, Circle, Hitbox, Polygon, Scene, Segment, Transform
 from framework.collision import raycast
 from framework.collision.batch_queries import hypot
 from framework.collision.distance import point_distance
@@ -20,8 +20,11 @@ from framework.tiles import terrain_pieces
 
 HEXAGON = Polygon([(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)])
 TRIANGLE = Polygon([(-1.0, -0.5), (1.0, -0.5), (0.0, 1.0)])
+# (segments and chain segments too: a batch once took a segment for a polygon of no points)
+CHAIN = Chain([(-2.0, 0.0), (-1.0, 0.5), (0.0, 0.0), (1.0, -0.5)])
 SHAPES = [AABB(1.0, 2.0), AABB(0.5, 0.5), Circle(0.75), Circle(0.25), Capsule(0.25, 1.5), Capsule(0.5, 0.5),
-          HEXAGON, TRIANGLE, Polygon.box(2.0, 0.5)]
+          HEXAGON, TRIANGLE, Polygon.box(2.0, 0.5), Segment((-1.0, -0.5), (1.0, 0.75)),
+          Segment((0.0, -1.0), (0.0, 1.0)), CHAIN.segments[1], CHAIN.segments[2]]
 
 
 # --- helpers ------------------------------------------------------------------------------------
@@ -76,6 +79,7 @@ def _spawn(s, items):
     """items: (shape, x, y, rot, layer, body); entity -> (shape, pose, layer)."""
     placed = {}
     for shape, x, y, rot, layer, body in items:
+        body = "static" if isinstance(shape, Segment) else body  # (a segment has no area: never dynamic)
         e = s.spawn(Transform(x, y, rot), Hitbox(shape, layer=layer, body=body))
         placed[e] = (shape, (x, y, rot), layer)
     return placed
@@ -175,7 +179,8 @@ def test_offset_hitboxes_tiles_and_many_points_at_once():
         for k in range(40):
             shape = SHAPES[k % len(SHAPES)]
             s.spawn(Transform(*rng.uniform(-9, 9, 2), float(rng.uniform(0, 6))),
-                    Hitbox(shape, offset=tuple(rng.uniform(-1, 1, 2)), layer=1 + k % 3))
+                    Hitbox(shape, offset=tuple(rng.uniform(-1, 1, 2)), layer=1 + k % 3,
+                           body="kinematic" if isinstance(shape, Segment) else "dynamic"))
         s.step(1 / 60)
         pts = rng.uniform(-10, 10, (3000, 2))
         dirs = rng.normal(size=(3000, 2))
@@ -280,6 +285,28 @@ def test_nearest_far_away_ties_and_masks():
         none = s.nearest_many([(-3.0, 0.0)], mask=2, max_distance=5.5)
         assert none.entity.tolist() == [-1] and none.distance[0] == -1.0  # (a miss: never inf)
         assert none.point.tolist() == [[-3.0, 0.0]]
+
+
+def test_segments_and_chain_segments_as_the_single_queries():
+    """A segment's ray hit, nearest point and the points on it, exact and dyadic; a chain segment
+    is met by a ray from its front only."""
+    with Scene() as s:
+        seg = s.spawn(Transform(0.0, 0.0), Hitbox(Segment((-1.0, 0.0), (1.0, 0.0)), body="static"))
+        hits = s.raycast_many([(0.0, 1.0), (0.5, -2.0)], [(0.0, -1.0), (0.0, 1.0)])
+        assert _batch_ray(hits, 0) == (seg, 1.0, (0.0, 0.0), (0.0, 1.0))
+        assert _batch_ray(hits, 1) == (seg, 2.0, (0.5, 0.0), (0.0, -1.0))
+        near = s.nearest_many([(0.0, 1.0), (4.0, 4.0)])
+        assert _batch_near(near, 0) == (seg, 1.0, (0.0, 0.0)) and _batch_near(near, 1) == (seg, 5.0, (1.0, 0.0))
+        inside = s.query_points([(0.5, 0.0), (0.5, 0.25), (1.5, 0.0)])
+        assert [inside.of(i) for i in range(3)] == [[seg], [], []] == [s.query_point(*p) for p in
+                                                                       ((0.5, 0.0), (0.5, 0.25), (1.5, 0.0))]
+    with Scene() as s:
+        chain = Chain([(-2.0, 0.0), (-1.0, 0.0), (1.0, 0.0), (2.0, 0.0)])  # solid on the right: below
+        ents = [s.spawn(Transform(0.0, 0.0), Hitbox(piece, body="static")) for piece in chain.segments]
+        hits = s.raycast_many([(0.0, 1.0), (0.0, -1.0)], [(0.0, -1.0), (0.0, 1.0)])
+        single = [_hit_tuple(s.raycast(o, d)) for o, d in (((0.0, 1.0), (0.0, -1.0)), ((0.0, -1.0), (0.0, 1.0)))]
+        assert [_batch_ray(hits, 0), _batch_ray(hits, 1)] == single
+        assert (single[0] is None) != (single[1] is None) and ents[1] in [h[0] for h in single if h]
 
 
 def test_an_empty_scene_and_no_queries():

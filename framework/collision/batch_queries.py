@@ -41,10 +41,10 @@ from .pieces import TIE
 from .ray import closest_on_segment
 from .tiebreak import DIR_TOL
 
-__all__ = ["hypot", "nearest_points", "points_inside", "rays_first"]
+__all__ = ["hypot", "nearest_points", "points_inside", "rays_first", "ray_rows"]
 
 # Kind codes of the rows (as framework.collision.kinds; repeated for the compiled code).
-_AABB, _CIRCLE, _POLYGON, _CAPSULE = 0, 1, 2, 3
+_AABB, _CIRCLE, _POLYGON, _CAPSULE, _SEGMENT = 0, 1, 2, 3, 4
 _FAR = 500  # framework.collision.ray.FAR
 _NEAR = 1e-9  # the widening of the single queries' candidate boxes
 _SLACK = 1e-9  # relative margin of the skipping tests (rounding is below 1e-15 of the magnitudes)
@@ -153,6 +153,14 @@ def _contains(r, skind, kind, hx, hy, radius, cap_ux, cap_uy, hw, hh, world_poly
             if (x1 - x0) * (dy - y0) - (y1 - y0) * (dx - x0) < 0.0:
                 return False
         return True
+    if k == _SEGMENT:  # the point on it, between its ends (then on both of its sides' lines)
+        pts = world_poly[poly_slot[r]]
+        x0, y0, x1, y1 = pts[0, 0], pts[0, 1], pts[1, 0], pts[1, 1]
+        along = (x1 - x0) * (dx - x0) + (y1 - y0) * (dy - y0)
+        if not (0.0 <= along <= math.pow(x1 - x0, two) + math.pow(y1 - y0, two)):
+            return False
+        return not ((x1 - x0) * (dy - y0) - (y1 - y0) * (dx - x0) < 0.0
+                    or (x0 - x1) * (dy - y1) - (y0 - y1) * (dx - x1) < 0.0)
     if kind[r] == _POLYGON:
         pts = world_poly[poly_slot[r]]
         n = count[r]
@@ -474,7 +482,7 @@ def _ray_row(k, sa, sb, ext, local, cnt, px, py, rot, ox, oy, dx, dy, limit):  #
     mx, my = math.ldexp(rx, e - kk), math.ldexp(ry, e - kk)
     if k == _CIRCLE:
         status, tau, nx, ny = _ray_circle(mx, my, math.ldexp(sa, -kk), ux, uy)
-    elif k == _CAPSULE:
+    elif k == _CAPSULE or k == _SEGMENT:  # (a segment: an exact crossing, and a chain's one side)
         return -1, 0.0, 0.0, 0.0, 0.0, 0.0
     else:
         qx = np.empty(max(4, cnt))
@@ -513,6 +521,20 @@ def _ray_row(k, sa, sb, ext, local, cnt, px, py, rot, ox, oy, dx, dy, limit):  #
     if not (math.isfinite(hx) and math.isfinite(hy)):
         return 0, 0.0, 0.0, 0.0, 0.0, 0.0
     return 1, distance + 0.0, hx + 0.0, hy + 0.0, nx + 0.0, ny + 0.0
+
+
+@njit(cache=True)
+def ray_rows(rows, ox, oy, dx, dy, max_distance, skind, sa, sb, ext, local, cnt, hx, hy, rot):  # pragma: no cover
+    """One ray against each of ``rows`` (as ``Scene.raycast_all`` asks): per row ``(status,
+    distance, x, y, nx, ny)`` of :func:`~framework.collision.ray.raycast`, status 0 a miss, 1 a hit,
+    -1 unresolved (answer it with ``raycast`` itself)."""
+    out = np.zeros((rows.size, 6))
+    for i in range(rows.size):
+        r = rows[i]
+        status, d, qx, qy, nx, ny = _ray_row(skind[r], sa[r], sb[r], ext[r], local[r], cnt[r], hx[r], hy[r], rot[r],
+                                             ox, oy, dx, dy, max_distance)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = status, d, qx, qy, nx, ny
+    return out
 
 
 @njit(cache=True)
