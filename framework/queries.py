@@ -153,6 +153,34 @@ class _Shapes(NamedTuple):
     cnt: NDArray[np.int64]
 
 
+def _shape_table(shapes: list[Any]) -> _Shapes:
+    """Shapes (None: a row without a hitbox) as the batch kernels' columns: kind (0 box, 1 circle,
+    2 polygon, 3 capsule, 4 segment, -1 none), the box's half sizes, a circle's or capsule's radius
+    (and a capsule's length), the extent, and a polygon's or segment's points."""
+    n = len(shapes)
+    kind = np.full(n, -1, dtype=np.int8)
+    sa, sb, ext = np.zeros(n), np.zeros(n), np.zeros(n)
+    K = max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)])
+    local = np.zeros((n, K, 2))
+    cnt = np.zeros(n, dtype=np.int64)
+    for r, shape in enumerate(shapes):
+        if isinstance(shape, AABB):
+            kind[r], sa[r], sb[r], ext[r] = 0, shape.half_width, shape.half_height, max(shape.width, shape.height)
+        elif isinstance(shape, Circle):
+            kind[r], sa[r], ext[r] = 1, shape.radius, shape.radius
+        elif isinstance(shape, Capsule):
+            kind[r], sa[r], sb[r], ext[r] = 3, shape.radius, shape.length, shape.bounding_radius
+        elif isinstance(shape, Polygon):
+            kind[r], cnt[r] = 2, len(shape.points)
+            local[r, : cnt[r]] = shape.points
+            ext[r] = max(max(abs(x), abs(y)) for x, y in shape.points)
+        elif isinstance(shape, Segment):  # (its two ends; a chain segment's one side: rays ask raycast)
+            kind[r], cnt[r] = 4, 2
+            local[r, :2] = (shape.a, shape.b)
+            ext[r] = max(abs(shape.a[0]), abs(shape.a[1]), abs(shape.b[0]), abs(shape.b[1]))
+    return _Shapes(kind, sa, sb, ext, local, cnt)
+
+
 class SpatialQueries:
     """The queries of one scene (``Scene.raycast``, ``query_box``...), over its pipeline's bodies."""
 
@@ -221,8 +249,8 @@ class SpatialQueries:
         geom, store = self.bodies.geometry, self.bodies.store
         if rows.size:  # one compiled pass (the float path of raycast, the same bits); raycast itself
             # for what it leaves to exact arithmetic (a graze, a corner) and for capsules
-            cols = self._shapes()
-            found = bq.ray_rows(np.ascontiguousarray(rows, dtype=np.int64), ox, oy, dx, dy, md, cols.kind, cols.sa,
+            cols, at = self._shapes_of(rows)
+            found = bq.ray_rows(np.ascontiguousarray(rows, dtype=np.int64), at, ox, oy, dx, dy, md, cols.kind, cols.sa,
                                 cols.sb, cols.ext, cols.local, cols.cnt, geom.hx, geom.hy, store.rot)
             for r, (status, dist, px, py, nx, ny) in zip(rows.tolist(), found.tolist()):
                 if status > 0.0:
@@ -407,31 +435,20 @@ class SpatialQueries:
         cached: tuple[int, _Shapes] | None = getattr(self, "_shape_cols", None)
         if cached is not None and cached[0] == store.version and not store.dirty_hitboxes:
             return cached[1]
-        n = store.n
-        kind = np.full(n, -1, dtype=np.int8)
-        sa, sb, ext = np.zeros(n), np.zeros(n), np.zeros(n)
-        shapes = [None if hb is None else hb.shape for hb in store.hitboxes[:n]]
-        K = max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)])
-        local = np.zeros((n, K, 2))
-        cnt = np.zeros(n, dtype=np.int64)
-        for r, shape in enumerate(shapes):
-            if isinstance(shape, AABB):
-                kind[r], sa[r], sb[r], ext[r] = 0, shape.half_width, shape.half_height, max(shape.width, shape.height)
-            elif isinstance(shape, Circle):
-                kind[r], sa[r], ext[r] = 1, shape.radius, shape.radius
-            elif isinstance(shape, Capsule):
-                kind[r], sa[r], sb[r], ext[r] = 3, shape.radius, shape.length, shape.bounding_radius
-            elif isinstance(shape, Polygon):
-                kind[r], cnt[r] = 2, len(shape.points)
-                local[r, : cnt[r]] = shape.points
-                ext[r] = max(max(abs(x), abs(y)) for x, y in shape.points)
-            elif isinstance(shape, Segment):  # (its two ends; a chain segment's one side: rays ask raycast)
-                kind[r], cnt[r] = 4, 2
-                local[r, :2] = (shape.a, shape.b)
-                ext[r] = max(abs(shape.a[0]), abs(shape.a[1]), abs(shape.b[0]), abs(shape.b[1]))
-        cols = _Shapes(kind, sa, sb, ext, local, cnt)
+        cols = _shape_table([None if hb is None else hb.shape for hb in store.hitboxes[: store.n]])
         self._shape_cols = (store.version, cols)
         return cols
+
+    def _shapes_of(self, rows: NDArray[np.intp]) -> tuple[_Shapes, NDArray[np.int64]]:
+        """The live shapes of ``rows`` as columns, and where each row is in them: the scene's table
+        when it is current, else a table of these rows alone (a query after a spawn or a hitbox edit
+        does not measure every hitbox of the scene again)."""
+        store = self.bodies.store
+        cached: tuple[int, _Shapes] | None = getattr(self, "_shape_cols", None)
+        if cached is not None and cached[0] == store.version and not store.dirty_hitboxes:
+            return cached[1], np.ascontiguousarray(rows, dtype=np.int64)
+        hitboxes = store.hitboxes
+        return _shape_table([hitboxes[r].shape for r in rows.tolist()]), np.arange(rows.size)
 
     def _prepare(self) -> Geometry:
         """The geometry, current, as the single queries' candidate search leaves it."""

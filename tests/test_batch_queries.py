@@ -391,3 +391,29 @@ def test_hypot_is_cpythons():
         for x, y in zip(xs.tolist(), ys.tolist()):
             assert hypot(x, y) == math.hypot(x, y), (x, y)
     assert hypot(math.inf, math.nan) == math.inf and math.isnan(hypot(math.nan, 1.0)) and hypot(0.0, -0.0) == 0.0
+
+
+def test_a_ray_after_a_spawn_or_a_hitbox_edit_meets_the_live_shapes():
+    """Between a spawn (or an edited hitbox) and the next step, a scene's ray reads the shapes as
+    they are now, from a table of its candidates alone, and answers as the shape's own raycast."""
+    with Scene() as s:
+        box = s.spawn(Transform(0.0, 0.0), Hitbox(AABB(2.0, 2.0), body="static"))
+        s.step(1 / 60)
+        assert s.raycast((-4.0, 0.25), (1.0, 0.0)).distance == 3.0
+        s.get(box, Hitbox).shape = Circle(0.5)  # (waits for the next step in the store, not for queries)
+        hit = s.raycast((-4.0, 0.0), (1.0, 0.0))
+        assert _hit_tuple(hit) == (box, 3.5, (-0.5, 0.0), (-1.0, 0.0))
+        tri = s.spawn(Transform(-2.0, 0.0), Hitbox(TRIANGLE, body="static"))
+        got = [_hit_tuple(h) for h in s.raycast_all((-4.0, 0.0), (1.0, 0.0))]
+        want = [_hit_tuple(h) for h in sorted(
+            (h for h in (_scene_hit(e, sh, p) for e, sh, p in ((box, Circle(0.5), (0.0, 0.0, 0.0)),
+                                                                   (tri, TRIANGLE, (-2.0, 0.0, 0.0)))) if h),
+            key=lambda h: (h.distance, h.entity))]
+        assert got == want and len(got) == 2
+
+
+def _scene_hit(entity, shape, pose):
+    from framework.queries import SceneHit
+
+    h = raycast(shape, pose, (-4.0, 0.0), (1.0, 0.0))
+    return None if h is None else SceneHit(entity, *h)

@@ -524,14 +524,16 @@ def _ray_row(k, sa, sb, ext, local, cnt, px, py, rot, ox, oy, dx, dy, limit):  #
 
 
 @njit(cache=True)
-def ray_rows(rows, ox, oy, dx, dy, max_distance, skind, sa, sb, ext, local, cnt, hx, hy, rot):  # pragma: no cover
-    """One ray against each of ``rows`` (as ``Scene.raycast_all`` asks): per row ``(status,
-    distance, x, y, nx, ny)`` of :func:`~framework.collision.ray.raycast`, status 0 a miss, 1 a hit,
-    -1 unresolved (answer it with ``raycast`` itself)."""
+def ray_rows(rows, at, ox, oy, dx, dy, max_distance, skind, sa, sb, ext, local, cnt, hx, hy,
+             rot):  # pragma: no cover - compiled
+    """One ray against each of ``rows`` (as ``Scene.raycast_all`` asks; their shapes at ``at`` in
+    the shape columns): per row ``(status, distance, x, y, nx, ny)`` of
+    :func:`~framework.collision.ray.raycast`, status 0 a miss, 1 a hit, -1 unresolved (answer it
+    with ``raycast`` itself)."""
     out = np.zeros((rows.size, 6))
     for i in range(rows.size):
-        r = rows[i]
-        status, d, qx, qy, nx, ny = _ray_row(skind[r], sa[r], sb[r], ext[r], local[r], cnt[r], hx[r], hy[r], rot[r],
+        r, q = rows[i], at[i]
+        status, d, qx, qy, nx, ny = _ray_row(skind[q], sa[q], sb[q], ext[q], local[q], cnt[q], hx[r], hy[r], rot[r],
                                              ox, oy, dx, dy, max_distance)
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = status, d, qx, qy, nx, ny
     return out
