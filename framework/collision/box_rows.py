@@ -14,7 +14,7 @@ from numba import njit
 
 from ..compiled import leaf
 
-__all__ = ["holds", "rows_meeting", "rows_within"]
+__all__ = ["holds", "lower_bound", "rows_meeting", "rows_within"]
 
 
 @njit(cache=True)
@@ -31,9 +31,9 @@ def rows_meeting(kind, minx, miny, maxx, maxy, x0, y0, x1, y1):  # pragma: no co
 
 
 @leaf
-def holds(keys, key):  # pragma: no cover - compiled
-    """Whether the sorted ``keys`` hold ``key`` (a binary search; the soft step's pair and joint
-    filters use it too)."""
+def lower_bound(keys, key):  # pragma: no cover - compiled
+    """The first place in the sorted ``keys`` whose key is not below ``key`` (``np.searchsorted``'s
+    left side), by binary search."""
     lo, hi = 0, keys.size
     while lo < hi:
         mid = (lo + hi) >> 1
@@ -41,7 +41,14 @@ def holds(keys, key):  # pragma: no cover - compiled
             lo = mid + 1
         else:
             hi = mid
-    return lo < keys.size and keys[lo] == key
+    return lo
+
+
+@leaf
+def holds(keys, key):  # pragma: no cover - compiled
+    """Whether the sorted ``keys`` hold ``key`` (the soft step's pair and joint filters use it too)."""
+    i = lower_bound(keys, key)
+    return i < keys.size and keys[i] == key
 
 
 @njit(cache=True)

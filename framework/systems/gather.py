@@ -39,6 +39,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..collision.box_rows import lower_bound
 from ..compiled import leaf
 
 __all__ = ["gather"]
@@ -59,17 +60,9 @@ def _np_max(a, b):  # pragma: no cover - compiled
 
 @leaf
 def _find(table, key):  # pragma: no cover - compiled
-    """Where ``key`` is in the sorted ``table`` (``np.searchsorted``'s left side), or -1."""
-    lo, hi = 0, table.size
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if table[mid] < key:
-            lo = mid + 1
-        else:
-            hi = mid
-    if lo == table.size:
-        lo = table.size - 1  # (as sorted_find: the last, which then differs)
-    return lo if table.size and table[lo] == key else -1
+    """Where ``key`` is in the sorted ``table``, or -1 (as ``events.sorted_find``)."""
+    i = lower_bound(table, key)
+    return i if i < table.size and table[i] == key else -1
 
 
 @leaf
