@@ -42,7 +42,7 @@ from numba import njit
 from ..collision.box_rows import lower_bound
 from ..compiled import leaf
 
-__all__ = ["gather"]
+__all__ = ["centres_inside", "gather", "solid_pairs_mask", "taking_part"]
 
 
 @leaf
@@ -222,3 +222,58 @@ def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush
         opush[o], oimp[o], otpush[o], otimp[o] = spush[j], simp[j], stpush[j], stimp[j]
         o += 1
     return ra, rb, ea, eb, onx, ony, odepth, alive0, opush, oimp, otpush, otimp, opx, opy
+
+
+@leaf
+def _takes(a, b, kind, sensor, inv_mass, asleep):  # pragma: no cover - compiled
+    """Whether the response may act on the pair of rows ``a, b`` by their bodies alone: both have
+    a hitbox, neither is a sensor, at least one is movable (a finite mass, awake)."""
+    if kind[a] < 0 or kind[b] < 0 or sensor[a] or sensor[b]:
+        return False
+    return (inv_mass[a] > 0.0 and not asleep[a]) or (inv_mass[b] > 0.0 and not asleep[b])
+
+
+@njit(cache=True)
+def taking_part(ra, rb, kind, sensor, inv_mass, asleep):  # pragma: no cover - compiled
+    """:func:`_takes` of each pair ``(ra[i], rb[i])`` (rows of the store, below its ``n``)."""
+    out = np.zeros(ra.size, dtype=np.bool_)
+    for i in range(ra.size):
+        out[i] = _takes(ra[i], rb[i], kind, sensor, inv_mass, asleep)
+    return out
+
+
+@njit(cache=True)
+def solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask,
+                     layers_open):  # pragma: no cover - compiled
+    """The pairs of rows the response may act on: both rows real (>= 0), taking part
+    (:func:`_takes`), neither a one-way platform, their layers and masks meeting."""
+    out = np.zeros(ra.size, dtype=np.bool_)
+    for i in range(ra.size):
+        a, b = ra[i], rb[i]
+        if a < 0 or b < 0 or one_way[a] or one_way[b] or not _takes(a, b, kind, sensor, inv_mass, asleep):
+            continue
+        out[i] = layers_open or ((layer[a] & mask[b]) != 0 and (layer[b] & mask[a]) != 0)
+    return out
+
+
+@njit(cache=True)
+def centres_inside(ra, rb, hit, body, kind, static, box, hx, hy, minx, maxx, miny, maxy):  # pragma: no cover
+    """The contacts (``hit``) between one static box and a body of another kind of row whose
+    hitbox origin lies strictly inside the box's bounds: their indices, in order (the candidates of
+    ``Response._deep_inside``)."""
+    out = np.empty(ra.size, dtype=np.int64)
+    n = 0
+    for i in range(ra.size):
+        if not hit[i]:
+            continue
+        a, b = ra[i], rb[i]
+        static_a = body[a] == static and kind[a] == box
+        static_b = body[b] == static and kind[b] == box
+        if static_a == static_b:
+            continue
+        s, m = (b, a) if static_b else (a, b)
+        cx, cy = hx[m], hy[m]
+        if minx[s] < cx and cx < maxx[s] and miny[s] < cy and cy < maxy[s]:
+            out[n] = i
+            n += 1
+    return out[:n]

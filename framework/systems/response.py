@@ -23,7 +23,7 @@ from ..events import pair_keys, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..geometry import Geometry
 from ..store import STATIC
-from .gather import gather
+from .gather import centres_inside, gather, solid_pairs_mask, taking_part
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Pairs, Solve
@@ -173,18 +173,18 @@ class Response(Stage):
         """The pairs among ``(ra, rb, ea, eb)`` the response may act on: hitboxes whose layers
         meet, neither a sensor nor a one-way platform, at least one body movable."""
         store = self.bodies.store
-        ok = (ra >= 0) & (rb >= 0)
-        ra, rb, ea, eb = ra[ok], rb[ok], ea[ok], eb[ok]
-        ok = self._takes_part(ra, rb) & ~(store.one_way[ra] | store.one_way[rb]) & filter_layers(store, ra, rb)
+        c = store.cols
+        ok = solid_pairs_mask(ra, rb, c["kind"], c["sensor"], c["inv_mass"], c["asleep"], c["one_way"], c["layer"],
+                              c["mask"], store.layers_all_meet())
         return ra[ok], rb[ok], ea[ok], eb[ok]
 
     def _takes_part(self, ra: IntpArray, rb: IntpArray) -> BoolArray:
         """Mask of the pairs the response may act on by their bodies alone: both still have a
         hitbox (a system may have removed one), neither is a sensor, and at least one is movable
         (sleeping bodies keep still)."""
-        store = self.bodies.store
-        ok = (store.kind[ra] >= 0) & (store.kind[rb] >= 0) & ~(store.sensor[ra] | store.sensor[rb])
-        return ok & (store.movable(ra) | store.movable(rb))
+        c = self.bodies.store.cols
+        taking: BoolArray = taking_part(ra, rb, c["kind"], c["sensor"], c["inv_mass"], c["asleep"])
+        return taking
 
     # --- geometry the solve asks for ---------------------------------------------------------
 
@@ -215,20 +215,17 @@ class Response(Stage):
         takes the body's bounds clear of that face. (Faces other tiles cover: see
         :mod:`~framework.systems.internal_faces`, which runs after this.)"""
         store = self.bodies.store
-        static_a = (store.body[ra] == STATIC) & (store.kind[ra] == KIND_AABB)
-        static_b = (store.body[rb] == STATIC) & (store.kind[rb] == KIND_AABB)
-        pick = np.flatnonzero(hit & (static_a ^ static_b))
+        geom = self.bodies.geometry  # (the callers' measures brought the origins up to date)
+        c = store.cols
+        # (one compiled pass: the contacts with one static box whose body's centre is inside it)
+        pick = centres_inside(ra, rb, hit, c["body"], c["kind"], STATIC, KIND_AABB, geom.hx, geom.hy, geom.minx,
+                              geom.maxx, geom.miny, geom.maxy)
         if pick.size == 0:
             return
-        flip = static_b[pick]  # the static box is b: the normal (a to b) is the push, negated
+        flip = (store.body[rb[pick]] == STATIC) & (store.kind[rb[pick]] == KIND_AABB)  # the box is b: push negated
         s = np.where(flip, rb[pick], ra[pick])
         m = np.where(flip, ra[pick], rb[pick])
-        geom = self.bodies.geometry  # (the callers' measures brought the origins up to date)
         cx, cy = geom.hx[m], geom.hy[m]
-        inside = (geom.minx[s] < cx) & (cx < geom.maxx[s]) & (geom.miny[s] < cy) & (cy < geom.maxy[s])
-        if not inside.any():
-            return
-        pick, flip, s, m, cx, cy = pick[inside], flip[inside], s[inside], m[inside], cx[inside], cy[inside]
         geom.update_rows(store, m)  # (their bounds: the solve may have moved them since they were computed)
         # the four pushes that take the body's bounds clear of each face: +x, -x, +y, -y
         pushes = np.stack([geom.maxx[s] - geom.minx[m], geom.maxx[m] - geom.minx[s],
