@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
@@ -160,16 +161,18 @@ class InternalFaces:
         or a polygon's corner off the box's corner) through the two faces that meet there: if one
         of them is covered, the corner is that face's end (a ball rolling over the seam of two tiles
         is on the floor, not on a bump)."""
-        static_a = store.body[ra] == STATIC
-        static_b = store.body[rb] == STATIC
-        cand = np.flatnonzero(among & (static_a != static_b) & (store.kind[np.where(static_a, ra, rb)] == KIND_AABB))
+        c = store.cols
+        cand = static_box_contacts(ra, rb, among, c["body"], c["kind"], STATIC, KIND_AABB)  # (one compiled pass)
         if cand.size == 0:
             return None
-        t = np.where(static_a[cand], ra[cand], rb[cand])  # the static box
-        m = np.where(static_a[cand], rb[cand], ra[cand])  # the body pushed out of it
-        sgn = np.where(static_a[cand], 1.0, -1.0)  # the body moves along sgn * n
-        px, py = nx[cand] * sgn, ny[cand] * sgn
+        static_a = store.body[ra[cand]] == STATIC
+        t = np.where(static_a, ra[cand], rb[cand])  # the static box
         faces = self.masks(store, geom, hash_, rows_of, t)
+        if not faces.any():
+            return None  # (no box here has a covered face: a floor of one piece)
+        m = np.where(static_a, rb[cand], ra[cand])  # the body pushed out of it
+        sgn = np.where(static_a, 1.0, -1.0)  # the body moves along sgn * n
+        px, py = nx[cand] * sgn, ny[cand] * sgn
         cov_x = (faces & np.where(px < 0, LEFT, RIGHT).astype(np.uint8)) != 0
         cov_y = (faces & np.where(py < 0, DOWN, UP).astype(np.uint8)) != 0
         along_x = np.abs(py) <= AXIS_TOLERANCE
@@ -183,6 +186,23 @@ class InternalFaces:
             return None
         px, py = np.where(use_x, np.sign(px), 0.0), np.where(use_x, 0.0, np.sign(py))
         return cand[bad], t[bad], m[bad], sgn[bad], faces[bad], px[bad], py[bad]
+
+
+@njit(cache=True)
+def static_box_contacts(ra, rb, among, body, kind, static, box):  # pragma: no cover - compiled
+    """The indices, in order, of the contacts ``among`` these between a static body and one that is
+    not, the static one a box (``InternalFaces._through_covered``'s candidates)."""
+    out = np.empty(ra.size, dtype=np.int64)
+    n = 0
+    for i in range(ra.size):
+        if not among[i]:
+            continue
+        a, b = ra[i], rb[i]
+        static_a, static_b = body[a] == static, body[b] == static
+        if static_a != static_b and kind[a if static_a else b] == box:
+            out[n] = i
+            n += 1
+    return out[:n]
 
 
 def _extent(store: BodyStore, geom: Geometry, rows: IntpArray) -> tuple[F64Array, F64Array, F64Array, F64Array]:
