@@ -30,7 +30,7 @@ from .collide import POINT_TOL
 from .exact import BAND, TINY
 from .tiebreak import DEPTH_TOL
 
-__all__ = ["aabb_aabb", "aabb_aabb_fast"]
+__all__ = ["aabb_aabb", "aabb_aabb_fast", "aabb_pairs_fast"]
 
 
 def _two_sum(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -232,12 +232,30 @@ def aabb_aabb_fast(ax, ay, ahw, ahh, bx, by, bhw, bhh, *, exact: bool = True, po
     """
     ax, ay, ahw, ahh, bx, by, bhw, bhh = columns(ax, ay, ahw, ahh, bx, by, bhw, bhh)
     hit, nx, ny, depth, px, py, extreme = _aabb_rows(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points)
+    return _with_extremes(ContactArrays(hit, nx, ny, depth, px, py), extreme, exact, ax, ay, ahw, ahh, bx, by, bhw, bhh)
+
+
+def aabb_pairs_fast(ra, rb, hx, hy, hw, hh, *, exact: bool = True, points: bool = True) -> ContactArrays:
+    """:func:`aabb_aabb_fast` of the pairs of rows ``(ra, rb)`` of the columns (hitbox origins
+    ``hx, hy``, half sizes ``hw, hh``): the pipeline's narrow phase, which gathers nothing first."""
+    ra, rb = np.ascontiguousarray(ra, dtype=np.int64), np.ascontiguousarray(rb, dtype=np.int64)
+    hit, nx, ny, depth, px, py, extreme = _aabb_pairs(ra, rb, hx, hy, hw, hh, exact, points)
+    res = ContactArrays(hit, nx, ny, depth, px, py)
+    if not (exact and extreme.any()):
+        return res
+    return _with_extremes(res, extreme, exact, hx[ra], hy[ra], hw[ra], hh[ra], hx[rb], hy[rb], hw[rb], hh[rb])
+
+
+def _with_extremes(res: ContactArrays, extreme, exact, ax, ay, ahw, ahh, bx, by, bhw, bhh) -> ContactArrays:
+    """``res`` with its rows of extreme magnitudes (``extreme``) answered by the scaled exact
+    kernel (:func:`aabb_aabb`), where ``exact``."""
     e = np.flatnonzero(extreme) if exact else np.zeros(0, dtype=np.intp)
-    if e.size:  # extreme magnitudes: the scaled exact kernel
+    if e.size:
+        hit, nx, ny, depth, px, py = res
         ref = aabb_aabb(ax[e], ay[e], ahw[e], ahh[e], bx[e], by[e], bhw[e], bhh[e])
         hit[e] = ref.hit
         nx[e], ny[e], depth[e], px[e], py[e] = ref.nx, ref.ny, ref.depth, ref.px, ref.py
-    return ContactArrays(hit, nx, ny, depth, px, py)
+    return res
 
 
 
@@ -264,47 +282,71 @@ def _dd_overlap_1(dh, dl, rh, rl):  # pragma: no cover - compiled
     return (rh - abs(dh)) + (rl - sgn * dl)
 
 
+@leaf
+def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points, i, hit, nx, ny, depth, px, py,
+              extreme):  # pragma: no cover - compiled
+    """Row ``i`` of :func:`aabb_aabb_fast` but for extreme magnitudes (flagged in ``extreme``, for
+    the scaled exact kernel), into the output columns (zeros where there is no hit): the same
+    arithmetic in the same order as the numpy it replaced (so the same bits)."""
+    dx, dy = bx - ax, by - ay
+    adx, ady = abs(dx), abs(dy)
+    sx, sy = ahw + bhw, ahh + bhh
+    ox, oy = sx - adx, sy - ady
+    mag = sx + sy + adx + ady
+    band = (2.0**-48 if exact else 8.0 * BAND) * mag
+    unclear = (abs(ox) <= band and oy >= -band) or (abs(oy) <= band and ox >= -band)
+    ext = not (mag <= 1e150) or mag < 1e-150
+    extreme[i] = ext
+    h = ox > 0.0 and oy > 0.0 and not unclear and not ext
+    if exact and unclear and not ext:
+        dxh, dxl = _two_sum_1(bx, -ax)
+        rxh, rxl = _two_sum_1(ahw, bhw)
+        dyh, dyl = _two_sum_1(by, -ay)
+        ryh, ryl = _two_sum_1(ahh, bhh)
+        h = _less_1(dxh, dxl, rxh, rxl) and _less_1(dyh, dyl, ryh, ryl)
+        ox, oy = _dd_overlap_1(dxh, dxl, rxh, rxl), _dd_overlap_1(dyh, dyl, ryh, ryl)
+    if not h:
+        return
+    hit[i] = True
+    size = np.sqrt(ahw * ahw + ahh * ahh) + np.sqrt(bhw * bhw + bhh * bhh)
+    lim = (ox if ox < oy else oy) + DEPTH_TOL * size
+    if oy <= lim:
+        depth[i] = oy
+        ny[i] = 1.0 if sy - dy <= lim else -1.0
+    else:
+        depth[i] = ox
+        nx[i] = 1.0 if sx - dx <= lim else -1.0
+    if points:
+        lo_x, hi_x = max(ax - ahw, bx - bhw), min(ax + ahw, bx + bhw)
+        lo_y, hi_y = max(ay - ahh, by - bhh), min(ay + ahh, by + bhh)
+        px[i], py[i] = 0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)
+
+
 @njit(cache=True)
 def _aabb_rows(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points):  # pragma: no cover - compiled
-    """The rows of :func:`aabb_aabb_fast` but its extreme magnitudes (flagged, for the scaled
-    exact kernel): one compiled pass, the same arithmetic in the same order as the numpy it
-    replaced, row by row (so the same bits)."""
+    """:func:`_aabb_row` of every row of the gathered columns."""
     n = ax.size
     hit = np.zeros(n, dtype=np.bool_)
     nx, ny, depth = np.zeros(n), np.zeros(n), np.zeros(n)
     px, py = np.zeros(n), np.zeros(n)
     extreme = np.zeros(n, dtype=np.bool_)
     for i in range(n):
-        dx, dy = bx[i] - ax[i], by[i] - ay[i]
-        adx, ady = abs(dx), abs(dy)
-        sx, sy = ahw[i] + bhw[i], ahh[i] + bhh[i]
-        ox, oy = sx - adx, sy - ady
-        mag = sx + sy + adx + ady
-        band = (2.0**-48 if exact else 8.0 * BAND) * mag
-        unclear = (abs(ox) <= band and oy >= -band) or (abs(oy) <= band and ox >= -band)
-        ext = not (mag <= 1e150) or mag < 1e-150
-        extreme[i] = ext
-        h = ox > 0.0 and oy > 0.0 and not unclear and not ext
-        if exact and unclear and not ext:
-            dxh, dxl = _two_sum_1(bx[i], -ax[i])
-            rxh, rxl = _two_sum_1(ahw[i], bhw[i])
-            dyh, dyl = _two_sum_1(by[i], -ay[i])
-            ryh, ryl = _two_sum_1(ahh[i], bhh[i])
-            h = _less_1(dxh, dxl, rxh, rxl) and _less_1(dyh, dyl, ryh, ryl)
-            ox, oy = _dd_overlap_1(dxh, dxl, rxh, rxl), _dd_overlap_1(dyh, dyl, ryh, ryl)
-        if not h:
-            continue
-        hit[i] = True
-        size = np.sqrt(ahw[i] * ahw[i] + ahh[i] * ahh[i]) + np.sqrt(bhw[i] * bhw[i] + bhh[i] * bhh[i])
-        lim = (ox if ox < oy else oy) + DEPTH_TOL * size
-        if oy <= lim:
-            depth[i] = oy
-            ny[i] = 1.0 if sy - dy <= lim else -1.0
-        else:
-            depth[i] = ox
-            nx[i] = 1.0 if sx - dx <= lim else -1.0
-        if points:
-            lo_x, hi_x = max(ax[i] - ahw[i], bx[i] - bhw[i]), min(ax[i] + ahw[i], bx[i] + bhw[i])
-            lo_y, hi_y = max(ay[i] - ahh[i], by[i] - bhh[i]), min(ay[i] + ahh[i], by[i] + bhh[i])
-            px[i], py[i] = 0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)
+        _aabb_row(ax[i], ay[i], ahw[i], ahh[i], bx[i], by[i], bhw[i], bhh[i], exact, points, i, hit, nx, ny, depth, px,
+                  py, extreme)
+    return hit, nx, ny, depth, px, py, extreme
+
+
+@njit(cache=True)
+def _aabb_pairs(ra, rb, hx, hy, hw, hh, exact, points):  # pragma: no cover - compiled
+    """:func:`_aabb_row` of every pair of rows ``(ra[i], rb[i])`` of the columns (origins ``hx,
+    hy``, half sizes ``hw, hh``), gathered in the pass."""
+    n = ra.size
+    hit = np.zeros(n, dtype=np.bool_)
+    nx, ny, depth = np.zeros(n), np.zeros(n), np.zeros(n)
+    px, py = np.zeros(n), np.zeros(n)
+    extreme = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        a, b = ra[i], rb[i]
+        _aabb_row(hx[a], hy[a], hw[a], hh[a], hx[b], hy[b], hw[b], hh[b], exact, points, i, hit, nx, ny, depth, px,
+                  py, extreme)
     return hit, nx, ny, depth, px, py, extreme

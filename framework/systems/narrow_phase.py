@@ -11,6 +11,7 @@ import numpy as np
 
 from ..arrays import BoolArray, I64Array, IntpArray, distinct
 from ..collision import batch
+from ..collision.batch_box import aabb_pairs_fast
 from ..collision.chain import chain_rule, deepest_below
 from ..collision.kinds import (
     BOXES,
@@ -150,11 +151,9 @@ def _pair_contacts(
     for f in fams:
         idx = np.flatnonzero(family == f) if len(fams) > 1 else None
         a, b = (ra[idx], rb[idx]) if idx is not None else (ra, rb)
-        if f == BOXES:
-            res = batch.aabb_aabb_fast(
-                hx[a], hy[a], store.hw[a], store.hh[a], hx[b], hy[b], store.hw[b], store.hh[b],
-                exact=not remeasure, points=not remeasure,
-            )
+        if f == BOXES:  # (the rows' columns read in the compiled pass)
+            res = aabb_pairs_fast(a, b, hx, hy, store.cols["hw"], store.cols["hh"], exact=not remeasure,
+                                  points=not remeasure)
         elif f == CIRCLES:
             res = batch.circle_circle(hx[a], hy[a], store.radius[a], hx[b], hy[b], store.radius[b],
                                        exact=not remeasure)
