@@ -323,13 +323,17 @@ def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points, i, hit, nx, ny,
 
 
 @njit(cache=True)
+def _aabb_out(n):  # pragma: no cover - compiled
+    """The output columns of :func:`_aabb_row` for ``n`` rows, zeros."""
+    return (np.zeros(n, dtype=np.bool_), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+            np.zeros(n, dtype=np.bool_))
+
+
+@njit(cache=True)
 def _aabb_rows(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points):  # pragma: no cover - compiled
     """:func:`_aabb_row` of every row of the gathered columns."""
     n = ax.size
-    hit = np.zeros(n, dtype=np.bool_)
-    nx, ny, depth = np.zeros(n), np.zeros(n), np.zeros(n)
-    px, py = np.zeros(n), np.zeros(n)
-    extreme = np.zeros(n, dtype=np.bool_)
+    hit, nx, ny, depth, px, py, extreme = _aabb_out(n)
     for i in range(n):
         _aabb_row(ax[i], ay[i], ahw[i], ahh[i], bx[i], by[i], bhw[i], bhh[i], exact, points, i, hit, nx, ny, depth, px,
                   py, extreme)
@@ -341,10 +345,7 @@ def _aabb_pairs(ra, rb, hx, hy, hw, hh, exact, points):  # pragma: no cover - co
     """:func:`_aabb_row` of every pair of rows ``(ra[i], rb[i])`` of the columns (origins ``hx,
     hy``, half sizes ``hw, hh``), gathered in the pass."""
     n = ra.size
-    hit = np.zeros(n, dtype=np.bool_)
-    nx, ny, depth = np.zeros(n), np.zeros(n), np.zeros(n)
-    px, py = np.zeros(n), np.zeros(n)
-    extreme = np.zeros(n, dtype=np.bool_)
+    hit, nx, ny, depth, px, py, extreme = _aabb_out(n)
     for i in range(n):
         a, b = ra[i], rb[i]
         _aabb_row(hx[a], hy[a], hw[a], hh[a], hx[b], hy[b], hw[b], hh[b], exact, points, i, hit, nx, ny, depth, px,
