@@ -15,7 +15,7 @@ from contextlib import contextmanager
 __all__ = ["FIRST_STEP_NOTICE", "notice_if_slow"]
 
 FIRST_STEP_NOTICE = ("framework: compiling the physics kernels for this scene (once per installation, a few "
-                     "seconds; later runs load them from numba's cache)")
+                     "seconds, up to about 15 where bodies turn; later runs load them from numba's cache)")
 
 
 @contextmanager
