@@ -29,16 +29,6 @@ def _ulp_step(v: F64Array) -> F64Array:
     return step
 
 
-def _down(v: float) -> float:
-    """:func:`widen_down` of one float (the same arithmetic, so the same bits)."""
-    return v - max(abs(v) * 2.0**-52, _TINY)
-
-
-def _up(v: float) -> float:
-    """:func:`widen_up` of one float."""
-    return v + max(abs(v) * 2.0**-52, _TINY)
-
-
 def widen_down(v: F64Array, out: F64Array | None = None) -> F64Array:
     """``v`` lowered by one or two ulps (at least to ``np.nextafter(v, -inf)``), by arithmetic:
     several times faster than ``nextafter``. The rounded difference ``v - step`` lies one or two
@@ -180,32 +170,10 @@ class Geometry:
 
     def move_row(self, store: BodyStore, row: int) -> None:
         """Origin and bounds of one row that moved without turning (the character stage's
-        placements), bit for bit as :meth:`_compute` gives them, in scalars: a full update costs
-        some thirty numpy calls however few rows moved. The geometry must have been current
-        before the move."""
-        x, y = float(store.cols["x"][row]), float(store.cols["y"][row])
-        if self.has_offset:
-            ox, oy = float(store.cols["ox"][row]), float(store.cols["oy"][row])
-            if ox != 0.0 or oy != 0.0:
-                co, so = float(self.cos[row]), float(self.sin[row])
-                x += co * ox - so * oy
-                y += so * ox + co * oy
-            self.hx[row], self.hy[row] = x, y
-        # (else hx, hy are the store's x, y columns: already moved)
-        kind = int(store.cols["kind"][row])
-        if kind == KIND_POLYGON or kind == KIND_SEGMENT:
-            local = self.world_poly[self.poly_slot[row]]
-            lo_x, hi_x = x + float(local[:, 0].min()), x + float(local[:, 0].max())
-            lo_y, hi_y = y + float(local[:, 1].min()), y + float(local[:, 1].max())
-        else:
-            if kind == KIND_CAPSULE:
-                r = float(store.cols["radius"][row])
-                ex, ey = abs(float(self.cap_ux[row])) + r, abs(float(self.cap_uy[row])) + r
-            else:
-                ex, ey = float(store.cols["hw"][row]), float(store.cols["hh"][row])
-            lo_x, hi_x, lo_y, hi_y = x - ex, x + ex, y - ey, y + ey
-        self.minx[row], self.maxx[row] = _down(lo_x), _up(hi_x)
-        self.miny[row], self.maxy[row] = _down(lo_y), _up(hi_y)
+        placements): :func:`_place` of that row alone (a full update costs some thirty numpy calls
+        however few rows moved). The geometry must have been current before the move (its sines
+        and cosines are the row's)."""
+        self._place_rows(store, np.array([row], dtype=np.int64))
 
     def _compute(self, store: BodyStore, rows: IntpArray, full: bool, sel: slice | IntpArray | None = None) -> None:
         """Origins and bounds of ``rows`` (``sel``: the same rows as a slice, if they are one run):
@@ -239,11 +207,14 @@ class Geometry:
             if turned_rows.size:
                 rot = c["rot"][turned_rows]
                 self.cos[turned_rows], self.sin[turned_rows] = np.cos(rot), np.sin(rot)
-        # (the columns whole: the pass reads only ``rows``, all below n)
-        _place(np.ascontiguousarray(rows, dtype=np.int64), c["x"], c["y"], c["ox"], c["oy"], c["kind"], c["hw"],
-               c["hh"], c["radius"], self.cos, self.sin, self.local, self.poly_slot, self.world_poly, self.cap_half,
-               self.cap_ux, self.cap_uy, self.hx, self.hy, self.minx, self.maxx, self.miny, self.maxy,
-               self.has_offset)
+        self._place_rows(store, np.ascontiguousarray(rows, dtype=np.int64))
+
+    def _place_rows(self, store: BodyStore, rows: I64Array) -> None:
+        """:func:`_place` of ``rows`` (the columns whole: the pass reads only ``rows``, all below n)."""
+        c = store.cols
+        _place(rows, c["x"], c["y"], c["ox"], c["oy"], c["kind"], c["hw"], c["hh"], c["radius"], self.cos, self.sin,
+               self.local, self.poly_slot, self.world_poly, self.cap_half, self.cap_ux, self.cap_uy, self.hx, self.hy,
+               self.minx, self.maxx, self.miny, self.maxy, self.has_offset)
 
     def outlines(self, store: BodyStore, rows: IntpArray) -> tuple[F64Array, I64Array]:
         """Rotated outlines (relative to the hitbox origin) and vertex counts of AABB/polygon rows (a

@@ -431,24 +431,30 @@ class SpatialQueries:
     def _shapes(self) -> _Shapes:
         """The live shapes as columns, cached until a structural change (rebuilt while a hitbox
         edit waits for the next step, as the single queries read the edited shape at once)."""
-        store = self.bodies.store
-        cached: tuple[int, _Shapes] | None = getattr(self, "_shape_cols", None)
-        if cached is not None and cached[0] == store.version and not store.dirty_hitboxes:
-            return cached[1]
-        cols = _shape_table([None if hb is None else hb.shape for hb in store.hitboxes[: store.n]])
-        self._shape_cols = (store.version, cols)
+        cols = self._cached_shapes()
+        if cols is None:
+            store = self.bodies.store
+            cols = _shape_table([None if hb is None else hb.shape for hb in store.hitboxes[: store.n]])
+            self._shape_cols = (store.version, cols)
         return cols
 
     def _shapes_of(self, rows: NDArray[np.intp]) -> tuple[_Shapes, NDArray[np.int64]]:
         """The live shapes of ``rows`` as columns, and where each row is in them: the scene's table
         when it is current, else a table of these rows alone (a query after a spawn or a hitbox edit
         does not measure every hitbox of the scene again)."""
+        cols = self._cached_shapes()
+        if cols is not None:
+            return cols, np.ascontiguousarray(rows, dtype=np.int64)
+        hitboxes = self.bodies.store.hitboxes
+        return _shape_table([hitboxes[r].shape for r in rows.tolist()]), np.arange(rows.size)
+
+    def _cached_shapes(self) -> _Shapes | None:
+        """The scene's shape table if it is current (no structural change, no hitbox edit waiting)."""
         store = self.bodies.store
         cached: tuple[int, _Shapes] | None = getattr(self, "_shape_cols", None)
         if cached is not None and cached[0] == store.version and not store.dirty_hitboxes:
-            return cached[1], np.ascontiguousarray(rows, dtype=np.int64)
-        hitboxes = store.hitboxes
-        return _shape_table([hitboxes[r].shape for r in rows.tolist()]), np.arange(rows.size)
+            return cached[1]
+        return None
 
     def _prepare(self) -> Geometry:
         """The geometry, current, as the single queries' candidate search leaves it."""

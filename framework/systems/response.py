@@ -30,8 +30,6 @@ from .solve import KEEP_GAP, Contacts, Pairs, Solve
 from .stage import Stage
 from .turning import manifold_points
 
-_NO_IDS = np.zeros(0, dtype=np.int64)
-
 __all__ = ["Response"]
 
 
@@ -48,7 +46,6 @@ class Response(Stage):
         self._near: _NearStatics | None = None
 
     def run(self, frame: StepFrame) -> bool:
-        store = self.bodies.store
         if frame.support[0].size == 0 and self._idle(frame):
             # Nothing to act on: no pair was acted on last step and no contact has a body the
             # response may move (everything touching is static, kinematic or asleep: a platformer's
@@ -60,8 +57,6 @@ class Response(Stage):
         frame.support = NO_SUPPORT
         frame.resolved = NO_RESOLVED
         points, frame.points = frame.points, NO_POINTS
-        if cs.size and cs.ra.max() >= store.n:  # rows spawned mid-step are not in this step
-            return False
         cs = cs.take(np.flatnonzero(self._solid(frame, cs)))
         if cs.size == 0:
             return True
@@ -72,8 +67,8 @@ class Response(Stage):
         return True
 
     def _idle(self, frame: StepFrame) -> bool:
-        """Whether no contact of this step has a body the response may move (rows spawned during
-        the step excepted: the full pass leaves the step to them)."""
+        """Whether no contact of this step has a body the response may move (a contact's row beyond
+        the store's: not idle, the full pass says what is wrong)."""
         ra, rb = frame.contact_rows
         n = self.bodies.store.n
         if ra.size == 0:
@@ -97,7 +92,6 @@ class Response(Stage):
         if ra.size and (int(ra.max()) >= n or int(rb.max()) >= n):
             raise IndexError(f"a contact's row is beyond the store's {n} rows (a body removed during the step)")
         geom = self.bodies.ensure_geometry()
-        store.rows_of(_NO_IDS)  # (the entity -> row table, current)
         col = store.cols
         i64, f64 = np.int64, np.float64
         sa, sb, snx, sny, spush, simp, ssep, stpush, stimp = (
@@ -106,7 +100,7 @@ class Response(Stage):
         out = gather(
             np.asarray(c.a, dtype=i64), np.asarray(c.b, dtype=i64), c.nx, c.ny, c.depth, c.px, c.py,
             np.asarray(ra, dtype=i64), np.asarray(rb, dtype=i64), sa, sb, snx, sny, spush, simp, ssep, stpush, stimp,
-            store._lookup, col["kind"], col["layer"], col["mask"], store.layers_all_meet(), col["bound"],
+            store.row_table(), col["kind"], col["layer"], col["mask"], store.layers_all_meet(), col["bound"],
             col["radius"], col["inv_inertia"], col["friction"], col["hw"], col["hh"], col["x"], col["y"],
             frame.start_x, frame.start_y, geom.hx, geom.hy, geom.minx, geom.miny, geom.maxx, geom.maxy,
             "friction" in effects and "rotation" in effects, KEEP_GAP, KIND_AABB, KIND_CIRCLE)
