@@ -26,6 +26,7 @@ from ..collision.kinds import (
     POLYGON_CIRCLE,
     pair_code,
 )
+from ..collision.polygon_rows import polygon_pairs
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
 from ..geometry import Geometry
@@ -166,13 +167,30 @@ def _pair_contacts(
         elif f == CAPSULES:
             res = _capsule_pairs(store, geom, a, b, code if idx is None else code[idx], remeasure)
         else:
-            va, na = geom.outlines(store, a)
-            vb, nb = geom.outlines(store, b)
-            res = batch.polygon_polygon(hx[a], hy[a], va, na, hx[b], hy[b], vb, nb,
-                                        exact=not remeasure, points=not remeasure)
+            res = _polygon_pairs(store, geom, a, b, exact=not remeasure, points=not remeasure)
         if idx is None:  # one family: the kernel's rows are the pairs
             return res
         hit[idx], nx[idx], ny[idx], depth[idx], px[idx], py[idx] = res
+    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
+def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, *, exact: bool,
+                   points: bool) -> batch.ContactArrays:
+    """:func:`~framework.collision.batch.polygon_polygon` of pairs of box and polygon rows: the
+    compiled pass over the rows (:mod:`~framework.collision.polygon_rows`), and the numpy kernel on
+    the outlines of the few rows that pass leaves to it (exact fallbacks, two centred boxes)."""
+    a, b = np.ascontiguousarray(a, dtype=np.int64), np.ascontiguousarray(b, dtype=np.int64)
+    hit, nx, ny, depth, px, py, defer = polygon_pairs(a, b, geom.hx, geom.hy, store.kind, store.hw, store.hh,
+                                                      geom.world_poly, geom.poly_slot, geom.count, geom.K, exact,
+                                                      points)
+    if defer.any():
+        d = np.flatnonzero(defer)
+        da, db = a[d], b[d]
+        va, na = geom.outlines(store, da)
+        vb, nb = geom.outlines(store, db)
+        hx, hy = geom.hx, geom.hy
+        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.polygon_polygon(
+            hx[da], hy[da], va, na, hx[db], hy[db], vb, nb, exact=exact, points=points)
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
 
 

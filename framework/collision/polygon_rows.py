@@ -1,0 +1,385 @@
+"""The polygon kernel over the pipeline's rows, compiled: :func:`polygon_pairs`.
+
+:func:`~framework.collision.batch_polygon.polygon_polygon` of pairs of rows (boxes and polygons in
+any mix but AABB / AABB), one compiled pass that reads each row's outline where the geometry keeps
+it (an AABB's from its half extents, a polygon's or segment's turned outline) instead of gathering
+outlines into padded ``[K, P]`` arrays first. The narrow phase and the solve's re-measures call it
+some ten times a step with a few dozen pairs each, where the numpy kernel's hundred-odd calls cost
+far more than its arithmetic.
+
+It is the numpy kernel row by row, in the same order of operations, so the same bits: the scaled
+frame, the separating axes and their band around touching, the candidates of the tie-break rule
+and :func:`~framework.collision.tiebreak.pick`'s steps, the contact point as
+:func:`~framework.collision.batch_point.overlap_point` finds it (its sums in the same sequential
+order), and :func:`~framework.collision.batch_common.finish`.
+
+Rows it leaves to the numpy kernel (``defer``), which then answers them as it always did:
+
+- two centred axis-aligned boxes where contacts must be exact with their points (the box kernel
+  :func:`~framework.collision.batch_box.aabb_aabb`), or of extreme magnitudes;
+- rows within rounding of touching on some axis where contacts must be exact (the integer
+  fallback of :mod:`~framework.collision.exact`);
+- a contact beyond float64's range (the numpy kernel raises the error).
+
+A row's answer does not depend on the other rows of its batch (the numpy kernel's sums are
+sequential per row for that reason), so answering a few rows apart gives the same bits.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .batch_box import _aabb_row
+from .collide import POINT_TOL
+from .exact import BAND, TINY
+from .kinds import KIND_AABB
+from .tiebreak import DEPTH_TOL, DIR_TOL
+
+__all__ = ["polygon_pairs"]
+
+_BIG = 1e300  # (batch_common.BIG: "absent" in a min, in the scaled frames where values are about 1)
+
+
+@njit(cache=True)
+def _outline(r, kind, hw, hh, world_poly, poly_slot, count, vx, vy):  # pragma: no cover - compiled
+    """Row ``r``'s outline about its hitbox origin into ``vx, vy`` (``K`` slots, the padding
+    repeating the last vertex, as ``batch_common.outline_rows`` writes it); returns its count."""
+    k = vx.size
+    if kind[r] == KIND_AABB:
+        w, h = hw[r], hh[r]
+        vx[0], vy[0] = -w, -h
+        vx[1], vy[1] = w, -h
+        vx[2], vy[2] = w, h
+        for j in range(3, k):
+            vx[j], vy[j] = -w, h
+        return 4
+    s, c = poly_slot[r], count[r]
+    for j in range(k):
+        m = j if j < c else c - 1
+        vx[j], vy[j] = world_poly[s, m, 0], world_poly[s, m, 1]
+    return c
+
+
+@njit(cache=True)
+def _centred_box(vx, vy, c):  # pragma: no cover - compiled
+    """``batch_polygon._centred_boxes`` of one outline."""
+    if vx.size < 4:
+        return False
+    return (c == 4 and vx[1] > 0.0 and vy[2] > 0.0 and vx[0] == -vx[1] and vx[2] == vx[1] and vx[3] == vx[0]
+            and vy[1] == vy[0] and vy[0] == -vy[2] and vy[3] == vy[2])
+
+
+@njit(cache=True)
+def _norm(x, y):  # pragma: no cover - compiled
+    """``batch_common.norm`` of one vector."""
+    n = np.sqrt(x * x + y * y)
+    return math.hypot(x, y) if n < 1e-150 else n
+
+
+@njit(cache=True)
+def _edges(v, e):  # pragma: no cover - compiled
+    """``batch_common.edges`` of one outline coordinate into ``e``."""
+    k = v.size
+    for j in range(k - 1):
+        e[j] = v[j + 1] - v[j]
+    e[k - 1] = v[0] - v[k - 1]
+
+
+@njit(cache=True)
+def _extent(vx, vy):  # pragma: no cover - compiled
+    """``batch_common.extent`` of one outline."""
+    mx = abs(vx[0])
+    my = abs(vy[0])
+    for j in range(1, vx.size):
+        if abs(vx[j]) > mx:
+            mx = abs(vx[j])
+        if abs(vy[j]) > my:
+            my = abs(vy[j])
+    return mx if mx > my else my
+
+
+@njit(cache=True)
+def _radius(vx, vy):  # pragma: no cover - compiled
+    """The root of the largest squared vertex length (``_frame``'s bounding radius)."""
+    m = vx[0] * vx[0] + vy[0] * vy[0]
+    for j in range(1, vx.size):
+        q = vx[j] * vx[j] + vy[j] * vy[j]
+        if q > m:
+            m = q
+    return np.sqrt(m)
+
+
+@njit(cache=True)
+def _project(ux, uy, vx, vy):  # pragma: no cover - compiled
+    """Min and max of an outline's vertices projected on axis ``u`` (``batch_polygon._extent``)."""
+    lo = ux * vx[0] + uy * vy[0]
+    hi = lo
+    for j in range(1, vx.size):
+        p = ux * vx[j] + uy * vy[j]
+        if p < lo:
+            lo = p
+        if p > hi:
+            hi = p
+    return lo, hi
+
+
+@njit(cache=True)
+def _pick(cd, cx, cy, size):  # pragma: no cover - compiled
+    """``batch_common.pick`` of one pair's candidates ``(depth, nx, ny)``."""
+    c = cd.size
+    best = cd[0]
+    for j in range(1, c):
+        if cd[j] < best:
+            best = cd[j]
+    lim = best + DEPTH_TOL * size
+    near = np.empty(c, dtype=np.bool_)
+    top = 0.0
+    for j in range(c):
+        near[j] = cd[j] <= lim
+        v = abs(cy[j]) * (1.0 if near[j] else 0.0)
+        if j == 0 or v > top:
+            top = v
+    for j in range(c):
+        near[j] = near[j] and abs(cy[j]) >= top - DIR_TOL
+    top = 0.0
+    for j in range(c):
+        fold = cy[j] < -DIR_TOL or (abs(cy[j]) <= DIR_TOL and cx[j] < 0.0)
+        fx = cx[j] * (1.0 - 2.0 * (1.0 if fold else 0.0))
+        v = fx + ((1.0 if near[j] else 0.0) - 1.0) * 4.0
+        if j == 0 or v > top:
+            top = v
+    shortest = 0.0
+    for j in range(c):
+        fold = cy[j] < -DIR_TOL or (abs(cy[j]) <= DIR_TOL and cx[j] < 0.0)
+        fx = cx[j] * (1.0 - 2.0 * (1.0 if fold else 0.0))
+        near[j] = near[j] and fx >= top - DIR_TOL
+        v = cd[j] + (1.0 - (1.0 if near[j] else 0.0)) * _BIG
+        if j == 0 or v < shortest:
+            shortest = v
+    for key in range(2):
+        any_keep = False
+        for j in range(c):
+            if near[j] and ((cy[j] if key == 0 else cx[j]) > DIR_TOL):
+                any_keep = True
+        if any_keep:
+            for j in range(c):
+                near[j] = near[j] and ((cy[j] if key == 0 else cx[j]) > DIR_TOL)
+    low = 0.0
+    for j in range(c):
+        v = cd[j] + (1.0 - (1.0 if near[j] else 0.0)) * _BIG
+        if j == 0 or v < low:
+            low = v
+    i = 0
+    for j in range(c):
+        if near[j] and cd[j] == low:
+            i = j
+            break
+    return shortest, cx[i], cy[i]
+
+
+@njit(cache=True)
+def _inside(x, y, ox, oy, ex, ey, en, tol):  # pragma: no cover - compiled
+    """``batch_point._inside`` of one point against one outline (vertices ``o``, edges ``e``,
+    their lengths ``en``)."""
+    for e in range(ox.size):
+        cross = ex[e] * (y - oy[e])
+        cross -= ey[e] * (x - ox[e])
+        if cross < -tol * en[e]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _within_segment(x, y, ox, oy, tol):  # pragma: no cover - compiled
+    """``batch_point._within_segment`` of one point and a segment (an outline of two points)."""
+    ex, ey = ox[1] - ox[0], oy[1] - oy[0]
+    along = ex * (x - ox[0]) + ey * (y - oy[0])
+    slack = tol * _norm(ex, ey)
+    return along >= -slack and along <= ex * ex + ey * ey + slack
+
+
+@njit(cache=True)
+def _overlap_point(avx, avy, ac, bvx, bvy, bc, nx, ny, depth, size, exa, eya, exb, eyb, na, nb):
+    # pragma: no cover - compiled
+    """``batch_point.overlap_point`` of one pair (B at its offset): the mean of the vertices of
+    A ∩ B, its sums in the numpy kernel's order (A's vertices, B's, then the crossings)."""
+    k = avx.size
+    tol = POINT_TOL * size
+    _edges(avx, exa)
+    _edges(avy, eya)
+    _edges(bvx, exb)
+    _edges(bvy, eyb)
+    for j in range(k):
+        na[j] = _norm(exa[j], eya[j])
+        nb[j] = _norm(exb[j], eyb[j])
+    sxa = sya = ca = 0.0
+    sxb = syb = cb = 0.0
+    for j in range(k):
+        ina = j < ac and _inside(avx[j], avy[j], bvx, bvy, exb, eyb, nb, tol)
+        if ina and bc == 2:
+            ina = _within_segment(avx[j], avy[j], bvx, bvy, tol)
+        inb = j < bc and _inside(bvx[j], bvy[j], avx, avy, exa, eya, na, tol)
+        if inb and ac == 2:
+            inb = _within_segment(bvx[j], bvy[j], avx, avy, tol)
+        fa, fb = 1.0 if ina else 0.0, 1.0 if inb else 0.0
+        if j == 0:
+            sxa, sya, ca = avx[j] * fa, avy[j] * fa, fa
+            sxb, syb, cb = bvx[j] * fb, bvy[j] * fb, fb
+        else:
+            sxa += avx[j] * fa
+            sya += avy[j] * fa
+            ca += fa
+            sxb += bvx[j] * fb
+            syb += bvy[j] * fb
+            cb += fb
+    sx, sy, count = sxa + sxb, sya + syb, ca + cb
+    tx = ty = tc = 0.0
+    for i in range(k):
+        rx, ry = exa[i], eya[i]
+        for j in range(k):
+            sx_, sy_ = exb[j], eyb[j]
+            den = rx * sy_ - ry * sx_
+            wx = bvx[j] - avx[i]
+            wy = bvy[j] - avy[i]
+            parallel = den == 0.0
+            if parallel:
+                den += 1.0
+            t = (wx * sy_ - wy * sx_) / den
+            u = (wx * ry - wy * rx) / den
+            f = 1.0 if (t >= 0.0 and t <= 1.0 and u >= 0.0 and u <= 1.0 and not parallel) else 0.0
+            t = 0.0 if t < 0.0 else t
+            t = 1.0 if t > 1.0 else t
+            vx_ = (avx[i] + t * rx) * f
+            vy_ = (avy[i] + t * ry) * f
+            if i == 0 and j == 0:
+                tx, ty, tc = vx_, vy_, f
+            else:
+                tx += vx_
+                ty += vy_
+                tc += f
+    sx += tx
+    sy += ty
+    count += tc
+    if count > 0.0:
+        return sx / count, sy / count
+    # Rounding hid every vertex (near-degenerate only): the middle of the penetration segment from
+    # B's deepest vertex.
+    j = 0
+    low = bvx[0] * nx + bvy[0] * ny
+    for m in range(1, k):
+        v = bvx[m] * nx + bvy[m] * ny
+        if v < low:
+            low, j = v, m
+    half = depth * 0.5
+    return bvx[j] + nx * half, bvy[j] + ny * half
+
+
+@njit(cache=True)
+def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k, exact, points):
+    # pragma: no cover - compiled
+    """``polygon_polygon`` of the pairs of rows ``(ra[i], rb[i])`` (module docstring): the six
+    contact columns and ``defer``, the rows left to the numpy kernel."""
+    n = ra.size
+    hit = np.zeros(n, dtype=np.bool_)
+    nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    defer = np.zeros(n, dtype=np.bool_)
+    extreme = np.zeros(n, dtype=np.bool_)
+    avx, avy, bvx, bvy = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+    ux, uy, fwd, bwd = np.empty(2 * k), np.empty(2 * k), np.empty(2 * k), np.empty(2 * k)
+    cd, cx, cy = np.empty(4 * k), np.empty(4 * k), np.empty(4 * k)
+    exa, eya, exb, eyb, na, nb = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+    for i in range(n):
+        a, b = ra[i], rb[i]
+        ac = _outline(a, kind, hw, hh, world_poly, poly_slot, count, avx, avy)
+        bc = _outline(b, kind, hw, hh, world_poly, poly_slot, count, bvx, bvy)
+        ax, ay, bx, by = hx[a], hy[a], hx[b], hy[b]
+        if _centred_box(avx, avy, ac) and _centred_box(bvx, bvy, bc):
+            if exact and points:
+                defer[i] = True
+                continue
+            _aabb_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2], exact, points, i, hit, nx, ny, depth, px, py,
+                      extreme)
+            if exact and extreme[i]:
+                defer[i] = True
+            continue
+        # The scaled frame (batch_common.frame, batch_polygon._frame).
+        ea, eb = _extent(avx, avy), _extent(bvx, bvy)
+        reach = ea if ea > eb else eb  # (np.maximum: no NaN here)
+        hdx, hdy = 0.5 * bx - 0.5 * ax, 0.5 * by - 0.5 * ay
+        m = abs(hdx) if abs(hdx) > abs(hdy) else abs(hdy)
+        m = m if m > 0.5 * reach else 0.5 * reach
+        e = math.frexp(m)[1]
+        dx, dy = math.ldexp(hdx, 1 - e), math.ldexp(hdy, 1 - e)
+        for j in range(k):
+            avx[j], avy[j] = math.ldexp(avx[j], -e), math.ldexp(avy[j], -e)
+            bvx[j], bvy[j] = math.ldexp(bvx[j], -e), math.ldexp(bvy[j], -e)
+        sz = _radius(avx, avy) + _radius(bvx, bvy)
+        # Separating axes (batch_polygon._sat): unnormalised outward edge normals of A, then of B.
+        _edges(avy, exa)
+        _edges(avx, eya)
+        _edges(bvy, exb)
+        _edges(bvx, eyb)
+        for j in range(k):
+            ux[j], uy[j] = exa[j], -eya[j]
+            ux[k + j], uy[k + j] = exb[j], -eyb[j]
+        apart = ac == 2 and bc == 2
+        border = any_valid = False
+        reach2 = sz + abs(dx) + abs(dy)
+        for c in range(2 * k):
+            if ux[c] == 0.0 and uy[c] == 0.0:
+                continue
+            any_valid = True
+            amin, amax = _project(ux[c], uy[c], avx, avy)
+            bmin, bmax = _project(ux[c], uy[c], bvx, bvy)
+            ud = ux[c] * dx + uy[c] * dy
+            fwd[c] = (amax - bmin) - ud
+            bwd[c] = (bmax - amin) + ud
+            least = fwd[c] if fwd[c] < bwd[c] else bwd[c]
+            tol = BAND * (abs(ux[c]) + abs(uy[c])) * reach2
+            if least < -tol:
+                apart = True
+                break
+            if least <= tol:
+                border = True
+        if apart or not any_valid:
+            continue
+        if border:
+            defer[i] = exact  # (the exact fallback; without it, a row touching to rounding is apart)
+            continue
+        # Candidates in the scalar code's order: per axis, forward then backward.
+        for c in range(2 * k):
+            if ux[c] == 0.0 and uy[c] == 0.0:  # (a padding edge: ln 1, the depth BIG, as the numpy)
+                cx[2 * c], cy[2 * c] = ux[c], uy[c]
+                cx[2 * c + 1], cy[2 * c + 1] = -ux[c], -uy[c]
+                cd[2 * c] = cd[2 * c + 1] = _BIG
+                continue
+            ln = _norm(ux[c], uy[c])
+            cx[2 * c] = ux[c] / ln
+            cy[2 * c] = uy[c] / ln
+            cx[2 * c + 1] = -cx[2 * c]
+            cy[2 * c + 1] = -cy[2 * c]
+            d = fwd[c] / ln
+            cd[2 * c] = (d if d > TINY else TINY) + 0.0
+            d = bwd[c] / ln
+            cd[2 * c + 1] = (d if d > TINY else TINY) + 0.0
+        dep, nxi, nyi = _pick(cd, cx, cy, sz)
+        pxi = pyi = 0.0
+        if points:
+            for j in range(k):
+                bvx[j] += dx
+                bvy[j] += dy
+            pxi, pyi = _overlap_point(avx, avy, ac, bvx, bvy, bc, nxi, nyi, dep, sz, exa, eya, exb, eyb, na, nb)
+        # batch_common.finish: unscaled, in the world.
+        dep = math.ldexp(dep, e)
+        dep = dep if dep > TINY else TINY
+        pxi = ax + math.ldexp(pxi, e)
+        pyi = ay + math.ldexp(pyi, e)
+        if not (math.isfinite(dep) and math.isfinite(pxi) and math.isfinite(pyi)):
+            defer[i] = True  # (the numpy kernel raises its error)
+            continue
+        hit[i] = True
+        nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi
+    return hit, nx, ny, depth, px, py, defer

@@ -1,0 +1,144 @@
+"""The compiled polygon kernel over the pipeline's rows (:mod:`framework.collision.polygon_rows`)
+gives the numpy kernel's contacts bit for bit: every shape mix the polygon family holds (boxes
+unturned and turned, ``Polygon.box``, convex polygons, segments), overlapping, apart, touching to
+the last bit (the exact fallback it leaves to the numpy kernel), far from the origin and at
+extreme scales, with and without exactness and points (the narrow phase's calls and the solve's
+re-measures)."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from framework import AABB, Polygon, Segment
+from framework.collision import batch
+from framework.collision.kinds import KIND_AABB, KIND_POLYGON, KIND_SEGMENT
+from framework.geometry import Geometry
+from framework.systems.narrow_phase import _polygon_pairs
+
+
+def _rows(shapes, poses):
+    """A store and geometry holding ``shapes`` at ``poses`` (x, y, rotation), as the pipeline's."""
+    n = len(shapes)
+    kind = np.array([KIND_AABB if isinstance(s, AABB) else KIND_SEGMENT if isinstance(s, Segment) else KIND_POLYGON
+                     for s in shapes], dtype=np.int8)
+    hw = np.array([s.width * 0.5 if isinstance(s, AABB) else 0.0 for s in shapes])
+    hh = np.array([s.height * 0.5 if isinstance(s, AABB) else 0.0 for s in shapes])
+    store = SimpleNamespace(kind=kind, hw=hw, hh=hh)
+    geom = Geometry()
+    outlined = np.flatnonzero(kind != KIND_AABB)
+    verts, counts = batch.outlines([shapes[i] for i in outlined], np.array([poses[i][2] for i in outlined]))
+    geom.K = max(4, verts.shape[1]) if outlined.size else 4
+    geom.world_poly = np.zeros((outlined.size, geom.K, 2))
+    geom.world_poly[:, : verts.shape[1]] = verts
+    geom.world_poly[:, verts.shape[1]:] = verts[:, -1:]
+    geom.poly_slot = np.full(n, -1, dtype=np.int64)
+    geom.poly_slot[outlined] = np.arange(outlined.size)
+    geom.count = np.zeros(n, dtype=np.int64)
+    geom.count[outlined] = counts
+    geom.segments = bool((kind == KIND_SEGMENT).any())
+    geom.hx = np.array([p[0] for p in poses])
+    geom.hy = np.array([p[1] for p in poses])
+    return store, geom
+
+
+def _numpy(store, geom, a, b, exact, points):
+    va, na = geom.outlines(store, a)
+    vb, nb = geom.outlines(store, b)
+    return batch.polygon_polygon(geom.hx[a], geom.hy[a], va, na, geom.hx[b], geom.hy[b], vb, nb, exact=exact,
+                                 points=points)
+
+
+def _same_bits(got, want) -> None:
+    assert np.array_equal(got.hit, want.hit)
+    for g, w in zip(got[1:], want[1:], strict=True):
+        assert np.array_equal(np.asarray(g).view(np.int64), np.asarray(w).view(np.int64)), (g, w)
+
+
+def _check(shapes, poses, pairs) -> None:
+    store, geom = _rows(shapes, poses)
+    a = np.array([p[0] for p in pairs], dtype=np.int64)
+    b = np.array([p[1] for p in pairs], dtype=np.int64)
+    for exact in (True, False):
+        for points in (True, False):
+            if points and not exact:
+                continue  # (the pipeline asks for points only with exactness)
+            _same_bits(_polygon_pairs(store, geom, a, b, exact=exact, points=points),
+                       _numpy(store, geom, a, b, exact, points))
+            for i in range(a.size):  # a row's answer does not depend on its batch
+                _same_bits(_polygon_pairs(store, geom, a[i:i + 1], b[i:i + 1], exact=exact, points=points),
+                           _numpy(store, geom, a[i:i + 1], b[i:i + 1], exact, points))
+
+
+_DYADIC = st.integers(-64, 64).map(lambda k: k / 16.0)
+_SIZE = st.integers(1, 48).map(lambda k: k / 16.0)
+
+
+@st.composite
+def _shape(draw):
+    which = draw(st.sampled_from(["aabb", "box", "polygon", "segment"]))
+    if which == "aabb":
+        return AABB(draw(_SIZE), draw(_SIZE))
+    if which == "box":
+        return Polygon.box(draw(_SIZE), draw(_SIZE))
+    if which == "segment":
+        a = (draw(_DYADIC), draw(_DYADIC))
+        b = (draw(_DYADIC), draw(_DYADIC))
+        return Segment(a, b) if a != b else Segment(a, (a[0] + 1.0, a[1]))
+    n = draw(st.integers(3, 8))
+    r = draw(_SIZE)
+    start = draw(st.floats(0.0, 2.0 * math.pi))
+    return Polygon([(r * math.cos(start + 2.0 * math.pi * k / n), r * math.sin(start + 2.0 * math.pi * k / n))
+                    for k in range(n)])
+
+
+_ROTATION = st.one_of(st.just(0.0), st.just(math.pi / 2), st.floats(-math.pi, math.pi, allow_nan=False))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(_shape(), _DYADIC, _DYADIC, _ROTATION), min_size=2, max_size=7), st.data(),
+       st.sampled_from([1.0, 2.0**40, 2.0**-600, 2.0**900]), st.sampled_from([0.0, 1e9]))
+def test_random_rows_same_bits(bodies, data, scale, far) -> None:
+    """Random shapes and poses (dyadic, so many pairs touch exactly or share edges), scaled by a
+    power of two and moved far from the origin: the same bits as the numpy kernel."""
+    shapes = [_scaled(s, scale) for s, *_ in bodies]
+    poses = [(x * scale + far, y * scale, rot) for _s, x, y, rot in bodies]
+    n = len(shapes)
+    pairs = data.draw(st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)).filter(
+        lambda p: p[0] != p[1] and not (isinstance(shapes[p[0]], AABB) and isinstance(shapes[p[1]], AABB))),
+        min_size=1, max_size=12))
+    _check(shapes, poses, pairs)
+
+
+def _scaled(shape, k: float):
+    if isinstance(shape, AABB):
+        return AABB(shape.width * k, shape.height * k)
+    if isinstance(shape, Segment):
+        return Segment((shape.a[0] * k, shape.a[1] * k), (shape.b[0] * k, shape.b[1] * k))
+    return Polygon([(x * k, y * k) for x, y in shape.points])
+
+
+@pytest.mark.parametrize("dx, dy, rot", [
+    (1.0, 0.0, 0.0), (0.75, 0.5, 0.0), (1.0, 1.0, 0.0), (0.5, 0.5, math.pi / 4), (0.0, 0.0, 0.0),
+    (1.25, 0.0, 0.0), (0.5, 0.96875, 0.0), (0.5, 0.5, math.pi / 2),
+])
+def test_touching_overlapping_and_apart(dx, dy, rot) -> None:
+    """A unit ``Polygon.box`` against an AABB, a turned box and a triangle: edges touching exactly
+    (the exact fallback), corners touching, overlapping by dyadic depths, apart."""
+    shapes = [Polygon.box(1.0, 1.0), AABB(1.0, 1.0), Polygon.box(1.0, 1.0), Polygon([(0, 0), (1, 0), (0, 1)]),
+              Segment((-0.5, 0.0), (0.5, 0.0))]
+    poses = [(0.0, 0.0, rot), (dx, dy, 0.0), (dx, -dy, rot), (-dx, dy, 0.0), (dy, dx, 0.0)]
+    _check(shapes, poses, [(0, 1), (1, 0), (0, 2), (2, 0), (0, 3), (3, 2), (4, 0), (0, 4), (4, 3), (1, 2)])
+
+
+def test_deep_and_nested() -> None:
+    """One outline inside another, and two identical outlines on each other: every candidate
+    ties, so the tie-break's every step decides; points are the mean of the inner outline."""
+    shapes = [Polygon.box(4.0, 4.0), Polygon([(0, 0), (1, 0), (0.5, 1)]), Polygon.box(4.0, 4.0), AABB(1.0, 1.0)]
+    poses = [(0.0, 0.0, 0.0), (0.25, 0.25, 0.0), (0.0, 0.0, math.pi / 2), (0.0, 0.0, 0.0)]
+    _check(shapes, poses, [(0, 1), (1, 0), (0, 2), (2, 0), (0, 3), (3, 1), (2, 3)])
