@@ -142,3 +142,28 @@ def test_deep_and_nested() -> None:
     shapes = [Polygon.box(4.0, 4.0), Polygon([(0, 0), (1, 0), (0.5, 1)]), Polygon.box(4.0, 4.0), AABB(1.0, 1.0)]
     poses = [(0.0, 0.0, 0.0), (0.25, 0.25, 0.0), (0.0, 0.0, math.pi / 2), (0.0, 0.0, 0.0)]
     _check(shapes, poses, [(0, 1), (1, 0), (0, 2), (2, 0), (0, 3), (3, 1), (2, 3)])
+
+
+_FLOATS = st.one_of(_DYADIC, st.floats(-4.0, 4.0, allow_nan=False))
+_HALF = st.one_of(_SIZE, st.floats(1e-3, 3.0, allow_nan=False))
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.tuples(_FLOATS, _FLOATS, _HALF, _HALF, _FLOATS, _FLOATS, _HALF, _HALF),
+       st.sampled_from([1.0, 2.0**-500, 2.0**500]), st.sampled_from([0.0, 1e9, -3e15]))
+def test_centred_boxes_row_same_bits(box, scale, far) -> None:
+    """Two centred boxes, the box kernel of one pair compiled (:mod:`framework.collision.box_pair_row`):
+    ``aabb_aabb``'s contact bit for bit, touching (dyadic), overlapping and apart, far out and at
+    extreme scales."""
+    from framework.collision.batch_box import aabb_aabb
+    from framework.collision.box_pair_row import aabb_exact_row
+
+    ax, ay, ahw, ahh, bx, by, bhw, bhh = (v * scale for v in box)
+    ax, bx = ax + far, bx + far
+    hit, nx, ny, depth, px, py, found = aabb_exact_row(ax, ay, ahw, ahh, bx, by, bhw, bhh)
+    want = aabb_aabb(ax, ay, ahw, ahh, bx, by, bhw, bhh)
+    assert hit == bool(want.hit[0])
+    if hit and found:
+        got = np.array([nx, ny, depth, px, py])
+        ref = np.array([want.nx[0], want.ny[0], want.depth[0], want.px[0], want.py[0]])
+        assert np.array_equal(got.view(np.int64), ref.view(np.int64)), (got, ref)

@@ -15,8 +15,9 @@ order), and :func:`~framework.collision.batch_common.finish`.
 
 Rows it leaves to the numpy kernel (``defer``), which then answers them as it always did:
 
-- two centred axis-aligned boxes where contacts must be exact with their points (the box kernel
-  :func:`~framework.collision.batch_box.aabb_aabb`), or of extreme magnitudes;
+- two centred axis-aligned boxes of extreme magnitudes, or whose overlap rounding hid (the box
+  kernels answer two centred boxes, :func:`~framework.collision.batch_box.aabb_aabb` compiled
+  in :mod:`.box_pair_row` where contacts must be exact with their points);
 - rows within rounding of touching on some axis where contacts must be exact (the integer
   fallback of :mod:`~framework.collision.exact`);
 - a contact beyond float64's range (the numpy kernel raises the error).
@@ -33,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from .batch_box import _aabb_row
+from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
 from .exact import BAND, TINY
 from .kinds import KIND_AABB
@@ -298,7 +300,12 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
         ax, ay, bx, by = hx[a], hy[a], hx[b], hy[b]
         if _centred_box(avx, avy, ac) and _centred_box(bvx, bvy, bc):
             if exact and points:
-                defer[i] = True
+                h, nxi, nyi, dep, pxi, pyi, found = aabb_exact_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2])
+                if not (found and math.isfinite(dep) and math.isfinite(pxi) and math.isfinite(pyi)):
+                    defer[i] = True
+                elif h:
+                    hit[i] = True
+                    nx[i], ny[i], depth[i], px[i], py[i] = nxi, nyi, dep, pxi, pyi
                 continue
             _aabb_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2], exact, points, i, hit, nx, ny, depth, px, py,
                       extreme)
