@@ -615,10 +615,10 @@ def test_near_statics_never_misses_a_static_pair(large):
     assert not h2.near_statics(mx, my, mx + mw, my + mw).any()  # no statics at all
 
 
-def _scene_pairs(seed: int, direct: bool):
+def _scene_pairs(seed: int, direct: bool, movers: tuple[int, int] = (2, 30)):
     """A random scene's first steps' candidate pairs (entities) through the broad phase stage, the
-    direct pass on or off: a few movers (some touching, some sleeping), tiles touching edge to edge,
-    bodies without a hitbox in between."""
+    direct pass on or off: ``movers`` (low, high) movers (some touching, some sleeping), tiles
+    touching edge to edge, bodies without a hitbox in between."""
     import framework.systems.broad_phase as stage
     from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 
@@ -630,7 +630,7 @@ def _scene_pairs(seed: int, direct: bool):
         s.spawn(Transform(float(rng.uniform(-15, 15)), float(rng.uniform(1, 6))),
                 Hitbox(AABB(float(rng.uniform(0.5, 3)), 0.5), body="static"))
     shapes = [AABB(1.0, 1.0), Circle(0.5), Polygon.box(1.0, 0.5), AABB(0.5, 2.0)]
-    for k in range(int(rng.integers(2, 30))):
+    for k in range(int(rng.integers(*movers))):
         s.spawn(Transform(float(rng.uniform(-15, 15)), float(rng.uniform(0.2, 8))),
                 Velocity(float(rng.uniform(-3, 3)), 0.0), Hitbox(shapes[k % 4], friction=0.5))
         if k % 5 == 0:
@@ -650,9 +650,18 @@ def _scene_pairs(seed: int, direct: bool):
 
 @pytest.mark.parametrize("seed", range(6))
 def test_a_few_movers_paired_directly_give_the_hash_s_pairs_in_its_order(seed):
-    # the broad phase pairs up to SMALL movers with every hitbox in one compiled pass: the same
+    # the broad phase pairs few enough movers with every hitbox in one compiled pass: the same
     # pairs, in the same order, as the static and sleeping hashes give, step by step (the bodies
     # fall, land on tiles, slide into each other and fall asleep)
     direct, hashed = _scene_pairs(seed, True), _scene_pairs(seed, False)
     assert direct == hashed
     assert any(pairs for pairs, _b, _n in direct) and any(n for _a, _b, n in direct)  # pairs, sleepers
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_crowd_paired_directly_gives_the_hash_s_pairs(seed):
+    # more movers than the hash pairs every two of (48): a crowd of 100 to 160 piling up, the
+    # direct pass against the strips of the hash, step by step
+    direct, hashed = _scene_pairs(seed, True, (100, 160)), _scene_pairs(seed, False, (100, 160))
+    assert direct == hashed
+    assert any(len(pairs) > 100 for pairs, _b, _n in direct)

@@ -2,9 +2,10 @@
 
 Moving bodies are hashed every step against the static hash (kept until the static set changes)
 and against each other; sleeping bodies are kept in a hash of their own, entered only when one
-falls asleep or wakes. Up to :data:`~framework.collision.broad_phase.SMALL` moving bodies among
-not too many rows are paired with every hitbox in one compiled pass instead (the same pairs, in
-the same order; :func:`~framework.collision.broad_phase.direct_pairs`). Pairs whose layers and
+falls asleep or wakes. Where the moving bodies times the rows are at most
+:data:`~framework.collision.broad_phase.DIRECT_PAIRS`, the movers are paired with every hitbox in
+one compiled pass instead (the same pairs, in the same order;
+:func:`~framework.collision.broad_phase.direct_pairs`). Pairs whose layers and
 masks do not meet are dropped here, and, in a scene without the events effect, pairs nobody reads
 (neither the response nor a collision handler).
 """
@@ -14,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..arrays import BoolArray, IntpArray
-from ..collision.broad_phase import DIRECT_PAIRS, SMALL, direct_pairs
+from ..collision.broad_phase import DIRECT_PAIRS, direct_pairs
 from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from ..store import STATIC
@@ -40,9 +41,9 @@ class BroadPhase(Stage):
         moving = store.active_sel()[1]  # a slice where the bodies are one run of rows: views, no gathers
         bounds = (geom.minx[moving], geom.miny[moving], geom.maxx[moving], geom.maxy[moving])
         movers = store.active()[1]
-        # A few movers among not too many rows: paired with every hitbox directly, in one compiled
-        # pass (the hash's pairs, without its numpy calls); else through the hashes.
-        direct = movers.size <= SMALL and movers.size * store.n <= DIRECT_PAIRS
+        # Few enough tests (movers x rows): every mover paired with every hitbox directly, in one
+        # compiled pass (the hash's pairs, without its numpy calls); else through the hashes.
+        direct = movers.size * store.n <= DIRECT_PAIRS
         if direct:
             bodies.hash.enter_few(*bounds, store.entity[moving])
         else:
