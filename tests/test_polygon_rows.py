@@ -167,3 +167,48 @@ def test_centred_boxes_row_same_bits(box, scale, far) -> None:
         got = np.array([nx, ny, depth, px, py])
         ref = np.array([want.nx[0], want.ny[0], want.depth[0], want.px[0], want.py[0]])
         assert np.array_equal(got.view(np.int64), ref.view(np.int64)), (got, ref)
+
+
+@st.composite
+def _touching_pair(draw):
+    """A random convex outline A (turned: coordinates far from dyadic) and an outline B sharing one
+    of A's edges reversed, with a third vertex outside it: they touch exactly along that edge. B's
+    origin and A's are random; B's offset is nudged by 0 to 2 ulps either way."""
+    n = draw(st.integers(3, 7))
+    r = draw(st.floats(0.25, 4.0))
+    turn = draw(st.floats(0.0, 2.0 * math.pi))
+    a = [(r * math.cos(turn + 2.0 * math.pi * i / n), r * math.sin(turn + 2.0 * math.pi * i / n)) for i in range(n)]
+    i = draw(st.integers(0, n - 1))
+    (x0, y0), (x1, y1) = a[i], a[(i + 1) % n]
+    out = draw(st.floats(0.125, 2.0))
+    mx, my = 0.5 * (x0 + x1) + out * (y1 - y0), 0.5 * (y0 + y1) - out * (x1 - x0)
+    ox, oy = draw(st.floats(-8.0, 8.0)), draw(st.floats(-8.0, 8.0))
+    qx, qy = draw(st.floats(-8.0, 8.0)), draw(st.floats(-8.0, 8.0))
+    # B about its own origin q, so that its world points are A's edge (world: o + a) and the apex.
+    b = [(x1 + ox - qx, y1 + oy - qy), (x0 + ox - qx, y0 + oy - qy), (mx + ox - qx, my + oy - qy)]
+    nudge = draw(st.integers(-2, 2))
+    qx = float(np.nextafter(qx, math.copysign(math.inf, nudge))) if nudge else qx
+    return a, b, (ox, oy, qx, qy)
+
+
+@settings(max_examples=400, deadline=None)
+@given(_touching_pair(), st.sampled_from([0, 1, -3]))
+def test_exact_apart_decision_matches_the_integers(pair, k) -> None:
+    """:func:`framework.collision.exact_sign.polygons_apart` (floats, expansions) decides as
+    :func:`framework.collision.exact.polygon_polygon_exact` (integers) on outlines touching along
+    an edge to the last bit, and nudged an ulp either way."""
+    from framework.collision.exact import polygon_polygon_exact
+    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygons_apart
+
+    a, b, (ox, oy, qx, qy) = pair
+    kk = 8
+    avx, avy = (np.array([p[j] for p in a] + [a[-1][j]] * (kk - len(a))) for j in (0, 1))
+    bvx, bvy = (np.array([p[j] for p in b] + [b[-1][j]] * (kk - len(b))) for j in (0, 1))
+    need = np.full(2 * kk, 3, dtype=np.int64)
+    got = polygons_apart(avx, avy, len(a), bvx, bvy, 3, ox, oy, qx, qy, k, need)
+    want = polygon_polygon_exact(a, b, (ox, oy, qx, qy, k))
+    values = [abs(v) for v in (*avx, *avy, *bvx, *bvy, ox, oy, qx, qy, qx - ox, qy - oy) if v != 0.0]
+    if got == UNSURE:  # (only with a coordinate beyond the range where products are exact)
+        assert min(values) < 2.0**-300 or max(values) > 2.0**300
+    else:
+        assert got == (APART if want is None else OVERLAP)

@@ -18,8 +18,9 @@ Rows it leaves to the numpy kernel (``defer``), which then answers them as it al
 - two centred axis-aligned boxes of extreme magnitudes, or whose overlap rounding hid (the box
   kernels answer two centred boxes, :func:`~framework.collision.batch_box.aabb_aabb` compiled
   in :mod:`.box_pair_row` where contacts must be exact with their points);
-- rows within rounding of touching on some axis where contacts must be exact (the integer
-  fallback of :mod:`~framework.collision.exact`);
+- rows within rounding of touching on some axis where contacts must be exact, and which
+  overlap (decided exactly on the floats by :mod:`.exact_sign`; their depths are the integer
+  fallback's, :mod:`~framework.collision.exact`), or which that decision cannot take;
 - a contact beyond float64's range (the numpy kernel raises the error).
 
 A row's answer does not depend on the other rows of its batch (the numpy kernel's sums are
@@ -37,6 +38,7 @@ from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
 from .exact import BAND, TINY
+from .exact_sign import APART, polygons_apart
 from .kinds import KIND_AABB
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
@@ -291,6 +293,7 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
     extreme = np.zeros(n, dtype=np.bool_)
     avx, avy, bvx, bvy = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
     ux, uy, fwd, bwd = np.empty(2 * k), np.empty(2 * k), np.empty(2 * k), np.empty(2 * k)
+    need = np.zeros(2 * k, dtype=np.int64)
     cd, cx, cy = np.empty(4 * k), np.empty(4 * k), np.empty(4 * k)
     exa, eya, exb, eyb, na, nb = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
     for i in range(n):
@@ -336,6 +339,7 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
         border = any_valid = False
         reach2 = sz + abs(dx) + abs(dy)
         for c in range(2 * k):
+            need[c] = 0
             if ux[c] == 0.0 and uy[c] == 0.0:
                 continue
             any_valid = True
@@ -349,12 +353,16 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
             if least < -tol:
                 apart = True
                 break
+            need[c] = (1 if fwd[c] <= tol else 0) + (2 if bwd[c] <= tol else 0)
             if least <= tol:
                 border = True
         if apart or not any_valid:
             continue
         if border:
-            defer[i] = exact  # (the exact fallback; without it, a row touching to rounding is apart)
+            # Touching to rounding: apart unless exact, where the exact decision is made on the
+            # floats (exact_sign), and only an overlap needs the integers' depths.
+            if exact:
+                defer[i] = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need) != APART
             continue
         # Candidates in the scalar code's order: per axis, forward then backward.
         for c in range(2 * k):

@@ -1,0 +1,208 @@
+"""Exact decisions on floats, compiled: whether two outlines touching to rounding are apart.
+
+:func:`~framework.collision.exact.polygon_polygon_exact` decides the pairs within rounding of
+touching on Python integers, some hundred microseconds a pair; a pile at rest holds hundreds of
+such pairs every step (the exact solver leaves them touching exactly). Most of them are touching
+or apart, and then no number is needed but the decision. :func:`polygons_apart` makes that
+decision on the same floats without integers: each quantity of the separating-axis test is a sum
+of products of floats, kept exactly as a floating-point expansion (a sum of non-overlapping
+doubles, Shewchuk's arithmetic: ``two_sum`` and ``two_product`` lose nothing), whose sign is the
+sign of its largest part. Where the outlines overlap, the caller asks the integers for the depths.
+
+Exact only while no product underflows or overflows: every float involved is 0 or of magnitude in
+``[2**-300, 2**300]`` (the scaled frames put them near 1), else the answer is "not sure" and the
+integers decide, as before.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["APART", "OVERLAP", "UNSURE", "polygons_apart"]
+
+APART, OVERLAP, UNSURE = 0, 1, 2
+
+_LO, _HI = 2.0**-300, 2.0**300
+_SPLIT = 134217729.0  # 2**27 + 1 (Dekker's split of a double into two 26-bit halves)
+
+
+@njit(cache=True)
+def _two_sum(a, b):  # pragma: no cover - compiled
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+@njit(cache=True)
+def _two_product(a, b):  # pragma: no cover - compiled
+    p = a * b
+    c = _SPLIT * a
+    ah = c - (c - a)
+    al = a - ah
+    c = _SPLIT * b
+    bh = c - (c - b)
+    bl = b - bh
+    return p, al * bl - (((p - ah * bh) - al * bh) - ah * bl)
+
+
+@njit(cache=True)
+def _grow(e, m, b):  # pragma: no cover - compiled
+    """Add the double ``b`` to the expansion ``e[:m]`` (non-overlapping, increasing magnitude),
+    exactly, in place (zeros dropped); returns the new length."""
+    q = b
+    j = 0
+    for i in range(m):
+        q, h = _two_sum(q, e[i])
+        if h != 0.0:
+            e[j] = h
+            j += 1
+    if q != 0.0:
+        e[j] = q
+        j += 1
+    return j
+
+
+@njit(cache=True)
+def _add_product(e, m, a_hi, a_lo, b_hi, b_lo, sign):  # pragma: no cover - compiled
+    """``e += sign * (a_hi + a_lo) * (b_hi + b_lo)`` exactly; returns the new length."""
+    for x in (a_hi, a_lo):
+        if x == 0.0:
+            continue
+        for y in (b_hi, b_lo):
+            if y == 0.0:
+                continue
+            p, err = _two_product(x, y)
+            m = _grow(e, m, sign * p)
+            m = _grow(e, m, sign * err)
+    return m
+
+
+@njit(cache=True)
+def _sign(e, m):  # pragma: no cover - compiled
+    """The sign of the expansion's sum: its largest part's."""
+    if m == 0:
+        return 0
+    return 1 if e[m - 1] > 0.0 else -1
+
+
+@njit(cache=True)
+def _project(e, ux_h, ux_l, uy_h, uy_l, x, y):  # pragma: no cover - compiled
+    """``e = u . (x, y)`` exactly (``u`` two two-term sums); returns its length."""
+    m = _add_product(e, 0, ux_h, ux_l, x, 0.0, 1.0)
+    return _add_product(e, m, uy_h, uy_l, y, 0.0, 1.0)
+
+
+@njit(cache=True)
+def _copy_add(dst, src, m, other, n, sign):  # pragma: no cover - compiled
+    """``dst = src[:m] + sign * other[:n]`` exactly; returns its length."""
+    for i in range(m):
+        dst[i] = src[i]
+    for i in range(n):
+        m = _grow(dst, m, sign * other[i])
+    return m
+
+
+@njit(cache=True)
+def _extreme(vx, vy, c, ux_h, ux_l, uy_h, uy_l, want, best, cur, tmp):  # pragma: no cover - compiled
+    """The exact max (``want`` 1) or min (-1) over the first ``c`` vertices of their projections on
+    ``u``, into ``best``; returns its length. Only the vertices whose float projection is within a
+    generous bound of the float extreme are compared exactly (the bound, 2**-40 of the magnitudes,
+    is far above the floats' error, some 2**-51)."""
+    top = 0.0
+    reach = 0.0
+    for j in range(c):
+        p = (ux_h * vx[j] + uy_h * vy[j]) * want
+        if j == 0 or p > top:
+            top = p
+        r = abs(vx[j]) + abs(vy[j])
+        if r > reach:
+            reach = r
+    slack = 2.0**-40 * (abs(ux_h) + abs(uy_h)) * reach
+    nb = -1
+    for j in range(c):
+        if (ux_h * vx[j] + uy_h * vy[j]) * want < top - slack:
+            continue
+        nc = _project(cur, ux_h, ux_l, uy_h, uy_l, vx[j], vy[j])
+        if nb < 0:
+            for i in range(nc):
+                best[i] = cur[i]
+            nb = nc
+            continue
+        nt = _copy_add(tmp, cur, nc, best, nb, -1.0)
+        if _sign(tmp, nt) * want > 0:
+            for i in range(nc):
+                best[i] = cur[i]
+            nb = nc
+    return nb
+
+
+@njit(cache=True)
+def _fits(v):  # pragma: no cover - compiled
+    a = abs(v)
+    return a == 0.0 or (a >= _LO and a <= _HI)
+
+
+@njit(cache=True)
+def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # pragma: no cover - compiled
+    """:func:`~framework.collision.exact.polygon_polygon_exact`'s decision on floats: outlines A
+    (``ac`` vertices ``avx, avy``, scaled, about the origin, padded to ``K`` slots as the batch
+    kernels pad them) and B (about its own origin, at the exact offset ``(q - o) * 2**-k``):
+    :data:`APART` (separated or touching: the integers' None), :data:`OVERLAP`, or
+    :data:`UNSURE` (a float outside the range where products are exact).
+
+    ``need [2 K]``: per axis slot (A's edges, then B's), which overlaps the floats left in doubt
+    (1 forward, 2 backward, 3 both); the others are positive beyond the floats' error, and only a
+    separation or touch (an overlap <= 0) on some axis makes the pair apart."""
+    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
+    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
+    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
+            or math.ldexp(ty, k) != oy):
+        return UNSURE  # (a scaled offset lost bits below the smallest float)
+    ex_h, ex_l = _two_sum(sx, -tx)
+    ey_h, ey_l = _two_sum(sy, -ty)
+    for v in (ex_h, ex_l, ey_h, ey_l):
+        if not _fits(v):
+            return UNSURE
+    for j in range(avx.size):
+        if not (_fits(avx[j]) and _fits(avy[j]) and _fits(bvx[j]) and _fits(bvy[j])):
+            return UNSURE
+    size = 64
+    cur, tmp = np.empty(size), np.empty(size)
+    lo, hi = np.empty(size), np.empty(size)
+    out, ud = np.empty(4 * size), np.empty(size)
+    kk = avx.size
+    for c in range(2 * kk):
+        if need[c] == 0:
+            continue
+        vx, vy = (avx, avy) if c < kk else (bvx, bvy)
+        j = c % kk
+        x0, y0 = vx[j], vy[j]
+        x1, y1 = (vx[j + 1], vy[j + 1]) if j + 1 < kk else (vx[0], vy[0])
+        if x0 == x1 and y0 == y1:
+            continue  # (a padding slot, or an edge of no length: no axis)
+        ux_h, ux_l = _two_sum(y1, -y0)  # the axis (ey, -ex), exactly
+        uy_h, uy_l = _two_sum(x0, -x1)
+        if not (_fits(ux_h) and _fits(ux_l) and _fits(uy_h) and _fits(uy_l)):
+            return UNSURE
+        nd = _add_product(ud, 0, ux_h, ux_l, ex_h, ex_l, 1.0)
+        nd = _add_product(ud, nd, uy_h, uy_l, ey_h, ey_l, 1.0)
+        if need[c] & 1:  # forward: (max over A - min over B) - u . d
+            na = _extreme(avx, avy, ac, ux_h, ux_l, uy_h, uy_l, 1, hi, cur, tmp)
+            nb = _extreme(bvx, bvy, bc, ux_h, ux_l, uy_h, uy_l, -1, lo, cur, tmp)
+            m = _copy_add(out, hi, na, lo, nb, -1.0)
+            for i in range(nd):
+                m = _grow(out, m, -ud[i])
+            if _sign(out, m) <= 0:
+                return APART
+        if need[c] & 2:  # backward: (max over B - min over A) + u . d
+            na = _extreme(avx, avy, ac, ux_h, ux_l, uy_h, uy_l, -1, lo, cur, tmp)
+            nb = _extreme(bvx, bvy, bc, ux_h, ux_l, uy_h, uy_l, 1, hi, cur, tmp)
+            m = _copy_add(out, hi, nb, lo, na, -1.0)
+            for i in range(nd):
+                m = _grow(out, m, ud[i])
+            if _sign(out, m) <= 0:
+                return APART
+    return OVERLAP
