@@ -638,6 +638,7 @@ def _scene_pairs(seed: int, direct: bool, movers: tuple[int, int] = (2, 30)):
     seen = []
     limit = stage.DIRECT_PAIRS
     stage.DIRECT_PAIRS = limit if direct else -1
+    s.add_system(_check_pairs, after="broad_phase")
     try:
         for _ in range(150):
             s.step(1 / 30)
@@ -648,20 +649,83 @@ def _scene_pairs(seed: int, direct: bool, movers: tuple[int, int] = (2, 30)):
     return seen
 
 
+def _check_pairs(scene, _dt) -> None:
+    """A system right after the broad phase: its pairs are the oracle's."""
+    ea, eb, _ra, _rb = scene._pipeline.frame.pairs
+    assert (ea.tolist(), eb.tolist()) == _every_pair(scene)
+
+
+def _every_pair(scene) -> tuple[list[int], list[int]]:
+    """The oracle: every two hitbox rows, one moving and the other moving, static or asleep, whose
+    bounds (as the broad phase saw them) strictly overlap, as entity pairs a < b in sorted order."""
+    from framework.store import STATIC
+
+    bodies = scene._pipeline.bodies
+    store, geom = bodies.store, bodies.ensure_geometry()
+    n = store.n
+    moving = np.zeros(n, dtype=bool)
+    moving[store.active()[1]] = True
+    other = (store.kind[:n] >= 0) & ((store.body[:n] == STATIC) | store.asleep[:n]) & ~moving
+    found = []
+    for i in np.flatnonzero(moving).tolist():
+        for j in np.flatnonzero(moving | other).tolist():
+            if (moving[j] and j <= i) or not (geom.maxx[i] > geom.minx[j] and geom.maxx[j] > geom.minx[i]
+                                              and geom.maxy[i] > geom.miny[j] and geom.maxy[j] > geom.miny[i]):
+                continue
+            a, b = sorted((int(store.entity[i]), int(store.entity[j])))
+            found.append((a, b))
+    found.sort()
+    return [a for a, _ in found], [b for _, b in found]
+
+
 @pytest.mark.parametrize("seed", range(6))
-def test_a_few_movers_paired_directly_give_the_hash_s_pairs_in_its_order(seed):
-    # the broad phase pairs few enough movers with every hitbox in one compiled pass: the same
-    # pairs, in the same order, as the static and sleeping hashes give, step by step (the bodies
-    # fall, land on tiles, slide into each other and fall asleep)
+def test_a_few_movers_paired_directly_give_the_kept_pairs_in_their_order(seed):
+    # the broad phase pairs few enough movers with every hitbox in one compiled pass, and more
+    # movers from candidates kept between steps (kept_pairs): the same pairs, in the same order,
+    # each step the oracle's (_every_pair), as the bodies fall, land on tiles, slide into each
+    # other and fall asleep
     direct, hashed = _scene_pairs(seed, True), _scene_pairs(seed, False)
     assert direct == hashed
     assert any(pairs for pairs, _b, _n in direct) and any(n for _a, _b, n in direct)  # pairs, sleepers
 
 
 @pytest.mark.parametrize("seed", range(2))
-def test_a_crowd_paired_directly_gives_the_hash_s_pairs(seed):
-    # more movers than the hash pairs every two of (48): a crowd of 100 to 160 piling up, the
-    # direct pass against the strips of the hash, step by step
+def test_a_crowd_paired_directly_gives_the_kept_pairs(seed):
+    # a crowd of 100 to 160 piling up, the direct pass against the kept candidates, step by step
     direct, hashed = _scene_pairs(seed, True, (100, 160)), _scene_pairs(seed, False, (100, 160))
     assert direct == hashed
     assert any(len(pairs) > 100 for pairs, _b, _n in direct)
+
+
+def test_kept_pairs_are_kept_while_a_pile_rests_and_rebuilt_when_it_changes():
+    # 300 boxes dropped into a pit (too many for the direct pass): the candidates are built again
+    # while they fall, then kept while they rest; a despawn, a new body and a static moved build
+    # them again; every step the pairs are the oracle's
+    from framework import AABB, Hitbox, Scene, Transform, Velocity
+    from framework.effects import DEFAULT_EFFECTS
+    from framework.systems.broad_phase import BroadPhase
+
+    s = Scene(gravity=(0.0, -10.0), effects=DEFAULT_EFFECTS - {"sleeping"})
+    s.spawn(Transform(10.0, -0.5), Hitbox(AABB(24.0, 1.0), body="static"))
+    wall = s.spawn(Transform(-1.5, 10.0), Hitbox(AABB(1.0, 22.0), body="static"))
+    s.spawn(Transform(21.5, 10.0), Hitbox(AABB(1.0, 22.0), body="static"))
+    boxes = [s.spawn(Transform(0.5 + (k % 20) * 1.0, 0.5 + (k // 20) * 1.25), Velocity(), Hitbox(AABB(1.0, 1.0)))
+             for k in range(300)]
+    stage = s._stages["broad_phase"]
+    assert isinstance(stage, BroadPhase)
+    s.add_system(_check_pairs, after="broad_phase")
+
+    def steps(count: int) -> int:
+        before = stage.kept.builds
+        for _ in range(count):
+            s.step(1 / 60)
+        return stage.kept.builds - before
+
+    assert steps(240) > 1
+    assert steps(60) == 0  # at rest: kept
+    s.despawn(boxes[-1])
+    assert steps(2) >= 1
+    s.spawn(Transform(10.0, 30.0), Velocity(0.0, -5.0), Hitbox(AABB(1.0, 1.0)))
+    assert steps(2) >= 1
+    s.get(wall, Transform).x = -1.25  # a static moved: pushes the pile's edge
+    assert steps(30) >= 1

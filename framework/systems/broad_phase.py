@@ -1,21 +1,26 @@
 """Broad phase: the candidate pairs of the step, from the spatial hash (a few movers: directly).
 
-Moving bodies are hashed every step against the static hash (kept until the static set changes)
-and against each other; sleeping bodies are kept in a hash of their own, entered only when one
-falls asleep or wakes. Where the moving bodies times the rows are at most
+Where the moving bodies times the rows are at most
 :data:`~framework.collision.broad_phase.DIRECT_PAIRS`, the movers are paired with every hitbox in
-one compiled pass instead (the same pairs, in the same order;
-:func:`~framework.collision.broad_phase.direct_pairs`). Pairs whose layers and
+one compiled pass (:func:`~framework.collision.broad_phase.direct_pairs`); more movers keep their
+candidate pairs between steps, found from fat bounds and built again only when a mover leaves its
+fat bounds or the rows, statics or sleepers change (:mod:`~framework.collision.kept_pairs`). Both
+give the spatial hash's pairs in its order. The hash still takes each step's movers, and the
+sleepers when one falls asleep or wakes, for the scene's queries and the debug overlay. Pairs whose layers and
 masks do not meet are dropped here, and, in a scene without the events effect, pairs nobody reads
 (neither the response nor a collision handler).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from ..arrays import BoolArray, IntpArray
+from ..arrays import BoolArray, I64Array, IntpArray
 from ..collision.broad_phase import DIRECT_PAIRS, direct_pairs
+from ..collision.grid import Bounds
+from ..collision.kept_pairs import KeptPairs
 from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from ..store import STATIC
@@ -32,6 +37,10 @@ class BroadPhase(Stage):
     needs = frozenset({"detection"})
     solver = "exact"
 
+    def __init__(self, pipeline: Any) -> None:
+        super().__init__(pipeline)
+        self.kept = KeptPairs()  # the candidates of many movers, kept between steps
+
     def run(self, frame: StepFrame) -> bool:
         bodies = self.bodies
         store = bodies.store
@@ -44,10 +53,6 @@ class BroadPhase(Stage):
         # Few enough tests (movers x rows): every mover paired with every hitbox directly, in one
         # compiled pass (the hash's pairs, without its numpy calls); else through the hashes.
         direct = movers.size * store.n <= DIRECT_PAIRS
-        if direct:
-            bodies.hash.enter_few(*bounds, store.entity[moving])
-        else:
-            ea, eb = bodies.hash.pairs(*bounds, store.entity[moving])
         counters["rehashed"] += int(movers.size)
         if store.sleep_dirty:
             sleepers = np.flatnonzero(store.asleep)
@@ -56,23 +61,48 @@ class BroadPhase(Stage):
             counters["rehashed"] += int(sleepers.size)
             store.sleep_dirty = False
         counters["asleep"] = frame.n_asleep = int(np.count_nonzero(store.asleep[store.active_sel()[2]]))
-        if direct:
+        all_bounds = (geom.minx, geom.miny, geom.maxx, geom.maxy)
+        kept = self.kept
+        way = "direct" if direct else kept.choose((store.version, store.static_epoch, store.sleep_epoch, store.n),
+                                                  movers, all_bounds)
+        if way == "direct":
             c, n = store.cols, store.n
             ea, eb = pair_parts(direct_pairs(movers, c["kind"][:n], c["body"][:n], c["asleep"][:n], c["entity"][:n],
-                                             geom.minx, geom.miny, geom.maxx, geom.maxy, STATIC))
-        elif frame.n_asleep:
-            sa, sb = bodies.sleep_hash.pairs(*bounds, store.entity[moving], moving_pairs=False)
-            if sa.size:
-                keys = np.concatenate([pair_keys(ea, eb), pair_keys(sa, sb)])
-                keys.sort()
-                ea, eb = pair_parts(keys)
-        ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
+                                             *all_bounds, STATIC))
+            ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
+            bodies.hash.enter_few(*bounds, store.entity[moving])  # (for the queries and the overlay)
+        elif way == "plain":
+            keys = self._hashed(bounds, store.entity[moving], frame.n_asleep)
+            ea, eb = pair_parts(keys)
+            ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
+        else:
+            if way == "build":
+                fat = kept.fat(movers, all_bounds)
+                keys = self._hashed(fat, store.entity[moving], frame.n_asleep)
+                kept.keep((store.version, store.static_epoch, store.sleep_epoch, store.n), movers, fat, keys,
+                          bodies.rows_of(keys >> 32), bodies.rows_of(keys & 0xFFFFFFFF))
+            keys, ra, rb = kept.overlapping(all_bounds)
+            ea, eb = pair_parts(keys)
+            bodies.hash.enter_few(*bounds, store.entity[moving])  # (the movers as they are, not fat)
         keep = filter_layers(store, ra, rb)
         if "events" not in self.pipeline.effects:
             keep &= self._someone_reads(ra, rb)
         frame.pairs = (ea[keep], eb[keep], ra[keep], rb[keep])
         counters["candidate_pairs"] = int(keep.sum())
         return True
+
+    def _hashed(self, bounds: Bounds, ids: I64Array, asleep: int) -> I64Array:
+        """The sorted pair keys of the movers' ``bounds`` (``ids`` their entities) with each other,
+        the statics and (``asleep``: there are some) the sleepers, by the spatial hashes."""
+        bodies = self.bodies
+        ea, eb = bodies.hash.pairs(*bounds, ids)
+        keys = pair_keys(ea, eb)
+        if asleep:
+            sa, sb = bodies.sleep_hash.pairs(*bounds, ids, moving_pairs=False)
+            if sa.size:
+                keys = np.concatenate([keys, pair_keys(sa, sb)])
+                keys.sort()
+        return keys
 
     def _someone_reads(self, ra: IntpArray, rb: IntpArray) -> BoolArray:
         """Without the events effect, only pairs the response or a handler reads are tested."""
