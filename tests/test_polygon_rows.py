@@ -15,23 +15,24 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from framework import AABB, Polygon, Segment
+from framework import AABB, Circle, Polygon, Segment
 from framework.collision import batch
-from framework.collision.kinds import KIND_AABB, KIND_POLYGON, KIND_SEGMENT
+from framework.collision.kinds import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT
 from framework.geometry import Geometry
-from framework.systems.narrow_phase import _polygon_pairs
+from framework.systems.narrow_phase import _polygon_circle_pairs, _polygon_pairs
 
 
 def _rows(shapes, poses):
     """A store and geometry holding ``shapes`` at ``poses`` (x, y, rotation), as the pipeline's."""
     n = len(shapes)
-    kind = np.array([KIND_AABB if isinstance(s, AABB) else KIND_SEGMENT if isinstance(s, Segment) else KIND_POLYGON
-                     for s in shapes], dtype=np.int8)
+    kind = np.array([KIND_AABB if isinstance(s, AABB) else KIND_SEGMENT if isinstance(s, Segment) else
+                     KIND_CIRCLE if isinstance(s, Circle) else KIND_POLYGON for s in shapes], dtype=np.int8)
     hw = np.array([s.width * 0.5 if isinstance(s, AABB) else 0.0 for s in shapes])
     hh = np.array([s.height * 0.5 if isinstance(s, AABB) else 0.0 for s in shapes])
-    store = SimpleNamespace(kind=kind, hw=hw, hh=hh)
+    radius = np.array([s.radius if isinstance(s, Circle) else 0.0 for s in shapes])
+    store = SimpleNamespace(kind=kind, hw=hw, hh=hh, radius=radius)
     geom = Geometry()
-    outlined = np.flatnonzero(kind != KIND_AABB)
+    outlined = np.flatnonzero((kind != KIND_AABB) & (kind != KIND_CIRCLE))
     verts, counts = batch.outlines([shapes[i] for i in outlined], np.array([poses[i][2] for i in outlined]))
     geom.K = max(4, verts.shape[1]) if outlined.size else 4
     geom.world_poly = np.zeros((outlined.size, geom.K, 2))
@@ -212,3 +213,51 @@ def test_exact_apart_decision_matches_the_integers(pair, k) -> None:
         assert min(values) < 2.0**-300 or max(values) > 2.0**300
     else:
         assert got == (APART if want is None else OVERLAP)
+
+
+def _check_circles(shapes, poses, pairs) -> None:
+    """Polygon rows against circle rows, either way round: the compiled pass's bits are the numpy
+    kernel's, in a batch and one row at a time."""
+    store, geom = _rows(shapes, poses)
+    poly = np.array([p[0] for p in pairs], dtype=np.int64)
+    circ = np.array([p[1] for p in pairs], dtype=np.int64)
+    flip = np.array([p[2] for p in pairs], dtype=bool)
+
+    def numpy(rows):
+        vp, np_ = geom.outlines(store, poly[rows])
+        return batch.polygon_circle(geom.hx[poly[rows]], geom.hy[poly[rows]], vp, np_, geom.hx[circ[rows]],
+                                    geom.hy[circ[rows]], store.radius[circ[rows]], flip=flip[rows], exact=exact)
+
+    for exact in (True, False):
+        every = np.arange(poly.size)
+        _same_bits(_polygon_circle_pairs(store, geom, poly, circ, flip, exact=exact), numpy(every))
+        for i in range(poly.size):
+            one = every[i:i + 1]
+            _same_bits(_polygon_circle_pairs(store, geom, poly[one], circ[one], flip[one], exact=exact), numpy(one))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(_shape(), _DYADIC, _DYADIC, _ROTATION), min_size=1, max_size=5),
+       st.lists(st.tuples(_SIZE, _DYADIC, _DYADIC), min_size=1, max_size=5), st.data(),
+       st.sampled_from([1.0, 2.0**40, 2.0**-600]), st.sampled_from([0.0, 1e9]))
+def test_random_circle_rows_same_bits(bodies, balls, data, scale, far) -> None:
+    """Random polygons, boxes and segments against random circles (dyadic: many touch exactly,
+    centres on faces and vertices), scaled and moved far out: the numpy kernel's bits."""
+    shapes = [_scaled(s, scale) for s, *_ in bodies] + [Circle(r * scale) for r, _x, _y in balls]
+    poses = [(x * scale + far, y * scale, rot) for _s, x, y, rot in bodies] + [
+        (x * scale + far, y * scale, 0.0) for _r, x, y in balls]
+    pairs = data.draw(st.lists(st.tuples(st.integers(0, len(bodies) - 1),
+                                         st.integers(len(bodies), len(shapes) - 1), st.booleans()),
+                               min_size=1, max_size=10))
+    _check_circles(shapes, poses, pairs)
+
+
+def test_circle_rows_inside_on_faces_and_corners() -> None:
+    """A circle whose centre is inside a box (out through the nearest face; the middle: every
+    face ties), on a face, at a corner, touching a face and a corner, and a segment's ends."""
+    shapes = [Polygon.box(2.0, 2.0), AABB(2.0, 1.0), Segment((-1.0, 0.0), (1.0, 0.0)), Circle(0.5), Circle(0.5),
+              Circle(0.5), Circle(0.5), Circle(0.25)]
+    poses = [(0.0, 0.0, 0.0), (4.0, 0.0, 0.0), (0.0, 4.0, 0.0), (0.0, 0.0, 0.0), (0.25, 1.0, 0.0), (1.0, 1.0, 0.0),
+             (0.0, 1.5, 0.0), (1.25, 4.0, 0.0)]
+    pairs = [(p, c, f) for p in (0, 1, 2) for c in (3, 4, 5, 6, 7) for f in (False, True)]
+    _check_circles(shapes, poses, pairs)

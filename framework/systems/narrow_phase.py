@@ -13,6 +13,7 @@ from ..arrays import BoolArray, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.batch_box import aabb_pairs_fast
 from ..collision.chain import chain_rule, deepest_below
+from ..collision.circle_rows import polygon_circle_pairs
 from ..collision.kinds import (
     BOXES,
     CAPSULES,
@@ -161,9 +162,7 @@ def _pair_contacts(
         elif f == POLYGON_CIRCLE:
             flip = _PAIR_FLIP[code if idx is None else code[idx]]  # the circle is A: normals from it
             poly, circ = np.where(flip, b, a), np.where(flip, a, b)
-            vp, np_ = geom.outlines(store, poly)
-            res = batch.polygon_circle(hx[poly], hy[poly], vp, np_, hx[circ], hy[circ], store.radius[circ],
-                                      flip=flip, exact=not remeasure)
+            res = _polygon_circle_pairs(store, geom, poly, circ, flip, exact=not remeasure)
         elif f == CAPSULES:
             res = _capsule_pairs(store, geom, a, b, code if idx is None else code[idx], remeasure)
         else:
@@ -191,6 +190,26 @@ def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray,
         hx, hy = geom.hx, geom.hy
         hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.polygon_polygon(
             hx[da], hy[da], va, na, hx[db], hy[db], vb, nb, exact=exact, points=points)
+    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
+def _polygon_circle_pairs(store: BodyStore, geom: Geometry, poly: IntpArray, circ: IntpArray, flip: BoolArray, *,
+                          exact: bool) -> batch.ContactArrays:
+    """:func:`~framework.collision.batch.polygon_circle` of pairs of polygon (box, segment) and
+    circle rows: the compiled pass over the rows (:mod:`~framework.collision.circle_rows`), and
+    the numpy kernel on the outlines of the rows it leaves to it (exact fallbacks)."""
+    poly, circ = np.ascontiguousarray(poly, dtype=np.int64), np.ascontiguousarray(circ, dtype=np.int64)
+    flip = np.ascontiguousarray(flip, dtype=np.bool_)
+    hit, nx, ny, depth, px, py, defer = polygon_circle_pairs(poly, circ, flip, geom.hx, geom.hy, store.kind, store.hw,
+                                                             store.hh, store.radius, geom.world_poly, geom.poly_slot,
+                                                             geom.count, geom.K, exact)
+    if defer.any():
+        d = np.flatnonzero(defer)
+        dp, dc = poly[d], circ[d]
+        vp, np_ = geom.outlines(store, dp)
+        hx, hy = geom.hx, geom.hy
+        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.polygon_circle(
+            hx[dp], hy[dp], vp, np_, hx[dc], hy[dc], store.radius[dc], flip=flip[d], exact=exact)
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
 
 

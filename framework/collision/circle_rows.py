@@ -1,0 +1,133 @@
+"""The polygon / circle kernel over the pipeline's rows, compiled: :func:`polygon_circle_pairs`.
+
+:func:`~framework.collision.batch_circle.polygon_circle` of pairs of rows (a box, polygon or
+segment and a circle, either way round), one compiled pass that reads each outline where the
+geometry keeps it, as :mod:`.polygon_rows` does for polygon pairs: a pile of circles in a pit of
+boxes re-measures its circles against the walls a dozen times a step, and the numpy kernel's
+calls cost far more than its arithmetic.
+
+It is the numpy kernel row by row, in the same order of operations, so the same bits: the
+polygon's scaled frame, the centre's distance outside each face, inside (out through the nearest
+face, by the tie-break rule), nearest a face or nearest a vertex, and
+:func:`~framework.collision.batch_common.finish`. Rows within rounding of touching, where
+contacts must be exact, and a contact beyond float64's range are left to the numpy kernel
+(``defer``), which answers them as it always did; a row's answer does not depend on the others
+of its batch.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .exact import BAND, TINY
+from .polygon_rows import _BIG, _edges, _extent, _norm, _outline, _pick, _radius
+
+__all__ = ["polygon_circle_pairs"]
+
+
+@njit(cache=True)
+def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_poly, poly_slot, count, k, exact):
+    # pragma: no cover - compiled
+    """``polygon_circle`` of the polygon rows ``poly[i]`` and circle rows ``circ[i]`` (``flip[i]``:
+    the circle is shape A of the pair, normals from it): the six contact columns and ``defer``."""
+    n = poly.size
+    hit = np.zeros(n, dtype=np.bool_)
+    nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    defer = np.zeros(n, dtype=np.bool_)
+    vx, vy, ex, ey = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+    s, ln, cd, cnx, cny = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+    for i in range(n):
+        a, b = poly[i], circ[i]
+        c = _outline(a, kind, hw, hh, world_poly, poly_slot, count, vx, vy)
+        f = -1.0 if flip[i] else 1.0
+        ax, ay, bx, by, r = hx[a], hy[a], hx[b], hy[b], radius[b]
+        # The polygon's frame (batch_common.frame).
+        ext = _extent(vx, vy)
+        reach = ext if ext > r else r
+        hdx, hdy = 0.5 * bx - 0.5 * ax, 0.5 * by - 0.5 * ay
+        m = abs(hdx) if abs(hdx) > abs(hdy) else abs(hdy)
+        m = m if m > 0.5 * reach else 0.5 * reach
+        e = math.frexp(m)[1]
+        cx, cy = math.ldexp(hdx, 1 - e), math.ldexp(hdy, 1 - e)
+        for j in range(k):
+            vx[j], vy[j] = math.ldexp(vx[j], -e), math.ldexp(vy[j], -e)
+        r = math.ldexp(r, -e)
+        rp = _radius(vx, vy)
+        size = rp + r
+        tol = BAND * (abs(cx) + abs(cy) + rp + r)
+        _edges(vx, ex)
+        _edges(vy, ey)
+        any_valid = any_out = False
+        for j in range(k):
+            s[j] = ey[j] * (cx - vx[j]) - ex[j] * (cy - vy[j])
+            if s[j] > 0.0:
+                any_out = True
+            if ex[j] != 0.0 or ey[j] != 0.0:
+                any_valid = True
+        inside = not any_out and any_valid
+        if c == 2 and inside:  # a segment: on its line is inside only between its ends
+            t0, e0 = (cx - vx[0]) * ex[0] + (cy - vy[0]) * ey[0], ex[0] * ex[0] + ey[0] * ey[0]
+            inside = t0 >= 0.0 and t0 <= e0
+        low = 0.0
+        for j in range(k):
+            absent = 0.0 if (ex[j] != 0.0 or ey[j] != 0.0) else 1.0
+            ln[j] = _norm(ex[j], ey[j]) + absent
+            cd[j] = (r - s[j] / ln[j]) + absent * _BIG
+            if j == 0 or cd[j] < low:
+                low = cd[j]
+        inside_clear = inside and low > tol
+        # Outside: the first face whose region holds the centre, or else the nearest vertex.
+        fi = -1
+        vi = 0
+        best = 0.0
+        for j in range(k):
+            wx, wy = cx - vx[j], cy - vy[j]
+            if fi < 0 and s[j] > 0.0:
+                t = wx * ex[j] + wy * ey[j]
+                if t >= 0.0 and t <= ex[j] * ex[j] + ey[j] * ey[j]:
+                    fi = j
+            q = wx * wx + wy * wy
+            if j == 0 or q < best:
+                best, vi = q, j
+        has_face = fi >= 0
+        f_i = fi if has_face else 0
+        fex, fey = ex[f_i], ey[f_i]
+        fln = np.sqrt(fex * fex + fey * fey) + (0.0 if has_face else 1.0)
+        ddx, ddy = cx - vx[vi], cy - vy[vi]
+        dist = s[f_i] / fln if has_face else _norm(ddx, ddy)
+        out_hit = not inside and dist > 0.0 and dist <= r - tol
+        unclear = (inside and not inside_clear) or (not inside and (dist == 0.0 or (dist > r - tol and dist < r + tol)))
+        if unclear and exact:
+            defer[i] = True  # (the numpy kernel's exact fallback)
+            continue
+        if not (inside_clear or out_hit):
+            continue
+        if inside_clear:
+            for j in range(k):
+                cnx[j] = f * ey[j] / ln[j]
+                cny[j] = -f * ex[j] / ln[j]
+            dep, nxi, nyi = _pick(cd, cnx, cny, size)
+            pxi, pyi = cx, cy
+        elif has_face:
+            unx, uny = fey / fln, -fex / fln
+            nxi, nyi = f * unx, f * uny
+            dep = r - dist
+            pxi, pyi = cx - unx * dist, cy - uny * dist
+        else:
+            nxi, nyi = f * ddx / dist, f * ddy / dist
+            dep = r - dist
+            pxi, pyi = vx[vi], vy[vi]
+        # batch_common.finish: unscaled, in the world.
+        dep = math.ldexp(dep, e)
+        dep = dep if dep > TINY else TINY
+        pxi = ax + math.ldexp(pxi, e)
+        pyi = ay + math.ldexp(pyi, e)
+        if not (math.isfinite(dep) and math.isfinite(pxi) and math.isfinite(pyi)):
+            defer[i] = True  # (the numpy kernel raises its error)
+            continue
+        hit[i] = True
+        nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi
+    return hit, nx, ny, depth, px, py, defer
