@@ -170,6 +170,10 @@ def test_centred_boxes_row_same_bits(box, scale, far) -> None:
         assert np.array_equal(got.view(np.int64), ref.view(np.int64)), (got, ref)
 
 
+# (hypothesis's favourite floats, 5e-324 and such, only make the float decision decline: UNSURE)
+_OFFSET = st.one_of(st.just(0.0), st.floats(-8.0, 8.0).filter(lambda v: abs(v) > 1e-6))
+
+
 @st.composite
 def _touching_pair(draw):
     """A random convex outline A (turned: coordinates far from dyadic) and an outline B sharing one
@@ -183,8 +187,8 @@ def _touching_pair(draw):
     (x0, y0), (x1, y1) = a[i], a[(i + 1) % n]
     out = draw(st.floats(0.125, 2.0))
     mx, my = 0.5 * (x0 + x1) + out * (y1 - y0), 0.5 * (y0 + y1) - out * (x1 - x0)
-    ox, oy = draw(st.floats(-8.0, 8.0)), draw(st.floats(-8.0, 8.0))
-    qx, qy = draw(st.floats(-8.0, 8.0)), draw(st.floats(-8.0, 8.0))
+    ox, oy = draw(_OFFSET), draw(_OFFSET)
+    qx, qy = draw(_OFFSET), draw(_OFFSET)
     # B about its own origin q, so that its world points are A's edge (world: o + a) and the apex.
     b = [(x1 + ox - qx, y1 + oy - qy), (x0 + ox - qx, y0 + oy - qy), (mx + ox - qx, my + oy - qy)]
     nudge = draw(st.integers(-2, 2))
@@ -261,3 +265,56 @@ def test_circle_rows_inside_on_faces_and_corners() -> None:
              (0.0, 1.5, 0.0), (1.25, 4.0, 0.0)]
     pairs = [(p, c, f) for p in (0, 1, 2) for c in (3, 4, 5, 6, 7) for f in (False, True)]
     _check_circles(shapes, poses, pairs)
+
+
+@st.composite
+def _circle_on_outline(draw):
+    """A turned outline (coordinates far from dyadic; a segment sometimes) and a circle whose
+    centre is put at a distance r from a face, a vertex, or inside, its offset nudged by 0 to 2
+    ulps: touching to the last bit, or just apart or overlapping."""
+    n = draw(st.sampled_from([2, 3, 4, 5, 6]))
+    rad = draw(st.floats(0.25, 4.0))
+    turn = draw(st.floats(0.0, 2.0 * math.pi))
+    pts = [(rad * math.cos(turn + 2.0 * math.pi * i / max(n, 3)), rad * math.sin(turn + 2.0 * math.pi * i / max(n, 3)))
+           for i in range(n)]
+    r = draw(st.floats(0.0625, 2.0))
+    i = draw(st.integers(0, n - 1))
+    (x0, y0), (x1, y1) = pts[i], pts[(i + 1) % n]
+    where = draw(st.sampled_from(["face", "vertex", "inside"]))
+    if where == "face":
+        ln = math.hypot(x1 - x0, y1 - y0)
+        u = draw(st.floats(0.0, 1.0))
+        cx = x0 + u * (x1 - x0) + r * (y1 - y0) / ln
+        cy = y0 + u * (y1 - y0) - r * (x1 - x0) / ln
+    elif where == "vertex":
+        a = draw(st.floats(0.0, 2.0 * math.pi))
+        cx, cy = x0 + r * math.cos(a), y0 + r * math.sin(a)
+    else:
+        cx, cy = 0.25 * x0, 0.25 * y0
+    ox, oy = draw(_OFFSET), draw(_OFFSET)
+    qx, qy = ox + cx, oy + cy
+    nudge = draw(st.integers(-2, 2))
+    for _ in range(abs(nudge)):
+        qy = float(np.nextafter(qy, math.copysign(math.inf, nudge)))
+    return pts, r, (ox, oy, qx, qy)
+
+
+@settings(max_examples=500, deadline=None)
+@given(_circle_on_outline())
+def test_exact_polygon_circle_decision_matches_the_integers(case) -> None:
+    """:func:`framework.collision.exact_sign.polygon_circle_apart` (floats, expansions) decides as
+    :func:`framework.collision.exact.polygon_circle_exact` (integers): circles touching faces and
+    vertices to the last bit, nudged an ulp either way, and inside."""
+    from framework.collision.exact import polygon_circle_exact
+    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygon_circle_apart
+
+    pts, r, (ox, oy, qx, qy) = case
+    kk = 8
+    vx, vy = (np.array([p[j] for p in pts] + [pts[-1][j]] * (kk - len(pts))) for j in (0, 1))
+    got = polygon_circle_apart(vx, vy, len(pts), ox, oy, qx, qy, 0, r)
+    want = polygon_circle_exact(pts, (ox, oy, qx, qy, 0), r)
+    values = [abs(v) for v in (*vx, *vy, r, ox, oy, qx, qy, qx - ox, qy - oy) if v != 0.0]
+    if got == UNSURE:
+        assert min(values) < 2.0**-200 or max(values) > 2.0**200
+    else:
+        assert got == (APART if want is None else OVERLAP)

@@ -10,9 +10,10 @@ It is the numpy kernel row by row, in the same order of operations, so the same 
 polygon's scaled frame, the centre's distance outside each face, inside (out through the nearest
 face, by the tie-break rule), nearest a face or nearest a vertex, and
 :func:`~framework.collision.batch_common.finish`. Rows within rounding of touching, where
-contacts must be exact, and a contact beyond float64's range are left to the numpy kernel
-(``defer``), which answers them as it always did; a row's answer does not depend on the others
-of its batch.
+contacts must be exact, are decided exactly on the floats (:mod:`.exact_sign`); those that
+overlap (their contact comes from the integers), those that decision cannot take and a contact
+beyond float64's range are left to the numpy kernel (``defer``), which answers them as it always
+did; a row's answer does not depend on the others of its batch.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 from numba import njit
 
 from .exact import BAND, TINY
+from .exact_sign import APART, polygon_circle_apart
 from .polygon_rows import _BIG, _edges, _extent, _norm, _outline, _pick, _radius
 
 __all__ = ["polygon_circle_pairs"]
@@ -101,7 +103,9 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
         out_hit = not inside and dist > 0.0 and dist <= r - tol
         unclear = (inside and not inside_clear) or (not inside and (dist == 0.0 or (dist > r - tol and dist < r + tol)))
         if unclear and exact:
-            defer[i] = True  # (the numpy kernel's exact fallback)
+            # Touching to rounding: decided exactly on the floats (exact_sign); only an overlap
+            # needs the numpy kernel's exact fallback for its contact.
+            defer[i] = polygon_circle_apart(vx, vy, c, ax, ay, bx, by, e, r) != APART
             continue
         if not (inside_clear or out_hit):
             continue

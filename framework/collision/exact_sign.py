@@ -206,3 +206,124 @@ def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # prag
             if _sign(out, m) <= 0:
                 return APART
     return OVERLAP
+
+
+# --- polygon / circle -----------------------------------------------------------------------------
+# Quantities of degree up to four in the inputs: exact while every input is 0 or of magnitude in
+# [2**-200, 2**200] (a part's lowest bit then stays above 2**-1022 through four products).
+_LO4, _HI4 = 2.0**-200, 2.0**200
+
+
+@njit(cache=True)
+def _fits4(v):  # pragma: no cover - compiled
+    a = abs(v)
+    return a == 0.0 or (a >= _LO4 and a <= _HI4)
+
+
+@njit(cache=True)
+def _mul(dst, m, a, na, b, nb, sign):  # pragma: no cover - compiled
+    """``dst[:m] += sign * a[:na] * b[:nb]`` exactly; returns the new length."""
+    for i in range(na):
+        for j in range(nb):
+            p, err = _two_product(a[i], b[j])
+            m = _grow(dst, m, sign * p)
+            m = _grow(dst, m, sign * err)
+    return m
+
+
+@njit(cache=True)
+def _diff(dst, a, na, b):  # pragma: no cover - compiled
+    """``dst = a[:na] - b`` (``b`` a double) exactly; returns its length."""
+    for i in range(na):
+        dst[i] = a[i]
+    return _grow(dst, na, -b)
+
+
+@njit(cache=True)
+def polygon_circle_apart(vx, vy, c, ox, oy, qx, qy, k, r):  # pragma: no cover - compiled
+    """:func:`~framework.collision.exact.polygon_circle_exact`'s decision on floats: the outline
+    (``c`` vertices ``vx, vy``, scaled, about the origin) and the circle of radius ``r`` (scaled)
+    at the exact offset ``(q - o) * 2**-k``: :data:`APART` (its None), :data:`OVERLAP` or
+    :data:`UNSURE` (a float outside the range where these products are exact)."""
+    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
+    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
+    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
+            or math.ldexp(ty, k) != oy):
+        return UNSURE
+    cx = np.empty(2)
+    cy = np.empty(2)
+    cx[1], cx[0] = _two_sum(sx, -tx)  # (an expansion: smaller part first)
+    cy[1], cy[0] = _two_sum(sy, -ty)
+    if not (_fits4(cx[0]) and _fits4(cx[1]) and _fits4(cy[0]) and _fits4(cy[1]) and _fits4(r)):
+        return UNSURE
+    for j in range(c):
+        if not (_fits4(vx[j]) and _fits4(vy[j])):
+            return UNSURE
+    ncx = _grow(cx, 0, cx[0]) if cx[1] == 0.0 else 2  # (drop a zero part)
+    ncy = _grow(cy, 0, cy[0]) if cy[1] == 0.0 else 2
+    size = 32
+    wx, wy, ex, ey = np.empty(size), np.empty(size), np.empty(size), np.empty(size)
+    s, t, e2, num = np.empty(4 * size), np.empty(4 * size), np.empty(4 * size), np.empty(16 * size)
+    rr = np.empty(2)
+    rr[1], rr[0] = _two_product(r, r)
+    nrr = 2
+    # The centre's distance outside each edge's line (times its length): all <= 0 is inside.
+    inside = True
+    distinct = False
+    for i in range(c):
+        x0, y0 = vx[i], vy[i]
+        x1, y1 = vx[(i + 1) % c], vy[(i + 1) % c]
+        if x0 != x1 or y0 != y1:
+            distinct = True
+        nwx, nwy = _diff(wx, cx, ncx, x0), _diff(wy, cy, ncy, y0)
+        nex = _grow(ex, _grow(ex, 0, x1), -x0)
+        ney = _grow(ey, _grow(ey, 0, y1), -y0)
+        ns = _mul(s, 0, ey, ney, wx, nwx, 1.0)
+        ns = _mul(s, ns, ex, nex, wy, nwy, -1.0)
+        if _sign(s, ns) > 0:
+            inside = False
+    if c == 2 and inside:  # a segment: the centre on it only between its ends
+        nwx, nwy = _diff(wx, cx, ncx, vx[0]), _diff(wy, cy, ncy, vy[0])
+        nex = _grow(ex, _grow(ex, 0, vx[1]), -vx[0])
+        ney = _grow(ey, _grow(ey, 0, vy[1]), -vy[0])
+        nt = _mul(t, 0, wx, nwx, ex, nex, 1.0)
+        nt = _mul(t, nt, wy, nwy, ey, ney, 1.0)
+        n2 = _mul(e2, 0, ex, nex, ex, nex, 1.0)
+        n2 = _mul(e2, n2, ey, ney, ey, ney, 1.0)
+        for q in range(nt):
+            n2 = _grow(e2, n2, -t[q])
+        inside = _sign(t, nt) >= 0 and _sign(e2, n2) >= 0
+    if inside and distinct:
+        return OVERLAP
+    # Outside: the first face whose region holds the centre decides, else the nearest vertex.
+    for i in range(c):
+        x0, y0 = vx[i], vy[i]
+        x1, y1 = vx[(i + 1) % c], vy[(i + 1) % c]
+        nwx, nwy = _diff(wx, cx, ncx, x0), _diff(wy, cy, ncy, y0)
+        nex = _grow(ex, _grow(ex, 0, x1), -x0)
+        ney = _grow(ey, _grow(ey, 0, y1), -y0)
+        ns = _mul(s, 0, ey, ney, wx, nwx, 1.0)
+        ns = _mul(s, ns, ex, nex, wy, nwy, -1.0)
+        if _sign(s, ns) <= 0:
+            continue
+        nt = _mul(t, 0, wx, nwx, ex, nex, 1.0)
+        nt = _mul(t, nt, wy, nwy, ey, ney, 1.0)
+        n2 = _mul(e2, 0, ex, nex, ex, nex, 1.0)
+        n2 = _mul(e2, n2, ey, ney, ey, ney, 1.0)
+        if _sign(t, nt) < 0:
+            continue
+        nd = _copy_add(num, e2, n2, t, nt, -1.0)  # edge2 - t
+        if _sign(num, nd) < 0:
+            continue
+        # distance s / |e| < r  <=>  r^2 |e|^2 - s^2 > 0
+        nn = _mul(num, 0, rr, nrr, e2, n2, 1.0)
+        nn = _mul(num, nn, s, ns, s, ns, -1.0)
+        return OVERLAP if _sign(num, nn) > 0 else APART
+    for i in range(c):
+        nwx, nwy = _diff(wx, cx, ncx, vx[i]), _diff(wy, cy, ncy, vy[i])
+        nn = _copy_add(num, rr, nrr, rr, 0, 1.0)
+        nn = _mul(num, nn, wx, nwx, wx, nwx, -1.0)
+        nn = _mul(num, nn, wy, nwy, wy, nwy, -1.0)
+        if _sign(num, nn) > 0:
+            return OVERLAP
+    return APART
