@@ -201,9 +201,11 @@ def _touching_pair(draw):
 def test_exact_apart_decision_matches_the_integers(pair, k) -> None:
     """:func:`framework.collision.exact_sign.polygons_apart` (floats, expansions) decides as
     :func:`framework.collision.exact.polygon_polygon_exact` (integers) on outlines touching along
-    an edge to the last bit, and nudged an ulp either way."""
-    from framework.collision.exact import polygon_polygon_exact
-    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygons_apart
+    an edge to the last bit, and nudged an ulp either way; where they overlap,
+    :func:`~framework.collision.exact_sign.polygon_depths` rounds the integers' overlaps bit for
+    bit."""
+    from framework.collision.exact import float_rounded, polygon_polygon_exact
+    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygon_depths, polygons_apart
 
     a, b, (ox, oy, qx, qy) = pair
     kk = 8
@@ -215,8 +217,20 @@ def test_exact_apart_decision_matches_the_integers(pair, k) -> None:
     values = [abs(v) for v in (*avx, *avy, *bvx, *bvy, ox, oy, qx, qy, qx - ox, qy - oy) if v != 0.0]
     if got == UNSURE:  # (only with a coordinate beyond the range where products are exact)
         assert min(values) < 2.0**-300 or max(values) > 2.0**300
-    else:
-        assert got == (APART if want is None else OVERLAP)
+        return
+    assert got == (APART if want is None else OVERLAP)
+    if want is None:
+        return
+    # Overlapping: every axis's exact overlaps, rounded, are the integers' (batch_polygon's order:
+    # A's real edges, then B's, padding slots skipped).
+    found, u = want
+    fwd, bwd = np.full(2 * kk, np.nan), np.full(2 * kk, np.nan)
+    assert polygon_depths(avx, avy, len(a), bvx, bvy, 3, ox, oy, qx, qy, k, fwd, bwd)
+    valid = ~np.isnan(fwd)
+    expect = np.array([(float_rounded(fw, u), float_rounded(bw, u)) for fw, bw in found.values()])
+    assert valid.sum() == len(found)
+    assert np.array_equal(fwd[valid].view(np.int64), expect[:, 0].view(np.int64))
+    assert np.array_equal(bwd[valid].view(np.int64), expect[:, 1].view(np.int64))
 
 
 def _check_circles(shapes, poses, pairs) -> None:
@@ -318,3 +332,26 @@ def test_exact_polygon_circle_decision_matches_the_integers(case) -> None:
         assert min(values) < 2.0**-200 or max(values) > 2.0**200
     else:
         assert got == (APART if want is None else OVERLAP)
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.floats(0.5, 4.0), st.integers(-3, 3), st.sampled_from([0.0, 1.0, -1.0]), st.integers(-60, -1),
+       st.booleans())
+def test_expansions_round_to_nearest_ties_to_even(base, sign_half, nudge, tiny, negative) -> None:
+    """The exact sum of an expansion rounded as Python rounds an exact fraction: a double plus a
+    multiple of half its spacing (ties, either way round to even), nudged by a tiny amount."""
+    from fractions import Fraction
+
+    from framework.collision.exact_sign import _grow, _rounded
+
+    hi = -base if negative else base
+    gap = math.ulp(hi)
+    parts = [hi, sign_half * gap * 0.5, nudge * gap * 2.0**tiny]
+    e = np.empty(16)
+    m = 0
+    for p in parts:
+        m = _grow(e, m, p)
+    got, ok = _rounded(e, m, np.empty(64), np.empty(64))
+    assert ok
+    want = float(sum((Fraction(p) for p in parts), Fraction(0)))
+    assert got == want and math.copysign(1.0, got) == math.copysign(1.0, want)

@@ -327,3 +327,111 @@ def polygon_circle_apart(vx, vy, c, ox, oy, qx, qy, k, r):  # pragma: no cover -
         if _sign(num, nn) > 0:
             return OVERLAP
     return APART
+
+
+# --- exact depths of overlapping polygons ---------------------------------------------------------
+
+@njit(cache=True)
+def _steps(hi):  # pragma: no cover - compiled
+    """The gaps from ``hi`` (normal, nonzero) to the next double up and down."""
+    m, ex = math.frexp(abs(hi))
+    gap = math.ldexp(1.0, ex - 53)  # the spacing in hi's binade
+    toward = gap * 0.5 if m == 0.5 else gap  # (below a power of two the spacing halves)
+    return (gap, toward) if hi > 0.0 else (toward, gap)
+
+
+@njit(cache=True)
+def _even(v):  # pragma: no cover - compiled
+    m, _ex = math.frexp(abs(v))
+    return int(m * 9007199254740992.0) % 2 == 0  # (the 53-bit significand's last bit)
+
+
+@njit(cache=True)
+def _rounded(e, m, tmp, tmp2):  # pragma: no cover - compiled
+    """The expansion's sum correctly rounded (to nearest, ties to even), as Python's int division
+    rounds it, and whether that was found (False far from 1, where the gaps below are not exact)."""
+    if m == 0:
+        return 0.0, True
+    hi = 0.0
+    for i in range(m):
+        hi += e[i]
+    for _ in range(6):
+        if not (abs(hi) > 2.0**-900 and abs(hi) < 2.0**1000):
+            return 0.0, False
+        up, down = _steps(hi)
+        nr = _copy_add(tmp, e, m, e, 0, 1.0)
+        nr = _grow(tmp, nr, -hi)  # the remainder V - hi, exactly
+        n2 = _copy_add(tmp2, tmp, nr, tmp, 0, 1.0)
+        above = _sign(tmp2, _grow(tmp2, n2, -0.5 * up))  # V against the midpoint above hi
+        if above > 0:
+            hi += up
+            continue
+        if above == 0:
+            return (hi if _even(hi) else hi + up), True
+        n2 = _copy_add(tmp2, tmp, nr, tmp, 0, 1.0)
+        below = _sign(tmp2, _grow(tmp2, n2, 0.5 * down))  # and the midpoint below
+        if below < 0:
+            hi -= down
+            continue
+        if below == 0:
+            return (hi if _even(hi) else hi - down), True
+        return hi, True
+    return 0.0, False
+
+
+@njit(cache=True)
+def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # pragma: no cover - compiled
+    """For overlapping outlines (as :func:`polygons_apart` takes them): every axis slot's exact
+    forward and backward overlaps, correctly rounded, into ``fwd`` and ``bwd`` (padding slots are
+    left alone), as :mod:`~framework.collision.batch_polygon` writes the integers' ones; False
+    where an input is outside the exact range or a rounding could not be settled."""
+    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
+    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
+    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
+            or math.ldexp(ty, k) != oy):
+        return False
+    ex_h, ex_l = _two_sum(sx, -tx)
+    ey_h, ey_l = _two_sum(sy, -ty)
+    for v in (ex_h, ex_l, ey_h, ey_l):
+        if not _fits(v):
+            return False
+    for j in range(avx.size):
+        if not (_fits(avx[j]) and _fits(avy[j]) and _fits(bvx[j]) and _fits(bvy[j])):
+            return False
+    size = 64
+    cur, tmp, tmp2 = np.empty(size), np.empty(4 * size), np.empty(4 * size)
+    lo, hi = np.empty(size), np.empty(size)
+    out, ud = np.empty(4 * size), np.empty(size)
+    kk = avx.size
+    for c in range(2 * kk):
+        vx, vy = (avx, avy) if c < kk else (bvx, bvy)
+        j = c % kk
+        x0, y0 = vx[j], vy[j]
+        x1, y1 = (vx[j + 1], vy[j + 1]) if j + 1 < kk else (vx[0], vy[0])
+        if x0 == x1 and y0 == y1:
+            continue
+        ux_h, ux_l = _two_sum(y1, -y0)
+        uy_h, uy_l = _two_sum(x0, -x1)
+        if not (_fits(ux_h) and _fits(ux_l) and _fits(uy_h) and _fits(uy_l)):
+            return False
+        nd = _add_product(ud, 0, ux_h, ux_l, ex_h, ex_l, 1.0)
+        nd = _add_product(ud, nd, uy_h, uy_l, ey_h, ey_l, 1.0)
+        na = _extreme(avx, avy, ac, ux_h, ux_l, uy_h, uy_l, 1, hi, cur, tmp)
+        nb = _extreme(bvx, bvy, bc, ux_h, ux_l, uy_h, uy_l, -1, lo, cur, tmp)
+        m = _copy_add(out, hi, na, lo, nb, -1.0)
+        for i in range(nd):
+            m = _grow(out, m, -ud[i])
+        value, ok = _rounded(out, m, tmp, tmp2)
+        if not ok:
+            return False
+        fwd[c] = value
+        na = _extreme(avx, avy, ac, ux_h, ux_l, uy_h, uy_l, -1, lo, cur, tmp)
+        nb = _extreme(bvx, bvy, bc, ux_h, ux_l, uy_h, uy_l, 1, hi, cur, tmp)
+        m = _copy_add(out, hi, nb, lo, na, -1.0)
+        for i in range(nd):
+            m = _grow(out, m, ud[i])
+        value, ok = _rounded(out, m, tmp, tmp2)
+        if not ok:
+            return False
+        bwd[c] = value
+    return True

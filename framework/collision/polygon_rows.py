@@ -18,9 +18,10 @@ Rows it leaves to the numpy kernel (``defer``), which then answers them as it al
 - two centred axis-aligned boxes of extreme magnitudes, or whose overlap rounding hid (the box
   kernels answer two centred boxes, :func:`~framework.collision.batch_box.aabb_aabb` compiled
   in :mod:`.box_pair_row` where contacts must be exact with their points);
-- rows within rounding of touching on some axis where contacts must be exact, and which
-  overlap (decided exactly on the floats by :mod:`.exact_sign`; their depths are the integer
-  fallback's, :mod:`~framework.collision.exact`), or which that decision cannot take;
+- rows within rounding of touching on some axis where contacts must be exact and whose exact
+  decision and depths (on the floats, :mod:`.exact_sign`, the integer fallback's of
+  :mod:`~framework.collision.exact` bit for bit) cannot be settled there (inputs beyond about
+  2**±300);
 - a contact beyond float64's range (the numpy kernel raises the error).
 
 A row's answer does not depend on the other rows of its batch (the numpy kernel's sums are
@@ -38,7 +39,7 @@ from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
 from .exact import BAND, TINY
-from .exact_sign import APART, polygons_apart
+from .exact_sign import APART, OVERLAP, polygon_depths, polygons_apart
 from .kinds import KIND_AABB
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
@@ -359,11 +360,17 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
         if apart or not any_valid:
             continue
         if border:
-            # Touching to rounding: apart unless exact, where the exact decision is made on the
-            # floats (exact_sign), and only an overlap needs the integers' depths.
-            if exact:
-                defer[i] = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need) != APART
-            continue
+            # Touching to rounding: apart unless exact, where the exact decision and depths are
+            # found on the floats (exact_sign); only what that cannot settle is deferred.
+            if not exact:
+                continue
+            verdict = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need)
+            if verdict == APART:
+                continue
+            if not (verdict == OVERLAP and polygon_depths(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd, bwd)):
+                defer[i] = True
+                continue
+            # (an overlap: every axis's exact overlaps, rounded, as the integers give them)
         # Candidates in the scalar code's order: per axis, forward then backward.
         for c in range(2 * k):
             if ux[c] == 0.0 and uy[c] == 0.0:  # (a padding edge: ln 1, the depth BIG, as the numpy)
