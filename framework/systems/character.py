@@ -18,6 +18,7 @@ from ..casting import cast_rows, overlapping_rows, shape_bounds, touch_point
 from ..character import CharacterController
 from ..collision import collide
 from ..collision.box_rows import rows_within
+from ..collision.kinds import KIND_AABB
 from ..components import Velocity
 from ..frame import StepFrame
 from ..store import DYNAMIC, KINEMATIC, STATIC
@@ -28,9 +29,13 @@ if TYPE_CHECKING:
     from ..queries import SpatialQueries
     from ..shapes import Shape
 
-__all__ = ["CharacterStage"]
+__all__ = ["FAST", "CharacterStage"]
 
 _NONE = np.zeros(0, dtype=np.int64)
+
+#: Whether a box among boxes moves by the compiled move (:mod:`.character_kernel`; the same
+#: bits); False: every body by the Python move (the reference, the tests compare the two).
+FAST = True
 
 
 @dataclass
@@ -69,6 +74,8 @@ class CharacterStage(Stage):
         from ..queries import SpatialQueries
 
         self.queries: SpatialQueries = SpatialQueries(pipeline)
+        self._kernel: Any = None  # the compiled move's module, imported by the first character
+        self.fast_moves = 0  # moves made by the compiled move (the tests' evidence it ran)
 
     # --- checks before the step ------------------------------------------------------------------
 
@@ -158,6 +165,9 @@ class CharacterStage(Stage):
             c, s = math.cos(turn), math.sin(turn)
             carried = (carried[0] + (c * dx - s * dy - dx), carried[1] + (s * dx + c * dy - dy))
         self._gather(mv, ctrl, carried, vx, vy, dt, size)
+        if FAST and store.cols["kind"][row] == KIND_AABB and self._move_box(
+                mv, ctrl, vel, carried, vx, vy, dt, floor_row, was_on_floor, ride_after, ox, oy):
+            return
         if carried != (0.0, 0.0) and floor_row is not None and not ride_after:
             self._ride(mv, floor_row, carried)
         # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
@@ -220,6 +230,50 @@ class CharacterStage(Stage):
             vel.x = vx
         if vel.y != vy:
             vel.y = vy
+
+    def _move_box(self, mv: _Move, ctrl: CharacterController, vel: Velocity, carried: tuple[float, float],
+                  vx: float, vy: float, dt: float, floor_row: int | None, was_on_floor: bool, ride_after: bool,
+                  ox: float, oy: float) -> bool:
+        """The rest of ``_move`` (its candidates gathered) by the compiled move, for a box among
+        boxes: False, nothing changed, where it hands the move back to the Python code."""
+        if self._kernel is None:
+            from . import character_kernel
+
+            self._kernel = character_kernel
+        store, geom = self.bodies.store, self.bodies.geometry
+        c, row = store.cols, mv.row
+        assert mv.rows is not None and mv.box is not None  # (gathered)
+        gx, gy = self.pipeline.active_gravity()
+        snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
+        me = np.array([c["hw"][row], c["hh"][row], mv.skin, mv.floor_cos, c["bound"][row], *mv.box])
+        go = np.array([mv.x, mv.y, carried[0], carried[1], vx, vy, dt, gx, gy, ctrl.gravity_scale, ctrl.step_height,
+                       snap, math.tan(math.radians(ctrl.max_floor_angle)), *ctrl.floor_normal])
+        world = (mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, c["hw"], c["hh"],
+                 c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
+        status, st, si, push_r, push_n = self._kernel.move_box(
+            world, me, go, -1 if floor_row is None else floor_row, was_on_floor, ride_after, ctrl.max_slides)
+        if status:
+            return False
+        self.fast_moves += 1
+        x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()
+        floor, wall, ceiling = int(si[0]), int(si[1]), bool(si[2])
+        ctrl.on_floor = floor >= 0
+        if floor >= 0:
+            ctrl.floor_normal, ctrl.floor_entity = (fnx, fny), int(c["entity"][floor])
+        else:
+            ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
+        ctrl.on_wall = wall >= 0
+        ctrl.wall_normal = (wnx, wny) if wall >= 0 else (0.0, 0.0)
+        ctrl.on_ceiling = ceiling
+        if ctrl.push_mass > 0.0 and dt > 0.0 and push_r.size:
+            mv.pushed = [(r, nx, ny) for r, (nx, ny) in zip(push_r.tolist(), push_n.tolist())]
+            self._push(mv, ctrl.push_mass, mx / dt, my / dt)
+        self.bodies.place_row(row, x - ox, y - oy)
+        if vel.x != vx:
+            vel.x = vx
+        if vel.y != vy:
+            vel.y = vy
+        return True
 
     # --- moving ----------------------------------------------------------------------------
 
