@@ -75,6 +75,7 @@ class CharacterStage(Stage):
 
         self.queries: SpatialQueries = SpatialQueries(pipeline)
         self._kernel: Any = None  # the compiled move's module, imported by the first character
+        self._outputs: tuple[Any, ...] = ()  # the arrays it writes its outcome to
         self.fast_moves = 0  # moves made by the compiled move (the tests' evidence it ran)
 
     # --- checks before the step ------------------------------------------------------------------
@@ -240,6 +241,7 @@ class CharacterStage(Stage):
             from . import character_kernel
 
             self._kernel = character_kernel
+            self._outputs = character_kernel.outputs()
         store, geom = self.bodies.store, self.bodies.geometry
         c, row = store.cols, mv.row
         assert mv.rows is not None and mv.box is not None  # (gathered)
@@ -250,23 +252,20 @@ class CharacterStage(Stage):
                        snap, math.tan(math.radians(ctrl.max_floor_angle)), *ctrl.floor_normal])
         world = (mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, c["hw"], c["hh"],
                  c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
-        status, st, si, push_r, push_n = self._kernel.move_box(
-            world, me, go, -1 if floor_row is None else floor_row, was_on_floor, ride_after, ctrl.max_slides)
-        if status:
+        st, si, push_r, push_n = self._outputs
+        if self._kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor, ride_after,
+                                 ctrl.max_slides, st, si, push_r, push_n):
             return False
         self.fast_moves += 1
         x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()
-        floor, wall, ceiling = int(si[0]), int(si[1]), bool(si[2])
-        ctrl.on_floor = floor >= 0
-        if floor >= 0:
-            ctrl.floor_normal, ctrl.floor_entity = (fnx, fny), int(c["entity"][floor])
-        else:
-            ctrl.floor_normal, ctrl.floor_entity = (0.0, 0.0), None
-        ctrl.on_wall = wall >= 0
-        ctrl.wall_normal = (wnx, wny) if wall >= 0 else (0.0, 0.0)
-        ctrl.on_ceiling = ceiling
-        if ctrl.push_mass > 0.0 and dt > 0.0 and push_r.size:
-            mv.pushed = [(r, nx, ny) for r, (nx, ny) in zip(push_r.tolist(), push_n.tolist())]
+        floor, wall = int(si[0]), int(si[1])
+        # (the state, not settings: written past the settings' check)
+        ctrl.__dict__.update(on_floor=floor >= 0, floor_normal=(fnx, fny) if floor >= 0 else (0.0, 0.0),
+                             floor_entity=int(c["entity"][floor]) if floor >= 0 else None, on_wall=wall >= 0,
+                             wall_normal=(wnx, wny) if wall >= 0 else (0.0, 0.0), on_ceiling=bool(si[2]))
+        pushed = int(si[4])
+        if ctrl.push_mass > 0.0 and dt > 0.0 and pushed:
+            mv.pushed = [(r, nx, ny) for r, (nx, ny) in zip(push_r[:pushed].tolist(), push_n[:pushed].tolist())]
             self._push(mv, ctrl.push_mass, mx / dt, my / dt)
         self.bodies.place_row(row, x - ox, y - oy)
         if vel.x != vx:

@@ -22,10 +22,11 @@ import math
 import numpy as np
 from numba import njit
 
+from ..arrays import F64Array, I64Array, IntpArray
 from ..collision.kinds import KIND_AABB
 from ..store import DYNAMIC
 
-__all__ = ["BAIL", "move_box"]
+__all__ = ["BAIL", "move_box", "outputs"]
 
 #: ``move_box``'s status when the Python move must decide instead.
 BAIL = 1
@@ -147,27 +148,6 @@ def _unignore(si, ign, r):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _near(world, me, si, ign, x0, y0, x1, y1):  # pragma: no cover - compiled
-    """The stage's ``_near``: the gathered rows whose bounds meet the box, minus those ignored;
-    a box beyond the gathered region bails (the Python move looks up afresh)."""
-    cand, minx, miny, maxx, maxy = world[0], world[1], world[2], world[3], world[4]
-    if not (me[GB0] <= x0 and me[GB1] <= y0 and x1 <= me[GB2] and y1 <= me[GB3]):
-        si[BAILED] = 1
-        return cand[:0]
-    out = np.empty(cand.size, dtype=np.intp)
-    m = 0
-    for i in range(cand.size):
-        r = cand[i]
-        if not (minx[r] <= x1 and maxx[r] >= x0 and miny[r] <= y1 and maxy[r] >= y0):
-            continue
-        if _ignored(si, ign, r):
-            continue
-        out[m] = r
-        m += 1
-    return out[:m]
-
-
-@njit(cache=True)
 def _box_sweep(ax, ay, ahw, ahh, bx, by, bhw, bhh, mx, my):  # pragma: no cover - compiled
     """:func:`framework.casting._box_sweep`: ``(code, fraction, nx, ny)``, code 0 a miss, 1 a
     hit, 2 the answer at the very start (``time_of_impact`` decides: bail)."""
@@ -197,28 +177,32 @@ def _box_sweep(ax, ay, ahw, ahh, bx, by, bhw, bhh, mx, my):  # pragma: no cover 
 
 
 @njit(cache=True)
-def _cast(world, me, st, si, ign, mx, my):  # pragma: no cover - compiled
-    """The stage's ``_cast`` (``cast_rows`` by slabs, one-way platforms refusing hits from below):
-    ``(row, fraction, nx, ny)``, row -1 for none."""
+def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no cover - compiled
+    """The stage's ``_cast`` (``_near``, then ``cast_rows`` by slabs, one-way platforms refusing
+    hits from below): ``(row, fraction, nx, ny)``, row -1 for none. ``scratch`` (n x 3) and
+    ``rows_found`` (n): room for a hit per gathered row."""
+    cand, minx, miny, maxx, maxy = world[0], world[1], world[2], world[3], world[4]
     hx, hy, hw, hh, one_way, entity = world[5], world[6], world[7], world[8], world[9], world[11]
     x, y, ahw, ahh = st[X], st[Y], me[HW], me[HH]
     x0, y0, x1, y1 = x - ahw, y - ahh, x + ahw, y + ahh
+    # _near's box (it must lie in the gathered region) ...
     pad = 1e-6 * (abs(x0) + abs(y0) + abs(mx) + abs(my) + x1 - x0 + y1 - y0)
-    rows = _near(world, me, si, ign, _first_min(x0, x0 + mx) - pad, _first_min(y0, y0 + my) - pad,
-                 _first_max(x1, x1 + mx) + pad, _first_max(y1, y1 + my) + pad)
-    # cast_rows: its own (narrower) box
+    n0, n1 = _first_min(x0, x0 + mx) - pad, _first_min(y0, y0 + my) - pad
+    n2, n3 = _first_max(x1, x1 + mx) + pad, _first_max(y1, y1 + my) + pad
+    if not (me[GB0] <= n0 and me[GB1] <= n1 and n2 <= me[GB2] and n3 <= me[GB3]):
+        si[BAILED] = 1
+        return -1, 0.0, 0.0, 0.0
+    # ... and cast_rows' own (narrower) box
     pad = 1e-9 * (abs(x) + abs(y) + me[RAD] + abs(mx) + abs(my))
     b0, b1 = _first_min(x0, x0 + mx) - pad, _first_min(y0, y0 + my) - pad
     b2, b3 = _first_max(x1, x1 + mx) + pad, _first_max(y1, y1 + my) + pad
-    minx, miny, maxx, maxy = world[1], world[2], world[3], world[4]
-    n = rows.size
-    fs = np.empty(n)
-    nxs = np.empty(n)
-    nys = np.empty(n)
-    rs = np.empty(n, dtype=np.intp)
     m = 0
-    for i in range(n):
-        r = rows[i]
+    for i in range(cand.size):
+        r = cand[i]
+        if not (minx[r] <= n2 and maxx[r] >= n0 and miny[r] <= n3 and maxy[r] >= n1):
+            continue
+        if _ignored(si, ign, r):
+            continue
         if not (minx[r] <= b2 and maxx[r] >= b0 and miny[r] <= b3 and maxy[r] >= b1):
             continue
         code, f, nx, ny = _box_sweep(x, y, ahw, ahh, hx[r], hy[r], hw[r], hh[r], mx, my)
@@ -227,18 +211,19 @@ def _cast(world, me, st, si, ign, mx, my):  # pragma: no cover - compiled
         if code == 2:
             si[BAILED] = 1
             return -1, 0.0, 0.0, 0.0
-        fs[m], nxs[m], nys[m], rs[m] = f, nx, ny, r
+        scratch[m, 0], scratch[m, 1], scratch[m, 2], rows_found[m] = f, nx, ny, r
         m += 1
     # The hits in the order of (fraction, entity) (a row's entity is its own), the first accepted.
     for _ in range(m):
         k = -1
         for j in range(m):
-            if rs[j] < 0:
+            if rows_found[j] < 0:
                 continue
-            if k < 0 or fs[j] < fs[k] or (fs[j] == fs[k] and entity[rs[j]] < entity[rs[k]]):
+            if k < 0 or scratch[j, 0] < scratch[k, 0] or (
+                    scratch[j, 0] == scratch[k, 0] and entity[rows_found[j]] < entity[rows_found[k]]):
                 k = j
-        r, f, nx, ny = rs[k], fs[k], nxs[k], nys[k]
-        rs[k] = -1
+        r, f, nx, ny = rows_found[k], scratch[k, 0], scratch[k, 1], scratch[k, 2]
+        rows_found[k] = -1
         if not one_way[r]:
             return r, f, nx, ny
         if ny < me[COSF] or (my > 0.0 and f == 0.0):
@@ -328,11 +313,12 @@ def _contact_height(world, me, st, r, nx, ny):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _step_up(world, me, st, si, ign, hits_r, hits_n, rx, step):  # pragma: no cover - compiled
+def _step_up(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, rx,
+             step):  # pragma: no cover - compiled
     """The stage's ``_step_up`` for a box (no round bottom to carry further)."""
     x0, y0, cos_f, skin = st[X], st[Y], me[COSF], me[SKIN]
     bottom = st[Y] - me[HH]
-    ur, uf, _unx, _uny = _cast(world, me, st, si, ign, 0.0, step)
+    ur, uf, _unx, _uny = _cast(world, me, st, si, ign, scratch, rows_found, 0.0, step)
     rise = step
     if ur >= 0:
         v = step * uf - skin
@@ -344,7 +330,7 @@ def _step_up(world, me, st, si, ign, hits_r, hits_n, rx, step):  # pragma: no co
     nudged = False
     for _ in range(3):
         st[X], st[Y] = x0, top
-        ar, af, anx, any_ = _cast(world, me, st, si, ign, go, 0.0)
+        ar, af, anx, any_ = _cast(world, me, st, si, ign, scratch, rows_found, go, 0.0)
         if ar >= 0:
             _advance(me, st, go, 0.0, af, anx, any_)
         else:
@@ -354,7 +340,7 @@ def _step_up(world, me, st, si, ign, hits_r, hits_n, rx, step):  # pragma: no co
                 go, nudged = go + math.copysign(4.0 * skin, rx), True
                 continue
             break
-        dr, fd, nx, ny = _cast(world, me, st, si, ign, 0.0, -rise)
+        dr, fd, nx, ny = _cast(world, me, st, si, ign, scratch, rows_found, 0.0, -rise)
         if dr < 0:
             break
         if ny >= cos_f:
@@ -372,7 +358,7 @@ def _step_up(world, me, st, si, ign, hits_r, hits_n, rx, step):  # pragma: no co
 
 
 @njit(cache=True)
-def _slide(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, mx, my, on_floor, step,
+def _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, mx, my, on_floor, step,
            max_slides):  # pragma: no cover - compiled
     """The stage's ``_slide``: move, sliding along what it hits."""
     body = world[10]
@@ -385,7 +371,7 @@ def _slide(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, mx, my, on_fl
             return
         if abs(mx) <= scale and abs(my) <= scale:
             return
-        r, f, nx, ny = _cast(world, me, st, si, ign, mx, my)
+        r, f, nx, ny = _cast(world, me, st, si, ign, scratch, rows_found, mx, my)
         if r < 0:
             st[X] += mx
             st[Y] += my
@@ -409,7 +395,7 @@ def _slide(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, mx, my, on_fl
             if body[r] == DYNAMIC:
                 _record(si, push_r, push_n, NPUSH, r, nx, ny)
             if on_floor and step > 0.0 and rx != 0.0 and abs(ny) < cos_f and _step_up(
-                    world, me, st, si, ign, hits_r, hits_n, rx, step):
+                    world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, rx, step):
                 return
             si[WALL], st[WNX], st[WNY] = r, nx, ny
             _record(si, hits_r, hits_n, NHITS, r, nx, ny)
@@ -429,10 +415,11 @@ def _slide(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, mx, my, on_fl
 
 
 @njit(cache=True)
-def _ride(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, floor_row, cx, cy):  # pragma: no cover - compiled
+def _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx,
+          cy):  # pragma: no cover - compiled
     """The stage's ``_ride``: carried by the floor (not in the way); nothing met is kept."""
     _ignore(si, ign, floor_row)
-    _slide(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, cx, cy, False, 0.0, 4)
+    _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, cx, cy, False, 0.0, 4)
     _unignore(si, ign, floor_row)
     si[FLOOR] = si[WALL] = -1
     si[CEIL] = 0
@@ -440,11 +427,11 @@ def _ride(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, floor_row, cx,
 
 
 @njit(cache=True)
-def _land(world, me, st, si, ign, reach):  # pragma: no cover - compiled
+def _land(world, me, st, si, ign, scratch, rows_found, reach):  # pragma: no cover - compiled
     """The stage's ``_land``: cast down by ``reach``, onto a floor (the row, -1 for none, and
     its normal; the body moved onto it)."""
     cos_f = me[COSF]
-    hr, hf, hnx, hny = _cast(world, me, st, si, ign, 0.0, -reach)
+    hr, hf, hnx, hny = _cast(world, me, st, si, ign, scratch, rows_found, 0.0, -reach)
     fr, ff, fnx, fny = hr, hf, hnx, hny
     ignored = np.empty(3, dtype=np.intp)
     n_ignored = 0
@@ -459,7 +446,7 @@ def _land(world, me, st, si, ign, reach):  # pragma: no cover - compiled
         ignored[n_ignored] = hr
         n_ignored += 1
         _ignore(si, ign, hr)
-        hr, hf, hnx, hny = _cast(world, me, st, si, ign, 0.0, -reach)
+        hr, hf, hnx, hny = _cast(world, me, st, si, ign, scratch, rows_found, 0.0, -reach)
     for k in range(n_ignored):
         _unignore(si, ign, ignored[k])
     if found < 0 or fr < 0:
@@ -474,12 +461,18 @@ def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
     then the Python move depenetrates it."""
     minx, miny, maxx, maxy, hx, hy, hw, hh = world[1], world[2], world[3], world[4], world[5], world[6], world[7], \
         world[8]
+    cand = world[0]
     x, y = st[X], st[Y]
     x0, y0, x1, y1 = x - me[HW], y - me[HH], x + me[HW], y + me[HH]
-    rows = _near(world, me, si, ign, x0, y0, x1, y1)
+    if not (me[GB0] <= x0 and me[GB1] <= y0 and x1 <= me[GB2] and y1 <= me[GB3]):
+        return True  # (beyond the gathered region: the Python move looks up afresh)
     tol = 0.5 * me[SKIN]
-    for i in range(rows.size):
-        r = rows[i]
+    for i in range(cand.size):
+        r = cand[i]
+        if not (minx[r] <= x1 and maxx[r] >= x0 and miny[r] <= y1 and maxy[r] >= y0):
+            continue  # (_near's test, then overlapping_rows')
+        if _ignored(si, ign, r):
+            continue
         if minx[r] >= x1 + tol or maxx[r] <= x0 - tol or miny[r] >= y1 + tol or maxy[r] <= y0 - tol:
             continue
         if not (abs(hx[r] - x) < me[HW] + hw[r] and abs(hy[r] - y) < me[HH] + hh[r]):
@@ -525,34 +518,42 @@ def _unblocked(world, me, st, si, hits_r, hits_n, vx, vy):  # pragma: no cover -
     return vx, vy
 
 
+def outputs() -> tuple[F64Array, I64Array, IntpArray, F64Array]:
+    """The arrays :func:`move_box` writes its outcome to (a stage keeps one set: returning
+    arrays from a compiled call costs more than the move's arithmetic)."""
+    return np.zeros(10), np.zeros(7, dtype=np.int64), np.zeros(_HITS, dtype=np.intp), np.zeros((_HITS, 2))
+
+
 @njit(cache=True)
-def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides):  # pragma: no cover - compiled
-    """The stage's ``_move`` from its ride on (the candidates gathered): ``(status, st, si,
-    pushed rows, pushed normals)``. ``world``: the gathered rows, then the geometry's bounds and
-    origins and the store's columns by row (``minx, miny, maxx, maxy, hx, hy, hw, hh, one_way,
-    body, entity, bound, kind``); ``me``: the body's settings (``HW`` ...); ``go``: ``x, y,
-    carried x, carried y, vx, vy, dt, gx, gy, gravity scale, step height, snap, tan(max floor
-    angle), floor normal x, y``. ``st``: ``x, y, floor normal, wall normal, vx, vy, the own move``; ``si``:
-    floor and wall rows, ceiling, ..."""
+def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, st, si, push_r,
+             push_n):  # pragma: no cover - compiled
+    """The stage's ``_move`` from its ride on (the candidates gathered): 0, or ``BAIL``.
+    ``world``: the gathered rows, then the geometry's bounds and origins and the store's columns
+    by row (``minx, miny, maxx, maxy, hx, hy, hw, hh, one_way, body, entity, bound, kind``);
+    ``me``: the body's settings (``HW`` ...); ``go``: ``x, y, carried x, carried y, vx, vy, dt,
+    gx, gy, gravity scale, step height, snap, tan(max floor angle), floor normal x, y``. The
+    outcome (arrays from :func:`outputs`): ``st``: ``x, y, floor normal, wall normal, vx, vy, the
+    own move``; ``si``: floor and wall rows, ceiling, hits, pushed dynamic rows (``push_r``,
+    normals ``push_n``), ..."""
     cand, kind = world[0], world[13]
-    st = np.zeros(10)
-    si = np.zeros(7, dtype=np.int64)
+    st[:] = 0.0
+    si[:] = 0
     si[FLOOR] = si[WALL] = -1
     ign = np.empty(_IGNORED, dtype=np.intp)
     hits_r = np.empty(_HITS, dtype=np.intp)
     hits_n = np.empty((_HITS, 2))
-    push_r = np.empty(_HITS, dtype=np.intp)
-    push_n = np.empty((_HITS, 2))
+    scratch = np.empty((cand.size, 3))
+    rows_found = np.empty(cand.size, dtype=np.intp)
     for i in range(cand.size):
         if kind[cand[i]] != KIND_AABB:
-            return BAIL, st, si, push_r[:0], push_n[:0]
+            return BAIL
     st[X], st[Y] = go[0], go[1]
     cx, cy, vx, vy, dt = go[2], go[3], go[4], go[5], go[6]
     carried = not (cx == 0.0 and cy == 0.0)
     if carried and floor_row >= 0 and not ride_after:
-        _ride(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, floor_row, cx, cy)
+        _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy)
     if si[BAILED] or _overlaps(world, me, st, si, ign) or si[BAILED]:
-        return BAIL, st, si, push_r[:0], push_n[:0]
+        return BAIL
     cos_f = me[COSF]
     jumping = vy > 0.0
     if was_on_floor and jumping and floor_row >= 0 and dt > 0.0:
@@ -571,16 +572,17 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides):  #
     on_floor_now = was_on_floor and not jumping
     px = st[X]
     st[8], st[9] = mx, my
-    _slide(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, mx, my, on_floor_now, go[10], max_slides)
+    _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, mx, my, on_floor_now, go[10],
+           max_slides)
     if on_floor_now or (si[FLOOR] >= 0 and not jumping):
         reach = go[11] + abs(st[X] - px) * go[12] + 2.0 * me[SKIN]
-        si[FLOOR], st[FNX], st[FNY] = _land(world, me, st, si, ign, reach)
+        si[FLOOR], st[FNX], st[FNY] = _land(world, me, st, si, ign, scratch, rows_found, reach)
     elif si[FLOOR] >= 0:
-        si[FLOOR], st[FNX], st[FNY] = _land(world, me, st, si, ign, 4.0 * me[SKIN])
+        si[FLOOR], st[FNX], st[FNY] = _land(world, me, st, si, ign, scratch, rows_found, 4.0 * me[SKIN])
     if ride_after and carried and floor_row >= 0:
         kept_i = si.copy()
         kept_f = st.copy()
-        _ride(world, me, st, si, ign, hits_r, hits_n, push_r, push_n, floor_row, cx, cy)
+        _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy)
         si[FLOOR], si[WALL], si[CEIL], si[NHITS] = kept_i[FLOOR], kept_i[WALL], kept_i[CEIL], kept_i[NHITS]
         st[FNX], st[FNY], st[WNX], st[WNY] = kept_f[FNX], kept_f[FNY], kept_f[WNX], kept_f[WNY]
     if si[FLOOR] >= 0:
@@ -590,5 +592,5 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides):  #
     vx, vy = _unblocked(world, me, st, si, hits_r, hits_n, vx, vy)
     st[6], st[7] = vx, vy
     if si[BAILED]:
-        return BAIL, st, si, push_r[:0], push_n[:0]
-    return 0, st, si, push_r[:si[NPUSH]], push_n[:si[NPUSH]]
+        return BAIL
+    return 0
