@@ -36,6 +36,7 @@ _NONE = np.zeros(0, dtype=np.int64)
 #: Whether a box among boxes moves by the compiled move (:mod:`.character_kernel`; the same
 #: bits); False: every body by the Python move (the reference, the tests compare the two).
 FAST = True
+_RIDE_SLIDES = 4  # (the casts of a ride: ``_slide``'s default, as ``_ride`` calls it)
 
 
 @dataclass
@@ -254,7 +255,7 @@ class CharacterStage(Stage):
                  c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
         st, si, push_r, push_n = self._outputs
         if self._kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor, ride_after,
-                                 ctrl.max_slides, st, si, push_r, push_n):
+                                 ctrl.max_slides, _RIDE_SLIDES, st, si, push_r, push_n):
             return False
         self.fast_moves += 1
         x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()

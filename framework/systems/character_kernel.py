@@ -13,11 +13,15 @@ What it does not decide it hands back (``BAIL``), and the Python move runs inste
 candidate that is not a box, a cast or overlap test reaching beyond the gathered region, a cast
 starting inside a candidate or touching a one-way platform (``time_of_impact`` and ``collide``
 decide those), a body overlapping something at the start (depenetration), too many surfaces met.
+
+Compiling it costs about 6 to 8 seconds once per installation (numba's cache keeps it); the stage
+imports this module only when a scene first has a character to move.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -40,23 +44,28 @@ X, Y, FNX, FNY, WNX, WNY = range(6)
 # surfaces recorded, rows ignored, bail.
 FLOOR, WALL, CEIL, NHITS, NPUSH, NIGN, BAILED = range(7)
 
+# The helpers: compiled into the move, never called from Python (no wrapper to call them by: a
+# third less compiling). (``no_cpython_wrapper`` is numba's own option; its stubs do not list it.)
+_INNER_OPTIONS: dict[str, Any] = {"cache": True, "no_cpython_wrapper": True}
+_inner = njit(**_INNER_OPTIONS)
+
 _HITS = 64  # surfaces a move records at most (more: bail)
 _IGNORED = 8  # rows ignored at once at most
 
 
-@njit(cache=True)
+@_inner
 def _first_min(a, b):  # pragma: no cover - compiled
     """Python's ``min(a, b)``: ``a`` unless ``b`` is smaller."""
     return b if b < a else a
 
 
-@njit(cache=True)
+@_inner
 def _first_max(a, b):  # pragma: no cover - compiled
     """Python's ``max(a, b)``: ``a`` unless ``b`` is larger."""
     return b if b > a else a
 
 
-@njit(cache=True)
+@_inner
 def _two_product(x, y):  # pragma: no cover - compiled
     """``x * y`` exactly, as ``(hi, lo)`` (Dekker's product by Veltkamp's split)."""
     t = x * 134217729.0
@@ -71,7 +80,7 @@ def _two_product(x, y):  # pragma: no cover - compiled
     return z, p - z + q + xl * yl
 
 
-@njit(cache=True)
+@_inner
 def _norm(a, b, top):  # pragma: no cover - compiled
     """CPython's ``vector_norm`` of ``(a, b)`` (both >= 0, ``top`` the larger, normal)."""
     scale = math.ldexp(1.0, -math.frexp(top)[1])
@@ -116,7 +125,7 @@ def hypot(a, b):  # pragma: no cover - compiled
 # --- looking up and casting --------------------------------------------------------------------
 
 
-@njit(cache=True)
+@_inner
 def _ignored(si, ign, r):  # pragma: no cover - compiled
     for k in range(si[NIGN]):
         if ign[k] == r:
@@ -124,7 +133,7 @@ def _ignored(si, ign, r):  # pragma: no cover - compiled
     return False
 
 
-@njit(cache=True)
+@_inner
 def _ignore(si, ign, r):  # pragma: no cover - compiled
     """``mv.ignore.add(r)``."""
     if _ignored(si, ign, r):
@@ -136,7 +145,7 @@ def _ignore(si, ign, r):  # pragma: no cover - compiled
     si[NIGN] += 1
 
 
-@njit(cache=True)
+@_inner
 def _unignore(si, ign, r):  # pragma: no cover - compiled
     """``mv.ignore.discard(r)``."""
     n = si[NIGN]
@@ -147,7 +156,7 @@ def _unignore(si, ign, r):  # pragma: no cover - compiled
             return
 
 
-@njit(cache=True)
+@_inner
 def _box_sweep(ax, ay, ahw, ahh, bx, by, bhw, bhh, mx, my):  # pragma: no cover - compiled
     """:func:`framework.casting._box_sweep`: ``(code, fraction, nx, ny)``, code 0 a miss, 1 a
     hit, 2 the answer at the very start (``time_of_impact`` decides: bail)."""
@@ -176,7 +185,7 @@ def _box_sweep(ax, ay, ahw, ahh, bx, by, bhw, bhh, mx, my):  # pragma: no cover 
     return 1, t_in, 0.0, (-1.0 if by > ay else 1.0)
 
 
-@njit(cache=True)
+@_inner
 def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no cover - compiled
     """The stage's ``_cast`` (``_near``, then ``cast_rows`` by slabs, one-way platforms refusing
     hits from below): ``(row, fraction, nx, ny)``, row -1 for none. ``scratch`` (n x 3) and
@@ -235,7 +244,7 @@ def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no co
     return -1, 0.0, 0.0, 0.0
 
 
-@njit(cache=True)
+@_inner
 def _advance(me, st, mx, my, f, nx, ny):  # pragma: no cover - compiled
     """The stage's ``_advance``: by ``f`` of the move, then back until ``skin`` clear."""
     length = hypot(mx, my)
@@ -249,7 +258,7 @@ def _advance(me, st, mx, my, f, nx, ny):  # pragma: no cover - compiled
     st[Y] += my * t
 
 
-@njit(cache=True)
+@_inner
 def _record(si, rows, normals, count, r, nx, ny):  # pragma: no cover - compiled
     """Append ``(r, nx, ny)`` to a list of surfaces (``count`` indexes ``si``)."""
     k = si[count]
@@ -265,7 +274,7 @@ def _record(si, rows, normals, count, r, nx, ny):  # pragma: no cover - compiled
 # --- moving --------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@_inner
 def _contact_height(world, me, st, r, nx, ny):  # pragma: no cover - compiled
     """The stage's ``_contact_height``: ``touch_point`` of the body and box ``r`` (met at normal
     ``n``), its y; both supports of a box."""
@@ -312,7 +321,7 @@ def _contact_height(world, me, st, r, nx, ny):  # pragma: no cover - compiled
     return d * tny + mid * ty + 0.0
 
 
-@njit(cache=True)
+@_inner
 def _step_up(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, rx,
              step):  # pragma: no cover - compiled
     """The stage's ``_step_up`` for a box (no round bottom to carry further)."""
@@ -357,7 +366,7 @@ def _step_up(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, rx,
     return False
 
 
-@njit(cache=True)
+@_inner
 def _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, mx, my, on_floor, step,
            max_slides):  # pragma: no cover - compiled
     """The stage's ``_slide``: move, sliding along what it hits."""
@@ -414,19 +423,22 @@ def _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, 
         n_planes += 1
 
 
-@njit(cache=True)
-def _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx,
-          cy):  # pragma: no cover - compiled
-    """The stage's ``_ride``: carried by the floor (not in the way); nothing met is kept."""
+@_inner
+def _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy,
+          ride_slides):  # pragma: no cover - compiled
+    """The stage's ``_ride``: carried by the floor (not in the way); nothing met is kept.
+    (``ride_slides`` and the False made of it come typed as the walk's: one compiled ``_slide``
+    serves both, where literal ``False, 4`` compiled a second one.)"""
     _ignore(si, ign, floor_row)
-    _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, cx, cy, False, 0.0, 4)
+    _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, cx, cy, ride_slides < 0, 0.0,
+           ride_slides)
     _unignore(si, ign, floor_row)
     si[FLOOR] = si[WALL] = -1
     si[CEIL] = 0
     si[NHITS] = 0
 
 
-@njit(cache=True)
+@_inner
 def _land(world, me, st, si, ign, scratch, rows_found, reach):  # pragma: no cover - compiled
     """The stage's ``_land``: cast down by ``reach``, onto a floor (the row, -1 for none, and
     its normal; the body moved onto it)."""
@@ -455,7 +467,7 @@ def _land(world, me, st, si, ign, scratch, rows_found, reach):  # pragma: no cov
     return hr, hnx, hny
 
 
-@njit(cache=True)
+@_inner
 def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
     """Whether the body may overlap a candidate (``overlapping_rows``' tests before ``collide``):
     then the Python move depenetrates it."""
@@ -481,7 +493,7 @@ def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
     return False
 
 
-@njit(cache=True)
+@_inner
 def _unblocked(world, me, st, si, hits_r, hits_n, vx, vy):  # pragma: no cover - compiled
     """The stage's ``_unblocked``: the velocity without its part into the surfaces met."""
     body = world[10]
@@ -525,13 +537,14 @@ def outputs() -> tuple[F64Array, I64Array, IntpArray, F64Array]:
 
 
 @njit(cache=True)
-def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, st, si, push_r,
+def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r,
              push_n):  # pragma: no cover - compiled
     """The stage's ``_move`` from its ride on (the candidates gathered): 0, or ``BAIL``.
     ``world``: the gathered rows, then the geometry's bounds and origins and the store's columns
     by row (``minx, miny, maxx, maxy, hx, hy, hw, hh, one_way, body, entity, bound, kind``);
     ``me``: the body's settings (``HW`` ...); ``go``: ``x, y, carried x, carried y, vx, vy, dt,
-    gx, gy, gravity scale, step height, snap, tan(max floor angle), floor normal x, y``. The
+    gx, gy, gravity scale, step height, snap, tan(max floor angle), floor normal x, y``;
+    ``ride_slides``: the casts of a ride (the stage's ``_slide`` default, 4). The
     outcome (arrays from :func:`outputs`): ``st``: ``x, y, floor normal, wall normal, vx, vy, the
     own move``; ``si``: floor and wall rows, ceiling, hits, pushed dynamic rows (``push_r``,
     normals ``push_n``), ..."""
@@ -551,7 +564,8 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, st,
     cx, cy, vx, vy, dt = go[2], go[3], go[4], go[5], go[6]
     carried = not (cx == 0.0 and cy == 0.0)
     if carried and floor_row >= 0 and not ride_after:
-        _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy)
+        _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy,
+              ride_slides)
     if si[BAILED] or _overlaps(world, me, st, si, ign) or si[BAILED]:
         return BAIL
     cos_f = me[COSF]
@@ -582,7 +596,8 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, st,
     if ride_after and carried and floor_row >= 0:
         kept_i = si.copy()
         kept_f = st.copy()
-        _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy)
+        _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy,
+              ride_slides)
         si[FLOOR], si[WALL], si[CEIL], si[NHITS] = kept_i[FLOOR], kept_i[WALL], kept_i[CEIL], kept_i[NHITS]
         st[FNX], st[FNY], st[WNX], st[WNY] = kept_f[FNX], kept_f[FNY], kept_f[WNX], kept_f[WNY]
     if si[FLOOR] >= 0:
