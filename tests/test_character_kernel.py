@@ -228,3 +228,14 @@ def test_a_character_walks_the_same_beside_a_character(monkeypatch):
             s.get(e, Velocity).x = 128.0 if i == 0 else -128.0
 
     _same_bits(build, lambda: drive, 150, monkeypatch)
+
+
+def test_hand_backs_are_counted_by_reason():
+    """A character near a slope is handed back for its candidate that is not a box."""
+    s = scene_with(hill_level())
+    e = character(s, 40.0, 32.0)
+    for _ in range(120):
+        s.get(e, Velocity).x = 128.0
+        s.step(DT)
+    stage = s._stages["character"]  # type: ignore[attr-defined]
+    assert stage.fallbacks["a candidate not a box"] > 0 and stage.fast_moves > 0

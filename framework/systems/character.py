@@ -2,11 +2,17 @@
 (the rules: :mod:`framework.character`), right after the movement stage, by swept shape casts
 (:mod:`framework.casting`) against what blocks it. A Python loop over the characters (a game has a
 few); each cast is a handful of exact time-of-impact tests against the nearby hitboxes.
+
+The Python move here is the reference. A box among boxes (the body and every hitbox near it
+axis-aligned boxes: a tile level's player and walkers) moves instead by one compiled call,
+:mod:`.character_kernel`, with the same bits; it hands back to the Python move whatever it does
+not decide itself (see there). :data:`FAST` = False turns it off.
 """
 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -78,6 +84,7 @@ class CharacterStage(Stage):
         self._kernel: Any = None  # the compiled move's module, imported by the first character
         self._outputs: tuple[Any, ...] = ()  # the arrays it writes its outcome to
         self.fast_moves = 0  # moves made by the compiled move (the tests' evidence it ran)
+        self.fallbacks: Counter[str] = Counter()  # the moves it handed back, by reason
 
     # --- checks before the step ------------------------------------------------------------------
 
@@ -254,8 +261,10 @@ class CharacterStage(Stage):
         world = (mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, c["hw"], c["hh"],
                  c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
         st, si, push_r, push_n = self._outputs
-        if self._kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor, ride_after,
-                                 ctrl.max_slides, _RIDE_SLIDES, st, si, push_r, push_n):
+        reason = self._kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor,
+                                       ride_after, ctrl.max_slides, _RIDE_SLIDES, st, si, push_r, push_n)
+        if reason:
+            self.fallbacks[self._kernel.REASONS[reason]] += 1
             return False
         self.fast_moves += 1
         x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()

@@ -9,10 +9,11 @@ whose every gathered candidate is an axis-aligned box. It repeats the Python cod
 the same order (casts by slabs, :func:`~framework.casting._box_sweep`; hits taken in the order of
 ``(fraction, entity)``; ``math.hypot`` as CPython computes it), so the bits are the same.
 
-What it does not decide it hands back (``BAIL``), and the Python move runs instead, unchanged: a
-candidate that is not a box, a cast or overlap test reaching beyond the gathered region, a cast
-starting inside a candidate or touching a one-way platform (``time_of_impact`` and ``collide``
-decide those), a body overlapping something at the start (depenetration), too many surfaces met.
+What it does not decide it hands back (a reason, :data:`REASONS`), and the Python move runs instead,
+unchanged: a candidate that is not a box, a cast or overlap test reaching beyond the gathered
+region, a cast starting inside a candidate or touching a one-way platform (``time_of_impact`` and
+``collide`` decide those), a body overlapping something at the start (depenetration), too many
+surfaces met.
 
 Compiling it costs about 6 to 8 seconds once per installation (numba's cache keeps it); the stage
 imports this module only when a scene first has a character to move.
@@ -30,10 +31,13 @@ from ..arrays import F64Array, I64Array, IntpArray
 from ..collision.kinds import KIND_AABB
 from ..store import DYNAMIC
 
-__all__ = ["BAIL", "move_box", "outputs"]
+__all__ = ["REASONS", "move_box", "outputs"]
 
-#: ``move_box``'s status when the Python move must decide instead.
-BAIL = 1
+#: ``move_box``'s status when the Python move must decide instead: its first reason (0: moved).
+REGION, STARTS_INSIDE, ONE_WAY_TOUCH, OVERLAP, FULL, NOT_A_BOX = range(1, 7)
+#: The reasons' names, by status (the stage counts its hand-backs by them).
+REASONS = ("", "beyond the gathered region", "a cast starting inside a box", "touching a one-way platform",
+           "overlapping a box", "too many surfaces", "a candidate not a box")
 
 # The body's settings (``me``): half extents, skin, cos(max floor angle), bounding radius, the
 # gathered region's box.
@@ -126,6 +130,13 @@ def hypot(a, b):  # pragma: no cover - compiled
 
 
 @_inner
+def _bail(si, reason):  # pragma: no cover - compiled
+    """Hand the move back to the Python code (the first reason is kept)."""
+    if si[BAILED] == 0:
+        si[BAILED] = reason
+
+
+@_inner
 def _ignored(si, ign, r):  # pragma: no cover - compiled
     for k in range(si[NIGN]):
         if ign[k] == r:
@@ -139,7 +150,7 @@ def _ignore(si, ign, r):  # pragma: no cover - compiled
     if _ignored(si, ign, r):
         return
     if si[NIGN] == ign.size:
-        si[BAILED] = 1
+        _bail(si, FULL)
         return
     ign[si[NIGN]] = r
     si[NIGN] += 1
@@ -199,7 +210,7 @@ def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no co
     n0, n1 = _first_min(x0, x0 + mx) - pad, _first_min(y0, y0 + my) - pad
     n2, n3 = _first_max(x1, x1 + mx) + pad, _first_max(y1, y1 + my) + pad
     if not (me[GB0] <= n0 and me[GB1] <= n1 and n2 <= me[GB2] and n3 <= me[GB3]):
-        si[BAILED] = 1
+        _bail(si, REGION)
         return -1, 0.0, 0.0, 0.0
     # ... and cast_rows' own (narrower) box
     pad = 1e-9 * (abs(x) + abs(y) + me[RAD] + abs(mx) + abs(my))
@@ -218,7 +229,7 @@ def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no co
         if code == 0:
             continue
         if code == 2:
-            si[BAILED] = 1
+            _bail(si, STARTS_INSIDE)
             return -1, 0.0, 0.0, 0.0
         scratch[m, 0], scratch[m, 1], scratch[m, 2], rows_found[m] = f, nx, ny, r
         m += 1
@@ -238,7 +249,7 @@ def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no co
         if ny < me[COSF] or (my > 0.0 and f == 0.0):
             continue  # a one-way platform blocks only a body coming down onto its top
         if f == 0.0:  # touching it: collide decides
-            si[BAILED] = 1
+            _bail(si, ONE_WAY_TOUCH)
             return -1, 0.0, 0.0, 0.0
         return r, f, nx, ny
     return -1, 0.0, 0.0, 0.0
@@ -263,7 +274,7 @@ def _record(si, rows, normals, count, r, nx, ny):  # pragma: no cover - compiled
     """Append ``(r, nx, ny)`` to a list of surfaces (``count`` indexes ``si``)."""
     k = si[count]
     if k == rows.size:
-        si[BAILED] = 1
+        _bail(si, FULL)
         return
     rows[k] = r
     normals[k, 0] = nx
@@ -469,15 +480,16 @@ def _land(world, me, st, si, ign, scratch, rows_found, reach):  # pragma: no cov
 
 @_inner
 def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
-    """Whether the body may overlap a candidate (``overlapping_rows``' tests before ``collide``):
-    then the Python move depenetrates it."""
+    """Bail if the body may overlap a candidate (``overlapping_rows``' tests before ``collide``):
+    the Python move depenetrates it."""
     minx, miny, maxx, maxy, hx, hy, hw, hh = world[1], world[2], world[3], world[4], world[5], world[6], world[7], \
         world[8]
     cand = world[0]
     x, y = st[X], st[Y]
     x0, y0, x1, y1 = x - me[HW], y - me[HH], x + me[HW], y + me[HH]
     if not (me[GB0] <= x0 and me[GB1] <= y0 and x1 <= me[GB2] and y1 <= me[GB3]):
-        return True  # (beyond the gathered region: the Python move looks up afresh)
+        _bail(si, REGION)  # (the Python move looks up afresh)
+        return
     tol = 0.5 * me[SKIN]
     for i in range(cand.size):
         r = cand[i]
@@ -489,8 +501,8 @@ def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
             continue
         if not (abs(hx[r] - x) < me[HW] + hw[r] and abs(hy[r] - y) < me[HH] + hh[r]):
             continue
-        return True
-    return False
+        _bail(si, OVERLAP)
+        return
 
 
 @_inner
@@ -539,7 +551,8 @@ def outputs() -> tuple[F64Array, I64Array, IntpArray, F64Array]:
 @njit(cache=True)
 def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r,
              push_n):  # pragma: no cover - compiled
-    """The stage's ``_move`` from its ride on (the candidates gathered): 0, or ``BAIL``.
+    """The stage's ``_move`` from its ride on (the candidates gathered): 0, or the reason it hands
+    the move back (``REGION`` ...).
     ``world``: the gathered rows, then the geometry's bounds and origins and the store's columns
     by row (``minx, miny, maxx, maxy, hx, hy, hw, hh, one_way, body, entity, bound, kind``);
     ``me``: the body's settings (``HW`` ...); ``go``: ``x, y, carried x, carried y, vx, vy, dt,
@@ -559,15 +572,17 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, rid
     rows_found = np.empty(cand.size, dtype=np.intp)
     for i in range(cand.size):
         if kind[cand[i]] != KIND_AABB:
-            return BAIL
+            return NOT_A_BOX
     st[X], st[Y] = go[0], go[1]
     cx, cy, vx, vy, dt = go[2], go[3], go[4], go[5], go[6]
     carried = not (cx == 0.0 and cy == 0.0)
     if carried and floor_row >= 0 and not ride_after:
         _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy,
               ride_slides)
-    if si[BAILED] or _overlaps(world, me, st, si, ign) or si[BAILED]:
-        return BAIL
+    if si[BAILED] == 0:
+        _overlaps(world, me, st, si, ign)
+    if si[BAILED]:
+        return si[BAILED]
     cos_f = me[COSF]
     jumping = vy > 0.0
     if was_on_floor and jumping and floor_row >= 0 and dt > 0.0:
@@ -606,6 +621,4 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, rid
         vy = 0.0
     vx, vy = _unblocked(world, me, st, si, hits_r, hits_n, vx, vy)
     st[6], st[7] = vx, vy
-    if si[BAILED]:
-        return BAIL
-    return 0
+    return si[BAILED]
