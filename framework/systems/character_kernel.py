@@ -15,8 +15,9 @@ region, a cast starting inside a candidate or touching a one-way platform (``tim
 ``collide`` decide those), a body overlapping something at the start (depenetration), too many
 surfaces met.
 
-Compiling it costs about 6 to 8 seconds once per installation (numba's cache keeps it); the stage
-imports this module only when a scene first has a character to move.
+Compiling it costs about 7 to 10 seconds once per installation (measured on a busy two-core
+machine; numba's cache keeps it); the stage imports this module only when a scene first has a box
+character to move.
 """
 
 from __future__ import annotations
