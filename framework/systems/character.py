@@ -2,11 +2,17 @@
 (the rules: :mod:`framework.character`), right after the movement stage, by swept shape casts
 (:mod:`framework.casting`) against what blocks it. A Python loop over the characters (a game has a
 few); each cast is a handful of exact time-of-impact tests against the nearby hitboxes.
+
+The Python move here is the reference. A box among boxes (the body and every hitbox near it
+axis-aligned boxes: a tile level's player and walkers) moves instead by one compiled call,
+:mod:`.character_kernel`, with the same bits; it hands back to the Python move whatever it does
+not decide itself (see there). :data:`FAST` = False turns it off.
 """
 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -18,6 +24,7 @@ from ..casting import cast_rows, overlapping_rows, shape_bounds, touch_point
 from ..character import CharacterController
 from ..collision import collide
 from ..collision.box_rows import rows_within
+from ..collision.kinds import KIND_AABB
 from ..components import Velocity
 from ..frame import StepFrame
 from ..store import DYNAMIC, KINEMATIC, STATIC
@@ -28,9 +35,14 @@ if TYPE_CHECKING:
     from ..queries import SpatialQueries
     from ..shapes import Shape
 
-__all__ = ["CharacterStage"]
+__all__ = ["FAST", "CharacterStage"]
 
 _NONE = np.zeros(0, dtype=np.int64)
+
+#: Whether a box among boxes moves by the compiled move (:mod:`.character_kernel`; the same
+#: bits); False: every body by the Python move (the reference, the tests compare the two).
+FAST = True
+_RIDE_SLIDES = 4  # (the casts of a ride: ``_slide``'s default, as ``_ride`` calls it)
 
 
 @dataclass
@@ -69,6 +81,10 @@ class CharacterStage(Stage):
         from ..queries import SpatialQueries
 
         self.queries: SpatialQueries = SpatialQueries(pipeline)
+        self._kernel: Any = None  # the compiled move's module, imported by the first character
+        self._outputs: tuple[Any, ...] = ()  # the arrays it writes its outcome to
+        self.fast_moves = 0  # moves made by the compiled move (the tests' evidence it ran)
+        self.fallbacks: Counter[str] = Counter()  # the moves it handed back, by reason
 
     # --- checks before the step ------------------------------------------------------------------
 
@@ -158,6 +174,9 @@ class CharacterStage(Stage):
             c, s = math.cos(turn), math.sin(turn)
             carried = (carried[0] + (c * dx - s * dy - dx), carried[1] + (s * dx + c * dy - dy))
         self._gather(mv, ctrl, carried, vx, vy, dt, size)
+        if FAST and store.cols["kind"][row] == KIND_AABB and self._move_box(
+                mv, ctrl, vel, carried, vx, vy, dt, floor_row, was_on_floor, ride_after, ox, oy):
+            return
         if carried != (0.0, 0.0) and floor_row is not None and not ride_after:
             self._ride(mv, floor_row, carried)
         # 2. Whatever moved into it (a platform rising under it, one pushing it): out.
@@ -220,6 +239,50 @@ class CharacterStage(Stage):
             vel.x = vx
         if vel.y != vy:
             vel.y = vy
+
+    def _move_box(self, mv: _Move, ctrl: CharacterController, vel: Velocity, carried: tuple[float, float],
+                  vx: float, vy: float, dt: float, floor_row: int | None, was_on_floor: bool, ride_after: bool,
+                  ox: float, oy: float) -> bool:
+        """The rest of ``_move`` (its candidates gathered) by the compiled move, for a box among
+        boxes: False, nothing changed, where it hands the move back to the Python code."""
+        if self._kernel is None:
+            from . import character_kernel
+
+            self._kernel = character_kernel
+            self._outputs = character_kernel.outputs()
+        store, geom = self.bodies.store, self.bodies.geometry
+        c, row = store.cols, mv.row
+        assert mv.rows is not None and mv.box is not None  # (gathered)
+        gx, gy = self.pipeline.active_gravity()
+        snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
+        me = np.array([c["hw"][row], c["hh"][row], mv.skin, mv.floor_cos, c["bound"][row], *mv.box])
+        go = np.array([mv.x, mv.y, carried[0], carried[1], vx, vy, dt, gx, gy, ctrl.gravity_scale, ctrl.step_height,
+                       snap, math.tan(math.radians(ctrl.max_floor_angle)), *ctrl.floor_normal])
+        world = (mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, c["hw"], c["hh"],
+                 c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
+        st, si, push_r, push_n = self._outputs
+        reason = self._kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor,
+                                       ride_after, ctrl.max_slides, _RIDE_SLIDES, st, si, push_r, push_n)
+        if reason:
+            self.fallbacks[self._kernel.REASONS[reason]] += 1
+            return False
+        self.fast_moves += 1
+        x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()
+        floor, wall = int(si[0]), int(si[1])
+        # (the state, not settings: written past the settings' check)
+        ctrl.__dict__.update(on_floor=floor >= 0, floor_normal=(fnx, fny) if floor >= 0 else (0.0, 0.0),
+                             floor_entity=int(c["entity"][floor]) if floor >= 0 else None, on_wall=wall >= 0,
+                             wall_normal=(wnx, wny) if wall >= 0 else (0.0, 0.0), on_ceiling=bool(si[2]))
+        pushed = int(si[4])
+        if ctrl.push_mass > 0.0 and dt > 0.0 and pushed:
+            mv.pushed = [(r, nx, ny) for r, (nx, ny) in zip(push_r[:pushed].tolist(), push_n[:pushed].tolist())]
+            self._push(mv, ctrl.push_mass, mx / dt, my / dt)
+        self.bodies.place_row(row, x - ox, y - oy)
+        if vel.x != vx:
+            vel.x = vx
+        if vel.y != vy:
+            vel.y = vy
+        return True
 
     # --- moving ----------------------------------------------------------------------------
 
