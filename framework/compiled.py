@@ -16,10 +16,17 @@ from typing import Any
 
 from numba import njit
 
-__all__ = ["leaf"]
+__all__ = ["inner", "leaf"]
 
 # (``_nrt`` is numba's own switch for its reference counting; its type stubs do not list it)
 _LEAF_OPTIONS: dict[str, Any] = {"cache": True, "_nrt": False}
 
 #: ``@leaf``: compile (cached on disk) without reference counting. See the module docstring.
 leaf = njit(**_LEAF_OPTIONS)
+
+# (``no_cpython_wrapper`` is numba's own option; its type stubs do not list it)
+_INNER_OPTIONS: dict[str, Any] = {"cache": True, "no_cpython_wrapper": True}
+
+#: ``@inner``: a compiled helper only other compiled functions call: no wrapper to call it from
+#: Python is built, a third less compiling on a new installation (measured on the character move).
+inner = njit(**_INNER_OPTIONS)

@@ -338,20 +338,29 @@ def test_exact_polygon_circle_decision_matches_the_integers(case) -> None:
 @given(st.floats(0.5, 4.0), st.integers(-3, 3), st.sampled_from([0.0, 1.0, -1.0]), st.integers(-60, -1),
        st.booleans())
 def test_expansions_round_to_nearest_ties_to_even(base, sign_half, nudge, tiny, negative) -> None:
-    """The exact sum of an expansion rounded as Python rounds an exact fraction: a double plus a
-    multiple of half its spacing (ties, either way round to even), nudged by a tiny amount."""
+    """The exact sum of an expansion rounded as Python rounds an exact fraction (and as
+    ``math.fsum``): a double plus a multiple of half its spacing (ties, either way round to even),
+    nudged by a tiny amount."""
     from fractions import Fraction
 
-    from framework.collision.exact_sign import _grow, _rounded
+    from framework.collision.exact_sign import exact_sum
 
     hi = -base if negative else base
     gap = math.ulp(hi)
     parts = [hi, sign_half * gap * 0.5, nudge * gap * 2.0**tiny]
-    e = np.empty(16)
-    m = 0
-    for p in parts:
-        m = _grow(e, m, p)
-    got, ok = _rounded(e, m, np.empty(64), np.empty(64))
-    assert ok
+    got = exact_sum(np.array(parts))
     want = float(sum((Fraction(p) for p in parts), Fraction(0)))
+    assert want == math.fsum(parts)
     assert got == want and math.copysign(1.0, got) == math.copysign(1.0, want)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.floats(-2.0**60, 2.0**60).filter(lambda v: v == 0.0 or abs(v) > 2.0**-500), min_size=1,
+                max_size=12))
+def test_exact_sum_is_fsum(parts) -> None:
+    """Random doubles of many magnitudes (cancelling, too): the expansions' exact sum, rounded,
+    is ``math.fsum``'s."""
+    from framework.collision.exact_sign import exact_sum
+
+    got, want = exact_sum(np.array(parts)), math.fsum(parts)
+    assert got == want or (want == 0.0 and got == 0.0) or (abs(want) < 2.0**-900 and math.isnan(got))

@@ -13,6 +13,7 @@ import math
 
 from numba import njit
 
+from ..compiled import inner
 from .batch_box import _less_1, _two_sum_1
 from .collide import POINT_TOL
 from .exact import BAND, TINY
@@ -21,20 +22,20 @@ from .tiebreak import DEPTH_TOL
 __all__ = ["aabb_exact_row"]
 
 
-@njit(cache=True)
+@inner
 def _crossing(t, u, gone):  # pragma: no cover - compiled
     """``batch_box._crossing`` of one edge pair, as a float."""
     return 1.0 if (t >= 0.0 and t <= 1.0 and u >= 0.0 and u <= 1.0 and not gone) else 0.0
 
 
-@njit(cache=True)
+@inner
 def _clip(t):  # pragma: no cover - compiled
     """``np.minimum(np.maximum(t, 0.0), 1.0)``."""
     t = t if t >= 0.0 else 0.0
     return t if t <= 1.0 else 1.0
 
 
-@njit(cache=True)
+@inner
 def _box_point(hwa, hha, hwb, hhb, dx, dy, size):  # pragma: no cover - compiled
     """``batch_box._box_point`` of one pair (B at its offset ``d``, all in the scaled frame)."""
     xb0, xb1, yb0, yb1 = -hwb + dx, hwb + dx, -hhb + dy, hhb + dy

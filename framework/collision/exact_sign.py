@@ -21,6 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import inner
+
 __all__ = ["APART", "OVERLAP", "UNSURE", "polygons_apart"]
 
 APART, OVERLAP, UNSURE = 0, 1, 2
@@ -29,14 +31,14 @@ _LO, _HI = 2.0**-300, 2.0**300
 _SPLIT = 134217729.0  # 2**27 + 1 (Dekker's split of a double into two 26-bit halves)
 
 
-@njit(cache=True)
+@inner
 def _two_sum(a, b):  # pragma: no cover - compiled
     s = a + b
     bb = s - a
     return s, (a - (s - bb)) + (b - bb)
 
 
-@njit(cache=True)
+@inner
 def _two_product(a, b):  # pragma: no cover - compiled
     p = a * b
     c = _SPLIT * a
@@ -48,7 +50,7 @@ def _two_product(a, b):  # pragma: no cover - compiled
     return p, al * bl - (((p - ah * bh) - al * bh) - ah * bl)
 
 
-@njit(cache=True)
+@inner
 def _grow(e, m, b):  # pragma: no cover - compiled
     """Add the double ``b`` to the expansion ``e[:m]`` (non-overlapping, increasing magnitude),
     exactly, in place (zeros dropped); returns the new length."""
@@ -65,7 +67,7 @@ def _grow(e, m, b):  # pragma: no cover - compiled
     return j
 
 
-@njit(cache=True)
+@inner
 def _add_product(e, m, a_hi, a_lo, b_hi, b_lo, sign):  # pragma: no cover - compiled
     """``e += sign * (a_hi + a_lo) * (b_hi + b_lo)`` exactly; returns the new length."""
     for x in (a_hi, a_lo):
@@ -80,7 +82,7 @@ def _add_product(e, m, a_hi, a_lo, b_hi, b_lo, sign):  # pragma: no cover - comp
     return m
 
 
-@njit(cache=True)
+@inner
 def _sign(e, m):  # pragma: no cover - compiled
     """The sign of the expansion's sum: its largest part's."""
     if m == 0:
@@ -88,14 +90,14 @@ def _sign(e, m):  # pragma: no cover - compiled
     return 1 if e[m - 1] > 0.0 else -1
 
 
-@njit(cache=True)
+@inner
 def _project(e, ux_h, ux_l, uy_h, uy_l, x, y):  # pragma: no cover - compiled
     """``e = u . (x, y)`` exactly (``u`` two two-term sums); returns its length."""
     m = _add_product(e, 0, ux_h, ux_l, x, 0.0, 1.0)
     return _add_product(e, m, uy_h, uy_l, y, 0.0, 1.0)
 
 
-@njit(cache=True)
+@inner
 def _copy_add(dst, src, m, other, n, sign):  # pragma: no cover - compiled
     """``dst = src[:m] + sign * other[:n]`` exactly; returns its length."""
     for i in range(m):
@@ -105,7 +107,7 @@ def _copy_add(dst, src, m, other, n, sign):  # pragma: no cover - compiled
     return m
 
 
-@njit(cache=True)
+@inner
 def _extreme(vx, vy, c, ux_h, ux_l, uy_h, uy_l, want, best, cur, tmp):  # pragma: no cover - compiled
     """The exact max (``want`` 1) or min (-1) over the first ``c`` vertices of their projections on
     ``u``, into ``best``; returns its length. Only the vertices whose float projection is within a
@@ -139,7 +141,7 @@ def _extreme(vx, vy, c, ux_h, ux_l, uy_h, uy_l, want, best, cur, tmp):  # pragma
     return nb
 
 
-@njit(cache=True)
+@inner
 def _fits(v):  # pragma: no cover - compiled
     a = abs(v)
     return a == 0.0 or (a >= _LO and a <= _HI)
@@ -214,13 +216,13 @@ def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # prag
 _LO4, _HI4 = 2.0**-200, 2.0**200
 
 
-@njit(cache=True)
+@inner
 def _fits4(v):  # pragma: no cover - compiled
     a = abs(v)
     return a == 0.0 or (a >= _LO4 and a <= _HI4)
 
 
-@njit(cache=True)
+@inner
 def _mul(dst, m, a, na, b, nb, sign):  # pragma: no cover - compiled
     """``dst[:m] += sign * a[:na] * b[:nb]`` exactly; returns the new length."""
     for i in range(na):
@@ -231,7 +233,7 @@ def _mul(dst, m, a, na, b, nb, sign):  # pragma: no cover - compiled
     return m
 
 
-@njit(cache=True)
+@inner
 def _diff(dst, a, na, b):  # pragma: no cover - compiled
     """``dst = a[:na] - b`` (``b`` a double) exactly; returns its length."""
     for i in range(na):
@@ -331,7 +333,7 @@ def polygon_circle_apart(vx, vy, c, ox, oy, qx, qy, k, r):  # pragma: no cover -
 
 # --- exact depths of overlapping polygons ---------------------------------------------------------
 
-@njit(cache=True)
+@inner
 def _steps(hi):  # pragma: no cover - compiled
     """The gaps from ``hi`` (normal, nonzero) to the next double up and down."""
     m, ex = math.frexp(abs(hi))
@@ -340,13 +342,13 @@ def _steps(hi):  # pragma: no cover - compiled
     return (gap, toward) if hi > 0.0 else (toward, gap)
 
 
-@njit(cache=True)
+@inner
 def _even(v):  # pragma: no cover - compiled
     m, _ex = math.frexp(abs(v))
     return int(m * 9007199254740992.0) % 2 == 0  # (the 53-bit significand's last bit)
 
 
-@njit(cache=True)
+@inner
 def _rounded(e, m, tmp, tmp2):  # pragma: no cover - compiled
     """The expansion's sum correctly rounded (to nearest, ties to even), as Python's int division
     rounds it, and whether that was found (False far from 1, where the gaps below are not exact)."""
@@ -435,3 +437,16 @@ def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # 
             return False
         bwd[c] = value
     return True
+
+
+@njit(cache=True)
+def exact_sum(parts):  # pragma: no cover - compiled
+    """The sum of the doubles ``parts``, exact, then correctly rounded (``math.fsum``'s answer);
+    NaN where the rounding is not settled here (a sum beyond about 2**±900). The expansions'
+    arithmetic and rounding as the kernels use them, callable from Python (the tests')."""
+    e = np.empty(parts.size + 1)
+    m = 0
+    for i in range(parts.size):
+        m = _grow(e, m, parts[i])
+    value, ok = _rounded(e, m, np.empty(4 * parts.size + 8), np.empty(4 * parts.size + 8))
+    return value if ok else np.nan

@@ -35,6 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import inner
 from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
@@ -48,7 +49,7 @@ __all__ = ["polygon_pairs"]
 _BIG = 1e300  # (batch_common.BIG: "absent" in a min, in the scaled frames where values are about 1)
 
 
-@njit(cache=True)
+@inner
 def _outline(r, kind, hw, hh, world_poly, poly_slot, count, vx, vy):  # pragma: no cover - compiled
     """Row ``r``'s outline about its hitbox origin into ``vx, vy`` (``K`` slots, the padding
     repeating the last vertex, as ``batch_common.outline_rows`` writes it); returns its count."""
@@ -68,7 +69,7 @@ def _outline(r, kind, hw, hh, world_poly, poly_slot, count, vx, vy):  # pragma: 
     return c
 
 
-@njit(cache=True)
+@inner
 def _centred_box(vx, vy, c):  # pragma: no cover - compiled
     """``batch_polygon._centred_boxes`` of one outline."""
     if vx.size < 4:
@@ -77,14 +78,14 @@ def _centred_box(vx, vy, c):  # pragma: no cover - compiled
             and vy[1] == vy[0] and vy[0] == -vy[2] and vy[3] == vy[2])
 
 
-@njit(cache=True)
+@inner
 def _norm(x, y):  # pragma: no cover - compiled
     """``batch_common.norm`` of one vector."""
     n = np.sqrt(x * x + y * y)
     return math.hypot(x, y) if n < 1e-150 else n
 
 
-@njit(cache=True)
+@inner
 def _edges(v, e):  # pragma: no cover - compiled
     """``batch_common.edges`` of one outline coordinate into ``e``."""
     k = v.size
@@ -93,7 +94,7 @@ def _edges(v, e):  # pragma: no cover - compiled
     e[k - 1] = v[0] - v[k - 1]
 
 
-@njit(cache=True)
+@inner
 def _extent(vx, vy):  # pragma: no cover - compiled
     """``batch_common.extent`` of one outline."""
     mx = abs(vx[0])
@@ -106,7 +107,7 @@ def _extent(vx, vy):  # pragma: no cover - compiled
     return mx if mx > my else my
 
 
-@njit(cache=True)
+@inner
 def _radius(vx, vy):  # pragma: no cover - compiled
     """The root of the largest squared vertex length (``_frame``'s bounding radius)."""
     m = vx[0] * vx[0] + vy[0] * vy[0]
@@ -117,7 +118,7 @@ def _radius(vx, vy):  # pragma: no cover - compiled
     return np.sqrt(m)
 
 
-@njit(cache=True)
+@inner
 def _project(ux, uy, vx, vy):  # pragma: no cover - compiled
     """Min and max of an outline's vertices projected on axis ``u`` (``batch_polygon._extent``)."""
     lo = ux * vx[0] + uy * vy[0]
@@ -131,7 +132,7 @@ def _project(ux, uy, vx, vy):  # pragma: no cover - compiled
     return lo, hi
 
 
-@njit(cache=True)
+@inner
 def _pick(cd, cx, cy, size):  # pragma: no cover - compiled
     """``batch_common.pick`` of one pair's candidates ``(depth, nx, ny)``."""
     c = cd.size
@@ -185,7 +186,7 @@ def _pick(cd, cx, cy, size):  # pragma: no cover - compiled
     return shortest, cx[i], cy[i]
 
 
-@njit(cache=True)
+@inner
 def _inside(x, y, ox, oy, ex, ey, en, tol):  # pragma: no cover - compiled
     """``batch_point._inside`` of one point against one outline (vertices ``o``, edges ``e``,
     their lengths ``en``)."""
@@ -197,7 +198,7 @@ def _inside(x, y, ox, oy, ex, ey, en, tol):  # pragma: no cover - compiled
     return True
 
 
-@njit(cache=True)
+@inner
 def _within_segment(x, y, ox, oy, tol):  # pragma: no cover - compiled
     """``batch_point._within_segment`` of one point and a segment (an outline of two points)."""
     ex, ey = ox[1] - ox[0], oy[1] - oy[0]
@@ -206,7 +207,7 @@ def _within_segment(x, y, ox, oy, tol):  # pragma: no cover - compiled
     return along >= -slack and along <= ex * ex + ey * ey + slack
 
 
-@njit(cache=True)
+@inner
 def _overlap_point(avx, avy, ac, bvx, bvy, bc, nx, ny, depth, size, exa, eya, exb, eyb, na, nb):
     # pragma: no cover - compiled
     """``batch_point.overlap_point`` of one pair (B at its offset): the mean of the vertices of

@@ -23,13 +23,13 @@ character to move.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numba import njit
 
 from ..arrays import F64Array, I64Array, IntpArray
 from ..collision.kinds import KIND_AABB
+from ..compiled import inner
 from ..store import DYNAMIC
 
 __all__ = ["REASONS", "move_box", "outputs"]
@@ -49,10 +49,9 @@ X, Y, FNX, FNY, WNX, WNY = range(6)
 # surfaces recorded, rows ignored, bail.
 FLOOR, WALL, CEIL, NHITS, NPUSH, NIGN, BAILED = range(7)
 
-# The helpers: compiled into the move, never called from Python (no wrapper to call them by: a
-# third less compiling). (``no_cpython_wrapper`` is numba's own option; its stubs do not list it.)
-_INNER_OPTIONS: dict[str, Any] = {"cache": True, "no_cpython_wrapper": True}
-_inner = njit(**_INNER_OPTIONS)
+# The helpers: compiled into the move, never called from Python (``inner``: no wrapper to call
+# them by, a third less compiling).
+_inner = inner
 
 _HITS = 64  # surfaces a move records at most (more: bail)
 _IGNORED = 8  # rows ignored at once at most
