@@ -46,6 +46,7 @@ from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
+from .solve_columns import contact_columns, stays, velocity_stays, warm_pushes
 from .turning import expand, turning_polygons
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
@@ -147,7 +148,9 @@ class Solve:
                  points: Points = NO_POINTS) -> None:  # stage: the Response
         self.stage, self.frame = stage, frame
         self.store = store = stage.bodies.store
-        self.gravity = stage.pipeline.active_gravity()
+        gx, gy = stage.pipeline.active_gravity()
+        self.gravity = (float(gx), float(gy))
+        self.g = math.hypot(gx, gy)
         its = stage.pipeline.response_iterations
         self.iterations = max(SOLVER_PASSES * its, min(MAX_PASSES * its, PASS_BUDGET * its // cs.size))
         self.dt = frame.dt
@@ -175,20 +178,17 @@ class Solve:
         """Per-contact columns the solver reads, and how far a body may move in one run of the
         position solver (after the contact set changed)."""
         store, cs = self.store, self.cs
-        rows = self.rows
-        half = np.where(store.hw[rows] > 0.0, np.minimum(store.hw[rows], store.hh[rows]), 0.5 * store.bound[rows])
-        self.span = 0.5 * half  # a move this long may bring a body to bodies it was not paired with
-        # how far a body may move in one run of the position solver (nothing to be pushed through
-        # without statics)
-        self.reach = self.span if self.stage.bodies.n_static else np.full(rows.size, np.inf)
         C = cs.size
         self.a, self.b = self.local[:C], self.local[C:]
-        wa = np.where(store.asleep[cs.ra], 0.0, store.inv_mass[cs.ra])  # a sleeper keeps still
-        wb = np.where(store.asleep[cs.rb], 0.0, store.inv_mass[cs.rb])
-        w = 1.0 / (wa + wb)
+        # (one compiled pass, solve_columns.contact_columns; the spans: a move this long may bring a
+        # body to bodies it was not paired with; the reaches: how far a body may move in one run of
+        # the position solver, nothing to be pushed through without statics; a sleeper keeps still;
+        # the order: see _order)
+        gx, gy = self.gravity
+        (self.span, self.reach, wa, wb, self.share_a, self.share_b, self.immovable, self.order) = contact_columns(
+            self.rows, cs.ra, cs.rb, store.hw, store.hh, store.bound, store.asleep, store.inv_mass, store.x, store.y,
+            bool(self.stage.bodies.n_static), gx, gy, self.g)
         self.wa, self.wb = wa, wb
-        self.share_a, self.share_b = wa * w, wb * w
-        self.immovable = (wa == 0.0) | (wb == 0.0)
         arms = inertia = None
         self.turn_shares = None  # (contacts at points: how far a unit turns each body, shared by inverse mass)
         if self.rigid:
@@ -208,7 +208,6 @@ class Solve:
             roll_b = imm & (store.kind[cs.rb] == KIND_CIRCLE)
             self.fpos = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation,
                                     (roll_a * self.rt_a, roll_b * self.rt_b), inertia)
-        self.order = self._order()
         share_a, share_b, self.position_turns = self._shock_shares()
         self.position_shares = (share_a, share_b)
         fp = self.fpos
@@ -267,19 +266,19 @@ class Solve:
         :meth:`_velocity_shares`.) With the turns of contacts at points (None elsewhere):
         ``(share_a, share_b, turns)``."""
         gx, gy = self.gravity
-        g = math.hypot(gx, gy)
-        both = ~self.immovable
-        if g == 0.0 or not both.any():
+        g = self.g
+        if g == 0.0 or self.immovable.all():
             self.b_on_a = self.a_on_b = None
             return self.share_a, self.share_b, self.turn_shares
         cs = self.cs
-        up = -(cs.nx * gx + cs.ny * gy) / g  # > 0.5: b rests on a
-        fixed_a, fixed_b = self.share_a == 0.0, self.share_b == 0.0
-        held = solver.supported(self.order, self.a, self.b, up, fixed_a, fixed_b, self.rows.size)
-        rests = both & ~self._rolling()
-        self.b_on_a = b_on_a = rests & (up > 0.5) & held[self.a]
-        self.a_on_b = a_on_b = rests & (up < -0.5) & held[self.b]
-        return self._lower_stays(b_on_a, a_on_b)
+        # (one compiled pass, solve_columns.stays: up = -n.g / |g| > 0.5, b rests on a; held: the
+        # bodies resting on something immovable, as solver_loops.supported finds them)
+        self.b_on_a, self.a_on_b, share_a, share_b = stays(
+            self.order, self.a, self.b, cs.nx, cs.ny, gx, gy, g, self.share_a, self.share_b, self.immovable,
+            self._rolling(), self.rows.size)
+        if self.rigid:
+            return self._rigid_shares(self.b_on_a, self.a_on_b)
+        return share_a, share_b, None
 
     def _rolling(self) -> BoolArray:
         """The contacts whose friction rolls a circle (one of its bodies is a circle that friction
@@ -295,27 +294,9 @@ class Solve:
         circle_a, circle_b = store.kind[cs.ra] == KIND_CIRCLE, store.kind[cs.rb] == KIND_CIRCLE
         return (circle_a & (fr.turn_a != 0.0)) | (circle_b & (fr.turn_b != 0.0))
 
-    def _lower_stays(self, b_on_a: BoolArray, a_on_b: BoolArray) -> tuple[Any, ...]:
-        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still, and
-        the turns of contacts at points (None elsewhere): ``(share_a, share_b, turns)``."""
-        if self.rigid:
-            return self._rigid_shares(b_on_a, a_on_b)
-        share_a = np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, self.share_a))
-        share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
-        return share_a, share_b, None
-
-    def _order(self) -> IntpArray:
-        """Contacts from the bottom of a pile up (contacts with immovable bodies first): a push
-        then travels up a stack within one pass. Without gravity, in pair order."""
-        gx, gy = self.gravity
-        g = math.hypot(gx, gy)
-        if g == 0.0:
-            return np.arange(self.cs.size)
-        store, cs = self.store, self.cs
-        up_a = -(store.x[cs.ra] * gx + store.y[cs.ra] * gy) / g
-        up_b = -(store.x[cs.rb] * gx + store.y[cs.rb] * gy) / g
-        height = np.where(self.immovable, -np.inf, np.minimum(up_a, up_b))
-        return np.argsort(height, kind="stable")
+    # ``self.order`` (set by _columns): the contacts from the bottom of a pile up (contacts with
+    # immovable bodies first, then by the lower body's height against gravity, ties in pair order):
+    # a push then travels up a stack within one pass. Without gravity, in pair order.
 
     # --- positions ---------------------------------------------------------------------------
 
@@ -327,9 +308,7 @@ class Solve:
         the bodies' size), or the rounds run out (then :meth:`_clear_of_statics`)."""
         store, cs = self.store, self.cs
         self.x0, self.y0 = store.x[self.rows].copy(), store.y[self.rows].copy()
-        self.push = self._warm_pushes(cs.push0)
-        share_a, share_b = self.position_shares
-        self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
+        self.push, self.dx, self.dy = self._warm_pushes(cs.push0)
         self.tpush = np.zeros(cs.size)
         n = self.rows.size
         if self.rigid:
@@ -408,22 +387,18 @@ class Solve:
         need = float(np.max(np.ceil(np.maximum(deep, 0.0) / self.reach[mover])))
         return int(min(need + 1.0, MAX_CLEAR_ROUNDS))
 
-    def _warm_pushes(self, push0: F64Array) -> F64Array:
+    def _warm_pushes(self, push0: F64Array) -> tuple[F64Array, F64Array, F64Array]:
         """Last step's pushes as this step's first guess: none longer than its bodies' half-thickness
         (a body wedged between others that keep still may ask for more than any push can give, and
         its pushes must not grow from step to step: the 200-body soak shot a triangle 10 units
         through a wall that way), and scaled down where together they would move a body farther
-        than its reach (see :meth:`_solve`) before the solver has looked at anything."""
-        push0 = np.minimum(push0, self._push_cap())
-        if np.isfinite(self.reach).all() and push0.any():
-            share_a, share_b = self.position_shares
-            cs = self.cs
-            wx, wy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.rows.size)
-            far = np.hypot(wx, wy)
-            with np.errstate(over="ignore"):  # (a large reach over a tiny move: no scaling)
-                scale = np.minimum(1.0, self.reach / np.maximum(far, 1e-300))
-            return push0 * np.minimum(scale[self.a], scale[self.b])
-        return push0.copy()
+        than its reach (see :meth:`_solve`) before the solver has looked at anything (a large
+        reach over a tiny move: no scaling); with the moves they make, per body: ``(push, dx,
+        dy)``. (One compiled pass: :func:`~framework.systems.solve_columns.warm_pushes`.)"""
+        share_a, share_b = self.position_shares
+        cs = self.cs
+        push, dx, dy = warm_pushes(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.span, self.reach)
+        return push, dx, dy
 
     def _push_cap(self) -> F64Array:
         """Per contact, the longest push worth remembering: the smaller half-thickness of its two
@@ -814,12 +789,8 @@ class Solve:
             return self.share_a, self.share_b, self.turn_shares
         cs, a, b = self.cs, self.a, self.b
         gx, gy = self.gravity
-        resting_speed = 2.0 * np.abs(gx * cs.nx + gy * cs.ny) * self.dt
-        # the lower body's speed toward the upper one
-        a_up = vx[a] * cs.nx + vy[a] * cs.ny
-        b_down = -(vx[b] * cs.nx + vy[b] * cs.ny)
-        b_on_a = self.b_on_a & (a_up <= resting_speed)
-        a_on_b = self.a_on_b & (b_down <= resting_speed)
+        # (one compiled pass, solve_columns.velocity_stays: resting_speed = 2 |g.n| dt; the lower
+        # body's speed toward the upper one against it)
         # ... and where the upper body closes on the lower one faster than that (it hits, it does not
         # rest): an impulse against a lower body kept still goes to the upper body alone, so a heavy
         # ball thrown into a pyramid of boxes met the boxes under it as the ground and was turned
@@ -828,11 +799,12 @@ class Solve:
         # Only a heavier body hitting a lighter one: bodies of like mass landing on each other (a
         # pyramid spawned with gaps between its rows settling) keep the lower body still, as
         # before; without it a 20-row pyramid of boxes that turn fell apart as its rows landed.
-        closing = (vx[a] - vx[b]) * cs.nx + (vy[a] - vy[b]) * cs.ny
-        hits = closing > resting_speed
-        b_on_a &= ~(hits & (self.wb < self.wa))  # (b is the upper body: lighter inverse mass is heavier)
-        a_on_b &= ~(hits & (self.wa < self.wb))
-        return self._lower_stays(b_on_a, a_on_b)
+        # (b is the upper body: lighter inverse mass is heavier)
+        b_on_a, a_on_b, share_a, share_b = velocity_stays(a, b, cs.nx, cs.ny, vx, vy, gx, gy, self.dt, self.b_on_a,
+                                                          self.a_on_b, self.wa, self.wb, self.share_a, self.share_b)
+        if self.rigid:
+            return self._rigid_shares(b_on_a, a_on_b)
+        return share_a, share_b, None
 
     def _no_energy_made(self, bounce, movable, vx_in, vy_in, vx, vy, w_in=None, w=None) -> None:
         """Bounces hand back (some of) the energy the stopping took, never more than the bodies had
