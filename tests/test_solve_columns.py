@@ -1,5 +1,5 @@
-"""The solve's compiled column passes (framework.systems.solve_columns) give the bits of the numpy they
-replaced, on random columns with ties, -0.0, infinities and NaN."""
+"""The solve's compiled passes (framework.systems.solve_columns, solve_rounds) give the bits of the numpy
+they replaced, on random columns with ties, -0.0, infinities and NaN."""
 
 from __future__ import annotations
 
@@ -8,7 +8,10 @@ import math
 import numpy as np
 import pytest
 
+from framework.events import pair_keys, sorted_member
+from framework.systems import gather
 from framework.systems import solve_columns as sc
+from framework.systems import solve_rounds as sr
 from framework.systems import solver_loops as loops
 
 
@@ -140,3 +143,104 @@ def test_warm_pushes_are_the_numpy_warm_pushes(seed: int) -> None:
         got = sc.warm_pushes(a, b, nx, ny, share_a, share_b, push0, span, reach)
         for have, want in zip(got, (p, dx, dy)):
             _same(have, want)
+
+
+# --- the rounds' bookkeeping (framework.systems.solve_rounds) ---------------------------------
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_number_is_the_numpy_numbering(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = 30
+    table, want_table = np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    first = 0
+    for _ in range(3):
+        ra, rb = rng.integers(0, n, 8), rng.integers(0, n, 8)
+        rows = np.concatenate([ra, rb])
+        new = np.unique(rows[want_table[rows] < 0])
+        want_table[new] = first + np.arange(new.size)
+        got_new, got_local = sr.number(table, ra, rb, first)
+        _same(got_new, new)
+        _same(got_local, want_table[rows])
+        _same(table, want_table)
+        first += new.size
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_pair_picks_are_the_numpy_picks(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    ea, eb, ca, cb = (rng.integers(0, 50, 12) for _ in range(4))
+    known = sr.known_keys(ea, eb, ca, cb)
+    _same(known, np.sort(np.concatenate([pair_keys(ea, eb), pair_keys(ca, cb)])))
+    # candidates not known, in the store, solid
+    n = 40
+    kind = rng.integers(-1, 3, n)
+    sensor, asleep, one_way = (rng.random(n) < 0.1 for _ in range(3))
+    inv_mass = np.where(rng.random(n) < 0.4, 0.0, 1.0)
+    layer, mask = rng.integers(1, 4, n), rng.integers(1, 4, n)
+    pa, pb = rng.integers(0, 45, 30), rng.integers(0, 45, 30)
+    pea, peb = np.concatenate([ea[:5], rng.integers(0, 50, 25)]), np.concatenate([eb[:5], rng.integers(0, 50, 25)])
+    cols = (kind, sensor, inv_mass, asleep, one_way, layer, mask, False)
+    keep = ~sorted_member(pair_keys(pea, peb), known) & (pa < n) & (pb < n)
+    ok = gather.solid_pairs_mask(pa[keep], pb[keep], *cols)
+    want = tuple(v[keep][ok] for v in (pa, pb, pea, peb))
+    for have, w in zip(sr.unknown_solid_pairs(pa, pb, pea, peb, known, n, *cols), want):
+        _same(have, w)
+    # the statics near rows, and their kept pairs
+    x, y = _floats(rng, n, specials=False), _floats(rng, n, specials=False)
+    cx, cy = np.where(rng.random(n) < 0.3, np.nan, x + 0.1), y - 0.05
+    rows = rng.permutation(n)[:15]
+    margin = np.where(rng.random(15) < 0.2, np.inf, 0.1 + 0.1 * rng.random(15))
+    fin = np.isfinite(margin)
+    r, m = rows[fin], margin[fin]
+    far = ~(np.abs(x[r] - cx[r]) + np.abs(y[r] - cy[r]) <= m)
+    for have, w in zip(sr.near_rows(rows, margin, x, y, cx, cy), (r, m, far)):
+        _same(have, w)
+    lut = np.where(rng.random(60) < 0.1, -1, rng.integers(0, n, 60))
+    pair_row = rng.integers(0, n, 30)
+    want_rows = np.zeros(n, dtype=bool)
+    want_rows[r] = True
+    sel = want_rows[pair_row]
+    e1, e2 = pea[sel], peb[sel]
+    keep = ~sorted_member(pair_keys(e1, e2), known)
+    e1, e2 = e1[keep], e2[keep]
+    r1, r2 = lut[e1], lut[e2]
+    ok = gather.solid_pairs_mask(r1, r2, *cols)
+    got = sr.kept_static_pairs(n, r, pair_row, pea, peb, known, lut, *cols)
+    for have, w in zip(got, (r1[ok], r2[ok], e1[ok], e2[ok])):
+        _same(have, w)
+
+
+@pytest.mark.parametrize("rigid", [False, True])
+def test_apply_measures_is_the_numpy_update(rigid: bool) -> None:
+    rng = np.random.default_rng(int(rigid))
+    n, c = 10, 24
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny, depth = np.cos(angle), np.sin(angle), rng.normal(size=c) * 0.01
+    dx, dy = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01
+    rn_a, rn_b, dturn = (rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01) if rigid else (
+        np.zeros(0), np.zeros(0), np.zeros(0))
+    check = np.sort(rng.permutation(c)[:12])
+    hit = rng.random(12) < 0.5
+    ra = rng.uniform(-np.pi, np.pi, 12)
+    rnx, rny, rdepth = np.cos(ra), np.sin(ra), rng.normal(size=12) * 1e-8
+
+    def shift(idx):
+        s = (dx[b[idx]] - dx[a[idx]]) * nx[idx] + (dy[b[idx]] - dy[a[idx]]) * ny[idx]
+        if rigid:
+            s += rn_b[idx] * dturn[b[idx]] - rn_a[idx] * dturn[a[idx]]
+        return s
+
+    cols = [nx.copy(), ny.copy(), depth.copy()]
+    dirty = np.zeros(c, dtype=bool)
+    got = sr.apply_measures(check, hit, rnx, rny, rdepth, a, b, *cols, dx, dy, rn_a, rn_b, dturn, dirty, 1e-9)
+    apart = check[~hit]
+    depth[apart] = np.minimum(depth[apart], shift(apart))
+    h = check[hit]
+    nx[h], ny[h] = rnx[hit], rny[hit]
+    depth[h] = rdepth[hit] + shift(h)
+    for have, w in zip(cols, (nx, ny, depth)):
+        _same(have, w)
+    assert dirty.tobytes() == np.isin(np.arange(c), h).tobytes()
+    assert got == (bool(hit.any()), bool((rdepth[hit] > 1e-9).any()))

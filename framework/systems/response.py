@@ -27,10 +27,13 @@ from .gather import centres_inside, gather, solid_pairs_mask, taking_part
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Pairs, Solve
+from .solve_rounds import kept_static_pairs, known_keys, near_rows, unknown_solid_pairs
 from .stage import Stage
 from .turning import manifold_points
 
 __all__ = ["Response"]
+
+_NO_IDS = np.zeros(0, dtype=np.int64)  # (no pairs; no keys)
 
 
 class Response(Stage):
@@ -158,10 +161,13 @@ class Response(Stage):
         ea, eb, ra, rb = frame.pairs
         if ea.size == 0:
             return ra, rb, ea, eb
-        known = np.sort(pair_keys(cs.ea, cs.eb))
         store = self.bodies.store
-        keep = ~sorted_member(pair_keys(ea, eb), known) & (ra < store.n) & (rb < store.n)
-        return self.solid_pairs(ra[keep], rb[keep], ea[keep], eb[keep])
+        c = store.cols
+        # (one compiled pass: the pairs not among the contacts' keys, rows in the store, solid)
+        pairs: Pairs = unknown_solid_pairs(
+            ra, rb, ea, eb, known_keys(cs.ea, cs.eb, _NO_IDS, _NO_IDS), store.n, c["kind"], c["sensor"],
+            c["inv_mass"], c["asleep"], c["one_way"], c["layer"], c["mask"], store.layers_all_meet())
+        return pairs
 
     def solid_pairs(self, ra: IntpArray, rb: IntpArray, ea: I64Array, eb: I64Array) -> Pairs:
         """The pairs among ``(ra, rb, ea, eb)`` the response may act on: hitboxes whose layers
@@ -281,19 +287,21 @@ class Response(Stage):
         the static hash nothing."""
         bodies = self.bodies
         store = bodies.store
-        empty = np.zeros(0, dtype=np.int64)
-        ok = np.isfinite(margin)
-        rows, margin = rows[ok], margin[ok]
-        if rows.size == 0 or bodies.n_static == 0:
-            return empty, empty, empty, empty
+        if bodies.n_static == 0:
+            return _NO_IDS, _NO_IDS, _NO_IDS, _NO_IDS
         cache = self._static_cache()
-        far = ~(np.abs(store.x[rows] - cache.x[rows]) + np.abs(store.y[rows] - cache.y[rows]) <= margin)
+        # (compiled passes: the rows with a finite margin, which moved farther than it, and their
+        # kept pairs not among the known keys that the response may act on)
+        rows, margin, far = near_rows(rows, margin, store.x, store.y, cache.x, cache.y)
+        if rows.size == 0:
+            return _NO_IDS, _NO_IDS, _NO_IDS, _NO_IDS
         if far.any():
             cache.refresh(bodies, rows[far], 2.0 * margin[far])
-        ea, eb = cache.pairs_of(store.n, rows)
-        keep = ~sorted_member(pair_keys(ea, eb), known)
-        ea, eb = ea[keep], eb[keep]
-        return self.solid_pairs(bodies.rows_of(ea), bodies.rows_of(eb), ea, eb)
+        c = store.cols
+        pairs: Pairs = kept_static_pairs(store.n, rows, cache.row, cache.ea, cache.eb, known, store.row_table(),
+                                         c["kind"], c["sensor"], c["inv_mass"], c["asleep"], c["one_way"], c["layer"],
+                                         c["mask"], store.layers_all_meet())
+        return pairs
 
     def _static_cache(self) -> _NearStatics:
         store = self.bodies.store

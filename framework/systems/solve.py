@@ -40,13 +40,14 @@ import numpy as np
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
-from ..collision.kinds import KIND_CIRCLE
+from ..collision.kinds import KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
 from .solve_columns import contact_columns, stays, velocity_stays, warm_pushes
+from .solve_rounds import apply_measures, known_keys, movable_rows, moved_immovable, number, turning_pairs
 from .turning import expand, turning_polygons
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
@@ -78,6 +79,11 @@ MAX_CLEAR_ROUNDS = 1024
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
+
+# (empty columns: a compiled pass's "none")
+_NO_FLAGS = np.zeros(0, dtype=bool)
+_NO_FLOATS = np.zeros(0)
+_NO_IDS = np.zeros(0, dtype=np.int64)
 
 
 class Contacts:
@@ -164,12 +170,12 @@ class Solve:
         self.cs = cs = cs.take(np.flatnonzero(~dropped)) if dropped.any() else cs
         # Bodies that turn from contacts: the solve works on manifold points with lever arms.
         store = self.store
-        self.rigid = self.rotation and bool((turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)).any())
+        self.rigid = self.rotation and bool(turning_pairs(cs.ra, cs.rb, store.kind, store.inv_inertia, KIND_POLYGON))
         if self.rigid:
             self.cs = cs = expand(cs, store, stage.bodies.ensure_geometry(), points, KEEP_GAP)
         # Bodies are numbered locally; ``table`` maps a store row to its number (-1: not in the solve).
         self.table = np.full(store.n, -1, dtype=np.int64)
-        self.rows, self.local = _number(self.table, np.concatenate([cs.ra, cs.rb]), 0)
+        self.rows, self.local = number(self.table, cs.ra, cs.rb, 0)
         self.tolerance = (TOLERANCE_TURNING if self.rigid else TOLERANCE) * float(store.bound[self.rows].max())
         self.dirty = np.ones(cs.size, dtype=bool)  # the contacts the position solver is to look at
         self._columns()
@@ -467,26 +473,23 @@ class Solve:
         """Measure the pushed contacts with immovable bodies again; their depths (relative to where
         the solve began) follow the geometry. Whether one still overlaps."""
         cs = self.cs
-        moved = self.moved
-        check = self.immovable & (moved[self.a] | moved[self.b])
+        check, ra, rb, points = moved_immovable(self.immovable, self.moved, self.a, self.b,
+                                                self.at_points if self.rigid else _NO_FLAGS, cs.ra, cs.rb)
         overlapping = False
         if self.rigid:
-            overlapping = self._measure_points(np.flatnonzero(check & self.at_points))
-            check &= ~self.at_points
-        check = np.flatnonzero(check)
+            overlapping = self._measure_points(points)
         if check.size == 0:
             return overlapping
-        r = self.stage.remeasure(cs.ra[check], cs.rb[check])
-        apart = check[~r.hit]  # touching, or a sliver within rounding: no longer pushed along
-        cs.depth[apart] = np.minimum(cs.depth[apart], self._shift(apart))
-        if not r.hit.any():
+        r = self.stage.remeasure(ra, rb)
+        # (one compiled pass, solve_rounds.apply_measures: a pair apart, touching or a sliver within
+        # rounding, is no longer pushed along; one that overlaps takes the new normal and depth)
+        turns = (self.rn_a, self.rn_b, self.dturn) if self.rigid else (_NO_FLOATS,) * 3
+        hit, deep = apply_measures(check, r.hit, r.nx, r.ny, r.depth, self.a, self.b, cs.nx, cs.ny, cs.depth, self.dx,
+                                   self.dy, *turns, self.dirty, self.tolerance)
+        if not hit:
             return False
-        hit = check[r.hit]
-        cs.nx[hit], cs.ny[hit] = r.nx[r.hit], r.ny[r.hit]
-        cs.depth[hit] = r.depth[r.hit] + self._shift(hit)
-        self.dirty[hit] = True
         # Another round only for an overlap the solver would act on (not one within its tolerance).
-        return bool((r.depth[r.hit] > self.tolerance).any()) or overlapping
+        return bool(deep) or overlapping
 
     def _measure_points(self, check: IntpArray) -> bool:
         """Measure the contact points ``check`` (turning polygons against immovable bodies) again
@@ -545,17 +548,18 @@ class Solve:
 
     def _known_keys(self) -> I64Array:
         """The sorted pair keys of the solve's contacts and its candidates."""
-        ca, cb = self.candidates[2], self.candidates[3]
-        return np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
+        known: I64Array = known_keys(self.cs.ea, self.cs.eb, self.candidates[2], self.candidates[3])
+        return known
 
     def _static_candidates(self, bodies: IntpArray) -> None:
         """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
-        store, rows = self.store, self.rows[bodies]
-        movable = store.movable(rows)
-        if not movable.any() or self.stage.bodies.n_static == 0:
+        if self.stage.bodies.n_static == 0:
             return
-        known = self._known_keys()
-        near = self.stage.static_candidates(rows[movable], self.reach[bodies[movable]], known)
+        store = self.store
+        rows, reach = movable_rows(bodies, self.rows, self.reach, store.inv_mass, store.asleep)
+        if rows.size == 0:
+            return
+        near = self.stage.static_candidates(rows, reach, self._known_keys())
         if near[0].size:
             self._set_candidates(_joined(self.candidates, near))
 
@@ -637,7 +641,7 @@ class Solve:
         if not pushed.any():
             return False
         self.static_x[pushed], self.static_y[pushed] = self.dx[pushed], self.dy[pushed]
-        extra = self.stage.new_static_contacts(self.rows[pushed], np.sort(pair_keys(cs.ea, cs.eb)))
+        extra = self.stage.new_static_contacts(self.rows[pushed], known_keys(cs.ea, cs.eb, _NO_IDS, _NO_IDS))
         if extra is None:
             return False
         ea, eb, ra, rb, r = extra
@@ -656,7 +660,7 @@ class Solve:
             new = expand(new, self.store, self.stage.bodies.ensure_geometry(), NO_POINTS, KEEP_GAP)
             ra, rb = new.ra, new.rb
         n_old = self.rows.size
-        new_rows, local = _number(self.table, np.concatenate([ra, rb]), n_old)
+        new_rows, local = number(self.table, ra, rb, n_old)
         new_a, new_b = local[: ra.size], local[ra.size:]
         k = new_rows.size
         rows = np.concatenate([self.rows, new_rows])
@@ -919,15 +923,6 @@ def _joined(a: Pairs, b: Pairs) -> Pairs:
     """The pairs of ``a`` followed by those of ``b``, column by column."""
     return (np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]]), np.concatenate([a[2], b[2]]),
             np.concatenate([a[3], b[3]]))
-
-
-def _number(table: I64Array, rows: IntpArray, first: int) -> tuple[IntpArray, I64Array]:
-    """Number the rows of ``rows`` that ``table`` (row -> number, -1: none) does not know yet, from
-    ``first`` on in row order, entering them in the table; return ``(the new rows, every entry's
-    number)``."""
-    new = distinct(rows[table[rows] < 0])
-    table[new] = first + np.arange(new.size)
-    return new, table[rows]
 
 
 def bounce_speed(u: F64Array, g: F64Array, d: F64Array, dt: float) -> F64Array:

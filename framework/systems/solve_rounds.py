@@ -1,0 +1,185 @@
+"""The bookkeeping of the solve's rounds, in compiled passes (see :mod:`framework.systems.solve`).
+
+Between runs of the position solver, the solve numbers the bodies it meets, keeps sorted keys of
+the pairs it knows, picks the candidate pairs the broad phase and the static cache offer, and
+measures the contacts with immovable bodies again. Each of those was a handful of small numpy
+calls on a few dozen rows; here each is one loop:
+
+- :func:`number`: the local numbering of new bodies (:func:`framework.systems.solve._number`);
+- :func:`turning_pairs`: whether a contact has a box or polygon that turns;
+- :func:`known_keys`: the sorted pair keys of two lists of pairs;
+- :func:`unknown_solid_pairs`: the pairs not among known keys that the response may act on;
+- :func:`movable_rows`, :func:`near_rows`, :func:`kept_static_pairs`: the static candidates;
+- :func:`moved_immovable`, :func:`apply_measures`: the contacts with immovable bodies measured
+  again, before and after the geometry's measure.
+
+Each is the numpy it replaced, element by element, in the same order of operations (``np.minimum``
+as :func:`~framework.systems.gather._np_min`), so the same bits; sorts are of integers (any sort
+gives the same answer) and set membership is exact.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..compiled import leaf
+from .gather import _find, _np_min, _row, solid_pairs_mask
+
+__all__ = ["apply_measures", "kept_static_pairs", "known_keys", "movable_rows", "moved_immovable", "near_rows",
+           "number", "turning_pairs", "unknown_solid_pairs"]
+
+
+@njit(cache=True)
+def number(table, ra, rb, first):  # pragma: no cover - compiled
+    """Number the rows of ``ra`` and ``rb`` that ``table`` (row -> number, -1: none) does not know
+    yet, from ``first`` on in row order, entering them in the table: ``(the new rows, every
+    entry's number, ra's then rb's)``."""
+    rows = np.concatenate((ra, rb))
+    fresh = np.sort(rows[table[rows] < 0])
+    keep = np.ones(fresh.size, dtype=np.bool_)
+    for k in range(1, fresh.size):
+        keep[k] = fresh[k] != fresh[k - 1]
+    new = fresh[keep]
+    for k in range(new.size):
+        table[new[k]] = first + k
+    local = np.empty(rows.size, dtype=np.int64)
+    for k in range(rows.size):
+        local[k] = table[rows[k]]
+    return new, local
+
+
+@leaf
+def turning_pairs(ra, rb, kind, inv_inertia, polygon):  # pragma: no cover - compiled
+    """Whether a pair ``(ra, rb)`` has a body of kind ``polygon`` that turns (``inv_inertia > 0``),
+    as ``turning.turning_polygons`` of either row."""
+    for i in range(ra.size):
+        p, q = ra[i], rb[i]
+        if (kind[p] == polygon and inv_inertia[p] > 0.0) or (kind[q] == polygon and inv_inertia[q] > 0.0):
+            return True
+    return False
+
+
+@njit(cache=True)
+def known_keys(ea, eb, ca, cb):  # pragma: no cover - compiled
+    """The sorted pair keys (``events.pair_keys``) of the pairs ``(ea, eb)`` and ``(ca, cb)``."""
+    keys = np.empty(ea.size + ca.size, dtype=np.int64)
+    for i in range(ea.size):
+        keys[i] = (np.int64(ea[i]) << 32) | np.int64(eb[i])
+    for i in range(ca.size):
+        keys[ea.size + i] = (np.int64(ca[i]) << 32) | np.int64(cb[i])
+    return np.sort(keys)
+
+
+@njit(cache=True)
+def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep, one_way, layer, mask,
+                        layers_open):  # pragma: no cover - compiled
+    """The pairs ``(ra, rb, ea, eb)`` whose key is not in the sorted ``known``, both rows in the
+    store's ``n``, that the response may act on (``gather.solid_pairs_mask``)."""
+    ok = np.zeros(ra.size, dtype=np.bool_)
+    for i in range(ra.size):
+        ok[i] = ra[i] < n and rb[i] < n and _find(known, (np.int64(ea[i]) << 32) | np.int64(eb[i])) < 0
+    ra, rb, ea, eb = ra[ok], rb[ok], ea[ok], eb[ok]
+    ok = solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open)
+    return ra[ok], rb[ok], ea[ok], eb[ok]
+
+
+@njit(cache=True)
+def movable_rows(bodies, rows, reach, inv_mass, asleep):  # pragma: no cover - compiled
+    """Of the local ``bodies``, the store rows of those the response may move (``inv_mass > 0``,
+    awake) and their reaches: ``(rows, reach)``."""
+    ok = np.zeros(bodies.size, dtype=np.bool_)
+    for k in range(bodies.size):
+        r = rows[bodies[k]]
+        ok[k] = inv_mass[r] > 0.0 and not asleep[r]
+    picked = bodies[ok]
+    return rows[picked], reach[picked]
+
+
+@njit(cache=True)
+def near_rows(rows, margin, x, y, cx, cy):  # pragma: no cover - compiled
+    """Of ``rows`` with their ``margin``, those with a finite margin, and which of them stand more
+    than their margin (``|dx| + |dy|``) from where their statics were looked up ``(cx, cy)`` (or
+    were never looked up: NaN): ``(rows, margin, far)``."""
+    ok = np.zeros(rows.size, dtype=np.bool_)
+    for k in range(rows.size):
+        ok[k] = math.isfinite(margin[k])
+    rows, margin = rows[ok], margin[ok]
+    far = np.empty(rows.size, dtype=np.bool_)
+    for k in range(rows.size):
+        r = rows[k]
+        far[k] = not (abs(x[r] - cx[r]) + abs(y[r] - cy[r]) <= margin[k])
+    return rows, margin, far
+
+
+@njit(cache=True)
+def kept_static_pairs(n, rows, pair_row, pea, peb, known, lut, kind, sensor, inv_mass, asleep, one_way, layer, mask,
+                      layers_open):  # pragma: no cover - compiled
+    """The kept static pairs ``(pea, peb)`` of ``rows`` (each pair's dynamic row: ``pair_row``)
+    whose key is not in the sorted ``known``, that the response may act on: ``(rows a, rows b,
+    entities a, entities b)``, rows looked up in ``lut`` (-1: none)."""
+    want = np.zeros(n, dtype=np.bool_)
+    for k in range(rows.size):
+        want[rows[k]] = True
+    ok = np.zeros(pair_row.size, dtype=np.bool_)
+    for j in range(pair_row.size):
+        ok[j] = want[pair_row[j]] and _find(known, (np.int64(pea[j]) << 32) | np.int64(peb[j])) < 0
+    ea, eb = pea[ok], peb[ok]
+    ra = np.empty(ea.size, dtype=np.int64)
+    rb = np.empty(ea.size, dtype=np.int64)
+    for j in range(ea.size):
+        ra[j], rb[j] = _row(lut, ea[j]), _row(lut, eb[j])
+    ok = solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open)
+    return ra[ok], rb[ok], ea[ok], eb[ok]
+
+
+@njit(cache=True)
+def moved_immovable(immovable, moved, a, b, at_points, ra, rb):  # pragma: no cover - compiled
+    """The contacts with an immovable body one of whose bodies moved: those not at points (with
+    their rows ``ra``, ``rb``) and those at points (``at_points``; empty: none are):
+    ``(check, rows a, rows b, points)``."""
+    c = a.size
+    sel = np.zeros(c, dtype=np.bool_)
+    pts = np.zeros(c, dtype=np.bool_)
+    for i in range(c):
+        if immovable[i] and (moved[a[i]] or moved[b[i]]):
+            if at_points.size > 0 and at_points[i]:
+                pts[i] = True
+            else:
+                sel[i] = True
+    check = np.flatnonzero(sel)
+    return check, ra[check], rb[check], np.flatnonzero(pts)
+
+
+@leaf
+def _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn):  # pragma: no cover - compiled
+    """``Solve._shift`` of contact ``i`` (with turns where ``rn_a`` is not empty)."""
+    p, q = a[i], b[i]
+    s = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]
+    if rn_a.size > 0:
+        s += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
+    return s
+
+
+@leaf
+def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn_a, rn_b, dturn, dirty,
+                   tolerance):  # pragma: no cover - compiled
+    """The contacts ``check`` measured again (``hit``, normals, depths where the bodies now stand),
+    written into the solve's columns in place (depths relative to where the solve began): one
+    apart keeps its depth or the gap its shift opened, whichever is less; one that overlaps takes
+    the new normal and depth and is looked at again. Returns ``(any hit, any hit deeper than
+    tolerance)``."""
+    any_hit = over = False
+    for j in range(check.size):
+        i = check[j]
+        if hit[j]:
+            nx[i], ny[i] = rnx[j], rny[j]
+            depth[i] = rdepth[j] + _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn)
+            dirty[i] = True
+            any_hit = True
+            over = over or rdepth[j] > tolerance
+        else:  # touching, or a sliver within rounding: no longer pushed along
+            depth[i] = _np_min(depth[i], _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn))
+    return any_hit, over
