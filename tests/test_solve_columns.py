@@ -244,3 +244,62 @@ def test_apply_measures_is_the_numpy_update(rigid: bool) -> None:
         _same(have, w)
     assert dirty.tobytes() == np.isin(np.arange(c), h).tobytes()
     assert got == (bool(hit.any()), bool((rdepth[hit] > 1e-9).any()))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n_rows, c = 30, 20
+    rows, a, b = _scene(rng, n_rows, c)
+    ra, rb = rows[a], rows[b]
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny = np.cos(angle), np.sin(angle)
+    svx, svy = _floats(rng, n_rows, specials=False), _floats(rng, n_rows, specials=False)
+    vx, vy, u = sc.closing_speeds(rows, a, b, nx, ny, svx, svy)
+    want_vx, want_vy = svx[rows].copy(), svy[rows].copy()
+    _same(vx, want_vx)
+    _same(vy, want_vy)
+    _same(u, (want_vx[b] - want_vx[a]) * nx + (want_vy[b] - want_vy[a]) * ny)
+    if seed == 0:
+        u[3] = np.nan
+    warm = rng.random(c) < 0.6
+    touching = warm | (rng.random(c) < 0.2)
+    order = rng.permutation(c)
+    impulse0 = rng.random(c)
+    share_a = rng.random(c)
+    share_b = 1.0 - share_a
+    got_order, impulse, fastest = sc.warm_impulses(order, touching, warm, impulse0, a, b, nx, ny, share_a, share_b,
+                                                   vx, vy, u)
+    want_impulse = np.where(warm, impulse0, 0.0)
+    wx, wy = loops.warm_start(a, b, nx, ny, share_a, share_b, want_impulse, rows.size)
+    want_vx += wx
+    want_vy += wy
+    _same(got_order, order[touching[order]])
+    _same(impulse, want_impulse)
+    _same(vx, want_vx)
+    _same(vy, want_vy)
+    want_fastest = float(np.abs(u).max(initial=0.0))
+    assert np.float64(fastest).tobytes() == np.float64(want_fastest).tobytes()
+    # bounces
+    restitution = np.where(rng.random(n_rows) < 0.5, 0.0, rng.random(n_rows))
+    alive0 = rng.random(c) < 0.8
+    gx, gy, dt = 0.0, -10.0, 1.0 / 60.0
+    u = rng.normal(size=c)
+    rest = np.maximum(restitution[ra], restitution[rb])
+    g_n = gx * nx + gy * ny
+    resting_speed = 2.0 * np.abs(g_n) * dt
+    act = np.flatnonzero(warm)
+    hits = np.zeros(c, dtype=bool)
+    hits[act] = (rest[act] > 0.0) & (-u[act] > resting_speed[act]) & alive0[act]
+    for have, want in zip(sc.bounce_hits(warm, u, ra, rb, restitution, nx, ny, gx, gy, dt, alive0), (hits, rest, g_n)):
+        _same(have, want)
+    # the velocities written back
+    inv_mass = np.where(rng.random(n_rows) < 0.3, 0.0, 1.0)
+    asleep = rng.random(n_rows) < 0.2
+    out_vx, out_vy = svx.copy(), svy.copy()
+    movable = sc.write_velocities(rows, inv_mass, asleep, vx, vy, out_vx, out_vy)
+    want_movable = (inv_mass[rows] > 0.0) & ~asleep[rows]
+    _same(movable, want_movable)
+    svx[rows[want_movable]], svy[rows[want_movable]] = vx[want_movable], vy[want_movable]
+    _same(out_vx, svx)
+    _same(out_vy, svy)

@@ -44,9 +44,9 @@ from ..collision.kinds import KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
+from . import solve_columns as columns
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
-from .solve_columns import contact_columns, stays, velocity_stays, warm_pushes
 from .solve_rounds import apply_measures, known_keys, movable_rows, moved_immovable, number, turning_pairs
 from .turning import expand, turning_polygons
 
@@ -191,7 +191,8 @@ class Solve:
         # the position solver, nothing to be pushed through without statics; a sleeper keeps still;
         # the order: see _order)
         gx, gy = self.gravity
-        (self.span, self.reach, wa, wb, self.share_a, self.share_b, self.immovable, self.order) = contact_columns(
+        (self.span, self.reach, wa, wb, self.share_a, self.share_b, self.immovable,
+         self.order) = columns.contact_columns(
             self.rows, cs.ra, cs.rb, store.hw, store.hh, store.bound, store.asleep, store.inv_mass, store.x, store.y,
             bool(self.stage.bodies.n_static), gx, gy, self.g)
         self.wa, self.wb = wa, wb
@@ -279,7 +280,7 @@ class Solve:
         cs = self.cs
         # (one compiled pass, solve_columns.stays: up = -n.g / |g| > 0.5, b rests on a; held: the
         # bodies resting on something immovable, as solver_loops.supported finds them)
-        self.b_on_a, self.a_on_b, share_a, share_b = stays(
+        self.b_on_a, self.a_on_b, share_a, share_b = columns.stays(
             self.order, self.a, self.b, cs.nx, cs.ny, gx, gy, g, self.share_a, self.share_b, self.immovable,
             self._rolling(), self.rows.size)
         if self.rigid:
@@ -403,7 +404,7 @@ class Solve:
         dy)``. (One compiled pass: :func:`~framework.systems.solve_columns.warm_pushes`.)"""
         share_a, share_b = self.position_shares
         cs = self.cs
-        push, dx, dy = warm_pushes(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.span, self.reach)
+        push, dx, dy = columns.warm_pushes(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.span, self.reach)
         return push, dx, dy
 
     def _push_cap(self) -> F64Array:
@@ -715,15 +716,13 @@ class Solve:
             # step's speeds would close is in the solve too, allowed to close only its gap.)
             sep = self._separations()
             self.touching |= sep <= self.tolerance
-        vx, vy = store.vx[self.rows].copy(), store.vy[self.rows].copy()
         n = self.rows.size
         a, b = self.a, self.b
-        u = (vx[b] - vx[a]) * cs.nx + (vy[b] - vy[a]) * cs.ny  # closing speed before the solve
+        vx, vy, u = columns.closing_speeds(self.rows, a, b, cs.nx, cs.ny, store.vx, store.vy)  # (u: before the solve)
         spin = None
         if self.rigid:
             spin = store.w[self.rows].copy()
             u += self.rn_b * spin[b] - self.rn_a * spin[a]
-        act = np.flatnonzero(self.touching)
         target = np.zeros(cs.size)
         warm = self.touching
         if self.rigid:
@@ -732,12 +731,11 @@ class Solve:
             if speculative.any():
                 self.touching = self.touching | speculative  # (not warm started: not in contact yet)
                 target[speculative] = -sep[speculative] / dt
-        order = self.order[self.touching[self.order]]
         share_a, share_b, turns = self._velocity_shares(vx, vy)
-        self.impulse = np.where(warm, cs.impulse0, 0.0)
-        wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, n)
-        vx += wx
-        vy += wy
+        # (one compiled pass: the touching contacts in order, the warm start of those touching
+        # before the speculative ones joined, and max |u|)
+        order, self.impulse, fastest = columns.warm_impulses(
+            self.order, self.touching, warm, cs.impulse0, a, b, cs.nx, cs.ny, share_a, share_b, vx, vy, u)
         if spin is not None:
             spin += np.bincount(b, turns[1] * self.impulse, n) - np.bincount(a, turns[0] * self.impulse, n)
         self.timpulse = np.zeros(cs.size)
@@ -754,19 +752,17 @@ class Solve:
                 vy += wy
                 spin += turn
             friction = fr.velocities_args(limits, self.timpulse, spin)
-        gx, gy = self.gravity
-        tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
+        tol = TOLERANCE * (fastest + self.g * self.dt)
         self._solve_velocities(order, target, share_a, share_b, turns, vx, vy, spin, tol, friction)
-        bounce = self._bounce_targets(u, act)
-        movable = store.movable(self.rows)
+        bounce = self._bounce_targets(u, warm)
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             w_in = None if spin is None else spin.copy()
             self._solve_velocities(order, bounce, share_a, share_b, turns, vx, vy, spin, tol, friction)
             if not self.solo[bounce > 0.0].all() or self.rigid:
-                self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy, w_in, spin)
+                self._no_energy_made(bounce, store.movable(self.rows), vx_in, vy_in, vx, vy, w_in, spin)
+        movable = columns.write_velocities(self.rows, store.inv_mass, store.asleep, vx, vy, store.vx, store.vy)
         rows = self.rows[movable]
-        store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
         if self.rigid or (fr is not None and fr.turns):
             store.w[rows] = spin[movable]  # type: ignore[index]  # (spin is set for both)
 
@@ -804,8 +800,9 @@ class Solve:
         # pyramid spawned with gaps between its rows settling) keep the lower body still, as
         # before; without it a 20-row pyramid of boxes that turn fell apart as its rows landed.
         # (b is the upper body: lighter inverse mass is heavier)
-        b_on_a, a_on_b, share_a, share_b = velocity_stays(a, b, cs.nx, cs.ny, vx, vy, gx, gy, self.dt, self.b_on_a,
-                                                          self.a_on_b, self.wa, self.wb, self.share_a, self.share_b)
+        b_on_a, a_on_b, share_a, share_b = columns.velocity_stays(
+            a, b, cs.nx, cs.ny, vx, vy, gx, gy, self.dt, self.b_on_a, self.a_on_b, self.wa, self.wb, self.share_a,
+            self.share_b)
         if self.rigid:
             return self._rigid_shares(b_on_a, a_on_b)
         return share_a, share_b, None
@@ -849,19 +846,17 @@ class Solve:
         if w is not None:
             w[:] = w_in + t * dw
 
-    def _bounce_targets(self, u: F64Array, act: IntpArray) -> F64Array | None:
+    def _bounce_targets(self, u: F64Array, touching: BoolArray) -> F64Array | None:
         """The speed each touching contact must part at (0: no bounce), or None if none bounces.
 
         An approach no faster than gravity gives in two steps along the normal (``2 |g.n| dt``) is
         a body at rest, not a bounce: without that threshold a bouncy body on the floor would hop
-        by ``e g dt`` every step forever."""
+        by ``e g dt`` every step forever. (``touching``: the contacts in the velocity solve; the
+        hits, one compiled pass.)"""
         store, cs = self.store, self.cs
-        rest = np.maximum(store.restitution[cs.ra], store.restitution[cs.rb])
         gx, gy = self.gravity
-        g_n = gx * cs.nx + gy * cs.ny
-        resting_speed = 2.0 * np.abs(g_n) * self.dt
-        hits = np.zeros(cs.size, dtype=bool)
-        hits[act] = (rest[act] > 0.0) & (-u[act] > resting_speed[act]) & cs.alive0[act]
+        hits, rest, g_n = columns.bounce_hits(touching, u, cs.ra, cs.rb, store.restitution, cs.nx, cs.ny, gx, gy,
+                                              self.dt, cs.alive0)
         self.solo = np.zeros(cs.size, dtype=bool)
         if not hits.any():
             return None

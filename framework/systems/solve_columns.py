@@ -30,7 +30,8 @@ from numba import njit
 from .gather import _np_max, _np_min
 from .solver_loops import warm_start
 
-__all__ = ["contact_columns", "stable_argsort", "stays", "velocity_stays", "warm_pushes"]
+__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stable_argsort", "stays", "velocity_stays",
+           "warm_impulses", "warm_pushes", "write_velocities"]
 
 _compiled = njit(cache=True, error_model="numpy")
 
@@ -205,3 +206,73 @@ def warm_pushes(a, b, nx, ny, share_a, share_b, push0, span, reach):  # pragma: 
             push[i] = push[i] * _np_min(scale[a[i]], scale[b[i]])
     dx, dy = warm_start(a, b, nx, ny, share_a, share_b, push, n)
     return push, dx, dy
+
+
+@_compiled
+def closing_speeds(rows, a, b, nx, ny, svx, svy):  # pragma: no cover - compiled
+    """The velocities of the solve's bodies (``rows`` of the store's ``svx, svy``, copied) and each
+    contact's closing speed along its normal before the solve: ``(vx, vy, u)``."""
+    n, c = rows.size, a.size
+    vx, vy = np.empty(n), np.empty(n)
+    for k in range(n):
+        vx[k], vy[k] = svx[rows[k]], svy[rows[k]]
+    u = np.empty(c)
+    for i in range(c):
+        p, q = a[i], b[i]
+        u[i] = (vx[q] - vx[p]) * nx[i] + (vy[q] - vy[p]) * ny[i]
+    return vx, vy, u
+
+
+@_compiled
+def warm_impulses(order, touching, warm, impulse0, a, b, nx, ny, share_a, share_b, vx, vy,
+                  u):  # pragma: no cover - compiled
+    """The velocity solve's start: the ``touching`` contacts in ``order``, last step's impulses of
+    the ``warm`` ones (0 elsewhere) and the velocities they make, added to ``vx, vy`` in place, and
+    the fastest closing or parting speed ``max |u|`` (0 with no contact; NaN if one is NaN):
+    ``(order, impulse, max |u|)``."""
+    picked = np.zeros(order.size, dtype=np.bool_)
+    for k in range(order.size):
+        picked[k] = touching[order[k]]
+    c = a.size
+    impulse = np.empty(c)
+    fastest = 0.0
+    for i in range(c):
+        impulse[i] = impulse0[i] if warm[i] else 0.0
+        s = abs(u[i])
+        fastest = _np_max(fastest, s)
+    wx, wy = warm_start(a, b, nx, ny, share_a, share_b, impulse, vx.size)
+    for k in range(vx.size):
+        vx[k] += wx[k]
+        vy[k] += wy[k]
+    return order[picked], impulse, fastest
+
+
+@_compiled
+def bounce_hits(warm, u, ra, rb, restitution, nx, ny, gx, gy, dt, alive0):  # pragma: no cover - compiled
+    """:meth:`Solve._bounce_targets`' hits: the ``warm`` (touching) contacts that overlapped (``alive0``)
+    with a restitution (the larger of the pair's) and approached faster than gravity brings in two
+    steps along the normal; with each contact's restitution and gravity along its normal:
+    ``(hits, rest, g_n)``."""
+    c = ra.size
+    hits = np.zeros(c, dtype=np.bool_)
+    rest, g_n = np.empty(c), np.empty(c)
+    for i in range(c):
+        rest[i] = _np_max(restitution[ra[i]], restitution[rb[i]])
+        g_n[i] = gx * nx[i] + gy * ny[i]
+        if warm[i]:
+            resting_speed = 2.0 * abs(g_n[i]) * dt
+            hits[i] = rest[i] > 0.0 and -u[i] > resting_speed and alive0[i]
+    return hits, rest, g_n
+
+
+@_compiled
+def write_velocities(rows, inv_mass, asleep, vx, vy, svx, svy):  # pragma: no cover - compiled
+    """Write the velocities ``vx, vy`` of the solve's bodies the response may move (``inv_mass >
+    0``, awake) into the store's ``svx, svy``; returns which bodies those are."""
+    movable = np.empty(rows.size, dtype=np.bool_)
+    for k in range(rows.size):
+        r = rows[k]
+        movable[k] = inv_mass[r] > 0.0 and not asleep[r]
+        if movable[k]:
+            svx[r], svy[r] = vx[k], vy[k]
+    return movable
