@@ -303,3 +303,37 @@ def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
     svx[rows[want_movable]], svy[rows[want_movable]] = vx[want_movable], vy[want_movable]
     _same(out_vx, svx)
     _same(out_vy, svy)
+
+
+@pytest.mark.parametrize("rigid", [False, True])
+def test_recorded_is_the_numpy_record(rigid: bool) -> None:
+    rng = np.random.default_rng(7 + int(rigid))
+    n, c = 10, 30
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    ea, eb = rng.integers(0, 6, c), rng.integers(0, 6, c)  # (repeated pairs: a pair's points)
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny, depth = np.cos(angle), np.sin(angle), rng.normal(size=c) * 0.01
+    dx, dy, span = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01, 0.01 * rng.random(n)
+    rn_a, rn_b, dturn = (rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01) if rigid else (
+        np.zeros(0), np.zeros(0), np.zeros(0))
+    touching = rng.random(c) < 0.4
+    push = np.where(rng.random(c) < 0.5, 0.0, 0.02 * rng.random(c))
+    near = rng.random(c) < 0.3 if rigid else np.zeros(0, dtype=bool)
+    impulse, tpush, timpulse = rng.random(c), rng.random(c), rng.random(c)
+    got = sr.recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse,
+                      tpush, timpulse)
+    acted = touching | (push > 0.0)
+    kept = acted | near if rigid else acted
+    rows = np.flatnonzero(kept)
+    keys = pair_keys(ea[rows], eb[rows])
+    order = np.argsort(keys, kind="stable")
+    rows, keys = rows[order], keys[order]
+    sep = (dx[b] - dx[a]) * nx + (dy[b] - dy[a]) * ny
+    if rigid:
+        sep += rn_b * dturn[b] - rn_a * dturn[a]
+    sep = sep - depth
+    capped = np.minimum(push, 2.0 * np.minimum(span[a], span[b]))
+    want = (rows, keys, ea[rows], eb[rows], nx[rows], ny[rows], np.maximum(sep[rows], 0.0), push[rows], capped[rows],
+            impulse[rows], tpush[rows], timpulse[rows], acted[rows])
+    for have, w in zip(got, want):
+        _same(have, w)

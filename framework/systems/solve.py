@@ -45,6 +45,7 @@ from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
 from . import solve_columns as columns
+from . import solve_rounds as rounds
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
 from .solve_rounds import apply_measures, known_keys, movable_rows, moved_immovable, number, turning_pairs
@@ -878,25 +879,23 @@ class Solve:
         (the next step's warm start); for contacts at points, each point's (``frame.points``), and
         the pair's the sums of its points'."""
         cs = self.cs
-        acted = self.touching | (self.push > 0.0)
-        kept = acted
+        near, turns = _NO_FLAGS, (_NO_FLOATS,) * 3
         if self.rigid:  # (and the points a hair apart: a turn in a pile opens such gaps, and a pair
             # not kept would be found again only by the pushes, a round of the solve later)
             store = self.store
-            near = NEAR_GAP * np.minimum(store.bound[cs.ra], store.bound[cs.rb])
-            kept = acted | (self.at_points & (self._separations() <= near))
-        rows = np.flatnonzero(kept)
-        keys = pair_keys(cs.ea[rows], cs.eb[rows])
-        order = np.argsort(keys, kind="stable")
-        rows, keys = rows[order], keys[order]
-        ea, eb, nx, ny = cs.ea[rows], cs.eb[rows], cs.nx[rows], cs.ny[rows]
-        gap = np.maximum(self._separations()[rows], 0.0)
-        push = np.minimum(self.push, self._push_cap())[rows]  # (see _warm_pushes)
-        tpush = np.zeros(rows.size)
-        if self.fpos is not None:
-            tpush = self.fpos.clip(self.tpush[rows], push, self.position_mu[rows])  # type: ignore[index]  # (fpos: set)
-        values: tuple[F64Array, ...] = (self.push[rows], push, self.impulse[rows], tpush, self.timpulse[rows])
-        applied = acted[rows]
+            gap = NEAR_GAP * np.minimum(store.bound[cs.ra], store.bound[cs.rb])
+            near = self.at_points & (self._separations() <= gap)
+            turns = (self.rn_a, self.rn_b, self.dturn)
+        # (one compiled pass: the contacts acted on (touching or pushed) and kept, sorted by pair;
+        # their gaps where the bodies now stand, and their pushes capped as _warm_pushes caps them)
+        (rows, keys, ea, eb, nx, ny, gap, pushed, push, impulse, tpush, timpulse, applied) = rounds.recorded(
+            self.touching, self.push, near, cs.ea, cs.eb, cs.nx, cs.ny, self.a, self.b, self.dx, self.dy, cs.depth,
+            *turns, self.span, self.impulse, self.tpush, self.timpulse)
+        if self.fpos is None:
+            tpush = np.zeros(rows.size)
+        else:
+            tpush = self.fpos.clip(tpush, push, self.position_mu[rows])  # type: ignore[index]  # (fpos: set)
+        values: tuple[F64Array, ...] = (pushed, push, impulse, tpush, timpulse)
         if self.rigid:
             frame.points = (keys, cs.slot[rows], values[1], values[2], values[3], values[4], cs.px[rows], cs.py[rows])
             first = np.flatnonzero(np.diff(keys, prepend=keys[:1] - 1))  # (each pair's first point)

@@ -11,11 +11,12 @@ calls on a few dozen rows; here each is one loop:
 - :func:`unknown_solid_pairs`: the pairs not among known keys that the response may act on;
 - :func:`movable_rows`, :func:`near_rows`, :func:`kept_static_pairs`: the static candidates;
 - :func:`moved_immovable`, :func:`apply_measures`: the contacts with immovable bodies measured
-  again, before and after the geometry's measure.
+  again, before and after the geometry's measure;
+- :func:`recorded`: what the solve records of its contacts, sorted by pair.
 
 Each is the numpy it replaced, element by element, in the same order of operations (``np.minimum``
 as :func:`~framework.systems.gather._np_min`), so the same bits; sorts are of integers (any sort
-gives the same answer) and set membership is exact.
+gives the same answer; a stable one where ties are kept in order) and set membership is exact.
 """
 
 from __future__ import annotations
@@ -26,10 +27,11 @@ import numpy as np
 from numba import njit
 
 from ..compiled import leaf
-from .gather import _find, _np_min, _row, solid_pairs_mask
+from .gather import _find, _np_max, _np_min, _row, solid_pairs_mask
+from .solve_columns import stable_argsort
 
 __all__ = ["apply_measures", "kept_static_pairs", "known_keys", "movable_rows", "moved_immovable", "near_rows",
-           "number", "turning_pairs", "unknown_solid_pairs"]
+           "number", "recorded", "turning_pairs", "unknown_solid_pairs"]
 
 
 @njit(cache=True)
@@ -183,3 +185,32 @@ def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn
         else:  # touching, or a sliver within rounding: no longer pushed along
             depth[i] = _np_min(depth[i], _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn))
     return any_hit, over
+
+
+@njit(cache=True)
+def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse, tpush,
+             timpulse):  # pragma: no cover - compiled
+    """What :meth:`Solve.record` keeps, sorted by pair key (stably: a pair's points in order): the
+    contacts acted on (``touching`` or pushed) or ``near`` (empty: none), with ``(rows, keys, ea,
+    eb, nx, ny, gap, push, capped push, impulse, tpush, timpulse, applied)``: the gap where the
+    bodies now stand (0 if they overlap), the push capped as :func:`Solve._push_cap` says, and
+    whether the contact was acted on."""
+    c = ea.size
+    kept = np.zeros(c, dtype=np.bool_)
+    for i in range(c):
+        kept[i] = touching[i] or push[i] > 0.0 or (near.size > 0 and near[i])
+    rows = np.flatnonzero(kept)
+    keys = np.empty(rows.size, dtype=np.int64)
+    for k in range(rows.size):
+        keys[k] = (np.int64(ea[rows[k]]) << 32) | np.int64(eb[rows[k]])
+    order = stable_argsort(keys)
+    rows, keys = rows[order], keys[order]
+    m = rows.size
+    gap, capped, applied = np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_)
+    for k in range(m):
+        i = rows[k]
+        gap[k] = _np_max(_shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn) - depth[i], 0.0)
+        capped[k] = _np_min(push[i], 2.0 * _np_min(span[a[i]], span[b[i]]))
+        applied[k] = touching[i] or push[i] > 0.0
+    return (rows, keys, ea[rows], eb[rows], nx[rows], ny[rows], gap, push[rows], capped, impulse[rows], tpush[rows],
+            timpulse[rows], applied)
