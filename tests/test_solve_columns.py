@@ -337,3 +337,38 @@ def test_recorded_is_the_numpy_record(rigid: bool) -> None:
             impulse[rows], tpush[rows], timpulse[rows], acted[rows])
     for have, w in zip(got, want):
         _same(have, w)
+
+
+def test_place_moved_and_far_bodies_are_the_numpy_ones() -> None:
+    rng = np.random.default_rng(3)
+    n_rows, n, c = 20, 8, 12
+    rows = rng.permutation(n_rows)[:n]
+    x0, y0 = rng.normal(size=n), rng.normal(size=n)
+    dx = np.where(rng.random(n) < 0.4, 0.0, 0.1 * rng.normal(size=n))
+    dy = np.where(rng.random(n) < 0.4, 0.0, 0.1 * rng.normal(size=n))
+    sx, sy = rng.normal(size=n_rows), rng.normal(size=n_rows)
+    want_x, want_y = sx.copy(), sy.copy()
+    moved = np.flatnonzero((dx != 0.0) | (dy != 0.0))
+    want_x[rows[moved]], want_y[rows[moved]] = x0[moved] + dx[moved], y0[moved] + dy[moved]
+    assert sr.place(rows, x0, y0, dx, dy, sx, sy) == moved.size
+    _same(sx, want_x)
+    _same(sy, want_y)
+    seen_x, seen_y = np.where(rng.random(n) < 0.5, dx, 0.0), dy.copy()
+    got = sr.moved_since(dx, dy, seen_x, seen_y)
+    for have, want in zip(got, ((dx != seen_x) | (dy != seen_y), dx, dy)):
+        _same(have, want)
+    fx, fy, limit = 0.05 * rng.normal(size=n), 0.05 * rng.normal(size=n), 0.1 * rng.random(n)
+    far = np.hypot(dx - fx, dy - fy) > limit
+    got_far, anyone = sr.far_bodies(dx, dy, fx, fy, limit, np.zeros(0, dtype=bool), np.zeros(0),
+                                    np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
+    _same(got_far, far)
+    assert anyone == bool(far.any())
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    immovable, push = rng.random(c) < 0.3, np.where(rng.random(c) < 0.3, 0.0, rng.random(c))
+    both = ~immovable & (push > 0.0)
+    pushed = np.zeros(n, dtype=bool)
+    pushed[a[both]] = pushed[b[both]] = True
+    pushed &= far
+    got_far, anyone = sr.far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b)
+    _same(got_far, pushed)
+    assert anyone == bool(pushed.any())

@@ -60,7 +60,9 @@ class Response(Stage):
         frame.support = NO_SUPPORT
         frame.resolved = NO_RESOLVED
         points, frame.points = frame.points, NO_POINTS
-        cs = cs.take(np.flatnonzero(self._solid(frame, cs)))
+        solid = self._solid(frame, cs)
+        if not solid.all():  # (all solid: the gathered columns as they are, no copy of them)
+            cs = cs.take(np.flatnonzero(solid))
         if cs.size == 0:
             return True
         solve = Solve(self, frame, cs, points)

@@ -358,9 +358,7 @@ class Solve:
     def _moved(self) -> None:
         """``self.moved``: the bodies the solve moved since the geometry was last looked at (the
         last round); only their contacts and candidates need looking at again."""
-        n = self.seen_x.size
-        self.moved = (self.dx[:n] != self.seen_x) | (self.dy[:n] != self.seen_y)
-        self.seen_x, self.seen_y = self.dx.copy(), self.dy.copy()
+        self.moved, self.seen_x, self.seen_y = rounds.moved_since(self.dx, self.dy, self.seen_x, self.seen_y)
 
     def _clear_of_statics(self, rounds: int) -> None:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
@@ -448,9 +446,9 @@ class Solve:
         return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)  # type: ignore[arg-type]
 
     def _place(self) -> None:
-        moved = np.flatnonzero((self.dx != 0.0) | (self.dy != 0.0))
-        if moved.size:
-            self.store.place(self.rows[moved], self.x0[moved] + self.dx[moved], self.y0[moved] + self.dy[moved])
+        store = self.store
+        if rounds.place(self.rows, self.x0, self.y0, self.dx, self.dy, store.x, store.y):  # (as store.place)
+            store.motion += 1
         if self.rigid:
             turned = np.flatnonzero(self.dturn != 0.0)
             if turned.size:
@@ -570,8 +568,9 @@ class Solve:
         was last looked at (a heap spawned on one spot) may bring it to bodies the broad phase did
         not pair it with: the pairs of those bodies where everything now stands become candidates.
         Whether any did."""
-        far = np.hypot(self.dx - self.looked_x, self.dy - self.looked_y) > self.span
-        if not far.any():
+        far, anyone = rounds.far_bodies(self.dx, self.dy, self.looked_x, self.looked_y, self.span, _NO_FLAGS,
+                                        _NO_FLOATS, _NO_IDS, _NO_IDS)
+        if not anyone:
             return False
         self.looked_x[far], self.looked_y[far] = self.dx[far], self.dy[far]
         bodies = self.stage.bodies
@@ -636,11 +635,11 @@ class Solve:
         cs = self.cs
         if self.stage.bodies.n_static == 0:
             return False
-        both = ~self.immovable & (self.push > 0.0)
-        pushed = np.zeros(self.rows.size, dtype=bool)
-        pushed[self.a[both]] = pushed[self.b[both]] = True
-        pushed &= np.hypot(self.dx - self.static_x, self.dy - self.static_y) > self.reach
-        if not pushed.any():
+        # (the bodies of pushed contacts between movable bodies, farther than their reach from where
+        # the static hash was last asked about them)
+        pushed, anyone = rounds.far_bodies(self.dx, self.dy, self.static_x, self.static_y, self.reach, self.immovable,
+                                           self.push, self.a, self.b)
+        if not anyone:
             return False
         self.static_x[pushed], self.static_y[pushed] = self.dx[pushed], self.dy[pushed]
         extra = self.stage.new_static_contacts(self.rows[pushed], known_keys(cs.ea, cs.eb, _NO_IDS, _NO_IDS))

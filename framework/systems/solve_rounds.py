@@ -12,6 +12,8 @@ calls on a few dozen rows; here each is one loop:
 - :func:`movable_rows`, :func:`near_rows`, :func:`kept_static_pairs`: the static candidates;
 - :func:`moved_immovable`, :func:`apply_measures`: the contacts with immovable bodies measured
   again, before and after the geometry's measure;
+- :func:`place`, :func:`moved_since`, :func:`far_bodies`: the bodies placed after a run of the
+  solver, which moved since the last round, and which moved far (past their span or reach);
 - :func:`recorded`: what the solve records of its contacts, sorted by pair.
 
 Each is the numpy it replaced, element by element, in the same order of operations (``np.minimum``
@@ -31,7 +33,7 @@ from .gather import _find, _np_max, _np_min, _row, solid_pairs_mask
 from .solve_columns import stable_argsort
 
 __all__ = ["apply_measures", "kept_static_pairs", "known_keys", "movable_rows", "moved_immovable", "near_rows",
-           "number", "recorded", "turning_pairs", "unknown_solid_pairs"]
+           "far_bodies", "moved_since", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]
 
 
 @njit(cache=True)
@@ -214,3 +216,49 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
         applied[k] = touching[i] or push[i] > 0.0
     return (rows, keys, ea[rows], eb[rows], nx[rows], ny[rows], gap, push[rows], capped, impulse[rows], tpush[rows],
             timpulse[rows], applied)
+
+
+@leaf
+def place(rows, x0, y0, dx, dy, sx, sy):  # pragma: no cover - compiled
+    """Put the solve's bodies it moved (``dx, dy`` not both 0) at ``(x0 + dx, y0 + dy)`` in the
+    store's ``sx, sy`` (as ``BodyStore.place``, whose ``motion`` the caller bumps); returns how
+    many it placed."""
+    placed = 0
+    for k in range(rows.size):
+        if dx[k] != 0.0 or dy[k] != 0.0:
+            sx[rows[k]] = x0[k] + dx[k]
+            sy[rows[k]] = y0[k] + dy[k]
+            placed += 1
+    return placed
+
+
+@njit(cache=True)
+def moved_since(dx, dy, seen_x, seen_y):  # pragma: no cover - compiled
+    """Which bodies moved (``dx, dy``) since they were ``(seen_x, seen_y)``, and copies of where
+    they are now (to be seen next): ``(moved, dx, dy)``."""
+    n = seen_x.size
+    moved = np.empty(n, dtype=np.bool_)
+    for k in range(n):
+        moved[k] = dx[k] != seen_x[k] or dy[k] != seen_y[k]
+    return moved, dx.copy(), dy.copy()
+
+
+@njit(cache=True)
+def far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b):  # pragma: no cover - compiled
+    """The bodies that moved (``dx, dy``) farther than their ``limit`` from ``(fx, fy)``; with
+    contacts (``immovable`` not empty), only the bodies of the pushed contacts (``push > 0``)
+    between two movable bodies. Returns the mask and whether any is set."""
+    n = dx.size
+    among = np.ones(n, dtype=np.bool_)
+    if immovable.size > 0:
+        among[:] = False
+        for i in range(immovable.size):
+            if not immovable[i] and push[i] > 0.0:
+                among[a[i]] = True
+                among[b[i]] = True
+    far = np.zeros(n, dtype=np.bool_)
+    anyone = False
+    for k in range(n):
+        far[k] = among[k] and math.hypot(dx[k] - fx[k], dy[k] - fy[k]) > limit[k]
+        anyone = anyone or far[k]
+    return far, anyone
