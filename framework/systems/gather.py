@@ -42,7 +42,7 @@ from numba import njit
 from ..collision.box_rows import lower_bound
 from ..compiled import leaf
 
-__all__ = ["centres_inside", "gather", "solid_pairs_mask", "taking_part"]
+__all__ = ["centres_inside", "gather", "solid_contacts", "solid_pairs_mask", "taking_part"]
 
 
 @leaf
@@ -240,6 +240,20 @@ def taking_part(ra, rb, kind, sensor, inv_mass, asleep):  # pragma: no cover - c
     for i in range(ra.size):
         out[i] = _takes(ra[i], rb[i], kind, sensor, inv_mass, asleep)
     return out
+
+
+@njit(cache=True)
+def solid_contacts(ra, rb, kind, sensor, inv_mass, asleep, vx, vy, one_way):  # pragma: no cover - compiled
+    """``Response._solid`` before its one-way platforms: each contact :func:`_takes` whose bodies'
+    velocities are finite (a body a system spoiled with NaN is left alone); and whether a contact
+    has a one-way platform (those are then looked at): ``(mask, any one-way)``."""
+    out = np.zeros(ra.size, dtype=np.bool_)
+    one = False
+    for i in range(ra.size):
+        a, b = ra[i], rb[i]
+        out[i] = _takes(a, b, kind, sensor, inv_mass, asleep) and math.isfinite(vx[a] + vy[a] + vx[b] + vy[b])
+        one = one or one_way[a] or one_way[b]
+    return out, one
 
 
 @njit(cache=True)

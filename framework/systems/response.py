@@ -23,7 +23,7 @@ from ..events import pair_keys, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..geometry import Geometry
 from ..store import STATIC
-from .gather import centres_inside, gather, solid_pairs_mask, taking_part
+from .gather import centres_inside, gather, solid_contacts, solid_pairs_mask, taking_part
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Pairs, Solve
@@ -115,12 +115,13 @@ class Response(Stage):
         """Mask of the contacts the response acts on."""
         store = self.bodies.store
         ra, rb = cs.ra, cs.rb
-        solid = self._takes_part(ra, rb)
-        # A body a system spoiled (NaN) is left alone, so the step reports it as written and the
-        # bad value spreads to no other body.
-        solid &= np.isfinite(store.vx[ra] + store.vy[ra] + store.vx[rb] + store.vy[rb])
-        one_way = store.one_way[ra] | store.one_way[rb]
-        if one_way.any():
+        c = store.cols
+        # (one compiled pass: the pairs taking part; a body a system spoiled (NaN) is left alone, so
+        # the step reports it as written and the bad value spreads to no other body)
+        solid, platforms = solid_contacts(ra, rb, c["kind"], c["sensor"], c["inv_mass"], c["asleep"], store.vx,
+                                          store.vy, c["one_way"])
+        if platforms:
+            one_way = store.one_way[ra] | store.one_way[rb]
             solid &= ~one_way | self._lands_on_one_way(frame, cs)
         return solid
 
