@@ -372,3 +372,23 @@ def test_place_moved_and_far_bodies_are_the_numpy_ones() -> None:
     got_far, anyone = sr.far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b)
     _same(got_far, pushed)
     assert anyone == bool(pushed.any())
+
+
+@pytest.mark.parametrize("immovable_only", [False, True])
+def test_moved_candidates_are_the_numpy_ones(immovable_only: bool) -> None:
+    rng = np.random.default_rng(11)
+    n_rows, n, c = 30, 12, 25
+    table = np.full(n_rows, -1, dtype=np.int64)
+    table[rng.permutation(n_rows)[:n]] = np.arange(n)
+    moved = rng.random(n) < 0.5
+    ra, rb = rng.integers(0, n_rows, c), rng.integers(0, n_rows, c)
+    inv_mass, asleep = np.where(rng.random(n_rows) < 0.3, 0.0, 1.0), rng.random(n_rows) < 0.2
+    m = np.append(moved, False)
+    near = m[table[ra]] | m[table[rb]]
+    if immovable_only:
+        movable = (inv_mass > 0.0) & ~asleep
+        near &= ~(movable[ra] & movable[rb])
+    look = np.flatnonzero(near)
+    got = sr.moved_candidates(moved, table, ra, rb, immovable_only, inv_mass, asleep)
+    for have, want in zip(got, (look, ra[look], rb[look])):
+        _same(have, want)

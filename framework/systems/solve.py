@@ -605,16 +605,13 @@ class Solve:
         ra, rb, ea, eb = self.candidates
         if ra.size == 0:
             return False
-        # each candidate body's number, or -1 (the extra last slot: never moved) if it is not in the solve
-        moved = np.append(self.moved, False)
-        near = moved[self.table[ra]] | moved[self.table[rb]]
-        if immovable_only:
-            store = self.store
-            near &= ~(store.movable(ra) & store.movable(rb))
-        look = np.flatnonzero(near)
+        # (one compiled pass: the pairs with a body in the solve that moved)
+        store = self.store
+        look, ra_look, rb_look = rounds.moved_candidates(self.moved, self.table, ra, rb, immovable_only,
+                                                         store.inv_mass, store.asleep)
         if look.size == 0:
             return False
-        r = self.stage.remeasure(ra[look], rb[look])
+        r = self.stage.remeasure(ra_look, rb_look)
         h = np.flatnonzero(r.hit & (r.depth > self.tolerance))  # (a sliver is left to the next step)
         if h.size == 0:
             return False

@@ -11,7 +11,8 @@ calls on a few dozen rows; here each is one loop:
 - :func:`unknown_solid_pairs`: the pairs not among known keys that the response may act on;
 - :func:`movable_rows`, :func:`near_rows`, :func:`kept_static_pairs`: the static candidates;
 - :func:`moved_immovable`, :func:`apply_measures`: the contacts with immovable bodies measured
-  again, before and after the geometry's measure;
+  again, before and after the geometry's measure; :func:`moved_candidates`: the candidate pairs
+  to measure again;
 - :func:`place`, :func:`moved_since`, :func:`far_bodies`: the bodies placed after a run of the
   solver, which moved since the last round, and which moved far (past their span or reach);
 - :func:`recorded`: what the solve records of its contacts, sorted by pair.
@@ -33,7 +34,8 @@ from .gather import _find, _np_max, _np_min, _row, solid_pairs_mask
 from .solve_columns import stable_argsort
 
 __all__ = ["apply_measures", "kept_static_pairs", "known_keys", "movable_rows", "moved_immovable", "near_rows",
-           "far_bodies", "moved_since", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]
+           "far_bodies", "moved_candidates", "moved_since", "number", "place", "recorded", "turning_pairs",
+           "unknown_solid_pairs"]
 
 
 @njit(cache=True)
@@ -262,3 +264,19 @@ def far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b):  # pragma: no cove
         far[k] = among[k] and math.hypot(dx[k] - fx[k], dy[k] - fy[k]) > limit[k]
         anyone = anyone or far[k]
     return far, anyone
+
+
+@njit(cache=True)
+def moved_candidates(moved, table, ra, rb, immovable_only, inv_mass, asleep):  # pragma: no cover - compiled
+    """The candidate pairs ``(ra, rb)`` (store rows) one of whose bodies is in the solve (``table``:
+    row -> local number, -1: not) and ``moved``; ``immovable_only``: only those with a body the
+    response may not move (no finite mass, or asleep): ``(indices, rows a, rows b)``."""
+    near = np.zeros(ra.size, dtype=np.bool_)
+    for i in range(ra.size):
+        p, q = ra[i], rb[i]
+        ta, tb = table[p], table[q]
+        near[i] = (ta >= 0 and moved[ta]) or (tb >= 0 and moved[tb])
+        if immovable_only and near[i]:
+            near[i] = not ((inv_mass[p] > 0.0 and not asleep[p]) and (inv_mass[q] > 0.0 and not asleep[q]))
+    look = np.flatnonzero(near)
+    return look, ra[look], rb[look]
