@@ -186,15 +186,17 @@ def test_pair_picks_are_the_numpy_picks(seed: int) -> None:
     want = tuple(v[keep][ok] for v in (pa, pb, pea, peb))
     for have, w in zip(sr.unknown_solid_pairs(pa, pb, pea, peb, known, n, *cols), want):
         _same(have, w)
-    # the statics near rows, and their kept pairs
+    # the statics near the movable bodies, and their kept pairs
     x, y = _floats(rng, n, specials=False), _floats(rng, n, specials=False)
     cx, cy = np.where(rng.random(n) < 0.3, np.nan, x + 0.1), y - 0.05
-    rows = rng.permutation(n)[:15]
-    margin = np.where(rng.random(15) < 0.2, np.inf, 0.1 + 0.1 * rng.random(15))
-    fin = np.isfinite(margin)
-    r, m = rows[fin], margin[fin]
+    rows_all = rng.permutation(n)[:15]
+    local = rng.permutation(15)[:10]
+    reach = np.where(rng.random(15) < 0.2, np.inf, 0.1 + 0.1 * rng.random(15))
+    rows, margin = rows_all[local], reach[local]
+    ok = (inv_mass[rows] > 0.0) & ~asleep[rows] & np.isfinite(margin)
+    r, m = rows[ok], margin[ok]
     far = ~(np.abs(x[r] - cx[r]) + np.abs(y[r] - cy[r]) <= m)
-    for have, w in zip(sr.near_rows(rows, margin, x, y, cx, cy), (r, m, far)):
+    for have, w in zip(sr.near_rows(local, rows_all, reach, inv_mass, asleep, x, y, cx, cy), (r, m, far)):
         _same(have, w)
     lut = np.where(rng.random(60) < 0.1, -1, rng.integers(0, n, 60))
     pair_row = rng.integers(0, n, 30)
@@ -339,7 +341,7 @@ def test_recorded_is_the_numpy_record(rigid: bool) -> None:
         _same(have, w)
 
 
-def test_place_moved_and_far_bodies_are_the_numpy_ones() -> None:
+def test_place_and_far_bodies_are_the_numpy_ones() -> None:
     rng = np.random.default_rng(3)
     n_rows, n, c = 20, 8, 12
     rows = rng.permutation(n_rows)[:n]
@@ -350,11 +352,11 @@ def test_place_moved_and_far_bodies_are_the_numpy_ones() -> None:
     want_x, want_y = sx.copy(), sy.copy()
     moved = np.flatnonzero((dx != 0.0) | (dy != 0.0))
     want_x[rows[moved]], want_y[rows[moved]] = x0[moved] + dx[moved], y0[moved] + dy[moved]
-    assert sr.place(rows, x0, y0, dx, dy, sx, sy) == moved.size
+    seen_x, seen_y = np.where(rng.random(n) < 0.5, dx, 0.0), dy.copy()
+    placed, *got = sr.place(rows, x0, y0, dx, dy, sx, sy, seen_x, seen_y)
+    assert placed == moved.size
     _same(sx, want_x)
     _same(sy, want_y)
-    seen_x, seen_y = np.where(rng.random(n) < 0.5, dx, 0.0), dy.copy()
-    got = sr.moved_since(dx, dy, seen_x, seen_y)
     for have, want in zip(got, ((dx != seen_x) | (dy != seen_y), dx, dy)):
         _same(have, want)
     fx, fy, limit = 0.05 * rng.normal(size=n), 0.05 * rng.normal(size=n), 0.1 * rng.random(n)

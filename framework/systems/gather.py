@@ -42,7 +42,7 @@ from numba import njit
 from ..collision.box_rows import lower_bound
 from ..compiled import leaf
 
-__all__ = ["centres_inside", "gather", "solid_contacts", "solid_pairs_mask", "taking_part"]
+__all__ = ["centres_inside", "gather", "solid_contacts", "solid_pair", "solid_pairs_mask", "taking_part"]
 
 
 @leaf
@@ -263,11 +263,16 @@ def solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mas
     (:func:`_takes`), neither a one-way platform, their layers and masks meeting."""
     out = np.zeros(ra.size, dtype=np.bool_)
     for i in range(ra.size):
-        a, b = ra[i], rb[i]
-        if a < 0 or b < 0 or one_way[a] or one_way[b] or not _takes(a, b, kind, sensor, inv_mass, asleep):
-            continue
-        out[i] = layers_open or ((layer[a] & mask[b]) != 0 and (layer[b] & mask[a]) != 0)
+        out[i] = solid_pair(ra[i], rb[i], kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open)
     return out
+
+
+@leaf
+def solid_pair(a, b, kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open):  # pragma: no cover
+    """:func:`solid_pairs_mask` of one pair of rows ``a, b``."""
+    if a < 0 or b < 0 or one_way[a] or one_way[b] or not _takes(a, b, kind, sensor, inv_mass, asleep):
+        return False
+    return layers_open or ((layer[a] & mask[b]) != 0 and (layer[b] & mask[a]) != 0)
 
 
 @njit(cache=True)

@@ -279,23 +279,25 @@ class Response(Stage):
             geom.hx, geom.hy = store.x, store.y
         return geom
 
-    def static_candidates(self, rows: IntpArray, margin: F64Array, known: I64Array) -> Pairs:
-        """Pairs of the bodies ``rows`` with the static bodies their bounds, grown by ``margin`` (per
-        row), meet where they stand, other than the pairs whose keys are in ``known`` (sorted):
-        ``(rows a, rows b, entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the
-        margin can bring a body only to these statics.
+    def static_candidates(self, local: IntpArray, rows: IntpArray, reach: F64Array, known: I64Array) -> Pairs:
+        """Pairs of the solve's bodies ``local`` (local numbers of its ``rows``, with their ``reach``) that
+        the response may move, with the static bodies their bounds, grown by their reach, meet where
+        they stand, other than the pairs whose keys are in ``known`` (sorted): ``(rows a, rows b,
+        entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the reach can bring a
+        body only to these statics.
 
-        Kept from step to step: a body's statics are looked up (with twice the margin) again only
-        once it has moved more than the margin since, or the statics changed; a resting pile asks
+        Kept from step to step: a body's statics are looked up (with twice the reach) again only
+        once it has moved more than the reach since, or the statics changed; a resting pile asks
         the static hash nothing."""
         bodies = self.bodies
         store = bodies.store
         if bodies.n_static == 0:
             return _NO_IDS, _NO_IDS, _NO_IDS, _NO_IDS
         cache = self._static_cache()
-        # (compiled passes: the rows with a finite margin, which moved farther than it, and their
-        # kept pairs not among the known keys that the response may act on)
-        rows, margin, far = near_rows(rows, margin, store.x, store.y, cache.x, cache.y)
+        # (compiled passes: the movable bodies with a finite reach, which moved farther than it,
+        # and their kept pairs not among the known keys that the response may act on)
+        rows, margin, far = near_rows(local, rows, reach, store.inv_mass, store.asleep, store.x, store.y, cache.x,
+                                      cache.y)
         if rows.size == 0:
             return _NO_IDS, _NO_IDS, _NO_IDS, _NO_IDS
         if far.any():

@@ -48,7 +48,7 @@ from . import solve_columns as columns
 from . import solve_rounds as rounds
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
-from .solve_rounds import apply_measures, known_keys, movable_rows, moved_immovable, number, turning_pairs
+from .solve_rounds import apply_measures, known_keys, moved_immovable, number, turning_pairs
 from .turning import expand, turning_polygons
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
@@ -342,8 +342,7 @@ class Solve:
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
         self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _moved)
         for _round in range(rounds):
-            held_back = self._solve(self.order)
-            self._moved()
+            held_back = self._solve(self.order)  # (and self.moved: see _place)
             overlapping = self._measure_immovable()
             grew = self._far_candidates()
             grew = self._new_dynamic_contacts() or grew
@@ -355,10 +354,6 @@ class Solve:
                 return
         self._clear_of_statics(rounds)
 
-    def _moved(self) -> None:
-        """``self.moved``: the bodies the solve moved since the geometry was last looked at (the
-        last round); only their contacts and candidates need looking at again."""
-        self.moved, self.seen_x, self.seen_y = rounds.moved_since(self.dx, self.dy, self.seen_x, self.seen_y)
 
     def _clear_of_statics(self, rounds: int) -> None:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
@@ -375,7 +370,6 @@ class Solve:
                 return
             self.dirty[order] = True
             self._solve(order, tolerance=0.0, translate=True)
-            self._moved()
             overlapping = self._measure_immovable()
             grew = self._new_dynamic_contacts(immovable_only=True)
             grew = self._late_contacts() or grew
@@ -446,8 +440,13 @@ class Solve:
         return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)  # type: ignore[arg-type]
 
     def _place(self) -> None:
+        """Put the bodies where the solve has moved them (and turned them); ``self.moved``: the
+        bodies the solve moved since the geometry was last looked at (the last round): only their
+        contacts and candidates need looking at again. (Positions and moved: one compiled pass.)"""
         store = self.store
-        if rounds.place(self.rows, self.x0, self.y0, self.dx, self.dy, store.x, store.y):  # (as store.place)
+        placed, self.moved, self.seen_x, self.seen_y = rounds.place(
+            self.rows, self.x0, self.y0, self.dx, self.dy, store.x, store.y, self.seen_x, self.seen_y)
+        if placed:  # (as store.place)
             store.motion += 1
         if self.rigid:
             turned = np.flatnonzero(self.dturn != 0.0)
@@ -555,11 +554,7 @@ class Solve:
         """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
         if self.stage.bodies.n_static == 0:
             return
-        store = self.store
-        rows, reach = movable_rows(bodies, self.rows, self.reach, store.inv_mass, store.asleep)
-        if rows.size == 0:
-            return
-        near = self.stage.static_candidates(rows, reach, self._known_keys())
+        near = self.stage.static_candidates(bodies, self.rows, self.reach, self._known_keys())
         if near[0].size:
             self._set_candidates(_joined(self.candidates, near))
 

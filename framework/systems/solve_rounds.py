@@ -9,12 +9,12 @@ calls on a few dozen rows; here each is one loop:
 - :func:`turning_pairs`: whether a contact has a box or polygon that turns;
 - :func:`known_keys`: the sorted pair keys of two lists of pairs;
 - :func:`unknown_solid_pairs`: the pairs not among known keys that the response may act on;
-- :func:`movable_rows`, :func:`near_rows`, :func:`kept_static_pairs`: the static candidates;
+- :func:`near_rows`, :func:`kept_static_pairs`: the static candidates;
 - :func:`moved_immovable`, :func:`apply_measures`: the contacts with immovable bodies measured
   again, before and after the geometry's measure; :func:`moved_candidates`: the candidate pairs
   to measure again;
-- :func:`place`, :func:`moved_since`, :func:`far_bodies`: the bodies placed after a run of the
-  solver, which moved since the last round, and which moved far (past their span or reach);
+- :func:`place`, :func:`far_bodies`: the bodies placed after a run of the solver and which of
+  them moved since the last round, and which moved far (past their span or reach);
 - :func:`recorded`: what the solve records of its contacts, sorted by pair.
 
 Each is the numpy it replaced, element by element, in the same order of operations (``np.minimum``
@@ -30,30 +30,61 @@ import numpy as np
 from numba import njit
 
 from ..compiled import leaf
-from .gather import _find, _np_max, _np_min, _row, solid_pairs_mask
+from .gather import _find, _np_max, _np_min, _row, solid_pair
 from .solve_columns import stable_argsort
 
-__all__ = ["apply_measures", "kept_static_pairs", "known_keys", "movable_rows", "moved_immovable", "near_rows",
-           "far_bodies", "moved_candidates", "moved_since", "number", "place", "recorded", "turning_pairs",
-           "unknown_solid_pairs"]
+__all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "moved_candidates", "moved_immovable",
+           "near_rows", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]
+
+
+@njit(cache=True)
+def _where(mask):  # pragma: no cover - compiled
+    """``np.flatnonzero(mask)`` (int64), by two loops (numba compiles these faster than numpy's)."""
+    n = 0
+    for k in range(mask.size):
+        n += 1 if mask[k] else 0
+    out = np.empty(n, dtype=np.int64)
+    n = 0
+    for k in range(mask.size):
+        if mask[k]:
+            out[n] = k
+            n += 1
+    return out
+
+
+@njit(cache=True)
+def _at(values, idx):  # pragma: no cover - compiled
+    """``values[idx]`` for an index array ``idx``, by a loop."""
+    out = np.empty(idx.size, dtype=values.dtype)
+    for k in range(idx.size):
+        out[k] = values[idx[k]]
+    return out
 
 
 @njit(cache=True)
 def number(table, ra, rb, first):  # pragma: no cover - compiled
     """Number the rows of ``ra`` and ``rb`` that ``table`` (row -> number, -1: none) does not know
     yet, from ``first`` on in row order, entering them in the table: ``(the new rows, every
-    entry's number, ra's then rb's)``."""
-    rows = np.concatenate((ra, rb))
-    fresh = np.sort(rows[table[rows] < 0])
-    keep = np.ones(fresh.size, dtype=np.bool_)
-    for k in range(1, fresh.size):
-        keep[k] = fresh[k] != fresh[k - 1]
-    new = fresh[keep]
-    for k in range(new.size):
-        table[new[k]] = first + k
-    local = np.empty(rows.size, dtype=np.int64)
-    for k in range(rows.size):
-        local[k] = table[rows[k]]
+    entry's number, ra's then rb's)``. (The new rows are marked -2 in the table, then numbered in
+    one sweep over the rows between the least and the greatest: no sort.)"""
+    c = ra.size
+    fresh, lo, hi = 0, table.size, -1
+    for k in range(2 * c):
+        r = ra[k] if k < c else rb[k - c]
+        if table[r] == -1:
+            table[r] = -2
+            fresh += 1
+            lo, hi = min(lo, r), max(hi, r)
+    new = np.empty(fresh, dtype=np.int64)
+    j = 0
+    for r in range(lo, hi + 1):
+        if table[r] == -2:
+            table[r] = first + j
+            new[j] = r
+            j += 1
+    local = np.empty(2 * c, dtype=np.int64)
+    for k in range(2 * c):
+        local[k] = table[ra[k] if k < c else rb[k - c]]
     return new, local
 
 
@@ -76,43 +107,36 @@ def known_keys(ea, eb, ca, cb):  # pragma: no cover - compiled
         keys[i] = (np.int64(ea[i]) << 32) | np.int64(eb[i])
     for i in range(ca.size):
         keys[ea.size + i] = (np.int64(ca[i]) << 32) | np.int64(cb[i])
-    return np.sort(keys)
+    return _at(keys, stable_argsort(keys))
 
 
 @njit(cache=True)
 def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep, one_way, layer, mask,
                         layers_open):  # pragma: no cover - compiled
     """The pairs ``(ra, rb, ea, eb)`` whose key is not in the sorted ``known``, both rows in the
-    store's ``n``, that the response may act on (``gather.solid_pairs_mask``)."""
+    store's ``n``, that the response may act on (``gather.solid_pair``)."""
     ok = np.zeros(ra.size, dtype=np.bool_)
     for i in range(ra.size):
-        ok[i] = ra[i] < n and rb[i] < n and _find(known, (np.int64(ea[i]) << 32) | np.int64(eb[i])) < 0
-    ra, rb, ea, eb = ra[ok], rb[ok], ea[ok], eb[ok]
-    ok = solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open)
-    return ra[ok], rb[ok], ea[ok], eb[ok]
+        ok[i] = (ra[i] < n and rb[i] < n and _find(known, (np.int64(ea[i]) << 32) | np.int64(eb[i])) < 0
+                 and solid_pair(ra[i], rb[i], kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open))
+    idx = _where(ok)
+    return _at(ra, idx), _at(rb, idx), _at(ea, idx), _at(eb, idx)
+
+
 
 
 @njit(cache=True)
-def movable_rows(bodies, rows, reach, inv_mass, asleep):  # pragma: no cover - compiled
-    """Of the local ``bodies``, the store rows of those the response may move (``inv_mass > 0``,
-    awake) and their reaches: ``(rows, reach)``."""
+def near_rows(bodies, rows, reach, inv_mass, asleep, x, y, cx, cy):  # pragma: no cover - compiled
+    """Of the local ``bodies`` (store ``rows``, ``reach``), those the response may move (``inv_mass >
+    0``, awake) with a finite reach, their rows and reaches, and which of them stand more than their
+    reach (``|dx| + |dy|``) from where their statics were looked up ``(cx, cy)`` (or were never
+    looked up: NaN): ``(rows, margin, far)``."""
     ok = np.zeros(bodies.size, dtype=np.bool_)
     for k in range(bodies.size):
         r = rows[bodies[k]]
-        ok[k] = inv_mass[r] > 0.0 and not asleep[r]
-    picked = bodies[ok]
-    return rows[picked], reach[picked]
-
-
-@njit(cache=True)
-def near_rows(rows, margin, x, y, cx, cy):  # pragma: no cover - compiled
-    """Of ``rows`` with their ``margin``, those with a finite margin, and which of them stand more
-    than their margin (``|dx| + |dy|``) from where their statics were looked up ``(cx, cy)`` (or
-    were never looked up: NaN): ``(rows, margin, far)``."""
-    ok = np.zeros(rows.size, dtype=np.bool_)
-    for k in range(rows.size):
-        ok[k] = math.isfinite(margin[k])
-    rows, margin = rows[ok], margin[ok]
+        ok[k] = inv_mass[r] > 0.0 and not asleep[r] and math.isfinite(reach[bodies[k]])
+    picked = _at(bodies, _where(ok))
+    rows, margin = _at(rows, picked), _at(reach, picked)
     far = np.empty(rows.size, dtype=np.bool_)
     for k in range(rows.size):
         r = rows[k]
@@ -129,16 +153,15 @@ def kept_static_pairs(n, rows, pair_row, pea, peb, known, lut, kind, sensor, inv
     want = np.zeros(n, dtype=np.bool_)
     for k in range(rows.size):
         want[rows[k]] = True
-    ok = np.zeros(pair_row.size, dtype=np.bool_)
-    for j in range(pair_row.size):
-        ok[j] = want[pair_row[j]] and _find(known, (np.int64(pea[j]) << 32) | np.int64(peb[j])) < 0
-    ea, eb = pea[ok], peb[ok]
-    ra = np.empty(ea.size, dtype=np.int64)
-    rb = np.empty(ea.size, dtype=np.int64)
-    for j in range(ea.size):
-        ra[j], rb[j] = _row(lut, ea[j]), _row(lut, eb[j])
-    ok = solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open)
-    return ra[ok], rb[ok], ea[ok], eb[ok]
+    m = pair_row.size
+    ok = np.zeros(m, dtype=np.bool_)
+    ra, rb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+    for j in range(m):
+        ra[j], rb[j] = _row(lut, pea[j]), _row(lut, peb[j])
+        ok[j] = (want[pair_row[j]] and _find(known, (np.int64(pea[j]) << 32) | np.int64(peb[j])) < 0
+                 and solid_pair(ra[j], rb[j], kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open))
+    idx = _where(ok)
+    return _at(ra, idx), _at(rb, idx), _at(pea, idx), _at(peb, idx)
 
 
 @njit(cache=True)
@@ -155,8 +178,8 @@ def moved_immovable(immovable, moved, a, b, at_points, ra, rb):  # pragma: no co
                 pts[i] = True
             else:
                 sel[i] = True
-    check = np.flatnonzero(sel)
-    return check, ra[check], rb[check], np.flatnonzero(pts)
+    check = _where(sel)
+    return check, _at(ra, check), _at(rb, check), _where(pts)
 
 
 @leaf
@@ -203,12 +226,12 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
     kept = np.zeros(c, dtype=np.bool_)
     for i in range(c):
         kept[i] = touching[i] or push[i] > 0.0 or (near.size > 0 and near[i])
-    rows = np.flatnonzero(kept)
+    rows = _where(kept)
     keys = np.empty(rows.size, dtype=np.int64)
     for k in range(rows.size):
         keys[k] = (np.int64(ea[rows[k]]) << 32) | np.int64(eb[rows[k]])
     order = stable_argsort(keys)
-    rows, keys = rows[order], keys[order]
+    rows, keys = _at(rows, order), _at(keys, order)
     m = rows.size
     gap, capped, applied = np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_)
     for k in range(m):
@@ -216,33 +239,29 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
         gap[k] = _np_max(_shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn) - depth[i], 0.0)
         capped[k] = _np_min(push[i], 2.0 * _np_min(span[a[i]], span[b[i]]))
         applied[k] = touching[i] or push[i] > 0.0
-    return (rows, keys, ea[rows], eb[rows], nx[rows], ny[rows], gap, push[rows], capped, impulse[rows], tpush[rows],
-            timpulse[rows], applied)
+    return (rows, keys, _at(ea, rows), _at(eb, rows), _at(nx, rows), _at(ny, rows), gap, _at(push, rows), capped,
+            _at(impulse, rows), _at(tpush, rows), _at(timpulse, rows), applied)
 
 
-@leaf
-def place(rows, x0, y0, dx, dy, sx, sy):  # pragma: no cover - compiled
+
+
+@njit(cache=True)
+def place(rows, x0, y0, dx, dy, sx, sy, seen_x, seen_y):  # pragma: no cover - compiled
     """Put the solve's bodies it moved (``dx, dy`` not both 0) at ``(x0 + dx, y0 + dy)`` in the
-    store's ``sx, sy`` (as ``BodyStore.place``, whose ``motion`` the caller bumps); returns how
-    many it placed."""
+    store's ``sx, sy`` (as ``BodyStore.place``, whose ``motion`` the caller bumps); and say which
+    bodies moved since they were ``(seen_x, seen_y)``, with copies of where they are now (to be
+    seen next): ``(how many placed, moved, dx, dy)``."""
     placed = 0
     for k in range(rows.size):
         if dx[k] != 0.0 or dy[k] != 0.0:
             sx[rows[k]] = x0[k] + dx[k]
             sy[rows[k]] = y0[k] + dy[k]
             placed += 1
-    return placed
-
-
-@njit(cache=True)
-def moved_since(dx, dy, seen_x, seen_y):  # pragma: no cover - compiled
-    """Which bodies moved (``dx, dy``) since they were ``(seen_x, seen_y)``, and copies of where
-    they are now (to be seen next): ``(moved, dx, dy)``."""
     n = seen_x.size
     moved = np.empty(n, dtype=np.bool_)
     for k in range(n):
         moved[k] = dx[k] != seen_x[k] or dy[k] != seen_y[k]
-    return moved, dx.copy(), dy.copy()
+    return placed, moved, dx.copy(), dy.copy()
 
 
 @njit(cache=True)
@@ -278,5 +297,5 @@ def moved_candidates(moved, table, ra, rb, immovable_only, inv_mass, asleep):  #
         near[i] = (ta >= 0 and moved[ta]) or (tb >= 0 and moved[tb])
         if immovable_only and near[i]:
             near[i] = not ((inv_mass[p] > 0.0 and not asleep[p]) and (inv_mass[q] > 0.0 and not asleep[q]))
-    look = np.flatnonzero(near)
-    return look, ra[look], rb[look]
+    look = _where(near)
+    return look, _at(ra, look), _at(rb, look)
