@@ -295,16 +295,6 @@ def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
     hits[act] = (rest[act] > 0.0) & (-u[act] > resting_speed[act]) & alive0[act]
     for have, want in zip(sc.bounce_hits(warm, u, ra, rb, restitution, nx, ny, gx, gy, dt, alive0), (hits, rest, g_n)):
         _same(have, want)
-    # the velocities written back
-    inv_mass = np.where(rng.random(n_rows) < 0.3, 0.0, 1.0)
-    asleep = rng.random(n_rows) < 0.2
-    out_vx, out_vy = svx.copy(), svy.copy()
-    movable = sc.write_velocities(rows, inv_mass, asleep, vx, vy, out_vx, out_vy)
-    want_movable = (inv_mass[rows] > 0.0) & ~asleep[rows]
-    _same(movable, want_movable)
-    svx[rows[want_movable]], svy[rows[want_movable]] = vx[want_movable], vy[want_movable]
-    _same(out_vx, svx)
-    _same(out_vy, svy)
 
 
 @pytest.mark.parametrize("rigid", [False, True])

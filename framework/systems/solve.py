@@ -752,9 +752,11 @@ class Solve:
             w_in = None if spin is None else spin.copy()
             self._solve_velocities(order, bounce, share_a, share_b, turns, vx, vy, spin, tol, friction)
             if not self.solo[bounce > 0.0].all() or self.rigid:
+                # (before the velocities are written: it reads the store's, those before the response)
                 self._no_energy_made(bounce, store.movable(self.rows), vx_in, vy_in, vx, vy, w_in, spin)
-        movable = columns.write_velocities(self.rows, store.inv_mass, store.asleep, vx, vy, store.vx, store.vy)
+        movable = store.movable(self.rows)
         rows = self.rows[movable]
+        store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
         if self.rigid or (fr is not None and fr.turns):
             store.w[rows] = spin[movable]  # type: ignore[index]  # (spin is set for both)
 

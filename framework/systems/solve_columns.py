@@ -31,15 +31,11 @@ from .gather import _np_max, _np_min
 from .solver_loops import warm_start
 
 __all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stable_argsort", "stays", "velocity_stays",
-           "warm_impulses", "warm_pushes", "write_velocities"]
+           "warm_impulses", "warm_pushes"]
 
 _compiled = njit(cache=True, error_model="numpy")
 
 
-@_compiled
-def _before(x, y):  # pragma: no cover - compiled
-    """Whether ``x`` sorts strictly before ``y`` as numpy sorts floats (NaN last)."""
-    return x < y or (y != y and x == x)
 
 
 @_compiled
@@ -57,7 +53,8 @@ def stable_argsort(key):  # pragma: no cover - compiled
             hi = min(lo + 2 * width, n)
             i, j, k = lo, mid, lo
             while i < mid and j < hi:
-                if _before(key[idx[j]], key[idx[i]]):
+                x, y = key[idx[j]], key[idx[i]]
+                if x < y or (y != y and x == x):  # (x sorts strictly before y: NaN last)
                     tmp[k] = idx[j]
                     j += 1
                 else:
@@ -114,19 +111,6 @@ def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics
     return span, reach, wa, wb, share_a, share_b, immovable, order
 
 
-@_compiled
-def _lower_stays(b_on_a, a_on_b, share_a, share_b):  # pragma: no cover - compiled
-    """Shares with the lower body of the pairs ``b_on_a`` / ``a_on_b`` kept still (0 and 1)."""
-    c = share_a.size
-    sa, sb = np.empty(c), np.empty(c)
-    for i in range(c):
-        if b_on_a[i]:
-            sa[i], sb[i] = 0.0, 1.0
-        elif a_on_b[i]:
-            sa[i], sb[i] = 1.0, 0.0
-        else:
-            sa[i], sb[i] = share_a[i], share_b[i]
-    return sa, sb
 
 
 @_compiled
@@ -151,11 +135,15 @@ def stays(order, a, b, nx, ny, gx, gy, g, share_a, share_b, immovable, rolling, 
                 held[a[i]] = True
     b_on_a = np.empty(c, dtype=np.bool_)
     a_on_b = np.empty(c, dtype=np.bool_)
+    sa, sb = share_a.copy(), share_b.copy()
     for i in range(c):
         rests = not immovable[i] and not rolling[i]
         b_on_a[i] = rests and up[i] > 0.5 and held[a[i]]
         a_on_b[i] = rests and up[i] < -0.5 and held[b[i]]
-    sa, sb = _lower_stays(b_on_a, a_on_b, share_a, share_b)
+        if b_on_a[i]:  # (the lower body keeps still)
+            sa[i], sb[i] = 0.0, 1.0
+        elif a_on_b[i]:
+            sa[i], sb[i] = 1.0, 0.0
     return b_on_a, a_on_b, sa, sb
 
 
@@ -169,6 +157,7 @@ def velocity_stays(a, b, nx, ny, vx, vy, gx, gy, dt, b_on_a0, a_on_b0, wa, wb, s
     c = a.size
     b_on_a = np.empty(c, dtype=np.bool_)
     a_on_b = np.empty(c, dtype=np.bool_)
+    sa, sb = share_a.copy(), share_b.copy()
     for i in range(c):
         p, q = a[i], b[i]
         resting_speed = 2.0 * abs(gx * nx[i] + gy * ny[i]) * dt
@@ -178,7 +167,10 @@ def velocity_stays(a, b, nx, ny, vx, vy, gx, gy, dt, b_on_a0, a_on_b0, wa, wb, s
         hits = closing > resting_speed
         b_on_a[i] = b_on_a0[i] and a_up <= resting_speed and not (hits and wb[i] < wa[i])
         a_on_b[i] = a_on_b0[i] and b_down <= resting_speed and not (hits and wa[i] < wb[i])
-    sa, sb = _lower_stays(b_on_a, a_on_b, share_a, share_b)
+        if b_on_a[i]:  # (the lower body keeps still)
+            sa[i], sb[i] = 0.0, 1.0
+        elif a_on_b[i]:
+            sa[i], sb[i] = 1.0, 0.0
     return b_on_a, a_on_b, sa, sb
 
 
@@ -263,16 +255,3 @@ def bounce_hits(warm, u, ra, rb, restitution, nx, ny, gx, gy, dt, alive0):  # pr
             resting_speed = 2.0 * abs(g_n[i]) * dt
             hits[i] = rest[i] > 0.0 and -u[i] > resting_speed and alive0[i]
     return hits, rest, g_n
-
-
-@_compiled
-def write_velocities(rows, inv_mass, asleep, vx, vy, svx, svy):  # pragma: no cover - compiled
-    """Write the velocities ``vx, vy`` of the solve's bodies the response may move (``inv_mass >
-    0``, awake) into the store's ``svx, svy``; returns which bodies those are."""
-    movable = np.empty(rows.size, dtype=np.bool_)
-    for k in range(rows.size):
-        r = rows[k]
-        movable[k] = inv_mass[r] > 0.0 and not asleep[r]
-        if movable[k]:
-            svx[r], svy[r] = vx[k], vy[k]
-    return movable

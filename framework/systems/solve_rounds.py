@@ -182,14 +182,6 @@ def moved_immovable(immovable, moved, a, b, at_points, ra, rb):  # pragma: no co
     return check, _at(ra, check), _at(rb, check), _where(pts)
 
 
-@leaf
-def _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn):  # pragma: no cover - compiled
-    """``Solve._shift`` of contact ``i`` (with turns where ``rn_a`` is not empty)."""
-    p, q = a[i], b[i]
-    s = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]
-    if rn_a.size > 0:
-        s += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
-    return s
 
 
 @leaf
@@ -205,12 +197,17 @@ def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn
         i = check[j]
         if hit[j]:
             nx[i], ny[i] = rnx[j], rny[j]
-            depth[i] = rdepth[j] + _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn)
+        p, q = a[i], b[i]
+        shift = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]  # (Solve._shift, along the normal now)
+        if rn_a.size > 0:
+            shift += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
+        if hit[j]:
+            depth[i] = rdepth[j] + shift
             dirty[i] = True
             any_hit = True
             over = over or rdepth[j] > tolerance
         else:  # touching, or a sliver within rounding: no longer pushed along
-            depth[i] = _np_min(depth[i], _shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn))
+            depth[i] = _np_min(depth[i], shift)
     return any_hit, over
 
 
@@ -236,7 +233,11 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
     gap, capped, applied = np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_)
     for k in range(m):
         i = rows[k]
-        gap[k] = _np_max(_shift(i, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn) - depth[i], 0.0)
+        p, q = a[i], b[i]
+        shift = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]  # (Solve._shift)
+        if rn_a.size > 0:
+            shift += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
+        gap[k] = _np_max(shift - depth[i], 0.0)
         capped[k] = _np_min(push[i], 2.0 * _np_min(span[a[i]], span[b[i]]))
         applied[k] = touching[i] or push[i] > 0.0
     return (rows, keys, _at(ea, rows), _at(eb, rows), _at(nx, rows), _at(ny, rows), gap, _at(push, rows), capped,
