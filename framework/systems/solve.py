@@ -2,7 +2,8 @@
 
 :class:`Solve` works on the contacts the response stage gathered (:class:`Contacts`), on local
 copies of their bodies' positions and velocities, with the compiled loops of
-:mod:`framework.systems.solver_loops`:
+:mod:`framework.systems.solver_loops` (and the bookkeeping between them compiled too, in
+:mod:`framework.systems.solve_columns` and :mod:`framework.systems.solve_rounds`):
 
 1. **Positions**, in rounds. Each runs the position solver over every contact (warm started with
    last step's pushes); then the contacts with immovable bodies are measured again with the
@@ -190,7 +191,7 @@ class Solve:
         # (one compiled pass, solve_columns.contact_columns; the spans: a move this long may bring a
         # body to bodies it was not paired with; the reaches: how far a body may move in one run of
         # the position solver, nothing to be pushed through without statics; a sleeper keeps still;
-        # the order: see _order)
+        # the order: see the note on self.order below)
         gx, gy = self.gravity
         (self.span, self.reach, wa, wb, self.share_a, self.share_b, self.immovable,
          self.order) = columns.contact_columns(
@@ -340,7 +341,7 @@ class Solve:
         self._static_candidates(np.arange(self.rows.size))
         self.static_x, self.static_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _late_contacts)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
-        self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _moved)
+        self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _place)
         for _round in range(rounds):
             held_back = self._solve(self.order)  # (and self.moved: see _place)
             overlapping = self._measure_immovable()

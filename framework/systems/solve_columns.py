@@ -11,13 +11,19 @@ compiled loop per round:
   still (:meth:`Solve._shock_shares`), and the shares with the lower body kept still;
 - :func:`velocity_stays`: the same for the impulses (:meth:`Solve._velocity_shares`);
 - :func:`warm_pushes`: last step's pushes, capped and scaled within reach, and the moves they make
-  (:meth:`Solve._warm_pushes`).
+  (:meth:`Solve._warm_pushes`);
+- :func:`closing_speeds`, :func:`warm_impulses`, :func:`bounce_hits`: the velocity half's start
+  (the bodies' velocities, the contacts' closing speeds, the warm start) and its bounces.
 
 Each is the numpy it replaced, element by element, in the same order of operations (``np.minimum``
 and ``np.maximum`` as :func:`~framework.systems.gather._np_min` and ``_np_max``, which keep numpy's
 answers for -0.0 and NaN; ``np.argsort(kind="stable")`` as a merge sort that, like numpy's, puts
 NaN last), so the same bits. Divisions follow numpy's rules (``error_model="numpy"``: ``1/0`` is
 ``inf``, not an exception).
+
+A fresh install compiles each of these on its first call, a few tenths of a second each whatever
+its size (cached after): so there are few of them, and small helpers are written out where they
+are used rather than called.
 """
 
 from __future__ import annotations
@@ -77,7 +83,7 @@ def stable_argsort(key):  # pragma: no cover - compiled
 
 @_compiled
 def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g):  # pragma: no cover
-    """The columns of :meth:`Solve._columns` and :meth:`Solve._order`: per body (``rows``) its
+    """The columns of :meth:`Solve._columns` (and its ``order``): per body (``rows``) its
     ``span`` (half its half-thickness) and ``reach`` (the span with statics, else infinite); per
     contact ``(ra, rb)`` its bodies' inverse masses ``wa, wb`` (a sleeper's 0), the shares of a
     push by them, whether a body is immovable, and the contacts' order from the bottom of a pile

@@ -20,6 +20,7 @@ calls on a few dozen rows; here each is one loop:
 Each is the numpy it replaced, element by element, in the same order of operations (``np.minimum``
 as :func:`~framework.systems.gather._np_min`), so the same bits; sorts are of integers (any sort
 gives the same answer; a stable one where ties are kept in order) and set membership is exact.
+(Few functions, for a fresh install's compile: see :mod:`framework.systems.solve_columns`.)
 """
 
 from __future__ import annotations
