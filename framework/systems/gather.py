@@ -42,7 +42,7 @@ from numba import njit
 from ..collision.box_rows import lower_bound
 from ..compiled import leaf
 
-__all__ = ["centres_inside", "gather", "solid_pairs_mask", "taking_part"]
+__all__ = ["centres_inside", "gather", "solid_contacts", "solid_pair", "solid_pairs_mask", "taking_part"]
 
 
 @leaf
@@ -243,17 +243,36 @@ def taking_part(ra, rb, kind, sensor, inv_mass, asleep):  # pragma: no cover - c
 
 
 @njit(cache=True)
+def solid_contacts(ra, rb, kind, sensor, inv_mass, asleep, vx, vy, one_way):  # pragma: no cover - compiled
+    """``Response._solid`` before its one-way platforms: each contact :func:`_takes` whose bodies'
+    velocities are finite (a body a system spoiled with NaN is left alone); and whether a contact
+    has a one-way platform (those are then looked at): ``(mask, any one-way)``."""
+    out = np.zeros(ra.size, dtype=np.bool_)
+    one = False
+    for i in range(ra.size):
+        a, b = ra[i], rb[i]
+        out[i] = _takes(a, b, kind, sensor, inv_mass, asleep) and math.isfinite(vx[a] + vy[a] + vx[b] + vy[b])
+        one = one or one_way[a] or one_way[b]
+    return out, one
+
+
+@njit(cache=True)
 def solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask,
                      layers_open):  # pragma: no cover - compiled
     """The pairs of rows the response may act on: both rows real (>= 0), taking part
     (:func:`_takes`), neither a one-way platform, their layers and masks meeting."""
     out = np.zeros(ra.size, dtype=np.bool_)
     for i in range(ra.size):
-        a, b = ra[i], rb[i]
-        if a < 0 or b < 0 or one_way[a] or one_way[b] or not _takes(a, b, kind, sensor, inv_mass, asleep):
-            continue
-        out[i] = layers_open or ((layer[a] & mask[b]) != 0 and (layer[b] & mask[a]) != 0)
+        out[i] = solid_pair(ra[i], rb[i], kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open)
     return out
+
+
+@leaf
+def solid_pair(a, b, kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open):  # pragma: no cover
+    """:func:`solid_pairs_mask` of one pair of rows ``a, b``."""
+    if a < 0 or b < 0 or one_way[a] or one_way[b] or not _takes(a, b, kind, sensor, inv_mass, asleep):
+        return False
+    return layers_open or ((layer[a] & mask[b]) != 0 and (layer[b] & mask[a]) != 0)
 
 
 @njit(cache=True)

@@ -48,14 +48,19 @@ class InternalFaces:
     def masks(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
               rows: IntpArray) -> NDArray[np.uint8]:
         """Face bits of the static AABB ``rows`` (0 for rows of other kinds)."""
-        key = (store.version, store.static_epoch, store.n)
-        if key != self._key:
-            self._key = key
-            self._mask = np.full(store.n, _UNKNOWN, dtype=np.uint8)
+        self._table(store)
         todo = distinct(rows[self._mask[rows] == _UNKNOWN])
         if todo.size:
             self._mask[todo] = self._compute(store, geom, hash_, rows_of, todo)
         return self._mask[rows]
+
+    def _table(self, store: BodyStore) -> NDArray[np.uint8]:
+        """The face bits per row, as far as known (``_UNKNOWN``: not yet), for the current statics."""
+        key = (store.version, store.static_epoch, store.n)
+        if key != self._key:
+            self._key = key
+            self._mask = np.full(store.n, _UNKNOWN, dtype=np.uint8)
+        return self._mask
 
     @staticmethod
     def _eligible(store: BodyStore, rows: IntpArray) -> BoolArray:
@@ -162,11 +167,13 @@ class InternalFaces:
         of them is covered, the corner is that face's end (a ball rolling over the seam of two tiles
         is on the floor, not on a bump)."""
         c = store.cols
-        cand = static_box_contacts(ra, rb, among, c["body"], c["kind"], STATIC, KIND_AABB)  # (one compiled pass)
-        if cand.size == 0:
-            return None
+        # (one compiled pass: the candidates, their static boxes, and whether one of those may have a
+        # covered face: its bits not yet known, or known and not 0)
+        cand, t, maybe = static_box_contacts(ra, rb, among, c["body"], c["kind"], STATIC, KIND_AABB,
+                                             self._table(store), _UNKNOWN)
+        if cand.size == 0 or not maybe:
+            return None  # (no box here has a covered face: a floor of one piece)
         static_a = store.body[ra[cand]] == STATIC
-        t = np.where(static_a, ra[cand], rb[cand])  # the static box
         faces = self.masks(store, geom, hash_, rows_of, t)
         if not faces.any():
             return None  # (no box here has a covered face: a floor of one piece)
@@ -189,20 +196,27 @@ class InternalFaces:
 
 
 @njit(cache=True)
-def static_box_contacts(ra, rb, among, body, kind, static, box):  # pragma: no cover - compiled
+def static_box_contacts(ra, rb, among, body, kind, static, box, faces, unknown):  # pragma: no cover - compiled
     """The indices, in order, of the contacts ``among`` these between a static body and one that is
-    not, the static one a box (``InternalFaces._through_covered``'s candidates)."""
+    not, the static one a box (``InternalFaces._through_covered``'s candidates), those boxes' rows,
+    and whether one of them may have a covered face (its bits in ``faces`` are ``unknown`` or not
+    0): ``(indices, box rows, maybe)``."""
     out = np.empty(ra.size, dtype=np.int64)
+    boxes = np.empty(ra.size, dtype=np.int64)
     n = 0
+    maybe = False
     for i in range(ra.size):
         if not among[i]:
             continue
         a, b = ra[i], rb[i]
         static_a, static_b = body[a] == static, body[b] == static
-        if static_a != static_b and kind[a if static_a else b] == box:
+        t = a if static_a else b
+        if static_a != static_b and kind[t] == box:
             out[n] = i
+            boxes[n] = t
             n += 1
-    return out[:n]
+            maybe = maybe or faces[t] != 0
+    return out[:n], boxes[:n], maybe
 
 
 def _extent(store: BodyStore, geom: Geometry, rows: IntpArray) -> tuple[F64Array, F64Array, F64Array, F64Array]:

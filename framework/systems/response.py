@@ -23,14 +23,17 @@ from ..events import pair_keys, sorted_member
 from ..frame import NO_POINTS, NO_RESOLVED, NO_SUPPORT, StepFrame
 from ..geometry import Geometry
 from ..store import STATIC
-from .gather import centres_inside, gather, solid_pairs_mask, taking_part
+from .gather import centres_inside, gather, solid_contacts, solid_pairs_mask, taking_part
 from .internal_faces import InternalFaces
 from .narrow_phase import filter_layers, pair_contacts
 from .solve import KEEP_GAP, Contacts, Pairs, Solve
+from .solve_rounds import kept_static_pairs, known_keys, near_rows, unknown_solid_pairs
 from .stage import Stage
 from .turning import manifold_points
 
 __all__ = ["Response"]
+
+_NO_IDS = np.zeros(0, dtype=np.int64)  # (no pairs; no keys)
 
 
 class Response(Stage):
@@ -57,7 +60,9 @@ class Response(Stage):
         frame.support = NO_SUPPORT
         frame.resolved = NO_RESOLVED
         points, frame.points = frame.points, NO_POINTS
-        cs = cs.take(np.flatnonzero(self._solid(frame, cs)))
+        solid = self._solid(frame, cs)
+        if not solid.all():  # (all solid: the gathered columns as they are, no copy of them)
+            cs = cs.take(np.flatnonzero(solid))
         if cs.size == 0:
             return True
         solve = Solve(self, frame, cs, points)
@@ -110,12 +115,13 @@ class Response(Stage):
         """Mask of the contacts the response acts on."""
         store = self.bodies.store
         ra, rb = cs.ra, cs.rb
-        solid = self._takes_part(ra, rb)
-        # A body a system spoiled (NaN) is left alone, so the step reports it as written and the
-        # bad value spreads to no other body.
-        solid &= np.isfinite(store.vx[ra] + store.vy[ra] + store.vx[rb] + store.vy[rb])
-        one_way = store.one_way[ra] | store.one_way[rb]
-        if one_way.any():
+        c = store.cols
+        # (one compiled pass: the pairs taking part; a body a system spoiled (NaN) is left alone, so
+        # the step reports it as written and the bad value spreads to no other body)
+        solid, platforms = solid_contacts(ra, rb, c["kind"], c["sensor"], c["inv_mass"], c["asleep"], store.vx,
+                                          store.vy, c["one_way"])
+        if platforms:
+            one_way = store.one_way[ra] | store.one_way[rb]
             solid &= ~one_way | self._lands_on_one_way(frame, cs)
         return solid
 
@@ -158,10 +164,13 @@ class Response(Stage):
         ea, eb, ra, rb = frame.pairs
         if ea.size == 0:
             return ra, rb, ea, eb
-        known = np.sort(pair_keys(cs.ea, cs.eb))
         store = self.bodies.store
-        keep = ~sorted_member(pair_keys(ea, eb), known) & (ra < store.n) & (rb < store.n)
-        return self.solid_pairs(ra[keep], rb[keep], ea[keep], eb[keep])
+        c = store.cols
+        # (one compiled pass: the pairs not among the contacts' keys, rows in the store, solid)
+        pairs: Pairs = unknown_solid_pairs(
+            ra, rb, ea, eb, known_keys(cs.ea, cs.eb, _NO_IDS, _NO_IDS), store.n, c["kind"], c["sensor"],
+            c["inv_mass"], c["asleep"], c["one_way"], c["layer"], c["mask"], store.layers_all_meet())
+        return pairs
 
     def solid_pairs(self, ra: IntpArray, rb: IntpArray, ea: I64Array, eb: I64Array) -> Pairs:
         """The pairs among ``(ra, rb, ea, eb)`` the response may act on: hitboxes whose layers
@@ -270,30 +279,34 @@ class Response(Stage):
             geom.hx, geom.hy = store.x, store.y
         return geom
 
-    def static_candidates(self, rows: IntpArray, margin: F64Array, known: I64Array) -> Pairs:
-        """Pairs of the bodies ``rows`` with the static bodies their bounds, grown by ``margin`` (per
-        row), meet where they stand, other than the pairs whose keys are in ``known`` (sorted):
-        ``(rows a, rows b, entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the
-        margin can bring a body only to these statics.
+    def static_candidates(self, local: IntpArray, rows: IntpArray, reach: F64Array, known: I64Array) -> Pairs:
+        """Pairs of the solve's bodies ``local`` (local numbers of its ``rows``, with their ``reach``) that
+        the response may move, with the static bodies their bounds, grown by their reach, meet where
+        they stand, other than the pairs whose keys are in ``known`` (sorted): ``(rows a, rows b,
+        entities a, entities b)``, as :meth:`candidate_pairs`. Pushes within the reach can bring a
+        body only to these statics.
 
-        Kept from step to step: a body's statics are looked up (with twice the margin) again only
-        once it has moved more than the margin since, or the statics changed; a resting pile asks
+        Kept from step to step: a body's statics are looked up (with twice the reach) again only
+        once it has moved more than the reach since, or the statics changed; a resting pile asks
         the static hash nothing."""
         bodies = self.bodies
         store = bodies.store
-        empty = np.zeros(0, dtype=np.int64)
-        ok = np.isfinite(margin)
-        rows, margin = rows[ok], margin[ok]
-        if rows.size == 0 or bodies.n_static == 0:
-            return empty, empty, empty, empty
+        if bodies.n_static == 0:
+            return _NO_IDS, _NO_IDS, _NO_IDS, _NO_IDS
         cache = self._static_cache()
-        far = ~(np.abs(store.x[rows] - cache.x[rows]) + np.abs(store.y[rows] - cache.y[rows]) <= margin)
+        # (compiled passes: the movable bodies with a finite reach, which moved farther than it,
+        # and their kept pairs not among the known keys that the response may act on)
+        rows, margin, far = near_rows(local, rows, reach, store.inv_mass, store.asleep, store.x, store.y, cache.x,
+                                      cache.y)
+        if rows.size == 0:
+            return _NO_IDS, _NO_IDS, _NO_IDS, _NO_IDS
         if far.any():
             cache.refresh(bodies, rows[far], 2.0 * margin[far])
-        ea, eb = cache.pairs_of(store.n, rows)
-        keep = ~sorted_member(pair_keys(ea, eb), known)
-        ea, eb = ea[keep], eb[keep]
-        return self.solid_pairs(bodies.rows_of(ea), bodies.rows_of(eb), ea, eb)
+        c = store.cols
+        pairs: Pairs = kept_static_pairs(store.n, rows, cache.row, cache.ea, cache.eb, known, store.row_table(),
+                                         c["kind"], c["sensor"], c["inv_mass"], c["asleep"], c["one_way"], c["layer"],
+                                         c["mask"], store.layers_all_meet())
+        return pairs
 
     def _static_cache(self) -> _NearStatics:
         store = self.bodies.store

@@ -2,7 +2,8 @@
 
 :class:`Solve` works on the contacts the response stage gathered (:class:`Contacts`), on local
 copies of their bodies' positions and velocities, with the compiled loops of
-:mod:`framework.systems.solver_loops`:
+:mod:`framework.systems.solver_loops` (and the bookkeeping between them compiled too, in
+:mod:`framework.systems.solve_columns` and :mod:`framework.systems.solve_rounds`):
 
 1. **Positions**, in rounds. Each runs the position solver over every contact (warm started with
    last step's pushes); then the contacts with immovable bodies are measured again with the
@@ -40,12 +41,15 @@ import numpy as np
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.broad_phase import SpatialHash
-from ..collision.kinds import KIND_CIRCLE
+from ..collision.kinds import KIND_CIRCLE, KIND_POLYGON
 from ..events import pair_keys, pair_parts, sorted_member
 from ..frame import NO_POINTS, Points, StepFrame
 from ..store import KINEMATIC
+from . import solve_columns as columns
+from . import solve_rounds as rounds
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
+from .solve_rounds import apply_measures, known_keys, moved_immovable, number, turning_pairs
 from .turning import expand, turning_polygons
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
@@ -77,6 +81,11 @@ MAX_CLEAR_ROUNDS = 1024
 # A pair kept from last step stays in the solve while its gap is at most this fraction of the
 # smaller body's size (farther apart, it is no longer a resting contact).
 KEEP_GAP = 0.25
+
+# (empty columns: a compiled pass's "none")
+_NO_FLAGS = np.zeros(0, dtype=bool)
+_NO_FLOATS = np.zeros(0)
+_NO_IDS = np.zeros(0, dtype=np.int64)
 
 
 class Contacts:
@@ -147,7 +156,9 @@ class Solve:
                  points: Points = NO_POINTS) -> None:  # stage: the Response
         self.stage, self.frame = stage, frame
         self.store = store = stage.bodies.store
-        self.gravity = stage.pipeline.active_gravity()
+        gx, gy = stage.pipeline.active_gravity()
+        self.gravity = (float(gx), float(gy))
+        self.g = math.hypot(gx, gy)
         its = stage.pipeline.response_iterations
         self.iterations = max(SOLVER_PASSES * its, min(MAX_PASSES * its, PASS_BUDGET * its // cs.size))
         self.dt = frame.dt
@@ -161,12 +172,12 @@ class Solve:
         self.cs = cs = cs.take(np.flatnonzero(~dropped)) if dropped.any() else cs
         # Bodies that turn from contacts: the solve works on manifold points with lever arms.
         store = self.store
-        self.rigid = self.rotation and bool((turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)).any())
+        self.rigid = self.rotation and bool(turning_pairs(cs.ra, cs.rb, store.kind, store.inv_inertia, KIND_POLYGON))
         if self.rigid:
             self.cs = cs = expand(cs, store, stage.bodies.ensure_geometry(), points, KEEP_GAP)
         # Bodies are numbered locally; ``table`` maps a store row to its number (-1: not in the solve).
         self.table = np.full(store.n, -1, dtype=np.int64)
-        self.rows, self.local = _number(self.table, np.concatenate([cs.ra, cs.rb]), 0)
+        self.rows, self.local = number(self.table, cs.ra, cs.rb, 0)
         self.tolerance = (TOLERANCE_TURNING if self.rigid else TOLERANCE) * float(store.bound[self.rows].max())
         self.dirty = np.ones(cs.size, dtype=bool)  # the contacts the position solver is to look at
         self._columns()
@@ -175,20 +186,18 @@ class Solve:
         """Per-contact columns the solver reads, and how far a body may move in one run of the
         position solver (after the contact set changed)."""
         store, cs = self.store, self.cs
-        rows = self.rows
-        half = np.where(store.hw[rows] > 0.0, np.minimum(store.hw[rows], store.hh[rows]), 0.5 * store.bound[rows])
-        self.span = 0.5 * half  # a move this long may bring a body to bodies it was not paired with
-        # how far a body may move in one run of the position solver (nothing to be pushed through
-        # without statics)
-        self.reach = self.span if self.stage.bodies.n_static else np.full(rows.size, np.inf)
         C = cs.size
         self.a, self.b = self.local[:C], self.local[C:]
-        wa = np.where(store.asleep[cs.ra], 0.0, store.inv_mass[cs.ra])  # a sleeper keeps still
-        wb = np.where(store.asleep[cs.rb], 0.0, store.inv_mass[cs.rb])
-        w = 1.0 / (wa + wb)
+        # (one compiled pass, solve_columns.contact_columns; the spans: a move this long may bring a
+        # body to bodies it was not paired with; the reaches: how far a body may move in one run of
+        # the position solver, nothing to be pushed through without statics; a sleeper keeps still;
+        # the order: see the note on self.order below)
+        gx, gy = self.gravity
+        (self.span, self.reach, wa, wb, self.share_a, self.share_b, self.immovable,
+         self.order) = columns.contact_columns(
+            self.rows, cs.ra, cs.rb, store.hw, store.hh, store.bound, store.asleep, store.inv_mass, store.x, store.y,
+            bool(self.stage.bodies.n_static), gx, gy, self.g)
         self.wa, self.wb = wa, wb
-        self.share_a, self.share_b = wa * w, wb * w
-        self.immovable = (wa == 0.0) | (wb == 0.0)
         arms = inertia = None
         self.turn_shares = None  # (contacts at points: how far a unit turns each body, shared by inverse mass)
         if self.rigid:
@@ -208,7 +217,6 @@ class Solve:
             roll_b = imm & (store.kind[cs.rb] == KIND_CIRCLE)
             self.fpos = Friction.of(store, cs.ra, cs.rb, wa, wb, self.rotation,
                                     (roll_a * self.rt_a, roll_b * self.rt_b), inertia)
-        self.order = self._order()
         share_a, share_b, self.position_turns = self._shock_shares()
         self.position_shares = (share_a, share_b)
         fp = self.fpos
@@ -267,19 +275,19 @@ class Solve:
         :meth:`_velocity_shares`.) With the turns of contacts at points (None elsewhere):
         ``(share_a, share_b, turns)``."""
         gx, gy = self.gravity
-        g = math.hypot(gx, gy)
-        both = ~self.immovable
-        if g == 0.0 or not both.any():
+        g = self.g
+        if g == 0.0 or self.immovable.all():
             self.b_on_a = self.a_on_b = None
             return self.share_a, self.share_b, self.turn_shares
         cs = self.cs
-        up = -(cs.nx * gx + cs.ny * gy) / g  # > 0.5: b rests on a
-        fixed_a, fixed_b = self.share_a == 0.0, self.share_b == 0.0
-        held = solver.supported(self.order, self.a, self.b, up, fixed_a, fixed_b, self.rows.size)
-        rests = both & ~self._rolling()
-        self.b_on_a = b_on_a = rests & (up > 0.5) & held[self.a]
-        self.a_on_b = a_on_b = rests & (up < -0.5) & held[self.b]
-        return self._lower_stays(b_on_a, a_on_b)
+        # (one compiled pass, solve_columns.stays: up = -n.g / |g| > 0.5, b rests on a; held: the
+        # bodies resting on something immovable, as solver_loops.supported finds them)
+        self.b_on_a, self.a_on_b, share_a, share_b = columns.stays(
+            self.order, self.a, self.b, cs.nx, cs.ny, gx, gy, g, self.share_a, self.share_b, self.immovable,
+            self._rolling(), self.rows.size)
+        if self.rigid:
+            return self._rigid_shares(self.b_on_a, self.a_on_b)
+        return share_a, share_b, None
 
     def _rolling(self) -> BoolArray:
         """The contacts whose friction rolls a circle (one of its bodies is a circle that friction
@@ -295,27 +303,9 @@ class Solve:
         circle_a, circle_b = store.kind[cs.ra] == KIND_CIRCLE, store.kind[cs.rb] == KIND_CIRCLE
         return (circle_a & (fr.turn_a != 0.0)) | (circle_b & (fr.turn_b != 0.0))
 
-    def _lower_stays(self, b_on_a: BoolArray, a_on_b: BoolArray) -> tuple[Any, ...]:
-        """Shares in which the lower body of the pairs ``b_on_a`` / ``a_on_b`` keeps still, and
-        the turns of contacts at points (None elsewhere): ``(share_a, share_b, turns)``."""
-        if self.rigid:
-            return self._rigid_shares(b_on_a, a_on_b)
-        share_a = np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, self.share_a))
-        share_b = np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, self.share_b))
-        return share_a, share_b, None
-
-    def _order(self) -> IntpArray:
-        """Contacts from the bottom of a pile up (contacts with immovable bodies first): a push
-        then travels up a stack within one pass. Without gravity, in pair order."""
-        gx, gy = self.gravity
-        g = math.hypot(gx, gy)
-        if g == 0.0:
-            return np.arange(self.cs.size)
-        store, cs = self.store, self.cs
-        up_a = -(store.x[cs.ra] * gx + store.y[cs.ra] * gy) / g
-        up_b = -(store.x[cs.rb] * gx + store.y[cs.rb] * gy) / g
-        height = np.where(self.immovable, -np.inf, np.minimum(up_a, up_b))
-        return np.argsort(height, kind="stable")
+    # ``self.order`` (set by _columns): the contacts from the bottom of a pile up (contacts with
+    # immovable bodies first, then by the lower body's height against gravity, ties in pair order):
+    # a push then travels up a stack within one pass. Without gravity, in pair order.
 
     # --- positions ---------------------------------------------------------------------------
 
@@ -327,9 +317,7 @@ class Solve:
         the bodies' size), or the rounds run out (then :meth:`_clear_of_statics`)."""
         store, cs = self.store, self.cs
         self.x0, self.y0 = store.x[self.rows].copy(), store.y[self.rows].copy()
-        self.push = self._warm_pushes(cs.push0)
-        share_a, share_b = self.position_shares
-        self.dx, self.dy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, self.push, self.rows.size)
+        self.push, self.dx, self.dy = self._warm_pushes(cs.push0)
         self.tpush = np.zeros(cs.size)
         n = self.rows.size
         if self.rigid:
@@ -353,10 +341,9 @@ class Solve:
         self._static_candidates(np.arange(self.rows.size))
         self.static_x, self.static_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _late_contacts)
         rounds = 2 * max(2, self.stage.pipeline.response_iterations)
-        self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _moved)
+        self.seen_x, self.seen_y = np.zeros(self.rows.size), np.zeros(self.rows.size)  # (see _place)
         for _round in range(rounds):
-            held_back = self._solve(self.order)
-            self._moved()
+            held_back = self._solve(self.order)  # (and self.moved: see _place)
             overlapping = self._measure_immovable()
             grew = self._far_candidates()
             grew = self._new_dynamic_contacts() or grew
@@ -368,12 +355,6 @@ class Solve:
                 return
         self._clear_of_statics(rounds)
 
-    def _moved(self) -> None:
-        """``self.moved``: the bodies the solve moved since the geometry was last looked at (the
-        last round); only their contacts and candidates need looking at again."""
-        n = self.seen_x.size
-        self.moved = (self.dx[:n] != self.seen_x) | (self.dy[:n] != self.seen_y)
-        self.seen_x, self.seen_y = self.dx.copy(), self.dy.copy()
 
     def _clear_of_statics(self, rounds: int) -> None:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
@@ -390,7 +371,6 @@ class Solve:
                 return
             self.dirty[order] = True
             self._solve(order, tolerance=0.0, translate=True)
-            self._moved()
             overlapping = self._measure_immovable()
             grew = self._new_dynamic_contacts(immovable_only=True)
             grew = self._late_contacts() or grew
@@ -408,22 +388,18 @@ class Solve:
         need = float(np.max(np.ceil(np.maximum(deep, 0.0) / self.reach[mover])))
         return int(min(need + 1.0, MAX_CLEAR_ROUNDS))
 
-    def _warm_pushes(self, push0: F64Array) -> F64Array:
+    def _warm_pushes(self, push0: F64Array) -> tuple[F64Array, F64Array, F64Array]:
         """Last step's pushes as this step's first guess: none longer than its bodies' half-thickness
         (a body wedged between others that keep still may ask for more than any push can give, and
         its pushes must not grow from step to step: the 200-body soak shot a triangle 10 units
         through a wall that way), and scaled down where together they would move a body farther
-        than its reach (see :meth:`_solve`) before the solver has looked at anything."""
-        push0 = np.minimum(push0, self._push_cap())
-        if np.isfinite(self.reach).all() and push0.any():
-            share_a, share_b = self.position_shares
-            cs = self.cs
-            wx, wy = solver.warm_start(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.rows.size)
-            far = np.hypot(wx, wy)
-            with np.errstate(over="ignore"):  # (a large reach over a tiny move: no scaling)
-                scale = np.minimum(1.0, self.reach / np.maximum(far, 1e-300))
-            return push0 * np.minimum(scale[self.a], scale[self.b])
-        return push0.copy()
+        than its reach (see :meth:`_solve`) before the solver has looked at anything (a large
+        reach over a tiny move: no scaling); with the moves they make, per body: ``(push, dx,
+        dy)``. (One compiled pass: :func:`~framework.systems.solve_columns.warm_pushes`.)"""
+        share_a, share_b = self.position_shares
+        cs = self.cs
+        push, dx, dy = columns.warm_pushes(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.span, self.reach)
+        return push, dx, dy
 
     def _push_cap(self) -> F64Array:
         """Per contact, the longest push worth remembering: the smaller half-thickness of its two
@@ -465,9 +441,14 @@ class Solve:
         return NO_FRICTION_POSITIONS if fr is None else fr.positions_args(self.position_mu, self.tpush)  # type: ignore[arg-type]
 
     def _place(self) -> None:
-        moved = np.flatnonzero((self.dx != 0.0) | (self.dy != 0.0))
-        if moved.size:
-            self.store.place(self.rows[moved], self.x0[moved] + self.dx[moved], self.y0[moved] + self.dy[moved])
+        """Put the bodies where the solve has moved them (and turned them); ``self.moved``: the
+        bodies the solve moved since the geometry was last looked at (the last round): only their
+        contacts and candidates need looking at again. (Positions and moved: one compiled pass.)"""
+        store = self.store
+        placed, self.moved, self.seen_x, self.seen_y = rounds.place(
+            self.rows, self.x0, self.y0, self.dx, self.dy, store.x, store.y, self.seen_x, self.seen_y)
+        if placed:  # (as store.place)
+            store.motion += 1
         if self.rigid:
             turned = np.flatnonzero(self.dturn != 0.0)
             if turned.size:
@@ -492,26 +473,23 @@ class Solve:
         """Measure the pushed contacts with immovable bodies again; their depths (relative to where
         the solve began) follow the geometry. Whether one still overlaps."""
         cs = self.cs
-        moved = self.moved
-        check = self.immovable & (moved[self.a] | moved[self.b])
+        check, ra, rb, points = moved_immovable(self.immovable, self.moved, self.a, self.b,
+                                                self.at_points if self.rigid else _NO_FLAGS, cs.ra, cs.rb)
         overlapping = False
         if self.rigid:
-            overlapping = self._measure_points(np.flatnonzero(check & self.at_points))
-            check &= ~self.at_points
-        check = np.flatnonzero(check)
+            overlapping = self._measure_points(points)
         if check.size == 0:
             return overlapping
-        r = self.stage.remeasure(cs.ra[check], cs.rb[check])
-        apart = check[~r.hit]  # touching, or a sliver within rounding: no longer pushed along
-        cs.depth[apart] = np.minimum(cs.depth[apart], self._shift(apart))
-        if not r.hit.any():
+        r = self.stage.remeasure(ra, rb)
+        # (one compiled pass, solve_rounds.apply_measures: a pair apart, touching or a sliver within
+        # rounding, is no longer pushed along; one that overlaps takes the new normal and depth)
+        turns = (self.rn_a, self.rn_b, self.dturn) if self.rigid else (_NO_FLOATS,) * 3
+        hit, deep = apply_measures(check, r.hit, r.nx, r.ny, r.depth, self.a, self.b, cs.nx, cs.ny, cs.depth, self.dx,
+                                   self.dy, *turns, self.dirty, self.tolerance)
+        if not hit:
             return False
-        hit = check[r.hit]
-        cs.nx[hit], cs.ny[hit] = r.nx[r.hit], r.ny[r.hit]
-        cs.depth[hit] = r.depth[r.hit] + self._shift(hit)
-        self.dirty[hit] = True
         # Another round only for an overlap the solver would act on (not one within its tolerance).
-        return bool((r.depth[r.hit] > self.tolerance).any()) or overlapping
+        return bool(deep) or overlapping
 
     def _measure_points(self, check: IntpArray) -> bool:
         """Measure the contact points ``check`` (turning polygons against immovable bodies) again
@@ -570,17 +548,14 @@ class Solve:
 
     def _known_keys(self) -> I64Array:
         """The sorted pair keys of the solve's contacts and its candidates."""
-        ca, cb = self.candidates[2], self.candidates[3]
-        return np.sort(np.concatenate([pair_keys(self.cs.ea, self.cs.eb), pair_keys(ca, cb)]))
+        known: I64Array = known_keys(self.cs.ea, self.cs.eb, self.candidates[2], self.candidates[3])
+        return known
 
     def _static_candidates(self, bodies: IntpArray) -> None:
         """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
-        store, rows = self.store, self.rows[bodies]
-        movable = store.movable(rows)
-        if not movable.any() or self.stage.bodies.n_static == 0:
+        if self.stage.bodies.n_static == 0:
             return
-        known = self._known_keys()
-        near = self.stage.static_candidates(rows[movable], self.reach[bodies[movable]], known)
+        near = self.stage.static_candidates(bodies, self.rows, self.reach, self._known_keys())
         if near[0].size:
             self._set_candidates(_joined(self.candidates, near))
 
@@ -589,8 +564,9 @@ class Solve:
         was last looked at (a heap spawned on one spot) may bring it to bodies the broad phase did
         not pair it with: the pairs of those bodies where everything now stands become candidates.
         Whether any did."""
-        far = np.hypot(self.dx - self.looked_x, self.dy - self.looked_y) > self.span
-        if not far.any():
+        far, anyone = rounds.far_bodies(self.dx, self.dy, self.looked_x, self.looked_y, self.span, _NO_FLAGS,
+                                        _NO_FLOATS, _NO_IDS, _NO_IDS)
+        if not anyone:
             return False
         self.looked_x[far], self.looked_y[far] = self.dx[far], self.dy[far]
         bodies = self.stage.bodies
@@ -625,16 +601,13 @@ class Solve:
         ra, rb, ea, eb = self.candidates
         if ra.size == 0:
             return False
-        # each candidate body's number, or -1 (the extra last slot: never moved) if it is not in the solve
-        moved = np.append(self.moved, False)
-        near = moved[self.table[ra]] | moved[self.table[rb]]
-        if immovable_only:
-            store = self.store
-            near &= ~(store.movable(ra) & store.movable(rb))
-        look = np.flatnonzero(near)
+        # (one compiled pass: the pairs with a body in the solve that moved)
+        store = self.store
+        look, ra_look, rb_look = rounds.moved_candidates(self.moved, self.table, ra, rb, immovable_only,
+                                                         store.inv_mass, store.asleep)
         if look.size == 0:
             return False
-        r = self.stage.remeasure(ra[look], rb[look])
+        r = self.stage.remeasure(ra_look, rb_look)
         h = np.flatnonzero(r.hit & (r.depth > self.tolerance))  # (a sliver is left to the next step)
         if h.size == 0:
             return False
@@ -655,14 +628,14 @@ class Solve:
         cs = self.cs
         if self.stage.bodies.n_static == 0:
             return False
-        both = ~self.immovable & (self.push > 0.0)
-        pushed = np.zeros(self.rows.size, dtype=bool)
-        pushed[self.a[both]] = pushed[self.b[both]] = True
-        pushed &= np.hypot(self.dx - self.static_x, self.dy - self.static_y) > self.reach
-        if not pushed.any():
+        # (the bodies of pushed contacts between movable bodies, farther than their reach from where
+        # the static hash was last asked about them)
+        pushed, anyone = rounds.far_bodies(self.dx, self.dy, self.static_x, self.static_y, self.reach, self.immovable,
+                                           self.push, self.a, self.b)
+        if not anyone:
             return False
         self.static_x[pushed], self.static_y[pushed] = self.dx[pushed], self.dy[pushed]
-        extra = self.stage.new_static_contacts(self.rows[pushed], np.sort(pair_keys(cs.ea, cs.eb)))
+        extra = self.stage.new_static_contacts(self.rows[pushed], known_keys(cs.ea, cs.eb, _NO_IDS, _NO_IDS))
         if extra is None:
             return False
         ea, eb, ra, rb, r = extra
@@ -681,7 +654,7 @@ class Solve:
             new = expand(new, self.store, self.stage.bodies.ensure_geometry(), NO_POINTS, KEEP_GAP)
             ra, rb = new.ra, new.rb
         n_old = self.rows.size
-        new_rows, local = _number(self.table, np.concatenate([ra, rb]), n_old)
+        new_rows, local = number(self.table, ra, rb, n_old)
         new_a, new_b = local[: ra.size], local[ra.size:]
         k = new_rows.size
         rows = np.concatenate([self.rows, new_rows])
@@ -736,15 +709,13 @@ class Solve:
             # step's speeds would close is in the solve too, allowed to close only its gap.)
             sep = self._separations()
             self.touching |= sep <= self.tolerance
-        vx, vy = store.vx[self.rows].copy(), store.vy[self.rows].copy()
         n = self.rows.size
         a, b = self.a, self.b
-        u = (vx[b] - vx[a]) * cs.nx + (vy[b] - vy[a]) * cs.ny  # closing speed before the solve
+        vx, vy, u = columns.closing_speeds(self.rows, a, b, cs.nx, cs.ny, store.vx, store.vy)  # (u: before the solve)
         spin = None
         if self.rigid:
             spin = store.w[self.rows].copy()
             u += self.rn_b * spin[b] - self.rn_a * spin[a]
-        act = np.flatnonzero(self.touching)
         target = np.zeros(cs.size)
         warm = self.touching
         if self.rigid:
@@ -753,12 +724,11 @@ class Solve:
             if speculative.any():
                 self.touching = self.touching | speculative  # (not warm started: not in contact yet)
                 target[speculative] = -sep[speculative] / dt
-        order = self.order[self.touching[self.order]]
         share_a, share_b, turns = self._velocity_shares(vx, vy)
-        self.impulse = np.where(warm, cs.impulse0, 0.0)
-        wx, wy = solver.warm_start(a, b, cs.nx, cs.ny, share_a, share_b, self.impulse, n)
-        vx += wx
-        vy += wy
+        # (one compiled pass: the touching contacts in order, the warm start of those touching
+        # before the speculative ones joined, and max |u|)
+        order, self.impulse, fastest = columns.warm_impulses(
+            self.order, self.touching, warm, cs.impulse0, a, b, cs.nx, cs.ny, share_a, share_b, vx, vy, u)
         if spin is not None:
             spin += np.bincount(b, turns[1] * self.impulse, n) - np.bincount(a, turns[0] * self.impulse, n)
         self.timpulse = np.zeros(cs.size)
@@ -775,17 +745,17 @@ class Solve:
                 vy += wy
                 spin += turn
             friction = fr.velocities_args(limits, self.timpulse, spin)
-        gx, gy = self.gravity
-        tol = TOLERANCE * (float(np.abs(u).max(initial=0.0)) + math.hypot(gx, gy) * self.dt)
+        tol = TOLERANCE * (fastest + self.g * self.dt)
         self._solve_velocities(order, target, share_a, share_b, turns, vx, vy, spin, tol, friction)
-        bounce = self._bounce_targets(u, act)
-        movable = store.movable(self.rows)
+        bounce = self._bounce_targets(u, warm)
         if bounce is not None:
             vx_in, vy_in = vx.copy(), vy.copy()
             w_in = None if spin is None else spin.copy()
             self._solve_velocities(order, bounce, share_a, share_b, turns, vx, vy, spin, tol, friction)
             if not self.solo[bounce > 0.0].all() or self.rigid:
-                self._no_energy_made(bounce, movable, vx_in, vy_in, vx, vy, w_in, spin)
+                # (before the velocities are written: it reads the store's, those before the response)
+                self._no_energy_made(bounce, store.movable(self.rows), vx_in, vy_in, vx, vy, w_in, spin)
+        movable = store.movable(self.rows)
         rows = self.rows[movable]
         store.vx[rows], store.vy[rows] = vx[movable], vy[movable]
         if self.rigid or (fr is not None and fr.turns):
@@ -814,12 +784,8 @@ class Solve:
             return self.share_a, self.share_b, self.turn_shares
         cs, a, b = self.cs, self.a, self.b
         gx, gy = self.gravity
-        resting_speed = 2.0 * np.abs(gx * cs.nx + gy * cs.ny) * self.dt
-        # the lower body's speed toward the upper one
-        a_up = vx[a] * cs.nx + vy[a] * cs.ny
-        b_down = -(vx[b] * cs.nx + vy[b] * cs.ny)
-        b_on_a = self.b_on_a & (a_up <= resting_speed)
-        a_on_b = self.a_on_b & (b_down <= resting_speed)
+        # (one compiled pass, solve_columns.velocity_stays: resting_speed = 2 |g.n| dt; the lower
+        # body's speed toward the upper one against it)
         # ... and where the upper body closes on the lower one faster than that (it hits, it does not
         # rest): an impulse against a lower body kept still goes to the upper body alone, so a heavy
         # ball thrown into a pyramid of boxes met the boxes under it as the ground and was turned
@@ -828,11 +794,13 @@ class Solve:
         # Only a heavier body hitting a lighter one: bodies of like mass landing on each other (a
         # pyramid spawned with gaps between its rows settling) keep the lower body still, as
         # before; without it a 20-row pyramid of boxes that turn fell apart as its rows landed.
-        closing = (vx[a] - vx[b]) * cs.nx + (vy[a] - vy[b]) * cs.ny
-        hits = closing > resting_speed
-        b_on_a &= ~(hits & (self.wb < self.wa))  # (b is the upper body: lighter inverse mass is heavier)
-        a_on_b &= ~(hits & (self.wa < self.wb))
-        return self._lower_stays(b_on_a, a_on_b)
+        # (b is the upper body: lighter inverse mass is heavier)
+        b_on_a, a_on_b, share_a, share_b = columns.velocity_stays(
+            a, b, cs.nx, cs.ny, vx, vy, gx, gy, self.dt, self.b_on_a, self.a_on_b, self.wa, self.wb, self.share_a,
+            self.share_b)
+        if self.rigid:
+            return self._rigid_shares(b_on_a, a_on_b)
+        return share_a, share_b, None
 
     def _no_energy_made(self, bounce, movable, vx_in, vy_in, vx, vy, w_in=None, w=None) -> None:
         """Bounces hand back (some of) the energy the stopping took, never more than the bodies had
@@ -873,19 +841,17 @@ class Solve:
         if w is not None:
             w[:] = w_in + t * dw
 
-    def _bounce_targets(self, u: F64Array, act: IntpArray) -> F64Array | None:
+    def _bounce_targets(self, u: F64Array, touching: BoolArray) -> F64Array | None:
         """The speed each touching contact must part at (0: no bounce), or None if none bounces.
 
         An approach no faster than gravity gives in two steps along the normal (``2 |g.n| dt``) is
         a body at rest, not a bounce: without that threshold a bouncy body on the floor would hop
-        by ``e g dt`` every step forever."""
+        by ``e g dt`` every step forever. (``touching``: the contacts in the velocity solve; the
+        hits, one compiled pass.)"""
         store, cs = self.store, self.cs
-        rest = np.maximum(store.restitution[cs.ra], store.restitution[cs.rb])
         gx, gy = self.gravity
-        g_n = gx * cs.nx + gy * cs.ny
-        resting_speed = 2.0 * np.abs(g_n) * self.dt
-        hits = np.zeros(cs.size, dtype=bool)
-        hits[act] = (rest[act] > 0.0) & (-u[act] > resting_speed[act]) & cs.alive0[act]
+        hits, rest, g_n = columns.bounce_hits(touching, u, cs.ra, cs.rb, store.restitution, cs.nx, cs.ny, gx, gy,
+                                              self.dt, cs.alive0)
         self.solo = np.zeros(cs.size, dtype=bool)
         if not hits.any():
             return None
@@ -907,25 +873,23 @@ class Solve:
         (the next step's warm start); for contacts at points, each point's (``frame.points``), and
         the pair's the sums of its points'."""
         cs = self.cs
-        acted = self.touching | (self.push > 0.0)
-        kept = acted
+        near, turns = _NO_FLAGS, (_NO_FLOATS,) * 3
         if self.rigid:  # (and the points a hair apart: a turn in a pile opens such gaps, and a pair
             # not kept would be found again only by the pushes, a round of the solve later)
             store = self.store
-            near = NEAR_GAP * np.minimum(store.bound[cs.ra], store.bound[cs.rb])
-            kept = acted | (self.at_points & (self._separations() <= near))
-        rows = np.flatnonzero(kept)
-        keys = pair_keys(cs.ea[rows], cs.eb[rows])
-        order = np.argsort(keys, kind="stable")
-        rows, keys = rows[order], keys[order]
-        ea, eb, nx, ny = cs.ea[rows], cs.eb[rows], cs.nx[rows], cs.ny[rows]
-        gap = np.maximum(self._separations()[rows], 0.0)
-        push = np.minimum(self.push, self._push_cap())[rows]  # (see _warm_pushes)
-        tpush = np.zeros(rows.size)
-        if self.fpos is not None:
-            tpush = self.fpos.clip(self.tpush[rows], push, self.position_mu[rows])  # type: ignore[index]  # (fpos: set)
-        values: tuple[F64Array, ...] = (self.push[rows], push, self.impulse[rows], tpush, self.timpulse[rows])
-        applied = acted[rows]
+            gap = NEAR_GAP * np.minimum(store.bound[cs.ra], store.bound[cs.rb])
+            near = self.at_points & (self._separations() <= gap)
+            turns = (self.rn_a, self.rn_b, self.dturn)
+        # (one compiled pass: the contacts acted on (touching or pushed) and kept, sorted by pair;
+        # their gaps where the bodies now stand, and their pushes capped as _warm_pushes caps them)
+        (rows, keys, ea, eb, nx, ny, gap, pushed, push, impulse, tpush, timpulse, applied) = rounds.recorded(
+            self.touching, self.push, near, cs.ea, cs.eb, cs.nx, cs.ny, self.a, self.b, self.dx, self.dy, cs.depth,
+            *turns, self.span, self.impulse, self.tpush, self.timpulse)
+        if self.fpos is None:
+            tpush = np.zeros(rows.size)
+        else:
+            tpush = self.fpos.clip(tpush, push, self.position_mu[rows])  # type: ignore[index]  # (fpos: set)
+        values: tuple[F64Array, ...] = (pushed, push, impulse, tpush, timpulse)
         if self.rigid:
             frame.points = (keys, cs.slot[rows], values[1], values[2], values[3], values[4], cs.px[rows], cs.py[rows])
             first = np.flatnonzero(np.diff(keys, prepend=keys[:1] - 1))  # (each pair's first point)
@@ -947,15 +911,6 @@ def _joined(a: Pairs, b: Pairs) -> Pairs:
     """The pairs of ``a`` followed by those of ``b``, column by column."""
     return (np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]]), np.concatenate([a[2], b[2]]),
             np.concatenate([a[3], b[3]]))
-
-
-def _number(table: I64Array, rows: IntpArray, first: int) -> tuple[IntpArray, I64Array]:
-    """Number the rows of ``rows`` that ``table`` (row -> number, -1: none) does not know yet, from
-    ``first`` on in row order, entering them in the table; return ``(the new rows, every entry's
-    number)``."""
-    new = distinct(rows[table[rows] < 0])
-    table[new] = first + np.arange(new.size)
-    return new, table[rows]
 
 
 def bounce_speed(u: F64Array, g: F64Array, d: F64Array, dt: float) -> F64Array:

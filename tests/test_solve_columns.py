@@ -1,0 +1,386 @@
+"""The solve's compiled passes (framework.systems.solve_columns, solve_rounds) give the bits of the numpy
+they replaced, on random columns with ties, -0.0, infinities and NaN."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from framework.events import pair_keys, sorted_member
+from framework.systems import gather
+from framework.systems import solve_columns as sc
+from framework.systems import solve_rounds as sr
+from framework.systems import solver_loops as loops
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> None:
+    assert a.dtype == b.dtype and a.shape == b.shape
+    assert a.tobytes() == b.tobytes()
+
+
+def _floats(rng: np.random.Generator, n: int, specials: bool = True) -> np.ndarray:
+    v = np.round(rng.normal(size=n), 1)  # (rounded: ties)
+    if specials and n > 4:
+        k = rng.integers(0, n, 4)
+        v[k] = [np.nan, -0.0, 0.0, -np.inf]
+    return v
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_stable_argsort_is_numpys_stable_argsort(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for n in (0, 1, 2, 7, 33, 200):
+        key = _floats(rng, n)
+        _same(sc.stable_argsort(key), np.argsort(key, kind="stable").astype(np.int64))
+
+
+def _scene(rng: np.random.Generator, n_rows: int, c: int):
+    rows = rng.permutation(n_rows)[: max(2, n_rows // 2)].astype(np.int64)
+    a = rng.integers(0, rows.size, c)
+    b = (a + 1 + rng.integers(0, rows.size - 1, c)) % rows.size
+    return rows, a.astype(np.int64), b.astype(np.int64)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_contact_columns_are_the_numpy_columns(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n_rows, c = 40, 30
+    rows, a, b = _scene(rng, n_rows, c)
+    ra, rb = rows[a], rows[b]
+    hw = np.where(rng.random(n_rows) < 0.3, 0.0, rng.random(n_rows))
+    hh, bound = rng.random(n_rows), rng.random(n_rows) + 0.5
+    asleep = rng.random(n_rows) < 0.2
+    inv_mass = np.where(rng.random(n_rows) < 0.3, 0.0, rng.random(n_rows) + 0.1)
+    x, y = _floats(rng, n_rows), _floats(rng, n_rows)
+    for statics, (gx, gy) in ((True, (0.0, -10.0)), (False, (3.0, -4.0)), (True, (0.0, 0.0))):
+        g = math.hypot(gx, gy)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            got = sc.contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g)
+            half = np.where(hw[rows] > 0.0, np.minimum(hw[rows], hh[rows]), 0.5 * bound[rows])
+            span = 0.5 * half
+            reach = span if statics else np.full(rows.size, np.inf)
+            wa = np.where(asleep[ra], 0.0, inv_mass[ra])
+            wb = np.where(asleep[rb], 0.0, inv_mass[rb])
+            w = 1.0 / (wa + wb)
+            shares = (wa * w, wb * w)
+            immovable = (wa == 0.0) | (wb == 0.0)
+            if g == 0.0:
+                order = np.arange(c)
+            else:
+                up_a = -(x[ra] * gx + y[ra] * gy) / g
+                up_b = -(x[rb] * gx + y[rb] * gy) / g
+                order = np.argsort(np.where(immovable, -np.inf, np.minimum(up_a, up_b)), kind="stable")
+        for have, want in zip(got, (span, reach, wa, wb, *shares, immovable, order.astype(np.int64))):
+            _same(have, want)
+
+
+def _lower_stays(b_on_a, a_on_b, share_a, share_b):
+    return (np.where(b_on_a, 0.0, np.where(a_on_b, 1.0, share_a)),
+            np.where(b_on_a, 1.0, np.where(a_on_b, 0.0, share_b)))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_stays_are_the_numpy_shock_shares(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n, c = 12, 25
+    a = rng.integers(0, n, c)
+    b = (a + 1 + rng.integers(0, n - 1, c)) % n
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny = np.cos(angle), np.sin(angle)
+    share_a = np.where(rng.random(c) < 0.3, 0.0, rng.random(c))
+    share_b = np.where(share_a == 0.0, 1.0, 1.0 - share_a)
+    immovable = (share_a == 0.0) & (rng.random(c) < 0.7)
+    rolling = rng.random(c) < 0.2
+    order = rng.permutation(c)
+    gx, gy = 1.0, -9.0
+    g = math.hypot(gx, gy)
+    up = -(nx * gx + ny * gy) / g
+    held = loops.supported(order, a, b, up, share_a == 0.0, share_b == 0.0, n)
+    rests = ~immovable & ~rolling
+    b_on_a = rests & (up > 0.5) & held[a]
+    a_on_b = rests & (up < -0.5) & held[b]
+    got = sc.stays(order, a, b, nx, ny, gx, gy, g, share_a, share_b, immovable, rolling, n)
+    for have, want in zip(got, (b_on_a, a_on_b, *_lower_stays(b_on_a, a_on_b, share_a, share_b))):
+        _same(have, want)
+    # the impulses' stays
+    vx, vy = _floats(rng, n, specials=False), _floats(rng, n, specials=False)
+    wa, wb = rng.random(c), rng.random(c)
+    dt = 1.0 / 60.0
+    resting_speed = 2.0 * np.abs(gx * nx + gy * ny) * dt
+    va = b_on_a & (vx[a] * nx + vy[a] * ny <= resting_speed)
+    vb = a_on_b & (-(vx[b] * nx + vy[b] * ny) <= resting_speed)
+    hits = (vx[a] - vx[b]) * nx + (vy[a] - vy[b]) * ny > resting_speed
+    va &= ~(hits & (wb < wa))
+    vb &= ~(hits & (wa < wb))
+    got = sc.velocity_stays(a, b, nx, ny, vx, vy, gx, gy, dt, b_on_a, a_on_b, wa, wb, share_a, share_b)
+    for have, want in zip(got, (va, vb, *_lower_stays(va, vb, share_a, share_b))):
+        _same(have, want)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_warm_pushes_are_the_numpy_warm_pushes(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n, c = 10, 20
+    a = rng.integers(0, n, c)
+    b = (a + 1 + rng.integers(0, n - 1, c)) % n
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny = np.cos(angle), np.sin(angle)
+    share_a = rng.random(c)
+    share_b = 1.0 - share_a
+    push0 = np.where(rng.random(c) < 0.3, 0.0, rng.random(c))
+    span = 0.1 + 0.2 * rng.random(n)
+    for reach in (span, np.full(n, np.inf), 1e-3 * span):
+        cap = 2.0 * np.minimum(span[a], span[b])
+        p = np.minimum(push0, cap)
+        if np.isfinite(reach).all() and p.any():
+            wx, wy = loops.warm_start(a, b, nx, ny, share_a, share_b, p, n)
+            with np.errstate(over="ignore"):
+                scale = np.minimum(1.0, reach / np.maximum(np.hypot(wx, wy), 1e-300))
+            p = p * np.minimum(scale[a], scale[b])
+        dx, dy = loops.warm_start(a, b, nx, ny, share_a, share_b, p, n)
+        got = sc.warm_pushes(a, b, nx, ny, share_a, share_b, push0, span, reach)
+        for have, want in zip(got, (p, dx, dy)):
+            _same(have, want)
+
+
+# --- the rounds' bookkeeping (framework.systems.solve_rounds) ---------------------------------
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_number_is_the_numpy_numbering(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = 30
+    table, want_table = np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    first = 0
+    for _ in range(3):
+        ra, rb = rng.integers(0, n, 8), rng.integers(0, n, 8)
+        rows = np.concatenate([ra, rb])
+        new = np.unique(rows[want_table[rows] < 0])
+        want_table[new] = first + np.arange(new.size)
+        got_new, got_local = sr.number(table, ra, rb, first)
+        _same(got_new, new)
+        _same(got_local, want_table[rows])
+        _same(table, want_table)
+        first += new.size
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_pair_picks_are_the_numpy_picks(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    ea, eb, ca, cb = (rng.integers(0, 50, 12) for _ in range(4))
+    known = sr.known_keys(ea, eb, ca, cb)
+    _same(known, np.sort(np.concatenate([pair_keys(ea, eb), pair_keys(ca, cb)])))
+    # candidates not known, in the store, solid
+    n = 40
+    kind = rng.integers(-1, 3, n)
+    sensor, asleep, one_way = (rng.random(n) < 0.1 for _ in range(3))
+    inv_mass = np.where(rng.random(n) < 0.4, 0.0, 1.0)
+    layer, mask = rng.integers(1, 4, n), rng.integers(1, 4, n)
+    pa, pb = rng.integers(0, 45, 30), rng.integers(0, 45, 30)
+    pea, peb = np.concatenate([ea[:5], rng.integers(0, 50, 25)]), np.concatenate([eb[:5], rng.integers(0, 50, 25)])
+    cols = (kind, sensor, inv_mass, asleep, one_way, layer, mask, False)
+    keep = ~sorted_member(pair_keys(pea, peb), known) & (pa < n) & (pb < n)
+    ok = gather.solid_pairs_mask(pa[keep], pb[keep], *cols)
+    want = tuple(v[keep][ok] for v in (pa, pb, pea, peb))
+    for have, w in zip(sr.unknown_solid_pairs(pa, pb, pea, peb, known, n, *cols), want):
+        _same(have, w)
+    # the statics near the movable bodies, and their kept pairs
+    x, y = _floats(rng, n, specials=False), _floats(rng, n, specials=False)
+    cx, cy = np.where(rng.random(n) < 0.3, np.nan, x + 0.1), y - 0.05
+    rows_all = rng.permutation(n)[:15]
+    local = rng.permutation(15)[:10]
+    reach = np.where(rng.random(15) < 0.2, np.inf, 0.1 + 0.1 * rng.random(15))
+    rows, margin = rows_all[local], reach[local]
+    ok = (inv_mass[rows] > 0.0) & ~asleep[rows] & np.isfinite(margin)
+    r, m = rows[ok], margin[ok]
+    far = ~(np.abs(x[r] - cx[r]) + np.abs(y[r] - cy[r]) <= m)
+    for have, w in zip(sr.near_rows(local, rows_all, reach, inv_mass, asleep, x, y, cx, cy), (r, m, far)):
+        _same(have, w)
+    lut = np.where(rng.random(60) < 0.1, -1, rng.integers(0, n, 60))
+    pair_row = rng.integers(0, n, 30)
+    want_rows = np.zeros(n, dtype=bool)
+    want_rows[r] = True
+    sel = want_rows[pair_row]
+    e1, e2 = pea[sel], peb[sel]
+    keep = ~sorted_member(pair_keys(e1, e2), known)
+    e1, e2 = e1[keep], e2[keep]
+    r1, r2 = lut[e1], lut[e2]
+    ok = gather.solid_pairs_mask(r1, r2, *cols)
+    got = sr.kept_static_pairs(n, r, pair_row, pea, peb, known, lut, *cols)
+    for have, w in zip(got, (r1[ok], r2[ok], e1[ok], e2[ok])):
+        _same(have, w)
+
+
+@pytest.mark.parametrize("rigid", [False, True])
+def test_apply_measures_is_the_numpy_update(rigid: bool) -> None:
+    rng = np.random.default_rng(int(rigid))
+    n, c = 10, 24
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny, depth = np.cos(angle), np.sin(angle), rng.normal(size=c) * 0.01
+    dx, dy = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01
+    rn_a, rn_b, dturn = (rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01) if rigid else (
+        np.zeros(0), np.zeros(0), np.zeros(0))
+    check = np.sort(rng.permutation(c)[:12])
+    hit = rng.random(12) < 0.5
+    ra = rng.uniform(-np.pi, np.pi, 12)
+    rnx, rny, rdepth = np.cos(ra), np.sin(ra), rng.normal(size=12) * 1e-8
+
+    def shift(idx):
+        s = (dx[b[idx]] - dx[a[idx]]) * nx[idx] + (dy[b[idx]] - dy[a[idx]]) * ny[idx]
+        if rigid:
+            s += rn_b[idx] * dturn[b[idx]] - rn_a[idx] * dturn[a[idx]]
+        return s
+
+    cols = [nx.copy(), ny.copy(), depth.copy()]
+    dirty = np.zeros(c, dtype=bool)
+    got = sr.apply_measures(check, hit, rnx, rny, rdepth, a, b, *cols, dx, dy, rn_a, rn_b, dturn, dirty, 1e-9)
+    apart = check[~hit]
+    depth[apart] = np.minimum(depth[apart], shift(apart))
+    h = check[hit]
+    nx[h], ny[h] = rnx[hit], rny[hit]
+    depth[h] = rdepth[hit] + shift(h)
+    for have, w in zip(cols, (nx, ny, depth)):
+        _same(have, w)
+    assert dirty.tobytes() == np.isin(np.arange(c), h).tobytes()
+    assert got == (bool(hit.any()), bool((rdepth[hit] > 1e-9).any()))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n_rows, c = 30, 20
+    rows, a, b = _scene(rng, n_rows, c)
+    ra, rb = rows[a], rows[b]
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny = np.cos(angle), np.sin(angle)
+    svx, svy = _floats(rng, n_rows, specials=False), _floats(rng, n_rows, specials=False)
+    vx, vy, u = sc.closing_speeds(rows, a, b, nx, ny, svx, svy)
+    want_vx, want_vy = svx[rows].copy(), svy[rows].copy()
+    _same(vx, want_vx)
+    _same(vy, want_vy)
+    _same(u, (want_vx[b] - want_vx[a]) * nx + (want_vy[b] - want_vy[a]) * ny)
+    if seed == 0:
+        u[3] = np.nan
+    warm = rng.random(c) < 0.6
+    touching = warm | (rng.random(c) < 0.2)
+    order = rng.permutation(c)
+    impulse0 = rng.random(c)
+    share_a = rng.random(c)
+    share_b = 1.0 - share_a
+    got_order, impulse, fastest = sc.warm_impulses(order, touching, warm, impulse0, a, b, nx, ny, share_a, share_b,
+                                                   vx, vy, u)
+    want_impulse = np.where(warm, impulse0, 0.0)
+    wx, wy = loops.warm_start(a, b, nx, ny, share_a, share_b, want_impulse, rows.size)
+    want_vx += wx
+    want_vy += wy
+    _same(got_order, order[touching[order]])
+    _same(impulse, want_impulse)
+    _same(vx, want_vx)
+    _same(vy, want_vy)
+    want_fastest = float(np.abs(u).max(initial=0.0))
+    assert np.float64(fastest).tobytes() == np.float64(want_fastest).tobytes()
+    # bounces
+    restitution = np.where(rng.random(n_rows) < 0.5, 0.0, rng.random(n_rows))
+    alive0 = rng.random(c) < 0.8
+    gx, gy, dt = 0.0, -10.0, 1.0 / 60.0
+    u = rng.normal(size=c)
+    rest = np.maximum(restitution[ra], restitution[rb])
+    g_n = gx * nx + gy * ny
+    resting_speed = 2.0 * np.abs(g_n) * dt
+    act = np.flatnonzero(warm)
+    hits = np.zeros(c, dtype=bool)
+    hits[act] = (rest[act] > 0.0) & (-u[act] > resting_speed[act]) & alive0[act]
+    for have, want in zip(sc.bounce_hits(warm, u, ra, rb, restitution, nx, ny, gx, gy, dt, alive0), (hits, rest, g_n)):
+        _same(have, want)
+
+
+@pytest.mark.parametrize("rigid", [False, True])
+def test_recorded_is_the_numpy_record(rigid: bool) -> None:
+    rng = np.random.default_rng(7 + int(rigid))
+    n, c = 10, 30
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    ea, eb = rng.integers(0, 6, c), rng.integers(0, 6, c)  # (repeated pairs: a pair's points)
+    angle = rng.uniform(-np.pi, np.pi, c)
+    nx, ny, depth = np.cos(angle), np.sin(angle), rng.normal(size=c) * 0.01
+    dx, dy, span = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01, 0.01 * rng.random(n)
+    rn_a, rn_b, dturn = (rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01) if rigid else (
+        np.zeros(0), np.zeros(0), np.zeros(0))
+    touching = rng.random(c) < 0.4
+    push = np.where(rng.random(c) < 0.5, 0.0, 0.02 * rng.random(c))
+    near = rng.random(c) < 0.3 if rigid else np.zeros(0, dtype=bool)
+    impulse, tpush, timpulse = rng.random(c), rng.random(c), rng.random(c)
+    got = sr.recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse,
+                      tpush, timpulse)
+    acted = touching | (push > 0.0)
+    kept = acted | near if rigid else acted
+    rows = np.flatnonzero(kept)
+    keys = pair_keys(ea[rows], eb[rows])
+    order = np.argsort(keys, kind="stable")
+    rows, keys = rows[order], keys[order]
+    sep = (dx[b] - dx[a]) * nx + (dy[b] - dy[a]) * ny
+    if rigid:
+        sep += rn_b * dturn[b] - rn_a * dturn[a]
+    sep = sep - depth
+    capped = np.minimum(push, 2.0 * np.minimum(span[a], span[b]))
+    want = (rows, keys, ea[rows], eb[rows], nx[rows], ny[rows], np.maximum(sep[rows], 0.0), push[rows], capped[rows],
+            impulse[rows], tpush[rows], timpulse[rows], acted[rows])
+    for have, w in zip(got, want):
+        _same(have, w)
+
+
+def test_place_and_far_bodies_are_the_numpy_ones() -> None:
+    rng = np.random.default_rng(3)
+    n_rows, n, c = 20, 8, 12
+    rows = rng.permutation(n_rows)[:n]
+    x0, y0 = rng.normal(size=n), rng.normal(size=n)
+    dx = np.where(rng.random(n) < 0.4, 0.0, 0.1 * rng.normal(size=n))
+    dy = np.where(rng.random(n) < 0.4, 0.0, 0.1 * rng.normal(size=n))
+    sx, sy = rng.normal(size=n_rows), rng.normal(size=n_rows)
+    want_x, want_y = sx.copy(), sy.copy()
+    moved = np.flatnonzero((dx != 0.0) | (dy != 0.0))
+    want_x[rows[moved]], want_y[rows[moved]] = x0[moved] + dx[moved], y0[moved] + dy[moved]
+    seen_x, seen_y = np.where(rng.random(n) < 0.5, dx, 0.0), dy.copy()
+    placed, *got = sr.place(rows, x0, y0, dx, dy, sx, sy, seen_x, seen_y)
+    assert placed == moved.size
+    _same(sx, want_x)
+    _same(sy, want_y)
+    for have, want in zip(got, ((dx != seen_x) | (dy != seen_y), dx, dy)):
+        _same(have, want)
+    fx, fy, limit = 0.05 * rng.normal(size=n), 0.05 * rng.normal(size=n), 0.1 * rng.random(n)
+    far = np.hypot(dx - fx, dy - fy) > limit
+    got_far, anyone = sr.far_bodies(dx, dy, fx, fy, limit, np.zeros(0, dtype=bool), np.zeros(0),
+                                    np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
+    _same(got_far, far)
+    assert anyone == bool(far.any())
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    immovable, push = rng.random(c) < 0.3, np.where(rng.random(c) < 0.3, 0.0, rng.random(c))
+    both = ~immovable & (push > 0.0)
+    pushed = np.zeros(n, dtype=bool)
+    pushed[a[both]] = pushed[b[both]] = True
+    pushed &= far
+    got_far, anyone = sr.far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b)
+    _same(got_far, pushed)
+    assert anyone == bool(pushed.any())
+
+
+@pytest.mark.parametrize("immovable_only", [False, True])
+def test_moved_candidates_are_the_numpy_ones(immovable_only: bool) -> None:
+    rng = np.random.default_rng(11)
+    n_rows, n, c = 30, 12, 25
+    table = np.full(n_rows, -1, dtype=np.int64)
+    table[rng.permutation(n_rows)[:n]] = np.arange(n)
+    moved = rng.random(n) < 0.5
+    ra, rb = rng.integers(0, n_rows, c), rng.integers(0, n_rows, c)
+    inv_mass, asleep = np.where(rng.random(n_rows) < 0.3, 0.0, 1.0), rng.random(n_rows) < 0.2
+    m = np.append(moved, False)
+    near = m[table[ra]] | m[table[rb]]
+    if immovable_only:
+        movable = (inv_mass > 0.0) & ~asleep
+        near &= ~(movable[ra] & movable[rb])
+    look = np.flatnonzero(near)
+    got = sr.moved_candidates(moved, table, ra, rb, immovable_only, inv_mass, asleep)
+    for have, want in zip(got, (look, ra[look], rb[look])):
+        _same(have, want)
