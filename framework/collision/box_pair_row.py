@@ -17,6 +17,7 @@ from ..compiled import inner
 from .batch_box import _less_1, _two_sum_1
 from .collide import POINT_TOL
 from .exact import BAND, TINY
+from .row_frame import frame_row, world_row
 from .tiebreak import DEPTH_TOL
 
 __all__ = ["aabb_exact_row"]
@@ -119,7 +120,8 @@ def _box_point(hwa, hha, hwb, hhb, dx, dy, size):  # pragma: no cover - compiled
 @njit(cache=True)
 def aabb_exact_row(ax, ay, ahw, ahh, bx, by, bhw, bhh):  # pragma: no cover - compiled
     """``aabb_aabb`` of one pair: ``(hit, nx, ny, depth, px, py, found)``; ``found`` False where
-    rounding hid every vertex of the overlap (the caller answers that rare pair otherwise)."""
+    rounding hid every vertex of the overlap or a value is beyond float64's range (the caller
+    answers that rare pair otherwise)."""
     dxh, dxl = _two_sum_1(bx, -ax)
     rxh, rxl = _two_sum_1(ahw, bhw)
     dyh, dyl = _two_sum_1(by, -ay)
@@ -129,11 +131,7 @@ def aabb_exact_row(ax, ay, ahw, ahh, bx, by, bhw, bhh):  # pragma: no cover - co
     ra, rb = math.hypot(ahw, ahh), math.hypot(bhw, bhh)
     # batch_common.frame
     reach = ra if ra > rb else rb
-    hdx, hdy = 0.5 * bx - 0.5 * ax, 0.5 * by - 0.5 * ay
-    m = abs(hdx) if abs(hdx) > abs(hdy) else abs(hdy)
-    m = m if m > 0.5 * reach else 0.5 * reach
-    k = math.frexp(m)[1]
-    dx, dy = math.ldexp(hdx, 1 - k), math.ldexp(hdy, 1 - k)
+    dx, dy, k = frame_row(ax, ay, bx, by, reach)
     hwa, hha, hwb, hhb = math.ldexp(ahw, -k), math.ldexp(ahh, -k), math.ldexp(bhw, -k), math.ldexp(bhh, -k)
     size = math.ldexp(ra + rb, -k)
     wa, wb, ha, hb = hwa + hwa, hwb + hwb, hha + hha, hhb + hhb
@@ -164,7 +162,6 @@ def aabb_exact_row(ax, ay, ahw, ahh, bx, by, bhw, bhh):  # pragma: no cover - co
     else:
         nx, ny, depth = (1.0 if right <= lim else -1.0), 0.0, (right if right <= lim else left)
     px, py, found = _box_point(hwa, hha, hwb, hhb, dx, dy, size)
-    # batch_common.finish
-    depth = max(math.ldexp(depth, k), TINY)
-    return True, nx + 0.0, ny + 0.0, depth, ax + math.ldexp(px, k), ay + math.ldexp(py, k), found
+    finite, depth, px, py = world_row(depth, px, py, k, ax, ay)
+    return True, nx + 0.0, ny + 0.0, depth, px, py, found and finite
 

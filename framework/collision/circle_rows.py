@@ -23,9 +23,10 @@ import math
 import numpy as np
 from numba import njit
 
-from .exact import BAND, TINY
+from .exact import BAND
 from .exact_sign import APART, polygon_circle_apart
 from .polygon_rows import _BIG, _edges, _extent, _norm, _outline, _pick, _radius
+from .row_frame import frame_row, world_row
 
 __all__ = ["polygon_circle_pairs"]
 
@@ -49,11 +50,7 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
         # The polygon's frame (batch_common.frame).
         ext = _extent(vx, vy)
         reach = ext if ext > r else r
-        hdx, hdy = 0.5 * bx - 0.5 * ax, 0.5 * by - 0.5 * ay
-        m = abs(hdx) if abs(hdx) > abs(hdy) else abs(hdy)
-        m = m if m > 0.5 * reach else 0.5 * reach
-        e = math.frexp(m)[1]
-        cx, cy = math.ldexp(hdx, 1 - e), math.ldexp(hdy, 1 - e)
+        cx, cy, e = frame_row(ax, ay, bx, by, reach)
         for j in range(k):
             vx[j], vy[j] = math.ldexp(vx[j], -e), math.ldexp(vy[j], -e)
         r = math.ldexp(r, -e)
@@ -124,12 +121,8 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
             nxi, nyi = f * ddx / dist, f * ddy / dist
             dep = r - dist
             pxi, pyi = vx[vi], vy[vi]
-        # batch_common.finish: unscaled, in the world.
-        dep = math.ldexp(dep, e)
-        dep = dep if dep > TINY else TINY
-        pxi = ax + math.ldexp(pxi, e)
-        pyi = ay + math.ldexp(pyi, e)
-        if not (math.isfinite(dep) and math.isfinite(pxi) and math.isfinite(pyi)):
+        finite, dep, pxi, pyi = world_row(dep, pxi, pyi, e, ax, ay)
+        if not finite:
             defer[i] = True  # (the numpy kernel raises its error)
             continue
         hit[i] = True

@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from ..compiled import inner
+from .batch_box import _two_sum_1 as _two_sum
 
 __all__ = ["APART", "OVERLAP", "UNSURE", "polygons_apart"]
 
@@ -29,13 +30,6 @@ APART, OVERLAP, UNSURE = 0, 1, 2
 
 _LO, _HI = 2.0**-300, 2.0**300
 _SPLIT = 134217729.0  # 2**27 + 1 (Dekker's split of a double into two 26-bit halves)
-
-
-@inner
-def _two_sum(a, b):  # pragma: no cover - compiled
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
 
 
 @inner

@@ -42,6 +42,7 @@ from .collide import POINT_TOL
 from .exact import BAND, TINY
 from .exact_sign import APART, OVERLAP, polygon_depths, polygons_apart
 from .kinds import KIND_AABB
+from .row_frame import frame_row, world_row
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
 __all__ = ["polygon_pairs"]
@@ -306,7 +307,7 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
         if _centred_box(avx, avy, ac) and _centred_box(bvx, bvy, bc):
             if exact and points:
                 h, nxi, nyi, dep, pxi, pyi, found = aabb_exact_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2])
-                if not (found and math.isfinite(dep) and math.isfinite(pxi) and math.isfinite(pyi)):
+                if not found:
                     defer[i] = True
                 elif h:
                     hit[i] = True
@@ -320,11 +321,7 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
         # The scaled frame (batch_common.frame, batch_polygon._frame).
         ea, eb = _extent(avx, avy), _extent(bvx, bvy)
         reach = ea if ea > eb else eb  # (np.maximum: no NaN here)
-        hdx, hdy = 0.5 * bx - 0.5 * ax, 0.5 * by - 0.5 * ay
-        m = abs(hdx) if abs(hdx) > abs(hdy) else abs(hdy)
-        m = m if m > 0.5 * reach else 0.5 * reach
-        e = math.frexp(m)[1]
-        dx, dy = math.ldexp(hdx, 1 - e), math.ldexp(hdy, 1 - e)
+        dx, dy, e = frame_row(ax, ay, bx, by, reach)
         for j in range(k):
             avx[j], avy[j] = math.ldexp(avx[j], -e), math.ldexp(avy[j], -e)
             bvx[j], bvy[j] = math.ldexp(bvx[j], -e), math.ldexp(bvy[j], -e)
@@ -395,12 +392,8 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
                 bvx[j] += dx
                 bvy[j] += dy
             pxi, pyi = _overlap_point(avx, avy, ac, bvx, bvy, bc, nxi, nyi, dep, sz, exa, eya, exb, eyb, na, nb)
-        # batch_common.finish: unscaled, in the world.
-        dep = math.ldexp(dep, e)
-        dep = dep if dep > TINY else TINY
-        pxi = ax + math.ldexp(pxi, e)
-        pyi = ay + math.ldexp(pyi, e)
-        if not (math.isfinite(dep) and math.isfinite(pxi) and math.isfinite(pyi)):
+        finite, dep, pxi, pyi = world_row(dep, pxi, pyi, e, ax, ay)
+        if not finite:
             defer[i] = True  # (the numpy kernel raises its error)
             continue
         hit[i] = True
