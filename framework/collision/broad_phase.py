@@ -463,7 +463,8 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
                 a, b = b, a
             if m == out.size:
                 grown = np.empty(2 * m, dtype=np.int64)
-                grown[:m] = out
+                for q in range(m):  # (a loop: a slice assignment compiles numba's shape checks, seconds)
+                    grown[q] = out[q]
                 out = grown
             out[m] = (a << 32) | b
             m += 1

@@ -12,7 +12,6 @@ not decide itself (see there). :data:`FAST` = False turns it off.
 from __future__ import annotations
 
 import math
-from collections import Counter
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -81,10 +80,10 @@ class CharacterStage(Stage):
         from ..queries import SpatialQueries
 
         self.queries: SpatialQueries = SpatialQueries(pipeline)
-        self._kernel: Any = None  # the compiled move's module, imported by the first character
-        self._outputs: tuple[Any, ...] = ()  # the arrays it writes its outcome to
+        # (plain values only: a snapshot keeps the stages' state; the compiled move's module and
+        # its output arrays are the process's, _compiled_move)
         self.fast_moves = 0  # moves made by the compiled move (the tests' evidence it ran)
-        self.fallbacks: Counter[str] = Counter()  # the moves it handed back, by reason
+        self.fallbacks: dict[str, int] = {}  # the moves it handed back, by reason
 
     # --- checks before the step ------------------------------------------------------------------
 
@@ -245,11 +244,7 @@ class CharacterStage(Stage):
                   ox: float, oy: float) -> bool:
         """The rest of ``_move`` (its candidates gathered) by the compiled move, for a box among
         boxes: False, nothing changed, where it hands the move back to the Python code."""
-        if self._kernel is None:
-            from . import character_kernel
-
-            self._kernel = character_kernel
-            self._outputs = character_kernel.outputs()
+        kernel, outputs = _compiled_move()
         store, geom = self.bodies.store, self.bodies.geometry
         c, row = store.cols, mv.row
         assert mv.rows is not None and mv.box is not None  # (gathered)
@@ -260,11 +255,12 @@ class CharacterStage(Stage):
                        snap, math.tan(math.radians(ctrl.max_floor_angle)), *ctrl.floor_normal])
         world = (mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, c["hw"], c["hh"],
                  c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
-        st, si, push_r, push_n = self._outputs
-        reason = self._kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor,
+        st, si, push_r, push_n = outputs
+        reason = kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor,
                                        ride_after, ctrl.max_slides, _RIDE_SLIDES, st, si, push_r, push_n)
         if reason:
-            self.fallbacks[self._kernel.REASONS[reason]] += 1
+            why = kernel.REASONS[reason]
+            self.fallbacks[why] = self.fallbacks.get(why, 0) + 1
             return False
         self.fast_moves += 1
         x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()
@@ -639,6 +635,20 @@ class CharacterStage(Stage):
             store.cols["vy"][r] -= dv * ny
             if store.cols["asleep"][r]:
                 store.wake(r)
+
+
+_COMPILED_MOVE: tuple[Any, tuple[Any, ...]] | None = None
+
+
+def _compiled_move() -> tuple[Any, tuple[Any, ...]]:
+    """The compiled move's module and the arrays it writes its outcome to, imported (and so
+    compiled, or loaded from numba's cache) when a scene first has a box character to move."""
+    global _COMPILED_MOVE
+    if _COMPILED_MOVE is None:
+        from . import character_kernel
+
+        _COMPILED_MOVE = (character_kernel, character_kernel.outputs())
+    return _COMPILED_MOVE
 
 
 def default_skin(size: float, x: float, y: float) -> float:
