@@ -14,8 +14,8 @@ from contextlib import contextmanager
 
 __all__ = ["FIRST_STEP_NOTICE", "notice_if_slow"]
 
-FIRST_STEP_NOTICE = ("framework: compiling the physics kernels for this scene (once per installation, a few "
-                     "seconds, up to about 15 where bodies turn; later runs load them from numba's cache)")
+FIRST_STEP_NOTICE = ("framework: compiling the physics kernels for this scene (once per installation, 20 to 40 "
+                     "seconds; later runs load them from numba's cache)")
 
 
 @contextmanager
