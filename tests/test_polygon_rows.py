@@ -19,7 +19,7 @@ from framework import AABB, Circle, Polygon, Segment
 from framework.collision import batch
 from framework.collision.kinds import KIND_AABB, KIND_CIRCLE, KIND_POLYGON, KIND_SEGMENT
 from framework.geometry import Geometry
-from framework.systems.narrow_phase import _polygon_circle_pairs, _polygon_pairs
+from framework.systems.narrow_phase import _circle_pairs, _polygon_circle_pairs, _polygon_pairs
 
 
 def _rows(shapes, poses):
@@ -364,3 +364,50 @@ def test_exact_sum_is_fsum(parts) -> None:
 
     got, want = exact_sum(np.array(parts)), math.fsum(parts)
     assert got == want or (want == 0.0 and got == 0.0) or (abs(want) < 2.0**-900 and math.isnan(got))
+
+
+def _check_circle_pairs(radii, centres, pairs) -> None:
+    """Circle rows against circle rows: the compiled pass's bits are the numpy kernel's, in a
+    batch and one row at a time, with and without exactness."""
+    store = SimpleNamespace(radius=np.array(radii, dtype=float))
+    geom = SimpleNamespace(hx=np.array([c[0] for c in centres]), hy=np.array([c[1] for c in centres]))
+    a = np.array([p[0] for p in pairs], dtype=np.int64)
+    b = np.array([p[1] for p in pairs], dtype=np.int64)
+
+    def numpy(rows, exact):
+        ra, rb = a[rows], b[rows]
+        return batch.circle_circle(geom.hx[ra], geom.hy[ra], store.radius[ra], geom.hx[rb], geom.hy[rb],
+                                   store.radius[rb], exact=exact)
+
+    for exact in (True, False):
+        every = np.arange(a.size)
+        _same_bits(_circle_pairs(store, geom, a, b, exact=exact), numpy(every, exact))
+        for i in range(a.size):
+            one = every[i:i + 1]
+            _same_bits(_circle_pairs(store, geom, a[one], b[one], exact=exact), numpy(one, exact))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(_SIZE, _DYADIC, _DYADIC), min_size=2, max_size=8), st.data(),
+       st.sampled_from([1.0, 2.0**40, 2.0**-600]), st.sampled_from([0.0, 1e9]))
+def test_random_circle_pairs_same_bits(balls, data, scale, far) -> None:
+    """Random circles at dyadic places (many touching exactly, some concentric), scaled and moved
+    far out: the numpy kernel's bits, its exact fallback's included."""
+    radii = [r * scale for r, _x, _y in balls]
+    centres = [(x * scale + far, y * scale) for _r, x, y in balls]
+    n = len(balls)
+    pairs = data.draw(st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)).filter(lambda p: p[0] != p[1]),
+                               min_size=1, max_size=12))
+    _check_circle_pairs(radii, centres, pairs)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(0.25, 2.0), st.floats(0.25, 2.0), st.floats(0.0, 2.0 * math.pi), _OFFSET, _OFFSET,
+       st.integers(-2, 2))
+def test_circles_touching_to_the_last_bit_same_bits(r1, r2, angle, ox, oy, nudge) -> None:
+    """Two circles placed at the sum of their radii along a random direction (touching to rounding),
+    nudged by up to two ulps: the exact excess on floats is the integers' (the numpy kernel's)."""
+    qx, qy = ox + (r1 + r2) * math.cos(angle), oy + (r1 + r2) * math.sin(angle)
+    for _ in range(abs(nudge)):
+        qx = float(np.nextafter(qx, math.copysign(math.inf, nudge)))
+    _check_circle_pairs([r1, r2], [(ox, oy), (qx, qy)], [(0, 1), (1, 0)])

@@ -23,12 +23,12 @@ import math
 import numpy as np
 from numba import njit
 
-from .exact import BAND
-from .exact_sign import APART, polygon_circle_apart
+from .exact import BAND, TINY
+from .exact_sign import APART, UNSURE, circles_excess, polygon_circle_apart
 from .polygon_rows import _BIG, _edges, _extent, _norm, _outline, _pick, _radius
 from .row_frame import frame_row, world_row
 
-__all__ = ["polygon_circle_pairs"]
+__all__ = ["circle_pairs", "polygon_circle_pairs"]
 
 
 @njit(cache=True)
@@ -124,6 +124,57 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
         finite, dep, pxi, pyi = world_row(dep, pxi, pyi, e, ax, ay)
         if not finite:
             defer[i] = True  # (the numpy kernel raises its error)
+            continue
+        hit[i] = True
+        nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi
+    return hit, nx, ny, depth, px, py, defer
+
+
+@njit(cache=True)
+def circle_pairs(ra_rows, rb_rows, hx, hy, radius, exact):  # pragma: no cover - compiled
+    """``circle_circle`` of the circle rows ``(ra_rows[i], rb_rows[i])``: the six contact columns
+    and ``defer``, the rows left to the numpy kernel (touching to rounding where the exact
+    decision on floats, :func:`~framework.collision.exact_sign.circles_excess`, cannot be made;
+    a contact beyond float64's range)."""
+    n = ra_rows.size
+    hit = np.zeros(n, dtype=np.bool_)
+    nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    defer = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        a, b = ra_rows[i], rb_rows[i]
+        ax, ay, bx, by, ar, br = hx[a], hy[a], hx[b], hy[b], radius[a], radius[b]
+        dx, dy, e = frame_row(ax, ay, bx, by, ar if ar > br else br)
+        ra, rb = math.ldexp(ar, -e), math.ldexp(br, -e)
+        rsum = ra + rb
+        d2, r2 = dx * dx + dy * dy, rsum * rsum
+        band = BAND * (d2 + r2)
+        near = exact and d2 > r2 - band and d2 < r2 + band
+        num = 0.0
+        if near:
+            verdict, num = circles_excess(ax, ay, bx, by, e, ra, rb)
+            if verdict == UNSURE:
+                defer[i] = True
+                continue
+            if verdict == APART:
+                continue
+        elif not d2 <= r2 - band:
+            continue
+        dist = math.hypot(dx, dy)
+        if near:  # (the exact (ra + rb)^2 - |d|^2 = depth * (ra + rb + |d|))
+            dep = num / (rsum + dist)
+            dep = dep if dep > TINY else TINY
+        else:
+            dep = rsum - dist
+        if dist > 0.0:
+            nxi, nyi = dx / dist, dy / dist
+        else:  # (coincident centres: push up)
+            nxi, nyi = 0.0, 1.0
+        lo = dist - rb if dist - rb > -ra else -ra
+        hi = dist + rb if dist + rb < ra else ra
+        mid = 0.5 * (lo + hi)
+        finite, dep, pxi, pyi = world_row(dep, nxi * mid, nyi * mid, e, ax, ay)
+        if not finite:
+            defer[i] = True
             continue
         hit[i] = True
         nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi

@@ -444,3 +444,35 @@ def exact_sum(parts):  # pragma: no cover - compiled
         m = _grow(e, m, parts[i])
     value, ok = _rounded(e, m, np.empty(4 * parts.size + 8), np.empty(4 * parts.size + 8))
     return value if ok else np.nan
+
+
+# --- circle / circle --------------------------------------------------------------------------------
+
+@njit(cache=True)
+def circles_excess(ox, oy, qx, qy, k, ra, rb):  # pragma: no cover - compiled
+    """:func:`~framework.collision.exact.circle_circle_exact` on floats: circles of radius ``ra``
+    at the origin and ``rb`` at the exact offset ``(q - o) * 2**-k`` (radii scaled):
+    ``(verdict, excess)``, the excess ``(ra + rb)^2 - |d|^2`` correctly rounded where they
+    overlap (:data:`OVERLAP`), else :data:`APART` or :data:`UNSURE`."""
+    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
+    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
+    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
+            or math.ldexp(ty, k) != oy):
+        return UNSURE, 0.0
+    d = np.empty(2)
+    e = np.empty(2)
+    s = np.empty(2)
+    d[1], d[0] = _two_sum(sx, -tx)
+    e[1], e[0] = _two_sum(sy, -ty)
+    s[1], s[0] = _two_sum(ra, rb)
+    for v in (d[0], d[1], e[0], e[1], s[0], s[1]):
+        if not _fits(v):
+            return UNSURE, 0.0
+    out = np.empty(64)
+    m = _mul(out, 0, s, 2, s, 2, 1.0)
+    m = _mul(out, m, d, 2, d, 2, -1.0)
+    m = _mul(out, m, e, 2, e, 2, -1.0)
+    if _sign(out, m) <= 0:
+        return APART, 0.0
+    value, ok = _rounded(out, m, np.empty(256), np.empty(256))
+    return (OVERLAP, value) if ok else (UNSURE, 0.0)

@@ -13,7 +13,7 @@ from ..arrays import BoolArray, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.batch_box import aabb_pairs_fast
 from ..collision.chain import chain_rule, deepest_below
-from ..collision.circle_rows import polygon_circle_pairs
+from ..collision.circle_rows import circle_pairs, polygon_circle_pairs
 from ..collision.kinds import (
     BOXES,
     CAPSULES,
@@ -157,8 +157,7 @@ def _pair_contacts(
             res = aabb_pairs_fast(a, b, hx, hy, store.cols["hw"], store.cols["hh"], exact=not remeasure,
                                   points=not remeasure)
         elif f == CIRCLES:
-            res = batch.circle_circle(hx[a], hy[a], store.radius[a], hx[b], hy[b], store.radius[b],
-                                       exact=not remeasure)
+            res = _circle_pairs(store, geom, a, b, exact=not remeasure)
         elif f == POLYGON_CIRCLE:
             flip = _PAIR_FLIP[code if idx is None else code[idx]]  # the circle is A: normals from it
             poly, circ = np.where(flip, b, a), np.where(flip, a, b)
@@ -190,6 +189,22 @@ def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray,
         hx, hy = geom.hx, geom.hy
         hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.polygon_polygon(
             hx[da], hy[da], va, na, hx[db], hy[db], vb, nb, exact=exact, points=points)
+    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
+def _circle_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, *, exact: bool,
+                  ) -> batch.ContactArrays:
+    """:func:`~framework.collision.batch.circle_circle` of pairs of circle rows: the compiled pass
+    (:func:`~framework.collision.circle_rows.circle_pairs`), and the numpy kernel on the rows it
+    leaves to it."""
+    a, b = np.ascontiguousarray(a, dtype=np.int64), np.ascontiguousarray(b, dtype=np.int64)
+    hit, nx, ny, depth, px, py, defer = circle_pairs(a, b, geom.hx, geom.hy, store.radius, exact)
+    if defer.any():
+        d = np.flatnonzero(defer)
+        da, db = a[d], b[d]
+        hx, hy, radius = geom.hx, geom.hy, store.radius
+        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.circle_circle(
+            hx[da], hy[da], radius[da], hx[db], hy[db], radius[db], exact=exact)
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
 
 
