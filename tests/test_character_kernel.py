@@ -239,3 +239,32 @@ def test_hand_backs_are_counted_by_reason():
         s.step(DT)
     stage = s._stages["character"]  # type: ignore[attr-defined]
     assert stage.fallbacks["a candidate not a box"] > 0 and stage.fast_moves > 0
+
+
+def test_snapshots_of_a_scene_moving_by_the_compiled_move_continue_bit_for_bit(tmp_path):
+    # a snapshot keeps the stages' state: the character stage's must be savable in memory and in a
+    # file while the compiled move runs, and a restored scene continues as the original does
+    from framework.snapshot_file import load_snapshot, save_snapshot
+
+    s, drive = _boxes_level(), _walker(7)
+    for k in range(40):
+        drive(s, k)
+        s.step(DT)
+    assert s._stages["character"].fast_moves > 0  # type: ignore[attr-defined]
+    snap = s.snapshot()
+    save_snapshot(s, tmp_path / "level.npz")
+    rest = _walker(8)
+    want = []
+    for k in range(40):
+        rest(s, k)
+        s.step(DT)
+        want.append(_state(s))
+    s.restore(snap)
+    other = _boxes_level()
+    load_snapshot(other, tmp_path / "level.npz")
+    for scene in (s, other):
+        rest = _walker(8)
+        for k in range(40):
+            rest(scene, k)
+            scene.step(DT)
+            assert _state(scene) == want[k], f"step {k}"

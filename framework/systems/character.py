@@ -80,8 +80,9 @@ class CharacterStage(Stage):
         from ..queries import SpatialQueries
 
         self.queries: SpatialQueries = SpatialQueries(pipeline)
-        # (plain values only: a snapshot keeps the stages' state; the compiled move's module and
-        # its output arrays are the process's, _compiled_move)
+        # (values a snapshot can keep: it saves the stages' state; the compiled move's module is
+        # the process's, _compiled_move)
+        self._outputs: tuple[Any, ...] = ()  # the arrays the compiled move writes its outcome to
         self.fast_moves = 0  # moves made by the compiled move (the tests' evidence it ran)
         self.fallbacks: dict[str, int] = {}  # the moves it handed back, by reason
 
@@ -244,7 +245,9 @@ class CharacterStage(Stage):
                   ox: float, oy: float) -> bool:
         """The rest of ``_move`` (its candidates gathered) by the compiled move, for a box among
         boxes: False, nothing changed, where it hands the move back to the Python code."""
-        kernel, outputs = _compiled_move()
+        kernel = _compiled_move()
+        if not self._outputs:
+            self._outputs = kernel.outputs()
         store, geom = self.bodies.store, self.bodies.geometry
         c, row = store.cols, mv.row
         assert mv.rows is not None and mv.box is not None  # (gathered)
@@ -255,7 +258,7 @@ class CharacterStage(Stage):
                        snap, math.tan(math.radians(ctrl.max_floor_angle)), *ctrl.floor_normal])
         world = (mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, geom.hx, geom.hy, c["hw"], c["hh"],
                  c["one_way"], c["body"], c["entity"], c["bound"], c["kind"])
-        st, si, push_r, push_n = outputs
+        st, si, push_r, push_n = self._outputs
         reason = kernel.move_box(world, me, go, -1 if floor_row is None else floor_row, was_on_floor,
                                        ride_after, ctrl.max_slides, _RIDE_SLIDES, st, si, push_r, push_n)
         if reason:
@@ -637,18 +640,12 @@ class CharacterStage(Stage):
                 store.wake(r)
 
 
-_COMPILED_MOVE: tuple[Any, tuple[Any, ...]] | None = None
+def _compiled_move() -> Any:
+    """The compiled move's module, imported (and so compiled, or loaded from numba's cache) when a
+    scene first has a box character to move."""
+    from . import character_kernel
 
-
-def _compiled_move() -> tuple[Any, tuple[Any, ...]]:
-    """The compiled move's module and the arrays it writes its outcome to, imported (and so
-    compiled, or loaded from numba's cache) when a scene first has a box character to move."""
-    global _COMPILED_MOVE
-    if _COMPILED_MOVE is None:
-        from . import character_kernel
-
-        _COMPILED_MOVE = (character_kernel, character_kernel.outputs())
-    return _COMPILED_MOVE
+    return character_kernel
 
 
 def default_skin(size: float, x: float, y: float) -> float:
