@@ -176,7 +176,8 @@ def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray,
                    points: bool) -> batch.ContactArrays:
     """:func:`~framework.collision.batch.polygon_polygon` of pairs of box and polygon rows: the
     compiled pass over the rows (:mod:`~framework.collision.polygon_rows`), and the numpy kernel on
-    the outlines of the few rows that pass leaves to it (exact fallbacks, two centred boxes)."""
+    the outlines of the rare rows that pass leaves to it (inputs beyond the range where the exact
+    decisions on floats hold, a contact beyond float64's range)."""
     a, b = np.ascontiguousarray(a, dtype=np.int64), np.ascontiguousarray(b, dtype=np.int64)
     hit, nx, ny, depth, px, py, defer = polygon_pairs(a, b, geom.hx, geom.hy, store.kind, store.hw, store.hh,
                                                       geom.world_poly, geom.poly_slot, geom.count, geom.K, exact,
@@ -212,7 +213,8 @@ def _polygon_circle_pairs(store: BodyStore, geom: Geometry, poly: IntpArray, cir
                           exact: bool) -> batch.ContactArrays:
     """:func:`~framework.collision.batch.polygon_circle` of pairs of polygon (box, segment) and
     circle rows: the compiled pass over the rows (:mod:`~framework.collision.circle_rows`), and
-    the numpy kernel on the outlines of the rows it leaves to it (exact fallbacks)."""
+    the numpy kernel on the outlines of the rows it leaves to it (overlaps touching to rounding,
+    whose contacts come from the exact integers)."""
     poly, circ = np.ascontiguousarray(poly, dtype=np.int64), np.ascontiguousarray(circ, dtype=np.int64)
     flip = np.ascontiguousarray(flip, dtype=np.bool_)
     hit, nx, ny, depth, px, py, defer = polygon_circle_pairs(poly, circ, flip, geom.hx, geom.hy, store.kind, store.hw,
