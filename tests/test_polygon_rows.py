@@ -314,24 +314,27 @@ def _circle_on_outline(draw):
 
 
 @settings(max_examples=500, deadline=None)
-@given(_circle_on_outline())
-def test_exact_polygon_circle_decision_matches_the_integers(case) -> None:
-    """:func:`framework.collision.exact_sign.polygon_circle_apart` (floats, expansions) decides as
-    :func:`framework.collision.exact.polygon_circle_exact` (integers): circles touching faces and
-    vertices to the last bit, nudged an ulp either way, and inside."""
-    from framework.collision.exact import polygon_circle_exact
-    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygon_circle_apart
+@given(_circle_on_outline(), st.sampled_from([1.0, -1.0]))
+def test_exact_polygon_circle_contact_matches_the_integers(case, f) -> None:
+    """:func:`framework.collision.exact_sign.polygon_circle_contact` (floats, expansions) gives
+    :func:`framework.collision.batch_circle._polygon_circle_exact`'s answer (integers) bit for bit:
+    circles touching faces and vertices to the last bit, nudged an ulp either way, and inside."""
+    from framework.collision.batch_circle import _polygon_circle_exact
+    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygon_circle_contact
 
     pts, r, (ox, oy, qx, qy) = case
     kk = 8
     vx, vy = (np.array([p[j] for p in pts] + [pts[-1][j]] * (kk - len(pts))) for j in (0, 1))
-    got = polygon_circle_apart(vx, vy, len(pts), ox, oy, qx, qy, 0, r)
-    want = polygon_circle_exact(pts, (ox, oy, qx, qy, 0), r)
+    cx, cy, size = qx - ox, qy - oy, 2.0
+    verdict, *got = polygon_circle_contact(vx, vy, len(pts), ox, oy, qx, qy, 0, r, cx, cy, size, f)
+    want = _polygon_circle_exact(pts, (ox, oy, qx, qy, 0), r, cx, cy, size, f)
     values = [abs(v) for v in (*vx, *vy, r, ox, oy, qx, qy, qx - ox, qy - oy) if v != 0.0]
-    if got == UNSURE:
+    if verdict == UNSURE:
         assert min(values) < 2.0**-200 or max(values) > 2.0**200
-    else:
-        assert got == (APART if want is None else OVERLAP)
+        return
+    assert verdict == (APART if want is None else OVERLAP)
+    if want is not None:
+        assert np.array_equal(np.array(got).view(np.int64), np.array(want).view(np.int64)), (got, want)
 
 
 @settings(max_examples=500, deadline=None)

@@ -10,10 +10,10 @@ It is the numpy kernel row by row, in the same order of operations, so the same 
 polygon's scaled frame, the centre's distance outside each face, inside (out through the nearest
 face, by the tie-break rule), nearest a face or nearest a vertex, and
 :func:`~framework.collision.batch_common.finish`. Rows within rounding of touching, where
-contacts must be exact, are decided exactly on the floats (:mod:`.exact_sign`); those that
-overlap (their contact comes from the integers), those that decision cannot take and a contact
-beyond float64's range are left to the numpy kernel (``defer``), which answers them as it always
-did; a row's answer does not depend on the others of its batch.
+contacts must be exact, are decided and their contacts found exactly on the floats
+(:mod:`.exact_sign`, the integers' bits); the rare rows that cannot be settled there (inputs
+beyond 2**±200) and a contact beyond float64's range are left to the numpy kernel (``defer``),
+which answers them as it always did; a row's answer does not depend on the others of its batch.
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ import numpy as np
 from numba import njit
 
 from .exact import BAND, TINY
-from .exact_sign import APART, UNSURE, circles_excess, polygon_circle_apart
-from .polygon_rows import _BIG, _edges, _extent, _norm, _outline, _pick, _radius
-from .row_frame import frame_row, world_row
+from .exact_sign import APART, UNSURE, circles_excess, polygon_circle_contact
+from .polygon_rows import _edges, _extent, _norm, _outline, _radius
+from .row_frame import BIG, frame_row, pick_row, world_row
 
 __all__ = ["circle_pairs", "polygon_circle_pairs"]
 
@@ -74,7 +74,7 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
         for j in range(k):
             absent = 0.0 if (ex[j] != 0.0 or ey[j] != 0.0) else 1.0
             ln[j] = _norm(ex[j], ey[j]) + absent
-            cd[j] = (r - s[j] / ln[j]) + absent * _BIG
+            cd[j] = (r - s[j] / ln[j]) + absent * BIG
             if j == 0 or cd[j] < low:
                 low = cd[j]
         inside_clear = inside and low > tol
@@ -100,17 +100,20 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
         out_hit = not inside and dist > 0.0 and dist <= r - tol
         unclear = (inside and not inside_clear) or (not inside and (dist == 0.0 or (dist > r - tol and dist < r + tol)))
         if unclear and exact:
-            # Touching to rounding: decided exactly on the floats (exact_sign); only an overlap
-            # needs the numpy kernel's exact fallback for its contact.
-            defer[i] = polygon_circle_apart(vx, vy, c, ax, ay, bx, by, e, r) != APART
+            # Touching to rounding: the exact decision and contact, on the floats (exact_sign).
+            verdict, nxi, nyi, dep, pxi, pyi = polygon_circle_contact(vx, vy, c, ax, ay, bx, by, e, r, cx, cy, size, f)
+            if verdict == UNSURE:
+                defer[i] = True
+                continue
+            if verdict == APART:
+                continue
+        elif not (inside_clear or out_hit):
             continue
-        if not (inside_clear or out_hit):
-            continue
-        if inside_clear:
+        elif inside_clear:
             for j in range(k):
                 cnx[j] = f * ey[j] / ln[j]
                 cny[j] = -f * ex[j] / ln[j]
-            dep, nxi, nyi = _pick(cd, cnx, cny, size)
+            dep, nxi, nyi = pick_row(cd, cnx, cny, size)
             pxi, pyi = cx, cy
         elif has_face:
             unx, uny = fey / fln, -fex / fln

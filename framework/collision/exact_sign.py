@@ -23,6 +23,9 @@ from numba import njit
 
 from ..compiled import inner
 from .batch_box import _two_sum_1 as _two_sum
+from .exact import TINY
+from .py_hypot import hypot
+from .row_frame import pick_row
 
 __all__ = ["APART", "OVERLAP", "UNSURE", "polygons_apart"]
 
@@ -235,47 +238,59 @@ def _diff(dst, a, na, b):  # pragma: no cover - compiled
     return _grow(dst, na, -b)
 
 
+@inner
+def _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s):  # pragma: no cover - compiled
+    """Edge ``i``'s exact ``(ey (cx - x0) - ex (cy - y0))`` into ``s`` (the centre's distance
+    outside its line, times its length), its parts into ``wx, wy, ex, ey``: their lengths."""
+    x0, y0 = vx[i], vy[i]
+    x1, y1 = vx[(i + 1) % c], vy[(i + 1) % c]
+    nwx, nwy = _diff(wx, cx, ncx, x0), _diff(wy, cy, ncy, y0)
+    nex = _grow(ex, _grow(ex, 0, x1), -x0)
+    ney = _grow(ey, _grow(ey, 0, y1), -y0)
+    ns = _mul(s, 0, ey, ney, wx, nwx, 1.0)
+    ns = _mul(s, ns, ex, nex, wy, nwy, -1.0)
+    return nwx, nwy, nex, ney, ns
+
+
 @njit(cache=True)
-def polygon_circle_apart(vx, vy, c, ox, oy, qx, qy, k, r):  # pragma: no cover - compiled
-    """:func:`~framework.collision.exact.polygon_circle_exact`'s decision on floats: the outline
+def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f):  # pragma: no cover - compiled
+    """:func:`~framework.collision.batch_circle._polygon_circle_exact` on floats: the outline
     (``c`` vertices ``vx, vy``, scaled, about the origin) and the circle of radius ``r`` (scaled)
-    at the exact offset ``(q - o) * 2**-k``: :data:`APART` (its None), :data:`OVERLAP` or
-    :data:`UNSURE` (a float outside the range where these products are exact)."""
+    at the exact offset ``(q - o) * 2**-k`` (``cx0, cy0``: that offset in floats, ``size`` the
+    tie-break's scale, ``f`` -1 where the circle is shape A): ``(verdict, nx, ny, depth, px, py)``,
+    the contact (in the scaled frame) where :data:`OVERLAP`, as the integers give it bit for bit;
+    else :data:`APART` or :data:`UNSURE` (a float outside the range where these products are exact,
+    or a rounding not settled)."""
     sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
     tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
     if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
             or math.ldexp(ty, k) != oy):
-        return UNSURE
+        return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
     cx = np.empty(2)
     cy = np.empty(2)
     cx[1], cx[0] = _two_sum(sx, -tx)  # (an expansion: smaller part first)
     cy[1], cy[0] = _two_sum(sy, -ty)
     if not (_fits4(cx[0]) and _fits4(cx[1]) and _fits4(cy[0]) and _fits4(cy[1]) and _fits4(r)):
-        return UNSURE
+        return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
     for j in range(c):
         if not (_fits4(vx[j]) and _fits4(vy[j])):
-            return UNSURE
+            return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
     ncx = _grow(cx, 0, cx[0]) if cx[1] == 0.0 else 2  # (drop a zero part)
     ncy = _grow(cy, 0, cy[0]) if cy[1] == 0.0 else 2
-    size = 32
-    wx, wy, ex, ey = np.empty(size), np.empty(size), np.empty(size), np.empty(size)
-    s, t, e2, num = np.empty(4 * size), np.empty(4 * size), np.empty(4 * size), np.empty(16 * size)
+    size_e = 32
+    wx, wy, ex, ey = np.empty(size_e), np.empty(size_e), np.empty(size_e), np.empty(size_e)
+    s, t, e2, num = np.empty(4 * size_e), np.empty(4 * size_e), np.empty(4 * size_e), np.empty(16 * size_e)
+    tmp, tmp2 = np.empty(32 * size_e), np.empty(32 * size_e)
     rr = np.empty(2)
     rr[1], rr[0] = _two_product(r, r)
     nrr = 2
-    # The centre's distance outside each edge's line (times its length): all <= 0 is inside.
+    # Inside (or on the boundary): every edge's line has the centre on its inner side.
     inside = True
     distinct = False
     for i in range(c):
-        x0, y0 = vx[i], vy[i]
-        x1, y1 = vx[(i + 1) % c], vy[(i + 1) % c]
-        if x0 != x1 or y0 != y1:
+        if vx[i] != vx[(i + 1) % c] or vy[i] != vy[(i + 1) % c]:
             distinct = True
-        nwx, nwy = _diff(wx, cx, ncx, x0), _diff(wy, cy, ncy, y0)
-        nex = _grow(ex, _grow(ex, 0, x1), -x0)
-        ney = _grow(ey, _grow(ey, 0, y1), -y0)
-        ns = _mul(s, 0, ey, ney, wx, nwx, 1.0)
-        ns = _mul(s, ns, ex, nex, wy, nwy, -1.0)
+        ns = _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s)[4]
         if _sign(s, ns) > 0:
             inside = False
     if c == 2 and inside:  # a segment: the centre on it only between its ends
@@ -290,16 +305,25 @@ def polygon_circle_apart(vx, vy, c, ox, oy, qx, qy, k, r):  # pragma: no cover -
             n2 = _grow(e2, n2, -t[q])
         inside = _sign(t, nt) >= 0 and _sign(e2, n2) >= 0
     if inside and distinct:
-        return OVERLAP
+        # Out through the nearest face, plus the radius: the tie-break among the faces.
+        cd, cnx, cny = np.empty(c), np.empty(c), np.empty(c)
+        m = 0
+        for i in range(c):
+            fex, fey = vx[(i + 1) % c] - vx[i], vy[(i + 1) % c] - vy[i]
+            ln = hypot(fex, fey)
+            if not ln > 0.0:
+                continue
+            ns = _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s)[4]
+            fs, ok = _rounded(s, ns, tmp, tmp2)
+            if not ok:
+                return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
+            cd[m], cnx[m], cny[m] = r - fs / ln, f * fey / ln, -f * fex / ln
+            m += 1
+        depth, nx, ny = pick_row(cd[:m], cnx[:m], cny[:m], size)
+        return OVERLAP, nx, ny, (depth if depth > TINY else TINY), cx0, cy0
     # Outside: the first face whose region holds the centre decides, else the nearest vertex.
     for i in range(c):
-        x0, y0 = vx[i], vy[i]
-        x1, y1 = vx[(i + 1) % c], vy[(i + 1) % c]
-        nwx, nwy = _diff(wx, cx, ncx, x0), _diff(wy, cy, ncy, y0)
-        nex = _grow(ex, _grow(ex, 0, x1), -x0)
-        ney = _grow(ey, _grow(ey, 0, y1), -y0)
-        ns = _mul(s, 0, ey, ney, wx, nwx, 1.0)
-        ns = _mul(s, ns, ex, nex, wy, nwy, -1.0)
+        nwx, nwy, nex, ney, ns = _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s)
         if _sign(s, ns) <= 0:
             continue
         nt = _mul(t, 0, wx, nwx, ex, nex, 1.0)
@@ -314,15 +338,46 @@ def polygon_circle_apart(vx, vy, c, ox, oy, qx, qy, k, r):  # pragma: no cover -
         # distance s / |e| < r  <=>  r^2 |e|^2 - s^2 > 0
         nn = _mul(num, 0, rr, nrr, e2, n2, 1.0)
         nn = _mul(num, nn, s, ns, s, ns, -1.0)
-        return OVERLAP if _sign(num, nn) > 0 else APART
-    for i in range(c):
-        nwx, nwy = _diff(wx, cx, ncx, vx[i]), _diff(wy, cy, ncy, vy[i])
-        nn = _copy_add(num, rr, nrr, rr, 0, 1.0)
-        nn = _mul(num, nn, wx, nwx, wx, nwx, -1.0)
-        nn = _mul(num, nn, wy, nwy, wy, nwy, -1.0)
-        if _sign(num, nn) > 0:
-            return OVERLAP
-    return APART
+        if _sign(num, nn) <= 0:
+            return APART, 0.0, 0.0, 0.0, 0.0, 0.0
+        fs, ok = _rounded(s, ns, tmp, tmp2)
+        numr, ok2 = _rounded(num, nn, tmp, tmp2)
+        if not (ok and ok2):
+            return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
+        fex, fey = vx[(i + 1) % c] - vx[i], vy[(i + 1) % c] - vy[i]
+        ln = hypot(fex, fey)
+        depth = numr / (ln * (r * ln + fs))
+        nx, ny = fey / ln, -fex / ln
+        dist = fs / ln
+        return OVERLAP, f * nx, f * ny, (depth if depth > TINY else TINY), cx0 - nx * dist, cy0 - ny * dist
+    # The nearest vertex (the first of equals), exactly.
+    best = np.empty(4 * size_e)
+    nb = 0
+    jb = -1
+    for j in range(c):
+        nwx, nwy = _diff(wx, cx, ncx, vx[j]), _diff(wy, cy, ncy, vy[j])
+        nq = _mul(t, 0, wx, nwx, wx, nwx, 1.0)
+        nq = _mul(t, nq, wy, nwy, wy, nwy, 1.0)
+        if jb >= 0:
+            nd = _copy_add(num, t, nq, best, nb, -1.0)
+            if _sign(num, nd) >= 0:
+                continue
+        for q in range(nq):
+            best[q] = t[q]
+        nb, jb = nq, j
+    nn = _copy_add(num, rr, nrr, best, nb, -1.0)  # r^2 - |d|^2
+    if _sign(num, nn) <= 0:
+        return APART, 0.0, 0.0, 0.0, 0.0, 0.0
+    nwx, nwy = _diff(wx, cx, ncx, vx[jb]), _diff(wy, cy, ncy, vy[jb])
+    ddx, ok = _rounded(wx, nwx, tmp, tmp2)
+    ddy, ok2 = _rounded(wy, nwy, tmp, tmp2)
+    numr, ok3 = _rounded(num, nn, tmp, tmp2)
+    if not (ok and ok2 and ok3):
+        return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
+    dist = hypot(ddx, ddy)
+    depth = numr / (r + dist)
+    nx, ny = (ddx / dist, ddy / dist) if dist > 0.0 else (0.0, f)
+    return OVERLAP, f * nx, f * ny, (depth if depth > TINY else TINY), vx[jb], vy[jb]
 
 
 # --- exact depths of overlapping polygons ---------------------------------------------------------

@@ -42,12 +42,10 @@ from .collide import POINT_TOL
 from .exact import BAND, TINY
 from .exact_sign import APART, OVERLAP, polygon_depths, polygons_apart
 from .kinds import KIND_AABB
-from .row_frame import frame_row, world_row
-from .tiebreak import DEPTH_TOL, DIR_TOL
+from .row_frame import BIG, frame_row, pick_row, world_row
 
 __all__ = ["polygon_pairs"]
 
-_BIG = 1e300  # (batch_common.BIG: "absent" in a min, in the scaled frames where values are about 1)
 
 
 @inner
@@ -131,60 +129,6 @@ def _project(ux, uy, vx, vy):  # pragma: no cover - compiled
         if p > hi:
             hi = p
     return lo, hi
-
-
-@inner
-def _pick(cd, cx, cy, size):  # pragma: no cover - compiled
-    """``batch_common.pick`` of one pair's candidates ``(depth, nx, ny)``."""
-    c = cd.size
-    best = cd[0]
-    for j in range(1, c):
-        if cd[j] < best:
-            best = cd[j]
-    lim = best + DEPTH_TOL * size
-    near = np.empty(c, dtype=np.bool_)
-    top = 0.0
-    for j in range(c):
-        near[j] = cd[j] <= lim
-        v = abs(cy[j]) * (1.0 if near[j] else 0.0)
-        if j == 0 or v > top:
-            top = v
-    for j in range(c):
-        near[j] = near[j] and abs(cy[j]) >= top - DIR_TOL
-    top = 0.0
-    for j in range(c):
-        fold = cy[j] < -DIR_TOL or (abs(cy[j]) <= DIR_TOL and cx[j] < 0.0)
-        fx = cx[j] * (1.0 - 2.0 * (1.0 if fold else 0.0))
-        v = fx + ((1.0 if near[j] else 0.0) - 1.0) * 4.0
-        if j == 0 or v > top:
-            top = v
-    shortest = 0.0
-    for j in range(c):
-        fold = cy[j] < -DIR_TOL or (abs(cy[j]) <= DIR_TOL and cx[j] < 0.0)
-        fx = cx[j] * (1.0 - 2.0 * (1.0 if fold else 0.0))
-        near[j] = near[j] and fx >= top - DIR_TOL
-        v = cd[j] + (1.0 - (1.0 if near[j] else 0.0)) * _BIG
-        if j == 0 or v < shortest:
-            shortest = v
-    for key in range(2):
-        any_keep = False
-        for j in range(c):
-            if near[j] and ((cy[j] if key == 0 else cx[j]) > DIR_TOL):
-                any_keep = True
-        if any_keep:
-            for j in range(c):
-                near[j] = near[j] and ((cy[j] if key == 0 else cx[j]) > DIR_TOL)
-    low = 0.0
-    for j in range(c):
-        v = cd[j] + (1.0 - (1.0 if near[j] else 0.0)) * _BIG
-        if j == 0 or v < low:
-            low = v
-    i = 0
-    for j in range(c):
-        if near[j] and cd[j] == low:
-            i = j
-            break
-    return shortest, cx[i], cy[i]
 
 
 @inner
@@ -374,7 +318,7 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
             if ux[c] == 0.0 and uy[c] == 0.0:  # (a padding edge: ln 1, the depth BIG, as the numpy)
                 cx[2 * c], cy[2 * c] = ux[c], uy[c]
                 cx[2 * c + 1], cy[2 * c + 1] = -ux[c], -uy[c]
-                cd[2 * c] = cd[2 * c + 1] = _BIG
+                cd[2 * c] = cd[2 * c + 1] = BIG
                 continue
             ln = _norm(ux[c], uy[c])
             cx[2 * c] = ux[c] / ln
@@ -385,7 +329,7 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
             cd[2 * c] = (d if d > TINY else TINY) + 0.0
             d = bwd[c] / ln
             cd[2 * c + 1] = (d if d > TINY else TINY) + 0.0
-        dep, nxi, nyi = _pick(cd, cx, cy, sz)
+        dep, nxi, nyi = pick_row(cd, cx, cy, sz)
         pxi = pyi = 0.0
         if points:
             for j in range(k):
