@@ -26,7 +26,7 @@ from numba import njit
 from .exact import BAND, TINY
 from .exact_sign import APART, UNSURE, circles_excess, polygon_circle_contact
 from .polygon_rows import _edges, _extent, _norm, _outline, _radius
-from .row_frame import BIG, frame_row, pick_row, world_row
+from .row_frame import BIG, frame_row, pick_row, put_row
 
 __all__ = ["circle_pairs", "polygon_circle_pairs"]
 
@@ -124,12 +124,7 @@ def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_p
             nxi, nyi = f * ddx / dist, f * ddy / dist
             dep = r - dist
             pxi, pyi = vx[vi], vy[vi]
-        finite, dep, pxi, pyi = world_row(dep, pxi, pyi, e, ax, ay)
-        if not finite:
-            defer[i] = True  # (the numpy kernel raises its error)
-            continue
-        hit[i] = True
-        nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi
+        put_row(i, nxi, nyi, dep, pxi, pyi, e, ax, ay, hit, nx, ny, depth, px, py, defer)
     return hit, nx, ny, depth, px, py, defer
 
 
@@ -175,10 +170,5 @@ def circle_pairs(ra_rows, rb_rows, hx, hy, radius, exact):  # pragma: no cover -
         lo = dist - rb if dist - rb > -ra else -ra
         hi = dist + rb if dist + rb < ra else ra
         mid = 0.5 * (lo + hi)
-        finite, dep, pxi, pyi = world_row(dep, nxi * mid, nyi * mid, e, ax, ay)
-        if not finite:
-            defer[i] = True
-            continue
-        hit[i] = True
-        nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi
+        put_row(i, nxi, nyi, dep, nxi * mid, nyi * mid, e, ax, ay, hit, nx, ny, depth, px, py, defer)
     return hit, nx, ny, depth, px, py, defer

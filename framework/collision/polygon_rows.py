@@ -42,7 +42,7 @@ from .collide import POINT_TOL
 from .exact import BAND, TINY
 from .exact_sign import APART, OVERLAP, polygon_depths, polygons_apart
 from .kinds import KIND_AABB
-from .row_frame import BIG, frame_row, pick_row, world_row
+from .row_frame import BIG, frame_row, pick_row, put_row
 
 __all__ = ["polygon_pairs"]
 
@@ -336,10 +336,5 @@ def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k,
                 bvx[j] += dx
                 bvy[j] += dy
             pxi, pyi = _overlap_point(avx, avy, ac, bvx, bvy, bc, nxi, nyi, dep, sz, exa, eya, exb, eyb, na, nb)
-        finite, dep, pxi, pyi = world_row(dep, pxi, pyi, e, ax, ay)
-        if not finite:
-            defer[i] = True  # (the numpy kernel raises its error)
-            continue
-        hit[i] = True
-        nx[i], ny[i], depth[i], px[i], py[i] = nxi + 0.0, nyi + 0.0, dep, pxi, pyi
+        put_row(i, nxi, nyi, dep, pxi, pyi, e, ax, ay, hit, nx, ny, depth, px, py, defer)
     return hit, nx, ny, depth, px, py, defer

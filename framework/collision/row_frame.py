@@ -14,7 +14,7 @@ from ..compiled import inner
 from .exact import TINY
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
-__all__ = ["BIG", "frame_row", "pick_row", "world_row"]
+__all__ = ["BIG", "frame_row", "pick_row", "put_row", "world_row"]
 
 #: "absent" in a min, in the scaled frames where values are about 1 (``batch_common.BIG``)
 BIG = 1e300
@@ -41,6 +41,20 @@ def world_row(depth, px, py, k, ax, ay):  # pragma: no cover - compiled
     px, py = ax + math.ldexp(px, k), ay + math.ldexp(py, k)
     return math.isfinite(depth) and math.isfinite(px) and math.isfinite(py), depth, px, py
 
+
+
+@inner
+def put_row(i, nx_i, ny_i, depth_i, px_i, py_i, k, ax, ay, hit, nx, ny, depth, px, py, defer):
+    # pragma: no cover - compiled
+    """Row ``i``'s contact (scaled, frame ``k`` at ``(ax, ay)``) into the output columns as
+    ``batch_common.finish`` writes it (normals with -0.0 made 0.0), or ``defer[i]`` where a value
+    is beyond float64's range (the numpy kernel raises its error there)."""
+    finite, d, x, y = world_row(depth_i, px_i, py_i, k, ax, ay)
+    if not finite:
+        defer[i] = True
+        return
+    hit[i] = True
+    nx[i], ny[i], depth[i], px[i], py[i] = nx_i + 0.0, ny_i + 0.0, d, x, y
 
 @inner
 def pick_row(cd, cx, cy, size):  # pragma: no cover - compiled
