@@ -640,12 +640,18 @@ class CharacterStage(Stage):
                 store.wake(r)
 
 
+_KERNEL: Any = None  # the compiled move's module, once imported (a module is no stage state)
+
+
 def _compiled_move() -> Any:
     """The compiled move's module, imported (and so compiled, or loaded from numba's cache) when a
     scene first has a box character to move."""
-    from . import character_kernel
+    global _KERNEL
+    if _KERNEL is None:
+        from . import character_kernel
 
-    return character_kernel
+        _KERNEL = character_kernel
+    return _KERNEL
 
 
 def default_skin(size: float, x: float, y: float) -> float:
