@@ -206,6 +206,7 @@ def test_platformer_levels_same_bits(level, monkeypatch):
 
 
 @pytest.mark.parametrize("a, b", [(3.0, 4.0), (0.1, 0.7), (1e-200, 3e-200), (1e300, 1e300), (5e-324, 1e-323),
+                                  (-8.8495887409525e-311, 1.377324228e-314),  # (subnormal: the last bit)
                                   (-0.0, 0.0), (0.0, -2.5), (math.inf, 1.0), (1.0, -math.inf)])
 def test_hypot_is_cpythons(a, b):
     assert hypot(a, b).hex() == math.hypot(a, b).hex()

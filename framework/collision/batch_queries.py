@@ -6,9 +6,9 @@ The kernels redo, query by query and row by row, the float arithmetic of the sin
 and the containment test of ``Scene.query_point``) in the same order of operations, so that
 their answers are the same floats, bit for bit, not only close:
 
-- ``math.hypot`` is CPython's own algorithm (:func:`hypot`, a port of ``vector_norm`` in
-  ``Modules/mathmodule.c``: scaled, with exact squares and a correction step), not the C
-  library's, which differs from it in the last bit for about 1 input in 500;
+- ``math.hypot`` is CPython's own algorithm (:func:`~framework.collision.py_hypot.hypot`, a port
+  of ``vector_norm`` in ``Modules/mathmodule.c``), not the C library's, which differs from it in
+  the last bit for about 1 input in 500;
 - ``x ** 2`` is ``math.pow(x, two)`` with ``two`` a run-time argument (CPython calls the C
   library's ``pow``; a literal exponent would be folded into ``x * x``, which rounds differently
   for about 1 input in 1,000);
@@ -38,6 +38,7 @@ from numba import njit
 
 from .exact import BAND
 from .pieces import TIE
+from .py_hypot import hypot
 from .ray import closest_on_segment
 from .tiebreak import DIR_TOL
 
@@ -50,72 +51,6 @@ _NEAR = 1e-9  # the widening of the single queries' candidate boxes
 _SLACK = 1e-9  # relative margin of the skipping tests (rounding is below 1e-15 of the magnitudes)
 
 
-# --- CPython's math.hypot ---------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _split(x):  # pragma: no cover - compiled
-    t = x * 134217729.0  # Veltkamp: 2**27 + 1
-    hi = t - (t - x)
-    return hi, x - hi
-
-
-@njit(cache=True)
-def _mul(x, y):  # pragma: no cover - compiled
-    """Dekker's exact product ``x * y == z + zz``."""
-    xh, xl = _split(x)
-    yh, yl = _split(y)
-    p = xh * yh
-    q = xh * yl + xl * yh
-    z = p + q
-    zz = p - z + q + xl * yl
-    return z, zz
-
-
-@njit(cache=True)
-def _norm(x, y, m):  # pragma: no cover - compiled
-    e = math.frexp(m)[1]
-    scale = math.ldexp(1.0, -e)
-    csum, frac1, frac2 = 1.0, 0.0, 0.0
-    for v in (x, y):
-        v *= scale
-        hi, lo = _mul(v, v)
-        s = csum + hi
-        frac2 += hi - (s - csum)
-        csum = s
-        frac1 += lo
-    h = math.sqrt(csum - 1.0 + (frac1 + frac2))
-    hi, lo = _mul(-h, h)
-    s = csum + hi
-    frac2 += hi - (s - csum)
-    csum = s
-    frac1 += lo
-    v = csum - 1.0 + (frac1 + frac2)
-    h += v / (2.0 * h)
-    return h / scale
-
-
-@njit(cache=True)
-def hypot(x, y):  # pragma: no cover - compiled
-    """``math.hypot(x, y)`` as CPython 3.11 computes it (the same bits)."""
-    x, y = abs(x), abs(y)
-    if math.isinf(x) or math.isinf(y):
-        return math.inf
-    m = x if x > y else y
-    if math.isnan(x) or math.isnan(y):
-        return math.nan
-    if m == 0.0:
-        return m
-    if math.frexp(m)[1] < -1023:  # subnormal: 2**-e would overflow; divided by the largest instead
-        csum, frac = 1.0, 0.0
-        for v in (x, y):
-            v /= m
-            v = v * v
-            old = csum
-            csum += v
-            frac += (old - csum) + v
-        return m * math.sqrt(csum - 1.0 + frac)
-    return _norm(x, y, m)
 
 
 _closest_on_segment = njit(cache=True)(closest_on_segment)  # (the single queries' own arithmetic, compiled)
