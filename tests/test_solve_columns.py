@@ -13,6 +13,7 @@ from framework.systems import gather
 from framework.systems import solve_columns as sc
 from framework.systems import solve_rounds as sr
 from framework.systems import solver_loops as loops
+from framework.systems.stable_sort import stable_argsort
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> None:
@@ -33,7 +34,9 @@ def test_stable_argsort_is_numpys_stable_argsort(seed: int) -> None:
     rng = np.random.default_rng(seed)
     for n in (0, 1, 2, 7, 33, 200):
         key = _floats(rng, n)
-        _same(sc.stable_argsort(key), np.argsort(key, kind="stable").astype(np.int64))
+        _same(stable_argsort(key), np.argsort(key, kind="stable").astype(np.int64))
+        ints = rng.integers(-3, 4, n).astype(np.int64) << 40  # (the soft step's keys: integers, many ties)
+        _same(stable_argsort(ints), np.argsort(ints, kind="stable").astype(np.int64))
 
 
 def _scene(rng: np.random.Generator, n_rows: int, c: int):

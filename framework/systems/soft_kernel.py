@@ -59,6 +59,7 @@ from ..collision.soft_manifold import (
 from ..compiled import leaf
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
+from .stable_sort import stable_argsort
 
 __all__ = ["CHAIN_KIND", "PARAMS", "SLOT", "internal_faces", "soft_step"]
 
@@ -99,7 +100,7 @@ def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
         box[r, 0], box[r, 1], box[r, 2], box[r, 3] = hx - half[r, 0], hy - half[r, 1], hx + half[r, 0], hy + half[r, 1]
         tol[r] = 1e-9 * (1.0 + abs(hx) + abs(hy) + half[r, 0] + half[r, 1])
         xs[k] = box[r, 0]
-    order = _stable_order(_float_keys(xs))
+    order = stable_argsort(_float_keys(xs))
     for ii in range(m):
         i = rows[order[ii]]
         for jj in range(ii + 1, m):
@@ -169,43 +170,9 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, sp
 
 
 @njit(cache=True)
-def _stable_order(keys):
-    """The indices that sort ``keys`` ascending, equal keys in their order (a bottom-up merge sort:
-    what ``np.argsort(kind="mergesort")`` returns, at a tenth of its compile time)."""
-    n = keys.size
-    order = np.arange(n)
-    tmp = np.empty(n, dtype=np.int64)
-    width = 1
-    while width < n:
-        for lo in range(0, n, 2 * width):
-            mid = min(lo + width, n)
-            hi = min(lo + 2 * width, n)
-            i, j, o = lo, mid, lo
-            while i < mid and j < hi:
-                if keys[order[j]] < keys[order[i]]:
-                    tmp[o] = order[j]
-                    j += 1
-                else:
-                    tmp[o] = order[i]
-                    i += 1
-                o += 1
-            while i < mid:
-                tmp[o] = order[i]
-                i += 1
-                o += 1
-            while j < hi:
-                tmp[o] = order[j]
-                j += 1
-                o += 1
-        order, tmp = tmp, order
-        width *= 2
-    return order
-
-
-@njit(cache=True)
 def _float_keys(v):
     """Integers in the order of the floats ``v`` (their bits, the negatives' flipped): one sort
-    (:func:`_stable_order` on integers) serves both."""
+    (:func:`~framework.systems.stable_sort.stable_argsort` on integers) serves both."""
     k = (v + 0.0).view(np.int64)  # (+ 0.0: -0.0 becomes 0.0, its equal)
     for i in range(k.size):
         if k[i] < 0:
@@ -223,7 +190,7 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity, owner):
     xs = np.empty(n)
     for i in range(n):
         xs[i] = fat[i, 0]
-    order = _stable_order(_float_keys(xs))
+    order = stable_argsort(_float_keys(xs))
     cap = 4 * n + 16
     pa = np.empty(cap, dtype=np.int64)
     pb = np.empty(cap, dtype=np.int64)
@@ -258,7 +225,7 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity, owner):
     keys = np.empty(m, dtype=np.int64)
     for k in range(m):
         keys[k] = (entity[pa[k]] << 32) | entity[pb[k]]
-    srt = _stable_order(keys)
+    srt = stable_argsort(keys)
     pairs = np.empty((m, 3), dtype=np.int64)
     for k in range(m):
         pairs[k, 0], pairs[k, 1], pairs[k, 2] = pa[srt[k]], pb[srt[k]], keys[srt[k]]
@@ -313,7 +280,7 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
     add_keys = np.empty(n_add, dtype=np.int64)
     for q in range(n_add):
         add_keys[q] = add[q, 2]
-    order = _stable_order(add_keys)
+    order = stable_argsort(add_keys)
     out = np.empty((n_keep + n_add, 3), dtype=np.int64)
     i, k, o = 0, 0, 0
     while i < m or k < n_add:

@@ -35,50 +35,14 @@ from numba import njit
 
 from .gather import _np_max, _np_min
 from .solver_loops import warm_start
+from .stable_sort import stable_argsort
 
-__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stable_argsort", "stays", "velocity_stays",
+__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stays", "velocity_stays",
            "warm_impulses", "warm_pushes"]
 
 _compiled = njit(cache=True, error_model="numpy")
 
 
-
-
-@_compiled
-def stable_argsort(key):  # pragma: no cover - compiled
-    """``np.argsort(key, kind="stable")`` of a float array: a bottom-up merge sort (ties keep
-    their order, NaN sorts last)."""
-    n = key.size
-    idx = np.arange(n)
-    tmp = np.empty(n, dtype=np.int64)
-    width = 1
-    while width < n:
-        lo = 0
-        while lo < n:
-            mid = min(lo + width, n)
-            hi = min(lo + 2 * width, n)
-            i, j, k = lo, mid, lo
-            while i < mid and j < hi:
-                x, y = key[idx[j]], key[idx[i]]
-                if x < y or (y != y and x == x):  # (x sorts strictly before y: NaN last)
-                    tmp[k] = idx[j]
-                    j += 1
-                else:
-                    tmp[k] = idx[i]
-                    i += 1
-                k += 1
-            while i < mid:
-                tmp[k] = idx[i]
-                i += 1
-                k += 1
-            while j < hi:
-                tmp[k] = idx[j]
-                j += 1
-                k += 1
-            lo = hi
-        idx, tmp = tmp, idx
-        width *= 2
-    return idx
 
 
 @_compiled
