@@ -144,6 +144,31 @@ def _fits(v):  # pragma: no cover - compiled
     return a == 0.0 or (a >= _LO and a <= _HI)
 
 
+@inner
+def _offset(ox, oy, qx, qy, k):  # pragma: no cover - compiled
+    """The exact offset ``(q - o) * 2**-k`` as two two-part sums ``(x_hi, x_lo, y_hi, y_lo)``,
+    after whether it is exact: False where a scaled coordinate lost bits below the smallest float
+    (the integers take those pairs)."""
+    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
+    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
+    exact = (math.ldexp(sx, k) == qx and math.ldexp(sy, k) == qy and math.ldexp(tx, k) == ox
+             and math.ldexp(ty, k) == oy)
+    x_hi, x_lo = _two_sum(sx, -tx)
+    y_hi, y_lo = _two_sum(sy, -ty)
+    return exact, x_hi, x_lo, y_hi, y_lo
+
+
+@inner
+def _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy):  # pragma: no cover - compiled
+    """Whether the offset's parts and both outlines' slots are all in :func:`_fits`'s range."""
+    if not (_fits(ex_h) and _fits(ex_l) and _fits(ey_h) and _fits(ey_l)):
+        return False
+    for j in range(avx.size):
+        if not (_fits(avx[j]) and _fits(avy[j]) and _fits(bvx[j]) and _fits(bvy[j])):
+            return False
+    return True
+
+
 @njit(cache=True)
 def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # pragma: no cover - compiled
     """:func:`~framework.collision.exact.polygon_polygon_exact`'s decision on floats: outlines A
@@ -155,19 +180,9 @@ def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # prag
     ``need [2 K]``: per axis slot (A's edges, then B's), which overlaps the floats left in doubt
     (1 forward, 2 backward, 3 both); the others are positive beyond the floats' error, and only a
     separation or touch (an overlap <= 0) on some axis makes the pair apart."""
-    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
-    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
-    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
-            or math.ldexp(ty, k) != oy):
-        return UNSURE  # (a scaled offset lost bits below the smallest float)
-    ex_h, ex_l = _two_sum(sx, -tx)
-    ey_h, ey_l = _two_sum(sy, -ty)
-    for v in (ex_h, ex_l, ey_h, ey_l):
-        if not _fits(v):
-            return UNSURE
-    for j in range(avx.size):
-        if not (_fits(avx[j]) and _fits(avy[j]) and _fits(bvx[j]) and _fits(bvy[j])):
-            return UNSURE
+    exact, ex_h, ex_l, ey_h, ey_l = _offset(ox, oy, qx, qy, k)
+    if not (exact and _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy)):
+        return UNSURE
     size = 64
     cur, tmp = np.empty(size), np.empty(size)
     lo, hi = np.empty(size), np.empty(size)
@@ -261,16 +276,10 @@ def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f): 
     the contact (in the scaled frame) where :data:`OVERLAP`, as the integers give it bit for bit;
     else :data:`APART` or :data:`UNSURE` (a float outside the range where these products are exact,
     or a rounding not settled)."""
-    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
-    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
-    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
-            or math.ldexp(ty, k) != oy):
-        return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
     cx = np.empty(2)
     cy = np.empty(2)
-    cx[1], cx[0] = _two_sum(sx, -tx)  # (an expansion: smaller part first)
-    cy[1], cy[0] = _two_sum(sy, -ty)
-    if not (_fits4(cx[0]) and _fits4(cx[1]) and _fits4(cy[0]) and _fits4(cy[1]) and _fits4(r)):
+    exact, cx[1], cx[0], cy[1], cy[0] = _offset(ox, oy, qx, qy, k)  # (expansions: smaller part first)
+    if not exact or not (_fits4(cx[0]) and _fits4(cx[1]) and _fits4(cy[0]) and _fits4(cy[1]) and _fits4(r)):
         return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
     for j in range(c):
         if not (_fits4(vx[j]) and _fits4(vy[j])):
@@ -436,19 +445,9 @@ def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # 
     forward and backward overlaps, correctly rounded, into ``fwd`` and ``bwd`` (padding slots are
     left alone), as :mod:`~framework.collision.batch_polygon` writes the integers' ones; False
     where an input is outside the exact range or a rounding could not be settled."""
-    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
-    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
-    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
-            or math.ldexp(ty, k) != oy):
+    exact, ex_h, ex_l, ey_h, ey_l = _offset(ox, oy, qx, qy, k)
+    if not (exact and _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy)):
         return False
-    ex_h, ex_l = _two_sum(sx, -tx)
-    ey_h, ey_l = _two_sum(sy, -ty)
-    for v in (ex_h, ex_l, ey_h, ey_l):
-        if not _fits(v):
-            return False
-    for j in range(avx.size):
-        if not (_fits(avx[j]) and _fits(avy[j]) and _fits(bvx[j]) and _fits(bvy[j])):
-            return False
     size = 64
     cur, tmp, tmp2 = np.empty(size), np.empty(4 * size), np.empty(4 * size)
     lo, hi = np.empty(size), np.empty(size)
@@ -509,16 +508,12 @@ def circles_excess(ox, oy, qx, qy, k, ra, rb):  # pragma: no cover - compiled
     at the origin and ``rb`` at the exact offset ``(q - o) * 2**-k`` (radii scaled):
     ``(verdict, excess)``, the excess ``(ra + rb)^2 - |d|^2`` correctly rounded where they
     overlap (:data:`OVERLAP`), else :data:`APART` or :data:`UNSURE`."""
-    sx, sy = math.ldexp(qx, -k), math.ldexp(qy, -k)
-    tx, ty = math.ldexp(ox, -k), math.ldexp(oy, -k)
-    if (math.ldexp(sx, k) != qx or math.ldexp(sy, k) != qy or math.ldexp(tx, k) != ox
-            or math.ldexp(ty, k) != oy):
-        return UNSURE, 0.0
     d = np.empty(2)
     e = np.empty(2)
     s = np.empty(2)
-    d[1], d[0] = _two_sum(sx, -tx)
-    e[1], e[0] = _two_sum(sy, -ty)
+    exact, d[1], d[0], e[1], e[0] = _offset(ox, oy, qx, qy, k)
+    if not exact:
+        return UNSURE, 0.0
     s[1], s[0] = _two_sum(ra, rb)
     for v in (d[0], d[1], e[0], e[1], s[0], s[1]):
         if not _fits(v):
