@@ -50,21 +50,20 @@ X, Y, FNX, FNY, WNX, WNY = range(6)
 # surfaces recorded, rows ignored, bail.
 FLOOR, WALL, CEIL, NHITS, NPUSH, NIGN, BAILED = range(7)
 
-# The helpers: compiled into the move, never called from Python (``inner``: no wrapper to call
-# them by, a third less compiling).
-_inner = inner
+# (The helpers are ``inner``: compiled into the move, never called from Python, so no wrapper to
+# call them by is built: a third less compiling.)
 
 _HITS = 64  # surfaces a move records at most (more: bail)
 _IGNORED = 8  # rows ignored at once at most
 
 
-@_inner
+@inner
 def _first_min(a, b):  # pragma: no cover - compiled
     """Python's ``min(a, b)``: ``a`` unless ``b`` is smaller."""
     return b if b < a else a
 
 
-@_inner
+@inner
 def _first_max(a, b):  # pragma: no cover - compiled
     """Python's ``max(a, b)``: ``a`` unless ``b`` is larger."""
     return b if b > a else a
@@ -73,14 +72,14 @@ def _first_max(a, b):  # pragma: no cover - compiled
 # --- looking up and casting --------------------------------------------------------------------
 
 
-@_inner
+@inner
 def _bail(si, reason):  # pragma: no cover - compiled
     """Hand the move back to the Python code (the first reason is kept)."""
     if si[BAILED] == 0:
         si[BAILED] = reason
 
 
-@_inner
+@inner
 def _ignored(si, ign, r):  # pragma: no cover - compiled
     for k in range(si[NIGN]):
         if ign[k] == r:
@@ -88,7 +87,7 @@ def _ignored(si, ign, r):  # pragma: no cover - compiled
     return False
 
 
-@_inner
+@inner
 def _ignore(si, ign, r):  # pragma: no cover - compiled
     """``mv.ignore.add(r)``."""
     if _ignored(si, ign, r):
@@ -100,7 +99,7 @@ def _ignore(si, ign, r):  # pragma: no cover - compiled
     si[NIGN] += 1
 
 
-@_inner
+@inner
 def _unignore(si, ign, r):  # pragma: no cover - compiled
     """``mv.ignore.discard(r)``."""
     n = si[NIGN]
@@ -111,7 +110,7 @@ def _unignore(si, ign, r):  # pragma: no cover - compiled
             return
 
 
-@_inner
+@inner
 def _box_sweep(ax, ay, ahw, ahh, bx, by, bhw, bhh, mx, my):  # pragma: no cover - compiled
     """:func:`framework.casting._box_sweep`: ``(code, fraction, nx, ny)``, code 0 a miss, 1 a
     hit, 2 the answer at the very start (``time_of_impact`` decides: bail)."""
@@ -140,7 +139,7 @@ def _box_sweep(ax, ay, ahw, ahh, bx, by, bhw, bhh, mx, my):  # pragma: no cover 
     return 1, t_in, 0.0, (-1.0 if by > ay else 1.0)
 
 
-@_inner
+@inner
 def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no cover - compiled
     """The stage's ``_cast`` (``_near``, then ``cast_rows`` by slabs, one-way platforms refusing
     hits from below): ``(row, fraction, nx, ny)``, row -1 for none. ``scratch`` (n x 3) and
@@ -199,7 +198,7 @@ def _cast(world, me, st, si, ign, scratch, rows_found, mx, my):  # pragma: no co
     return -1, 0.0, 0.0, 0.0
 
 
-@_inner
+@inner
 def _advance(me, st, mx, my, f, nx, ny):  # pragma: no cover - compiled
     """The stage's ``_advance``: by ``f`` of the move, then back until ``skin`` clear."""
     length = hypot(mx, my)
@@ -213,7 +212,7 @@ def _advance(me, st, mx, my, f, nx, ny):  # pragma: no cover - compiled
     st[Y] += my * t
 
 
-@_inner
+@inner
 def _record(si, rows, normals, count, r, nx, ny):  # pragma: no cover - compiled
     """Append ``(r, nx, ny)`` to a list of surfaces (``count`` indexes ``si``)."""
     k = si[count]
@@ -229,7 +228,7 @@ def _record(si, rows, normals, count, r, nx, ny):  # pragma: no cover - compiled
 # --- moving --------------------------------------------------------------------------------------
 
 
-@_inner
+@inner
 def _contact_height(world, me, st, r, nx, ny):  # pragma: no cover - compiled
     """The stage's ``_contact_height``: ``touch_point`` of the body and box ``r`` (met at normal
     ``n``), its y; both supports of a box."""
@@ -276,7 +275,7 @@ def _contact_height(world, me, st, r, nx, ny):  # pragma: no cover - compiled
     return d * tny + mid * ty + 0.0
 
 
-@_inner
+@inner
 def _step_up(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, rx,
              step):  # pragma: no cover - compiled
     """The stage's ``_step_up`` for a box (no round bottom to carry further)."""
@@ -321,7 +320,7 @@ def _step_up(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, rx,
     return False
 
 
-@_inner
+@inner
 def _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, mx, my, on_floor, step,
            max_slides):  # pragma: no cover - compiled
     """The stage's ``_slide``: move, sliding along what it hits."""
@@ -378,7 +377,7 @@ def _slide(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, 
         n_planes += 1
 
 
-@_inner
+@inner
 def _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, push_n, floor_row, cx, cy,
           ride_slides):  # pragma: no cover - compiled
     """The stage's ``_ride``: carried by the floor (not in the way); nothing met is kept.
@@ -393,7 +392,7 @@ def _ride(world, me, st, si, ign, scratch, rows_found, hits_r, hits_n, push_r, p
     si[NHITS] = 0
 
 
-@_inner
+@inner
 def _land(world, me, st, si, ign, scratch, rows_found, reach):  # pragma: no cover - compiled
     """The stage's ``_land``: cast down by ``reach``, onto a floor (the row, -1 for none, and
     its normal; the body moved onto it)."""
@@ -422,7 +421,7 @@ def _land(world, me, st, si, ign, scratch, rows_found, reach):  # pragma: no cov
     return hr, hnx, hny
 
 
-@_inner
+@inner
 def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
     """Bail if the body may overlap a candidate (``overlapping_rows``' tests before ``collide``):
     the Python move depenetrates it."""
@@ -449,7 +448,7 @@ def _overlaps(world, me, st, si, ign):  # pragma: no cover - compiled
         return
 
 
-@_inner
+@inner
 def _unblocked(world, me, st, si, hits_r, hits_n, vx, vy):  # pragma: no cover - compiled
     """The stage's ``_unblocked``: the velocity without its part into the surfaces met."""
     body = world[10]
