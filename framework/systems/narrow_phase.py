@@ -7,6 +7,9 @@ geometry is computed.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from ..arrays import BoolArray, I64Array, IntpArray, distinct
@@ -172,6 +175,16 @@ def _pair_contacts(
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
 
 
+def _with_deferred(cols: tuple[Any, ...], answer: Callable[[IntpArray], batch.ContactArrays]) -> batch.ContactArrays:
+    """A compiled row pass's contact columns, its rows marked ``defer`` answered by ``answer(rows)``
+    (the numpy kernel on those rows: a row's answer does not depend on its batch)."""
+    hit, nx, ny, depth, px, py, defer = cols
+    if defer.any():
+        d = np.flatnonzero(defer)
+        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = answer(d)
+    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
 def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, *, exact: bool,
                    points: bool) -> batch.ContactArrays:
     """:func:`~framework.collision.batch.polygon_polygon` of pairs of box and polygon rows: the
@@ -179,55 +192,47 @@ def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray,
     the outlines of the rare rows that pass leaves to it (inputs beyond the range where the exact
     decisions on floats hold, a contact beyond float64's range)."""
     a, b = np.ascontiguousarray(a, dtype=np.int64), np.ascontiguousarray(b, dtype=np.int64)
-    hit, nx, ny, depth, px, py, defer = polygon_pairs(a, b, geom.hx, geom.hy, store.kind, store.hw, store.hh,
-                                                      geom.world_poly, geom.poly_slot, geom.count, geom.K, exact,
-                                                      points)
-    if defer.any():
-        d = np.flatnonzero(defer)
-        da, db = a[d], b[d]
-        va, na = geom.outlines(store, da)
-        vb, nb = geom.outlines(store, db)
-        hx, hy = geom.hx, geom.hy
-        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.polygon_polygon(
-            hx[da], hy[da], va, na, hx[db], hy[db], vb, nb, exact=exact, points=points)
-    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+    hx, hy = geom.hx, geom.hy
+
+    def numpy(d: IntpArray) -> batch.ContactArrays:
+        (va, na), (vb, nb) = geom.outlines(store, a[d]), geom.outlines(store, b[d])
+        return batch.polygon_polygon(hx[a[d]], hy[a[d]], va, na, hx[b[d]], hy[b[d]], vb, nb, exact=exact,
+                                     points=points)
+
+    return _with_deferred(polygon_pairs(a, b, hx, hy, store.kind, store.hw, store.hh, geom.world_poly,
+                                        geom.poly_slot, geom.count, geom.K, exact, points), numpy)
 
 
 def _circle_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, *, exact: bool,
                   ) -> batch.ContactArrays:
     """:func:`~framework.collision.batch.circle_circle` of pairs of circle rows: the compiled pass
-    (:func:`~framework.collision.circle_rows.circle_pairs`), and the numpy kernel on the rows it
-    leaves to it."""
+    (:func:`~framework.collision.circle_rows.circle_pairs`), and the numpy kernel on the rare rows
+    it leaves to it (the same reasons)."""
     a, b = np.ascontiguousarray(a, dtype=np.int64), np.ascontiguousarray(b, dtype=np.int64)
-    hit, nx, ny, depth, px, py, defer = circle_pairs(a, b, geom.hx, geom.hy, store.radius, exact)
-    if defer.any():
-        d = np.flatnonzero(defer)
-        da, db = a[d], b[d]
-        hx, hy, radius = geom.hx, geom.hy, store.radius
-        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.circle_circle(
-            hx[da], hy[da], radius[da], hx[db], hy[db], radius[db], exact=exact)
-    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+    hx, hy, radius = geom.hx, geom.hy, store.radius
+
+    def numpy(d: IntpArray) -> batch.ContactArrays:
+        return batch.circle_circle(hx[a[d]], hy[a[d]], radius[a[d]], hx[b[d]], hy[b[d]], radius[b[d]], exact=exact)
+
+    return _with_deferred(circle_pairs(a, b, hx, hy, radius, exact), numpy)
 
 
 def _polygon_circle_pairs(store: BodyStore, geom: Geometry, poly: IntpArray, circ: IntpArray, flip: BoolArray, *,
                           exact: bool) -> batch.ContactArrays:
     """:func:`~framework.collision.batch.polygon_circle` of pairs of polygon (box, segment) and
     circle rows: the compiled pass over the rows (:mod:`~framework.collision.circle_rows`), and
-    the numpy kernel on the outlines of the rows it leaves to it (overlaps touching to rounding,
-    whose contacts come from the exact integers)."""
+    the numpy kernel on the outlines of the rare rows it leaves to it (the same reasons)."""
     poly, circ = np.ascontiguousarray(poly, dtype=np.int64), np.ascontiguousarray(circ, dtype=np.int64)
     flip = np.ascontiguousarray(flip, dtype=np.bool_)
-    hit, nx, ny, depth, px, py, defer = polygon_circle_pairs(poly, circ, flip, geom.hx, geom.hy, store.kind, store.hw,
-                                                             store.hh, store.radius, geom.world_poly, geom.poly_slot,
-                                                             geom.count, geom.K, exact)
-    if defer.any():
-        d = np.flatnonzero(defer)
-        dp, dc = poly[d], circ[d]
-        vp, np_ = geom.outlines(store, dp)
-        hx, hy = geom.hx, geom.hy
-        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = batch.polygon_circle(
-            hx[dp], hy[dp], vp, np_, hx[dc], hy[dc], store.radius[dc], flip=flip[d], exact=exact)
-    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+    hx, hy, radius = geom.hx, geom.hy, store.radius
+
+    def numpy(d: IntpArray) -> batch.ContactArrays:
+        vp, np_ = geom.outlines(store, poly[d])
+        return batch.polygon_circle(hx[poly[d]], hy[poly[d]], vp, np_, hx[circ[d]], hy[circ[d]], radius[circ[d]],
+                                    flip=flip[d], exact=exact)
+
+    return _with_deferred(polygon_circle_pairs(poly, circ, flip, hx, hy, store.kind, store.hw, store.hh, radius,
+                                               geom.world_poly, geom.poly_slot, geom.count, geom.K, exact), numpy)
 
 
 def _capsule_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, code: IntpArray,
