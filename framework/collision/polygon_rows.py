@@ -25,7 +25,11 @@ Rows it leaves to the numpy kernel (``defer``), which then answers them as it al
 - a contact beyond float64's range (the numpy kernel raises the error).
 
 A row's answer does not depend on the other rows of its batch (the numpy kernel's sums are
-sequential per row for that reason), so answering a few rows apart gives the same bits.
+sequential per row for that reason), so answering a few rows apart gives the same bits. The pass
+is built twice for that reason: :data:`polygon_pairs` marks the rows touching to rounding
+(``pending``) and :data:`polygon_pairs_settled` decides them exactly. Most scenes never have such
+a row, and a new installation then never compiles the exact functions (about 8 seconds of
+numba's time with the polygon / circle and circle passes, which are built the same way).
 """
 
 from __future__ import annotations
@@ -44,7 +48,7 @@ from .exact_sign import APART, OVERLAP, polygon_depths, polygons_apart
 from .kinds import KIND_AABB
 from .row_frame import BIG, frame_row, pick_row, put_row
 
-__all__ = ["polygon_pairs"]
+__all__ = ["polygon_pairs", "polygon_pairs_settled"]
 
 
 
@@ -228,113 +232,134 @@ def _overlap_point(avx, avy, ac, bvx, bvy, bc, nx, ny, depth, size, exa, eya, ex
     return bvx[j] + nx * half, bvy[j] + ny * half
 
 
-@njit(cache=True)
-def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k, exact, points):
-    # pragma: no cover - compiled
-    """``polygon_polygon`` of the pairs of rows ``(ra[i], rb[i])`` (module docstring): the six
-    contact columns and ``defer``, the rows left to the numpy kernel."""
-    n = ra.size
-    hit = np.zeros(n, dtype=np.bool_)
-    nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    defer = np.zeros(n, dtype=np.bool_)
-    extreme = np.zeros(n, dtype=np.bool_)
-    avx, avy, bvx, bvy = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
-    ux, uy, fwd, bwd = np.empty(2 * k), np.empty(2 * k), np.empty(2 * k), np.empty(2 * k)
-    need = np.zeros(2 * k, dtype=np.int64)
-    cd, cx, cy = np.empty(4 * k), np.empty(4 * k), np.empty(4 * k)
-    exa, eya, exb, eyb, na, nb = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
-    for i in range(n):
-        a, b = ra[i], rb[i]
-        ac = _outline(a, kind, hw, hh, world_poly, poly_slot, count, avx, avy)
-        bc = _outline(b, kind, hw, hh, world_poly, poly_slot, count, bvx, bvy)
-        ax, ay, bx, by = hx[a], hy[a], hx[b], hy[b]
-        if _centred_box(avx, avy, ac) and _centred_box(bvx, bvy, bc):
-            if exact and points:
-                h, nxi, nyi, dep, pxi, pyi, found = aabb_exact_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2])
-                if not found:
+def _polygon_pairs(settle):
+    """The row pass, built twice (module docstring): ``settle`` false, rows touching to rounding
+    where contacts must be exact are only marked ``pending``; ``settle`` true, they are decided
+    exactly. (``settle`` is a constant of the closure: numba drops the branch not taken before
+    typing, so the exact functions compile only with the settling variant.)"""
+
+    @njit(cache=True)
+    def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k, exact, points):
+        # pragma: no cover - compiled
+        """``polygon_polygon`` of the pairs of rows ``(ra[i], rb[i])`` (module docstring): the six
+        contact columns, ``defer`` (the rows left to the numpy kernel) and ``pending`` (the rows
+        left to the settling variant)."""
+        n = ra.size
+        hit = np.zeros(n, dtype=np.bool_)
+        nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+        defer = np.zeros(n, dtype=np.bool_)
+        pending = np.zeros(n, dtype=np.bool_)
+        extreme = np.zeros(n, dtype=np.bool_)
+        avx, avy, bvx, bvy = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+        ux, uy, fwd, bwd = np.empty(2 * k), np.empty(2 * k), np.empty(2 * k), np.empty(2 * k)
+        need = np.zeros(2 * k, dtype=np.int64)
+        cd, cx, cy = np.empty(4 * k), np.empty(4 * k), np.empty(4 * k)
+        exa, eya, exb, eyb, na, nb = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+        for i in range(n):
+            a, b = ra[i], rb[i]
+            ac = _outline(a, kind, hw, hh, world_poly, poly_slot, count, avx, avy)
+            bc = _outline(b, kind, hw, hh, world_poly, poly_slot, count, bvx, bvy)
+            ax, ay, bx, by = hx[a], hy[a], hx[b], hy[b]
+            if _centred_box(avx, avy, ac) and _centred_box(bvx, bvy, bc):
+                if exact and points:
+                    h, nxi, nyi, dep, pxi, pyi, found = aabb_exact_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2])
+                    if not found:
+                        defer[i] = True
+                    elif h:
+                        hit[i] = True
+                        nx[i], ny[i], depth[i], px[i], py[i] = nxi, nyi, dep, pxi, pyi
+                    continue
+                _aabb_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2], exact, points, i, hit, nx, ny, depth, px, py,
+                          extreme)
+                if exact and extreme[i]:
                     defer[i] = True
-                elif h:
-                    hit[i] = True
-                    nx[i], ny[i], depth[i], px[i], py[i] = nxi, nyi, dep, pxi, pyi
                 continue
-            _aabb_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2], exact, points, i, hit, nx, ny, depth, px, py,
-                      extreme)
-            if exact and extreme[i]:
-                defer[i] = True
-            continue
-        # The scaled frame (batch_common.frame, batch_polygon._frame).
-        ea, eb = _extent(avx, avy), _extent(bvx, bvy)
-        reach = ea if ea > eb else eb  # (np.maximum: no NaN here)
-        dx, dy, e = frame_row(ax, ay, bx, by, reach)
-        for j in range(k):
-            avx[j], avy[j] = math.ldexp(avx[j], -e), math.ldexp(avy[j], -e)
-            bvx[j], bvy[j] = math.ldexp(bvx[j], -e), math.ldexp(bvy[j], -e)
-        sz = _radius(avx, avy) + _radius(bvx, bvy)
-        # Separating axes (batch_polygon._sat): unnormalised outward edge normals of A, then of B.
-        _edges(avy, exa)
-        _edges(avx, eya)
-        _edges(bvy, exb)
-        _edges(bvx, eyb)
-        for j in range(k):
-            ux[j], uy[j] = exa[j], -eya[j]
-            ux[k + j], uy[k + j] = exb[j], -eyb[j]
-        apart = ac == 2 and bc == 2
-        border = any_valid = False
-        reach2 = sz + abs(dx) + abs(dy)
-        for c in range(2 * k):
-            need[c] = 0
-            if ux[c] == 0.0 and uy[c] == 0.0:
-                continue
-            any_valid = True
-            amin, amax = _project(ux[c], uy[c], avx, avy)
-            bmin, bmax = _project(ux[c], uy[c], bvx, bvy)
-            ud = ux[c] * dx + uy[c] * dy
-            fwd[c] = (amax - bmin) - ud
-            bwd[c] = (bmax - amin) + ud
-            least = fwd[c] if fwd[c] < bwd[c] else bwd[c]
-            tol = BAND * (abs(ux[c]) + abs(uy[c])) * reach2
-            if least < -tol:
-                apart = True
-                break
-            need[c] = (1 if fwd[c] <= tol else 0) + (2 if bwd[c] <= tol else 0)
-            if least <= tol:
-                border = True
-        if apart or not any_valid:
-            continue
-        if border:
-            # Touching to rounding: apart unless exact, where the exact decision and depths are
-            # found on the floats (exact_sign); only what that cannot settle is deferred.
-            if not exact:
-                continue
-            verdict = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need)
-            if verdict == APART:
-                continue
-            if not (verdict == OVERLAP and polygon_depths(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd, bwd)):
-                defer[i] = True
-                continue
-            # (an overlap: every axis's exact overlaps, rounded, as the integers give them)
-        # Candidates in the scalar code's order: per axis, forward then backward.
-        for c in range(2 * k):
-            if ux[c] == 0.0 and uy[c] == 0.0:  # (a padding edge: ln 1, the depth BIG, as the numpy)
-                cx[2 * c], cy[2 * c] = ux[c], uy[c]
-                cx[2 * c + 1], cy[2 * c + 1] = -ux[c], -uy[c]
-                cd[2 * c] = cd[2 * c + 1] = BIG
-                continue
-            ln = _norm(ux[c], uy[c])
-            cx[2 * c] = ux[c] / ln
-            cy[2 * c] = uy[c] / ln
-            cx[2 * c + 1] = -cx[2 * c]
-            cy[2 * c + 1] = -cy[2 * c]
-            d = fwd[c] / ln
-            cd[2 * c] = (d if d > TINY else TINY) + 0.0
-            d = bwd[c] / ln
-            cd[2 * c + 1] = (d if d > TINY else TINY) + 0.0
-        dep, nxi, nyi = pick_row(cd, cx, cy, sz)
-        pxi = pyi = 0.0
-        if points:
+            # The scaled frame (batch_common.frame, batch_polygon._frame).
+            ea, eb = _extent(avx, avy), _extent(bvx, bvy)
+            reach = ea if ea > eb else eb  # (np.maximum: no NaN here)
+            dx, dy, e = frame_row(ax, ay, bx, by, reach)
             for j in range(k):
-                bvx[j] += dx
-                bvy[j] += dy
-            pxi, pyi = _overlap_point(avx, avy, ac, bvx, bvy, bc, nxi, nyi, dep, sz, exa, eya, exb, eyb, na, nb)
-        put_row(i, nxi, nyi, dep, pxi, pyi, e, ax, ay, hit, nx, ny, depth, px, py, defer)
-    return hit, nx, ny, depth, px, py, defer
+                avx[j], avy[j] = math.ldexp(avx[j], -e), math.ldexp(avy[j], -e)
+                bvx[j], bvy[j] = math.ldexp(bvx[j], -e), math.ldexp(bvy[j], -e)
+            sz = _radius(avx, avy) + _radius(bvx, bvy)
+            # Separating axes (batch_polygon._sat): unnormalised outward edge normals of A, then of B.
+            _edges(avy, exa)
+            _edges(avx, eya)
+            _edges(bvy, exb)
+            _edges(bvx, eyb)
+            for j in range(k):
+                ux[j], uy[j] = exa[j], -eya[j]
+                ux[k + j], uy[k + j] = exb[j], -eyb[j]
+            apart = ac == 2 and bc == 2
+            border = any_valid = False
+            reach2 = sz + abs(dx) + abs(dy)
+            for c in range(2 * k):
+                need[c] = 0
+                if ux[c] == 0.0 and uy[c] == 0.0:
+                    continue
+                any_valid = True
+                amin, amax = _project(ux[c], uy[c], avx, avy)
+                bmin, bmax = _project(ux[c], uy[c], bvx, bvy)
+                ud = ux[c] * dx + uy[c] * dy
+                fwd[c] = (amax - bmin) - ud
+                bwd[c] = (bmax - amin) + ud
+                least = fwd[c] if fwd[c] < bwd[c] else bwd[c]
+                tol = BAND * (abs(ux[c]) + abs(uy[c])) * reach2
+                if least < -tol:
+                    apart = True
+                    break
+                need[c] = (1 if fwd[c] <= tol else 0) + (2 if bwd[c] <= tol else 0)
+                if least <= tol:
+                    border = True
+            if apart or not any_valid:
+                continue
+            if border:
+                # Touching to rounding: apart unless exact, where the exact decision and depths are
+                # found on the floats (exact_sign); only what that cannot settle is deferred.
+                if not exact:
+                    continue
+                if settle:
+                    verdict = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need)
+                    if verdict == APART:
+                        continue
+                    if not (verdict == OVERLAP and polygon_depths(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd,
+                                                                  bwd)):
+                        defer[i] = True
+                        continue
+                else:  # (left to the settling variant)
+                    pending[i] = True
+                    continue
+                # (an overlap: every axis's exact overlaps, rounded, as the integers give them)
+            # Candidates in the scalar code's order: per axis, forward then backward.
+            for c in range(2 * k):
+                if ux[c] == 0.0 and uy[c] == 0.0:  # (a padding edge: ln 1, the depth BIG, as the numpy)
+                    cx[2 * c], cy[2 * c] = ux[c], uy[c]
+                    cx[2 * c + 1], cy[2 * c + 1] = -ux[c], -uy[c]
+                    cd[2 * c] = cd[2 * c + 1] = BIG
+                    continue
+                ln = _norm(ux[c], uy[c])
+                cx[2 * c] = ux[c] / ln
+                cy[2 * c] = uy[c] / ln
+                cx[2 * c + 1] = -cx[2 * c]
+                cy[2 * c + 1] = -cy[2 * c]
+                d = fwd[c] / ln
+                cd[2 * c] = (d if d > TINY else TINY) + 0.0
+                d = bwd[c] / ln
+                cd[2 * c + 1] = (d if d > TINY else TINY) + 0.0
+            dep, nxi, nyi = pick_row(cd, cx, cy, sz)
+            pxi = pyi = 0.0
+            if points:
+                for j in range(k):
+                    bvx[j] += dx
+                    bvy[j] += dy
+                pxi, pyi = _overlap_point(avx, avy, ac, bvx, bvy, bc, nxi, nyi, dep, sz, exa, eya, exb, eyb, na, nb)
+            put_row(i, nxi, nyi, dep, pxi, pyi, e, ax, ay, hit, nx, ny, depth, px, py, defer)
+        return hit, nx, ny, depth, px, py, defer, pending
+
+    return polygon_pairs
+
+
+#: Every row; rows touching to rounding where contacts must be exact are marked ``pending``.
+polygon_pairs = _polygon_pairs(False)
+#: The ``pending`` rows of :data:`polygon_pairs`, decided exactly (compiled when a scene first has one).
+polygon_pairs_settled = _polygon_pairs(True)

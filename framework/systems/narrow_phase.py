@@ -16,7 +16,12 @@ from ..arrays import BoolArray, I64Array, IntpArray, distinct
 from ..collision import batch
 from ..collision.batch_box import aabb_pairs_fast
 from ..collision.chain import chain_rule, deepest_below
-from ..collision.circle_rows import circle_pairs, polygon_circle_pairs
+from ..collision.circle_rows import (
+    circle_pairs,
+    circle_pairs_settled,
+    polygon_circle_pairs,
+    polygon_circle_pairs_settled,
+)
 from ..collision.kinds import (
     BOXES,
     CAPSULES,
@@ -30,7 +35,7 @@ from ..collision.kinds import (
     POLYGON_CIRCLE,
     pair_code,
 )
-from ..collision.polygon_rows import polygon_pairs
+from ..collision.polygon_rows import polygon_pairs, polygon_pairs_settled
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
 from ..geometry import Geometry
@@ -175,10 +180,16 @@ def _pair_contacts(
     return batch.ContactArrays(hit, nx, ny, depth, px, py)
 
 
-def _with_deferred(cols: tuple[Any, ...], answer: Callable[[IntpArray], batch.ContactArrays]) -> batch.ContactArrays:
-    """A compiled row pass's contact columns, its rows marked ``defer`` answered by ``answer(rows)``
-    (the numpy kernel on those rows: a row's answer does not depend on its batch)."""
-    hit, nx, ny, depth, px, py, defer = cols
+def _with_deferred(cols: tuple[Any, ...], settle: Callable[[IntpArray], tuple[Any, ...]],
+                   answer: Callable[[IntpArray], batch.ContactArrays]) -> batch.ContactArrays:
+    """A compiled row pass's contact columns: its rows marked ``pending`` (touching to rounding,
+    where contacts must be exact) answered by ``settle(rows)``, the pass's settling variant (whose
+    exact functions compile only when a scene first has such a row), then its rows marked ``defer``
+    by ``answer(rows)``, the numpy kernel (a row's answer does not depend on its batch)."""
+    hit, nx, ny, depth, px, py, defer, pending = cols
+    if pending.any():
+        p = np.flatnonzero(pending)
+        hit[p], nx[p], ny[p], depth[p], px[p], py[p], defer[p], _ = settle(p)
     if defer.any():
         d = np.flatnonzero(defer)
         hit[d], nx[d], ny[d], depth[d], px[d], py[d] = answer(d)
@@ -199,8 +210,11 @@ def _polygon_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray,
         return batch.polygon_polygon(hx[a[d]], hy[a[d]], va, na, hx[b[d]], hy[b[d]], vb, nb, exact=exact,
                                      points=points)
 
-    return _with_deferred(polygon_pairs(a, b, hx, hy, store.kind, store.hw, store.hh, geom.world_poly,
-                                        geom.poly_slot, geom.count, geom.K, exact, points), numpy)
+    def rows(kernel: Callable[..., tuple[Any, ...]], a: IntpArray, b: IntpArray) -> tuple[Any, ...]:
+        return kernel(a, b, hx, hy, store.kind, store.hw, store.hh, geom.world_poly, geom.poly_slot, geom.count,
+                      geom.K, exact, points)
+
+    return _with_deferred(rows(polygon_pairs, a, b), lambda p: rows(polygon_pairs_settled, a[p], b[p]), numpy)
 
 
 def _circle_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, *, exact: bool,
@@ -214,7 +228,8 @@ def _circle_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, 
     def numpy(d: IntpArray) -> batch.ContactArrays:
         return batch.circle_circle(hx[a[d]], hy[a[d]], radius[a[d]], hx[b[d]], hy[b[d]], radius[b[d]], exact=exact)
 
-    return _with_deferred(circle_pairs(a, b, hx, hy, radius, exact), numpy)
+    return _with_deferred(circle_pairs(a, b, hx, hy, radius, exact),
+                          lambda p: circle_pairs_settled(a[p], b[p], hx, hy, radius, exact), numpy)
 
 
 def _polygon_circle_pairs(store: BodyStore, geom: Geometry, poly: IntpArray, circ: IntpArray, flip: BoolArray, *,
@@ -231,8 +246,13 @@ def _polygon_circle_pairs(store: BodyStore, geom: Geometry, poly: IntpArray, cir
         return batch.polygon_circle(hx[poly[d]], hy[poly[d]], vp, np_, hx[circ[d]], hy[circ[d]], radius[circ[d]],
                                     flip=flip[d], exact=exact)
 
-    return _with_deferred(polygon_circle_pairs(poly, circ, flip, hx, hy, store.kind, store.hw, store.hh, radius,
-                                               geom.world_poly, geom.poly_slot, geom.count, geom.K, exact), numpy)
+    def rows(kernel: Callable[..., tuple[Any, ...]], poly: IntpArray, circ: IntpArray, flip: BoolArray,
+             ) -> tuple[Any, ...]:
+        return kernel(poly, circ, flip, hx, hy, store.kind, store.hw, store.hh, radius, geom.world_poly,
+                      geom.poly_slot, geom.count, geom.K, exact)
+
+    return _with_deferred(rows(polygon_circle_pairs, poly, circ, flip),
+                          lambda p: rows(polygon_circle_pairs_settled, poly[p], circ[p], flip[p]), numpy)
 
 
 def _capsule_pairs(store: BodyStore, geom: Geometry, a: IntpArray, b: IntpArray, code: IntpArray,
