@@ -8,9 +8,9 @@ cached until the static set changes.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from .arrays import F64Array, I64Array, IntpArray
+from .compiled import kernel
 from .shapes import Capsule, ChainSegment, Polygon, Segment
 from .store import KIND_AABB, KIND_CAPSULE, KIND_POLYGON, KIND_SEGMENT, BodyStore
 
@@ -42,7 +42,7 @@ def widen_up(v: F64Array, out: F64Array | None = None) -> F64Array:
     return np.add(v, _ulp_step(v), out=out)
 
 
-@njit(cache=True)
+@kernel
 def _place(rows, x, y, ox, oy, kind, hw, hh, radius, cos, sin, local, slot, world_poly, cap_half, cap_ux, cap_uy, hx,
            hy, minx, maxx, miny, maxy, has_offset):  # pragma: no cover - compiled
     """Origins and bounds of ``rows`` from their poses, with ``cos``/``sin`` of their rotations
@@ -90,7 +90,7 @@ def _place(rows, x, y, ox, oy, kind, hw, hh, radius, cos, sin, local, slot, worl
         miny[r], maxy[r] = ly - _ulp(ly), hy_ + _ulp(hy_)
 
 
-@njit(cache=True)
+@kernel
 def _ulp(v):  # pragma: no cover - compiled
     """:func:`_ulp_step` of one float (NaN stays NaN, as ``np.maximum`` keeps it)."""
     step = abs(v) * 2.0**-52

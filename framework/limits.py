@@ -29,8 +29,8 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .compiled import kernel
 from .shapes import Shape
 from .validation import InvalidValue
 
@@ -94,7 +94,7 @@ def check_position(x: float, y: float, what: str = "Transform") -> None:
                            f"coordinates within {MAX_COORD:g} (see framework.limits)")
 
 
-@njit(cache=True)
+@kernel
 def rows_sound(x, y, rot, vx, vy, w, rows, max_coord):
     """Whether the ``rows`` of the six pose and velocity columns are all finite, with positions
     within ``max_coord``: the common case of the step's checks, in one compiled pass (the checks
@@ -108,7 +108,7 @@ def rows_sound(x, y, rot, vx, vy, w, rows, max_coord):
     return True
 
 
-@njit(cache=True)
+@kernel
 def motion_within(x, y, vx, vy, rows, dt, gx, gy, max_coord):
     """The first of ``rows`` that a step of ``dt`` could carry beyond ``max_coord`` (see
     :func:`check_motion`), or -1."""

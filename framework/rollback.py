@@ -24,9 +24,9 @@ from typing import Any
 
 import esper
 import numpy as np
-from numba import njit
 
 from .character import CharacterController
+from .compiled import kernel
 from .store import ROW_STATE, ROW_STRUCTURE
 
 __all__ = ["StepRollback"]
@@ -36,7 +36,7 @@ _CONTROLLER_STATE = ("drop_through", "on_floor", "floor_normal", "floor_entity",
                      "on_ceiling", "crushed")
 
 
-@njit(cache=True)
+@kernel
 def _keep(rows, entity, kind, body, has_vel, x, y, rot, vx, vy, w, still, asleep):
     """The ``rows`` of the columns (in :data:`~framework.store.ROW_STATE`'s order) as the rows of a
     new float array, one column per row kept."""

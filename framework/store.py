@@ -17,10 +17,10 @@ from numbers import Real
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from .collision.kinds import KIND_AABB, KIND_CAPSULE, KIND_CIRCLE, KIND_NONE, KIND_POLYGON, KIND_SEGMENT
+from .compiled import kernel
 from .components import _HITBOX_FIELDS as _HITBOX_FIELD_NAMES
 from .components import (
     Body,
@@ -68,7 +68,7 @@ _FIELD_NAMES = {
 }
 
 
-@njit(cache=True)
+@kernel
 def _move_rows(rows, x, y, rot, vx, vy, w, dt):  # pragma: no cover - compiled
     """:meth:`BodyStore.move_by_velocity`'s arithmetic, row by row (a rotation only where ``w``
     is not 0: adding 0 would turn a rotation of -0.0 into 0.0)."""

@@ -20,10 +20,9 @@ where the scalar code takes its depths from exact overlaps, so does this kernel 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 from .batch_common import F64, ContactArrays, columns, finish, frame, sum_leading
 from .batch_point import overlap_point
 from .collide import POINT_TOL
@@ -322,14 +321,14 @@ def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points, i, hit, nx, ny,
         px[i], py[i] = 0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)
 
 
-@njit(cache=True)
+@kernel
 def _aabb_out(n):  # pragma: no cover - compiled
     """The output columns of :func:`_aabb_row` for ``n`` rows, zeros."""
     return (np.zeros(n, dtype=np.bool_), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
             np.zeros(n, dtype=np.bool_))
 
 
-@njit(cache=True)
+@kernel
 def _aabb_rows(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points):  # pragma: no cover - compiled
     """:func:`_aabb_row` of every row of the gathered columns."""
     n = ax.size
@@ -340,7 +339,7 @@ def _aabb_rows(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points):  # pragma: no
     return hit, nx, ny, depth, px, py, extreme
 
 
-@njit(cache=True)
+@kernel
 def _aabb_pairs(ra, rb, hx, hy, hw, hh, exact, points):  # pragma: no cover - compiled
     """:func:`_aabb_row` of every pair of rows ``(ra[i], rb[i])`` of the columns (origins ``hx,
     hy``, half sizes ``hw, hh``), gathered in the pass."""

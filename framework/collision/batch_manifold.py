@@ -18,9 +18,8 @@ B's deepest vertex along the normal, with the overlap of the shapes' projections
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 from .kinds import KIND_AABB
 
 __all__ = ["pair_manifolds"]
@@ -76,7 +75,7 @@ def _facing(p, m, nx, ny):
     return best, along
 
 
-@njit(cache=True)
+@kernel
 def pair_manifolds(ra, rb, nx, ny, margin, kind, hx, hy, hw, hh, slot, world_poly, count):
     """Per pair ``(ra[i], rb[i])`` (boxes or polygons) with normal ``(nx, ny)`` (A toward B): the
     number of points (0 to 2), their positions ``px, py`` and separations ``sep`` (``(P, 2)``)."""

@@ -34,8 +34,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import kernel
 from .exact import BAND
 from .pieces import TIE
 from .py_hypot import hypot
@@ -53,10 +53,10 @@ _SLACK = 1e-9  # relative margin of the skipping tests (rounding is below 1e-15 
 
 
 
-_closest_on_segment = njit(cache=True)(closest_on_segment)  # (the single queries' own arithmetic, compiled)
+_closest_on_segment = kernel(closest_on_segment)  # (the single queries' own arithmetic, compiled)
 
 
-@njit(cache=True)
+@kernel
 def _grow(a, m):  # pragma: no cover - compiled
     b = np.empty(max(2 * a.size, m + 1), dtype=a.dtype)
     b[: a.size] = a
@@ -66,7 +66,7 @@ def _grow(a, m):  # pragma: no cover - compiled
 # --- points inside hitboxes (Scene.query_point) -----------------------------------------------
 
 
-@njit(cache=True)
+@kernel
 def _contains(r, skind, kind, hx, hy, radius, cap_ux, cap_uy, hw, hh, world_poly, poly_slot, count, px, py,
               two):  # pragma: no cover - compiled
     """SpatialQueries._contains: closed containment of (px, py) in row r."""
@@ -109,7 +109,7 @@ def _contains(r, skind, kind, hx, hy, radius, cap_ux, cap_uy, hw, hh, world_poly
     return False  # (a live shape of another kind than its row's: not reached between steps)
 
 
-@njit(cache=True)
+@kernel
 def points_inside(px, py, kind, skind, layer, entity, minx, miny, maxx, maxy, hx, hy, radius, cap_ux, cap_uy,
                   hw, hh, world_poly, poly_slot, count, mask, two):  # pragma: no cover - compiled
     """For each point, the entities whose hitbox contains it (closed), sorted: ``(offsets,
@@ -146,7 +146,7 @@ def points_inside(px, py, kind, skind, layer, entity, minx, miny, maxx, maxy, hx
 # --- the nearest hitbox (Scene.nearest) -------------------------------------------------------
 
 
-@njit(cache=True)
+@kernel
 def _point_distance(k, sa, sb, local, cnt, x, y, rot, px, py):  # pragma: no cover - compiled
     """framework.collision.distance.point_distance of the shape of kind ``k`` (``sa, sb``: half
     width and height of an AABB, radius of a circle, radius and length of a capsule; ``local``,
@@ -200,7 +200,7 @@ def _point_distance(k, sa, sb, local, cnt, x, y, rot, px, py):  # pragma: no cov
     return best - r, bx + r * (px - bx) / best, by + r * (py - by) / best
 
 
-@njit(cache=True)
+@kernel
 def nearest_points(px, py, max_distance, kind, skind, sa, sb, local, cnt, layer, entity, minx, miny, maxx, maxy,
                    hx, hy, rot, mask):  # pragma: no cover - compiled
     """For each point, the row nearest it within ``max_distance`` (as ``Scene.nearest``; ties to the
@@ -241,7 +241,7 @@ def nearest_points(px, py, max_distance, kind, skind, sa, sb, local, cnt, layer,
 # --- rays (Scene.raycast) ---------------------------------------------------------------------
 
 
-@njit(cache=True)
+@kernel
 def _pick(nxs, nys, m):  # pragma: no cover - compiled
     """framework.collision.tiebreak.pick of ``m`` candidates of equal depth: the index of the winner."""
     if m == 1:
@@ -283,7 +283,7 @@ def _pick(nxs, nys, m):  # pragma: no cover - compiled
     return best
 
 
-@njit(cache=True)
+@kernel
 def _ray_polygon(qx, qy, n, ox, oy, dx, dy, dlen):  # pragma: no cover - compiled
     """framework.collision.ray._ray_polygon with clip_polygon's float path on the scaled outline
     ``qx, qy`` (``n`` vertices, counter-clockwise): ``(status, tau, nx, ny)``, status 0 a miss,
@@ -355,7 +355,7 @@ def _ray_polygon(qx, qy, n, ox, oy, dx, dy, dlen):  # pragma: no cover - compile
     return 1, t_in, ux[w], uy[w]
 
 
-@njit(cache=True)
+@kernel
 def _ray_circle(mx, my, r, vx, vy):  # pragma: no cover - compiled
     """framework.collision.ray._ray_circle with disc_interval's float path: as _ray_polygon."""
     a = vx * vx + vy * vy
@@ -389,12 +389,12 @@ def _ray_circle(mx, my, r, vx, vy):  # pragma: no cover - compiled
     return 1, t1, 0.0, 1.0
 
 
-@njit(cache=True)
+@kernel
 def _exponent(v):  # pragma: no cover - compiled
     return math.frexp(abs(v))[1]
 
 
-@njit(cache=True)
+@kernel
 def _ray_row(k, sa, sb, ext, local, cnt, px, py, rot, ox, oy, dx, dy, limit):  # pragma: no cover - compiled
     """framework.collision.ray.raycast of one row: ``(status, distance, hit x, hit y, nx, ny)``,
     status 0 a miss, 1 a hit, -1 unresolved (answer it with raycast itself)."""
@@ -458,7 +458,7 @@ def _ray_row(k, sa, sb, ext, local, cnt, px, py, rot, ox, oy, dx, dy, limit):  #
     return 1, distance + 0.0, hx + 0.0, hy + 0.0, nx + 0.0, ny + 0.0
 
 
-@njit(cache=True)
+@kernel
 def ray_rows(rows, at, ox, oy, dx, dy, max_distance, skind, sa, sb, ext, local, cnt, hx, hy,
              rot):  # pragma: no cover - compiled
     """One ray against each of ``rows`` (as ``Scene.raycast_all`` asks; their shapes at ``at`` in
@@ -474,7 +474,7 @@ def ray_rows(rows, at, ox, oy, dx, dy, max_distance, skind, sa, sb, ext, local, 
     return out
 
 
-@njit(cache=True)
+@kernel
 def rays_first(ox, oy, dx, dy, max_distance, reach, kind, skind, sa, sb, ext, local, cnt, layer, entity, minx,
                miny, maxx, maxy, hx, hy, rot, mask):  # pragma: no cover - compiled
     """For each ray, the first row it enters (as ``Scene.raycast``: nearest, ties to the lower

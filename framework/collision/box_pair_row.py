@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
-from ..compiled import inner
+from ..compiled import inner, kernel
 from .batch_box import _less_1, _two_sum_1
 from .collide import POINT_TOL
 from .exact import BAND, TINY
@@ -117,7 +115,7 @@ def _box_point(hwa, hha, hwb, hhb, dx, dy, size):  # pragma: no cover - compiled
     return 0.0, 0.0, False  # (rounding hid every vertex: the caller's generic fallback)
 
 
-@njit(cache=True)
+@kernel
 def aabb_exact_row(ax, ay, ahw, ahh, bx, by, bhw, bhh):  # pragma: no cover - compiled
     """``aabb_aabb`` of one pair: ``(hit, nx, ny, depth, px, py, found)``; ``found`` False where
     rounding hid every vertex of the overlap or a value is beyond float64's range (the caller

@@ -10,14 +10,13 @@ rows are too many for a pass (:data:`~framework.collision.broad_phase.DIRECT_QUE
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 
 __all__ = ["holds", "lower_bound", "rows_meeting", "rows_within"]
 
 
-@njit(cache=True)
+@kernel
 def rows_meeting(kind, minx, miny, maxx, maxy, x0, y0, x1, y1):  # pragma: no cover - compiled
     """Rows with a hitbox (``kind >= 0``) whose bounds strictly overlap the box ``[x0, x1] x
     [y0, y1]`` (touching does not count), in row order."""
@@ -51,7 +50,7 @@ def holds(keys, key):  # pragma: no cover - compiled
     return i < keys.size and keys[i] == key
 
 
-@njit(cache=True)
+@kernel
 def rows_within(rows, minx, miny, maxx, maxy, x0, y0, x1, y1, layer, sensor, mask, skip_rows, entity,
                 skip_entities):  # pragma: no cover - compiled
     """The ``rows`` whose bounds meet the box (closed) that block a body of ``mask`` (their layer

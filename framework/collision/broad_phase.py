@@ -28,10 +28,10 @@ import math
 from typing import cast
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from ..arrays import distinct
+from ..compiled import kernel
 from ..validation import InvalidValue, finite, positive
 from . import grid
 from .grid import Bounds, CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
@@ -425,7 +425,7 @@ class SpatialHash:
 DIRECT_PAIRS = 1 << 16
 
 
-@njit(cache=True)
+@kernel
 def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind):  # pragma: no cover
     """The sorted pair keys (``entity a << 32 | entity b``, a < b) of every moving row (``moving``,
     sorted rows) with every other hitbox row whose bounds strictly overlap its own (touching is no

@@ -35,10 +35,9 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .exact import BAND, TINY, Offset, float_approx, ratio_approx, rounded_exact
 from .ray import closest_on_segment
@@ -116,7 +115,7 @@ def _folded_x(nx, ny):
     return nx
 
 
-@njit(cache=True)
+@kernel
 def _pick(cd, cx, cy, m, size):
     """:func:`framework.collision.tiebreak.pick` over the first ``m`` candidates."""
     best = np.inf
@@ -163,7 +162,7 @@ def _pick(cd, cx, cy, m, size):
 
 
 # The point of a segment closest to a point: ray.py's function, compiled for the kernels here.
-_on_segment = njit(cache=True)(closest_on_segment)
+_on_segment = kernel(closest_on_segment)
 
 
 @leaf
@@ -296,7 +295,7 @@ def _apart_contact(i, dist, depth, a0x, a0y, a1x, a1y, qx, qy, nb, ra, rb, f, ou
     out[3], out[4] = pax + nx * mid, pay + ny * mid
 
 
-@njit(cache=True)
+@kernel
 def _inside_contact(a0x, a0y, a1x, a1y, bx, by, qx, qy, nb, dx, dy, ra, rb, size, f, out):
     """The contact of cores that meet (or are within rounding of meeting): the shortest push-out
     over the axes, plus the radii."""
@@ -307,7 +306,7 @@ def _inside_contact(a0x, a0y, a1x, a1y, bx, by, qx, qy, nb, dx, dy, ra, rb, size
     out[0], out[1], out[2], out[3], out[4] = nx, ny, max(depth, TINY), px, py
 
 
-@njit(cache=True)
+@kernel
 def core(a0x, a0y, a1x, a1y, ra, bx, by, nb, dx, dy, rb, size, f, out):
     """Capsule A (segment a0 a1, radius ra, about A's origin) against B's core (``bx, by``, ``nb``
     points about B's origin: 1 a point, 2 a segment, 3+ a convex CCW outline) rounded by ``rb`` at
@@ -338,7 +337,7 @@ def core(a0x, a0y, a1x, a1y, ra, bx, by, nb, dx, dy, rb, size, f, out):
     return EXACT
 
 
-@njit(cache=True)
+@kernel
 def exact_contact(found, index, excess, a0x, a0y, a1x, a1y, ra, bx, by, nb, dx, dy, rb, size, f, out):
     """The contact of a pair decided on integers: ``found`` 1 the cores meet, 2 they are apart with
     closest points ``index`` and ``R^2 - d^2 = excess`` (> 0)."""
@@ -356,7 +355,7 @@ def exact_contact(found, index, excess, a0x, a0y, a1x, a1y, ra, bx, by, nb, dx, 
     _inside_contact(a0x, a0y, a1x, a1y, bx, by, qx, qy, nb, dx, dy, ra, rb, size, f, out)
 
 
-@njit(cache=True)
+@kernel
 def _core_many(a0x, a0y, a1x, a1y, ra, bvx, bvy, bn, dx, dy, rb, size, f, status, out):
     for p in range(a0x.shape[0]):
         status[p] = core(a0x[p], a0y[p], a1x[p], a1y[p], ra[p], bvx[p], bvy[p], bn[p], dx[p], dy[p], rb[p],

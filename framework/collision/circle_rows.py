@@ -24,8 +24,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import kernel
 from .exact import BAND, TINY
 from .exact_sign import APART, UNSURE, circles_excess, polygon_circle_contact
 from .polygon_rows import _edges, _extent, _norm, _outline, _radius
@@ -39,7 +39,7 @@ def _polygon_circle_pairs(settle):
     :func:`~framework.collision.polygon_rows._polygon_pairs` is: ``settle`` false, rows touching to
     rounding where contacts must be exact are marked ``pending``; true, they are decided exactly."""
 
-    @njit(cache=True)
+    @kernel
     def polygon_circle_pairs(poly, circ, flip, hx, hy, kind, hw, hh, radius, world_poly, poly_slot, count, k,
                              exact):
         # pragma: no cover - compiled
@@ -156,7 +156,7 @@ polygon_circle_pairs_settled = _polygon_circle_pairs(True)
 def _circle_pairs(settle):
     """The circle row pass, built twice as :func:`_polygon_circle_pairs` is."""
 
-    @njit(cache=True)
+    @kernel
     def circle_pairs(ra_rows, rb_rows, hx, hy, radius, exact):  # pragma: no cover - compiled
         """``circle_circle`` of the circle rows ``(ra_rows[i], rb_rows[i])``: the six contact columns,
         ``defer``, the rows left to the numpy kernel (touching to rounding where the exact decision

@@ -19,9 +19,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from ..compiled import inner
+from ..compiled import inner, kernel
 from .batch_box import _two_sum_1 as _two_sum
 from .exact import TINY
 from .py_hypot import hypot
@@ -169,7 +168,7 @@ def _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy):  # pragma: no cov
     return True
 
 
-@njit(cache=True)
+@kernel
 def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # pragma: no cover - compiled
     """:func:`~framework.collision.exact.polygon_polygon_exact`'s decision on floats: outlines A
     (``ac`` vertices ``avx, avy``, scaled, about the origin, padded to ``K`` slots as the batch
@@ -267,7 +266,7 @@ def _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s):  # pragma: no cove
     return nwx, nwy, nex, ney, ns
 
 
-@njit(cache=True)
+@kernel
 def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f):  # pragma: no cover - compiled
     """:func:`~framework.collision.batch_circle._polygon_circle_exact` on floats: the outline
     (``c`` vertices ``vx, vy``, scaled, about the origin) and the circle of radius ``r`` (scaled)
@@ -439,7 +438,7 @@ def _rounded(e, m, tmp, tmp2):  # pragma: no cover - compiled
     return 0.0, False
 
 
-@njit(cache=True)
+@kernel
 def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # pragma: no cover - compiled
     """For overlapping outlines (as :func:`polygons_apart` takes them): every axis slot's exact
     forward and backward overlaps, correctly rounded, into ``fwd`` and ``bwd`` (padding slots are
@@ -487,7 +486,7 @@ def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # 
     return True
 
 
-@njit(cache=True)
+@kernel
 def exact_sum(parts):  # pragma: no cover - compiled
     """The sum of the doubles ``parts``, exact, then correctly rounded (``math.fsum``'s answer);
     NaN where the rounding is not settled here (a sum beyond about 2**±900). The expansions'
@@ -502,7 +501,7 @@ def exact_sum(parts):  # pragma: no cover - compiled
 
 # --- circle / circle --------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def circles_excess(ox, oy, qx, qy, k, ra, rb):  # pragma: no cover - compiled
     """:func:`~framework.collision.exact.circle_circle_exact` on floats: circles of radius ``ra``
     at the origin and ``rb`` at the exact offset ``(q - o) * 2**-k`` (radii scaled):

@@ -39,9 +39,9 @@ from __future__ import annotations
 from typing import TypeAlias
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from ..compiled import kernel
 from ..validation import InvalidValue
 
 __all__ = [
@@ -500,7 +500,7 @@ class StripSweep:
         return body[q[ok]], stat.body[ps[ok]]
 
 
-@njit(cache=True)
+@kernel
 def sweep_pairs(skey, slim, x0, y0, x1, y1, first):
     """The sweep of :meth:`StripSweep.self_pairs` (compiled): entry ``p`` meets ``p + 1, p + 2, ...``
     while their sweep key is within its limit; a pair counts once (in the first row either of its

@@ -15,9 +15,9 @@ candidates again.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from ..compiled import kernel
 from .grid import Bounds
 
 __all__ = ["KeptPairs"]
@@ -26,7 +26,7 @@ __all__ = ["KeptPairs"]
 MARGIN = 0.125
 
 
-@njit(cache=True)
+@kernel
 def _grown(moving, minx, miny, maxx, maxy, margin):  # pragma: no cover - compiled
     """The movers' fat bounds: each side moved out by ``margin`` times the larger side."""
     k = moving.size
@@ -39,7 +39,7 @@ def _grown(moving, minx, miny, maxx, maxy, margin):  # pragma: no cover - compil
     return fx0, fy0, fx1, fy1
 
 
-@njit(cache=True)
+@kernel
 def _inside(moving, minx, miny, maxx, maxy, fx0, fy0, fx1, fy1):  # pragma: no cover - compiled
     """Whether every mover's bounds lie within its fat bounds (``f*[k]``: mover ``k``'s)."""
     for k in range(moving.size):
@@ -49,7 +49,7 @@ def _inside(moving, minx, miny, maxx, maxy, fx0, fy0, fx1, fy1):  # pragma: no c
     return True
 
 
-@njit(cache=True)
+@kernel
 def _overlapping(ra, rb, minx, miny, maxx, maxy):  # pragma: no cover - compiled
     """Which candidates' bounds strictly overlap now."""
     keep = np.empty(ra.size, dtype=np.bool_)

@@ -37,9 +37,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from ..compiled import inner
+from ..compiled import inner, kernel
 from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
@@ -238,7 +237,7 @@ def _polygon_pairs(settle):
     exactly. (``settle`` is a constant of the closure: numba drops the branch not taken before
     typing, so the exact functions compile only with the settling variant.)"""
 
-    @njit(cache=True)
+    @kernel
     def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k, exact, points):
         # pragma: no cover - compiled
         """``polygon_polygon`` of the pairs of rows ``(ra[i], rb[i])`` (module docstring): the six

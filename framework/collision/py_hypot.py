@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
-from ..compiled import inner
+from ..compiled import inner, kernel
 
 __all__ = ["hypot"]
 
@@ -61,7 +59,7 @@ def _norm(x, y, m):  # pragma: no cover - compiled
     return h / scale
 
 
-@njit(cache=True)
+@kernel
 def hypot(x, y):  # pragma: no cover - compiled
     """``math.hypot(x, y)`` as CPython 3.11 computes it (the same bits, subnormals included)."""
     x, y = abs(x), abs(y)

@@ -25,12 +25,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..arrays import F64Array, I64Array, IntpArray
 from ..collision.kinds import KIND_AABB
 from ..collision.py_hypot import hypot
-from ..compiled import inner
+from ..compiled import inner, kernel
 from ..store import DYNAMIC
 
 __all__ = ["REASONS", "move_box", "outputs"]
@@ -491,7 +490,7 @@ def outputs() -> tuple[F64Array, I64Array, IntpArray, F64Array]:
     return np.zeros(10), np.zeros(7, dtype=np.int64), np.zeros(_HITS, dtype=np.intp), np.zeros((_HITS, 2))
 
 
-@njit(cache=True)
+@kernel
 def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r,
              push_n):  # pragma: no cover - compiled
     """The stage's ``_move`` from its ride on (the candidates gathered): 0, or the reason it hands

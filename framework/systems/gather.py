@@ -37,10 +37,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..collision.box_rows import lower_bound
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 
 __all__ = ["centres_inside", "gather", "solid_contacts", "solid_pair", "solid_pairs_mask", "taking_part"]
 
@@ -71,7 +70,7 @@ def _row(lut, entity):  # pragma: no cover - compiled
     return lut[entity] if entity < lut.size else -1
 
 
-@njit(cache=True)
+@kernel
 def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush, simp, ssep, stpush, stimp, lut,
            kind, layer, mask, layers_open, bound, radius, inv_inertia, friction, hw, hh, x, y, sx, sy, hx, hy, minx,
            miny, maxx, maxy, rolling, keep_gap, box_kind, circle_kind):  # pragma: no cover - compiled
@@ -233,7 +232,7 @@ def _takes(a, b, kind, sensor, inv_mass, asleep):  # pragma: no cover - compiled
     return (inv_mass[a] > 0.0 and not asleep[a]) or (inv_mass[b] > 0.0 and not asleep[b])
 
 
-@njit(cache=True)
+@kernel
 def taking_part(ra, rb, kind, sensor, inv_mass, asleep):  # pragma: no cover - compiled
     """:func:`_takes` of each pair ``(ra[i], rb[i])`` (rows of the store, below its ``n``)."""
     out = np.zeros(ra.size, dtype=np.bool_)
@@ -242,7 +241,7 @@ def taking_part(ra, rb, kind, sensor, inv_mass, asleep):  # pragma: no cover - c
     return out
 
 
-@njit(cache=True)
+@kernel
 def solid_contacts(ra, rb, kind, sensor, inv_mass, asleep, vx, vy, one_way):  # pragma: no cover - compiled
     """``Response._solid`` before its one-way platforms: each contact :func:`_takes` whose bodies'
     velocities are finite (a body a system spoiled with NaN is left alone); and whether a contact
@@ -256,7 +255,7 @@ def solid_contacts(ra, rb, kind, sensor, inv_mass, asleep, vx, vy, one_way):  # 
     return out, one
 
 
-@njit(cache=True)
+@kernel
 def solid_pairs_mask(ra, rb, kind, sensor, inv_mass, asleep, one_way, layer, mask,
                      layers_open):  # pragma: no cover - compiled
     """The pairs of rows the response may act on: both rows real (>= 0), taking part
@@ -275,7 +274,7 @@ def solid_pair(a, b, kind, sensor, inv_mass, asleep, one_way, layer, mask, layer
     return layers_open or ((layer[a] & mask[b]) != 0 and (layer[b] & mask[a]) != 0)
 
 
-@njit(cache=True)
+@kernel
 def centres_inside(ra, rb, hit, body, kind, static, box, hx, hy, minx, maxx, miny, maxy):  # pragma: no cover
     """The contacts (``hit``) between one static box and a body of another kind of row whose
     hitbox origin lies strictly inside the box's bounds: their indices, in order (the candidates of

@@ -20,11 +20,11 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision.broad_phase import SpatialHash
+from ..compiled import kernel
 from ..geometry import Geometry
 from ..store import KIND_AABB, STATIC, BodyStore
 
@@ -195,7 +195,7 @@ class InternalFaces:
         return cand[bad], t[bad], m[bad], sgn[bad], faces[bad], px[bad], py[bad]
 
 
-@njit(cache=True)
+@kernel
 def static_box_contacts(ra, rb, among, body, kind, static, box, faces, unknown):  # pragma: no cover - compiled
     """The indices, in order, of the contacts ``among`` these between a static body and one that is
     not, the static one a box (``InternalFaces._through_covered``'s candidates), those boxes' rows,

@@ -9,9 +9,9 @@ detection will sweep.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ..arrays import IntpArray
+from ..compiled import kernel
 from ..frame import StepFrame
 from ..store import DYNAMIC, STATIC, BodyStore
 from .stage import Stage
@@ -19,7 +19,7 @@ from .stage import Stage
 __all__ = ["Movement", "integrate", "integrate_rows"]
 
 
-@njit(cache=True)
+@kernel
 def _fall(rows, body, vx, vy, gx_dt, gy_dt, along_x, along_y, dynamic):  # pragma: no cover - compiled
     """Gravity's step on the dynamic ``rows``' velocities (an axis without gravity untouched:
     adding 0 would turn a velocity of -0.0 into 0.0)."""

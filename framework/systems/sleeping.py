@@ -16,9 +16,9 @@ crate the game shoves away falls, rather than hanging where it slept).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ..arrays import I64Array, IntpArray, distinct
+from ..compiled import kernel
 from ..events import pair_keys, pair_parts
 from ..frame import StepFrame
 from ..store import DYNAMIC
@@ -33,7 +33,7 @@ SLEEP_STEPS = 30
 SLEEP_SPEED = 0.03
 
 
-@njit(cache=True)
+@kernel
 def count_rest(body, kind, asleep, bound, x, y, start_x, start_y, vx, vy, w, still, n, dt, speed_k,
                steps):  # pragma: no cover - compiled
     """Count, for the first ``n`` rows' awake dynamic bodies, the steps they have been at rest

@@ -27,9 +27,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 from .softness import soft
 
 __all__ = ["JOINT_F", "JOINT_IMP", "prepare_joints", "solve_joints", "warm_start_joints"]
@@ -63,7 +62,7 @@ _PX, _PY, _ILO, _IUP, _IANG, _ISPR = range(len(JOINT_IMP))
 _NP = 23
 
 
-@njit(cache=True)
+@kernel
 def prepare_joints(jint, jf, x, y, rot, moving, im, ii, h):
     """Each joint prepared for this step (rows of the columns above; ``_ON`` 0: skipped, no body
     of it moves or none takes impulses)."""

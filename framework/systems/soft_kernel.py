@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..collision.box_rows import holds
 from ..collision.soft_manifold import (
@@ -56,7 +55,7 @@ from ..collision.soft_manifold import (
     polygon_circle,
     polygon_polygon,
 )
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
 from .stable_sort import stable_argsort
@@ -75,7 +74,7 @@ _AABB, _CIRCLE, _CAPSULE = 0, 1, 3
 CHAIN_KIND = _CHAIN = 5  # a chain segment (kernel_tables' code: the store's kind is a segment's)
 
 
-@njit(cache=True)
+@kernel
 def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
     """Each row's internal faces (bits :data:`~framework.collision.soft_manifold.LEFT`, ``RIGHT``,
     ``DOWN``, ``UP``; 0 for rows not ``eligible``: static boxes that take part in the response). A
@@ -169,7 +168,7 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, sp
         reach[q] = m
 
 
-@njit(cache=True)
+@kernel
 def _float_keys(v):
     """Integers in the order of the floats ``v`` (their bits, the negatives' flipped): one sort
     (:func:`~framework.systems.stable_sort.stable_argsort` on integers) serves both."""
@@ -180,7 +179,7 @@ def _float_keys(v):
     return k
 
 
-@njit(cache=True)
+@kernel
 def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity, owner):
     """Sort-and-sweep along x over the fat bounds: the pairs of rows whose fat bounds overlap
     (never two fixed ones, never two shapes of one ``owner`` body; layers that meet), as rows
@@ -237,7 +236,7 @@ def _fat_overlap(fat, i, j):
     return not (fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3])
 
 
-@njit(cache=True)
+@kernel
 def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs, owner):
     """The candidate pairs after the ``moved`` rows took new fat bounds: exactly what
     :func:`_candidate_pairs` would find (pairs of unmoved rows keep their overlap), at the cost of a
@@ -307,7 +306,7 @@ _ID, _NI, _TI, _NP, _TOUCH, _NX, _NY, _DEPTH, _PX, _PY = 0, 2, 4, 6, 7, 8, 9, 10
 _RAX, _RAY, _RBX, _RBY, _BASE, _NMASS, _TMASS, _PNI, _PTI, _TOTAL, _RELV, _PID, _PEAK = range(13)
 
 
-@njit(cache=True)
+@kernel
 def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
     """The slots of the new (sorted) candidate pairs, carried over from the old ones by key; the
     old pairs that touched and are no longer candidates are written to ``ended_*`` (how many)."""
@@ -327,7 +326,7 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
     return slots, n_end
 
 
-@njit(cache=True)
+@kernel
 def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction, kind, cnt, rr, sensor,
                   one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity):
     """The manifold of every candidate pair, and the contacts the solver uses, prepared (anchors, effective
@@ -465,7 +464,7 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
     return nc, ci, cf, cp, tnow, evd
 
 
-@njit(cache=True)
+@kernel
 def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving, ended_keys, ended_f, n_end,
             rebuilt, sleepers, owner, part):
     """Store the impulses in the pairs' slots and report which pairs are in contact: ``(touch_i,
@@ -538,7 +537,7 @@ def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
     return touch_i, touch_f, end_i, end_f, info
 
 
-@njit(cache=True)
+@kernel
 def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, faces, driven, fat, pairs, slots,
               rebuild, jint, jf, jimp, apart):
     """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
@@ -736,7 +735,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     return fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp
 
 
-@njit(cache=True)
+@kernel
 def _to_centres(x, y, rot, off, bound, conv, owner):
     """Move the ``conv`` rows' positions from their origins to their centres of mass (``off``
     columns 2, 3, in the body's frame): returns copies of ``off`` and ``bound`` for the step, the
@@ -767,7 +766,7 @@ def _to_centres(x, y, rot, off, bound, conv, owner):
     return off, bound, centre0
 
 
-@njit(cache=True)
+@kernel
 def _anchors_from_centres(jint, jf, off, conv):
     """A copy of the joints' parameters with the anchors on the ``conv`` rows measured from their
     centres of mass (a world anchor, row -1, stays)."""

@@ -29,6 +29,7 @@ are used rather than called.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -40,9 +41,9 @@ from .stable_sort import stable_argsort
 __all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stays", "velocity_stays",
            "warm_impulses", "warm_pushes"]
 
-_compiled = njit(cache=True, error_model="numpy")
-
-
+# (numpy's error model: a division by zero gives inf or NaN as numpy does; the options as compiled.kernel's)
+_COMPILED_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True, "error_model": "numpy"}
+_compiled = njit(**_COMPILED_OPTIONS)
 
 
 @_compiled

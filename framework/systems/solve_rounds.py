@@ -28,9 +28,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 from .gather import _find, _np_max, _np_min, _row, solid_pair
 from .stable_sort import stable_argsort
 
@@ -38,7 +37,7 @@ __all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "m
            "near_rows", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]
 
 
-@njit(cache=True)
+@kernel
 def _where(mask):  # pragma: no cover - compiled
     """``np.flatnonzero(mask)`` (int64), by two loops (numba compiles these faster than numpy's)."""
     n = 0
@@ -53,7 +52,7 @@ def _where(mask):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True)
+@kernel
 def _at(values, idx):  # pragma: no cover - compiled
     """``values[idx]`` for an index array ``idx``, by a loop."""
     out = np.empty(idx.size, dtype=values.dtype)
@@ -62,7 +61,7 @@ def _at(values, idx):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True)
+@kernel
 def number(table, ra, rb, first):  # pragma: no cover - compiled
     """Number the rows of ``ra`` and ``rb`` that ``table`` (row -> number, -1: none) does not know
     yet, from ``first`` on in row order, entering them in the table: ``(the new rows, every
@@ -100,7 +99,7 @@ def turning_pairs(ra, rb, kind, inv_inertia, polygon):  # pragma: no cover - com
     return False
 
 
-@njit(cache=True)
+@kernel
 def known_keys(ea, eb, ca, cb):  # pragma: no cover - compiled
     """The sorted pair keys (``events.pair_keys``) of the pairs ``(ea, eb)`` and ``(ca, cb)``."""
     keys = np.empty(ea.size + ca.size, dtype=np.int64)
@@ -111,7 +110,7 @@ def known_keys(ea, eb, ca, cb):  # pragma: no cover - compiled
     return _at(keys, stable_argsort(keys))
 
 
-@njit(cache=True)
+@kernel
 def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep, one_way, layer, mask,
                         layers_open):  # pragma: no cover - compiled
     """The pairs ``(ra, rb, ea, eb)`` whose key is not in the sorted ``known``, both rows in the
@@ -126,7 +125,7 @@ def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep
 
 
 
-@njit(cache=True)
+@kernel
 def near_rows(bodies, rows, reach, inv_mass, asleep, x, y, cx, cy):  # pragma: no cover - compiled
     """Of the local ``bodies`` (store ``rows``, ``reach``), those the response may move (``inv_mass >
     0``, awake) with a finite reach, their rows and reaches, and which of them stand more than their
@@ -145,7 +144,7 @@ def near_rows(bodies, rows, reach, inv_mass, asleep, x, y, cx, cy):  # pragma: n
     return rows, margin, far
 
 
-@njit(cache=True)
+@kernel
 def kept_static_pairs(n, rows, pair_row, pea, peb, known, lut, kind, sensor, inv_mass, asleep, one_way, layer, mask,
                       layers_open):  # pragma: no cover - compiled
     """The kept static pairs ``(pea, peb)`` of ``rows`` (each pair's dynamic row: ``pair_row``)
@@ -165,7 +164,7 @@ def kept_static_pairs(n, rows, pair_row, pea, peb, known, lut, kind, sensor, inv
     return _at(ra, idx), _at(rb, idx), _at(pea, idx), _at(peb, idx)
 
 
-@njit(cache=True)
+@kernel
 def moved_immovable(immovable, moved, a, b, at_points, ra, rb):  # pragma: no cover - compiled
     """The contacts with an immovable body one of whose bodies moved: those not at points (with
     their rows ``ra``, ``rb``) and those at points (``at_points``; empty: none are):
@@ -212,7 +211,7 @@ def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn
     return any_hit, over
 
 
-@njit(cache=True)
+@kernel
 def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse, tpush,
              timpulse):  # pragma: no cover - compiled
     """What :meth:`Solve.record` keeps, sorted by pair key (stably: a pair's points in order): the
@@ -247,7 +246,7 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
 
 
 
-@njit(cache=True)
+@kernel
 def place(rows, x0, y0, dx, dy, sx, sy, seen_x, seen_y):  # pragma: no cover - compiled
     """Put the solve's bodies it moved (``dx, dy`` not both 0) at ``(x0 + dx, y0 + dy)`` in the
     store's ``sx, sy`` (as ``BodyStore.place``, whose ``motion`` the caller bumps); and say which
@@ -266,7 +265,7 @@ def place(rows, x0, y0, dx, dy, sx, sy, seen_x, seen_y):  # pragma: no cover - c
     return placed, moved, dx.copy(), dy.copy()
 
 
-@njit(cache=True)
+@kernel
 def far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b):  # pragma: no cover - compiled
     """The bodies that moved (``dx, dy``) farther than their ``limit`` from ``(fx, fy)``; with
     contacts (``immovable`` not empty), only the bodies of the pushed contacts (``push > 0``)
@@ -287,7 +286,7 @@ def far_bodies(dx, dy, fx, fy, limit, immovable, push, a, b):  # pragma: no cove
     return far, anyone
 
 
-@njit(cache=True)
+@kernel
 def moved_candidates(moved, table, ra, rb, immovable_only, inv_mass, asleep):  # pragma: no cover - compiled
     """The candidate pairs ``(ra, rb)`` (store rows) one of whose bodies is in the solve (``table``:
     row -> local number, -1: not) and ``moved``; ``immovable_only``: only those with a body the

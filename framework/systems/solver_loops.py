@@ -41,9 +41,8 @@ from the rigid loop made it twice as slow, 2026-11-25).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from ..compiled import leaf
+from ..compiled import kernel, leaf
 
 __all__ = ["solve_positions", "solve_positions_rigid", "solve_velocities", "solve_velocities_rigid", "supported",
            "warm_start"]
@@ -88,7 +87,7 @@ def _kept_within(change, share, sign, ex, ey, nx, ny, reach):
     return change
 
 
-@njit(cache=True)
+@kernel
 def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, passes, tolerance, dirty, reach,
                     mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, tpush, mx, my, mturn, dturn):
     """Projected Gauss-Seidel on the separations. ``push`` (warm start on entry, the solution on
@@ -172,7 +171,7 @@ def solve_positions(order, a, b, nx, ny, sep0, share_a, share_b, push, dx, dy, p
     return passes, held
 
 
-@njit(cache=True)
+@kernel
 def solve_velocities(order, a, b, nx, ny, target, share_a, share_b, impulse, vx, vy, passes, tolerance, dirty,
                      mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b, timpulse, w):
     """Projected Gauss-Seidel on the normal velocities: ``impulse`` (warm start on entry; the
@@ -247,7 +246,7 @@ def _left(order, a, b, moved, last, dirty):
             dirty[i] = True
 
 
-@njit(cache=True)
+@kernel
 def supported(order, a, b, up, fixed_a, fixed_b, n_bodies):
     """Which bodies rest on something immovable, directly or through a chain of bodies resting on
     each other: ``up[i] > 0.5`` says b rests on a, ``< -0.5`` a on b; ``fixed_*`` whether a
@@ -264,7 +263,7 @@ def supported(order, a, b, up, fixed_a, fixed_b, n_bodies):
     return out
 
 
-@njit(cache=True)
+@kernel
 def warm_start(a, b, nx, ny, share_a, share_b, value, n_bodies):
     """Per-body ``(x, y)`` sums of the warm-start values (pushes or impulses) over the contacts."""
     ox, oy = np.zeros(n_bodies), np.zeros(n_bodies)
@@ -279,7 +278,7 @@ def warm_start(a, b, nx, ny, share_a, share_b, value, n_bodies):
     return ox, oy
 
 
-@njit(cache=True)
+@kernel
 def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, nturn_b, rn_a, rn_b, push, dx, dy,
                           dturn, passes, tolerance, dirty, reach, mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b,
                           tpush, mx, my, mturn, fturn):
@@ -358,7 +357,7 @@ def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, 
     return passes, held
 
 
-@njit(cache=True)
+@kernel
 def solve_velocities_rigid(order, a, b, nx, ny, target, share_a, share_b, nturn_a, nturn_b, rn_a, rn_b, impulse, vx,
                            vy, w, passes, tolerance, dirty, mu, tshare_a, tshare_b, turn_a, turn_b, arm_a, arm_b,
                            timpulse, fw):

@@ -9,12 +9,13 @@ numba's own ``argsort(kind="mergesort")``.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from ..compiled import kernel
 
 __all__ = ["stable_argsort"]
 
 
-@njit(cache=True)
+@kernel
 def stable_argsort(key):  # pragma: no cover - compiled
     """``np.argsort(key, kind="stable")`` of a float or integer array: a bottom-up merge sort (ties
     keep their order, NaN sorts last)."""
