@@ -769,3 +769,25 @@ def test_a_scene_keeping_its_candidates_restores_and_continues_bit_for_bit(tmp_p
         other.step(1 / 60)
     assert state(other) == want
     assert s._stages["broad_phase"].kept.builds > 0  # (the kept candidates were in use)
+
+
+@pytest.mark.parametrize("gap", [5.0, 0.0, -0.25])
+def test_movers_far_from_every_static_are_not_swept_against_them(monkeypatch, gap):
+    """A level's tiles cost the broad phase nothing while every mover's bounds lie outside the box
+    around all of them (``gap`` above their top; touching is outside, as for a pair), and the pairs
+    are brute force's either way: 100 movers above a floor of 2,000 unit tiles."""
+    rng = np.random.default_rng(7)
+    tx = np.arange(2000, dtype=np.float64) - 1000.0
+    tiles = (tx, np.full(2000, -1.0), tx + 1.0, np.zeros(2000))
+    x, y = rng.uniform(-30.0, 30.0, 100), rng.uniform(gap, gap + 20.0, 100)
+    movers = (x, y, x + rng.uniform(0.5, 2.0, 100), y + rng.uniform(0.5, 2.0, 100))
+    b = tuple(np.concatenate([m, t]) for m, t in zip(movers, tiles, strict=True))
+    static = np.arange(2100) >= 100
+    swept = []
+    real = SpatialHash._cross_static
+    monkeypatch.setattr(SpatialHash, "_cross_static", lambda self, *a: swept.append(1) or real(self, *a))
+    got = hashed_pairs(*b, static, np.arange(2100, dtype=np.int64))[1]
+    exp = brute_force_pairs(*b, static)
+    assert np.array_equal(got[0], exp[0]) and np.array_equal(got[1], exp[1])
+    assert (len(swept) == 0) == (gap >= 0.0)
+    assert bool((exp[1] >= 100).any()) == (gap < 0.0)  # (mover-tile pairs only when they overlap)

@@ -335,3 +335,28 @@ def test_bodies_at_the_edges_of_the_range_step_without_nan_or_errors(ka, kb, sa,
         assert math.isfinite(s.get(a, Transform).y)
         for ev in s.events:
             assert all(math.isfinite(v) for v in (*ev.normal, ev.depth, *ev.point))
+
+
+def test_a_step_that_fails_inside_the_solve_steps_on_as_a_twin_that_never_tried_it(monkeypatch):
+    """The solve's numbering (row -> local number) is kept between steps and reset row by row; a
+    solve that raises after numbering its bodies leaves it dirty, and the next one starts afresh."""
+    from framework.systems import solve as solve_module
+
+    s, twin = _busy(), _busy()
+    try:
+        assert _hashes(s, 30) == _hashes(twin, 30)
+        before = state_hash(s)
+        real = solve_module.Solve.velocities
+
+        def boom(self):
+            raise RuntimeError("failed inside the solve")
+
+        monkeypatch.setattr(solve_module.Solve, "velocities", boom)
+        with pytest.raises(RuntimeError, match="inside the solve"):
+            s.step(DT)
+        assert state_hash(s) == before
+        monkeypatch.setattr(solve_module.Solve, "velocities", real)
+        assert _hashes(s, 40) == _hashes(twin, 40)
+    finally:
+        s.close()
+        twin.close()

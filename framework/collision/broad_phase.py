@@ -220,7 +220,9 @@ class SpatialHash:
                     keep = ~is_large[j] | (i < j)
                     out_a.append(ids[i[keep]])
                     out_b.append(ids[j[keep]])
-            self._cross_static(mov, b, ids, out_a, out_b)
+            if n and not self.outside_statics(float(b[0].min()), float(b[1].min()), float(b[2].max()),
+                                              float(b[3].max())):  # (bodies all far from the level's tiles: none)
+                self._cross_static(mov, b, ids, out_a, out_b)
         if not out_a:
             return _EMPTY_I, _EMPTY_I
         return _sorted_id_pairs(np.concatenate(out_a), np.concatenate(out_b))

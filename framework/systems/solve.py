@@ -176,7 +176,7 @@ class Solve:
         if self.rigid:
             self.cs = cs = expand(cs, store, stage.bodies.ensure_geometry(), points, KEEP_GAP)
         # Bodies are numbered locally; ``table`` maps a store row to its number (-1: not in the solve).
-        self.table = np.full(store.n, -1, dtype=np.int64)
+        self.table = stage.numbering(store.n)
         self.rows, self.local = number(self.table, cs.ra, cs.rb, 0)
         self.tolerance = (TOLERANCE_TURNING if self.rigid else TOLERANCE) * float(store.bound[self.rows].max())
         self.dirty = np.ones(cs.size, dtype=bool)  # the contacts the position solver is to look at
@@ -555,7 +555,7 @@ class Solve:
         """Add the statics within reach of the movable ``bodies`` (local numbers) to the candidates."""
         if self.stage.bodies.n_static == 0:
             return
-        near = self.stage.static_candidates(bodies, self.rows, self.reach, self._known_keys())
+        near = self.stage.static_candidates(bodies, self.rows, self.reach, self._known_keys)
         if near[0].size:
             self._set_candidates(_joined(self.candidates, near))
 
