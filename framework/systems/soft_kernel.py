@@ -328,12 +328,14 @@ def _merge_slots(old_keys, old_slots, new_keys, ended_keys, ended_f):
 
 @kernel
 def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction, kind, cnt, rr, sensor,
-                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity):
+                  one_way, friction, restitution, faces, wc, lv, wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity,
+                  rare):
     """The manifold of every candidate pair, and the contacts the solver uses, prepared (anchors, effective
     masses, warm starts from the pair's slot by feature id): ``(nc, ci, cf, cp, tnow, evd)``, see
     :func:`soft_step`; a pair whose bodies both rest keeps its state (``tnow`` -1); a pair whose key is
     in ``apart`` (sorted: the bodies of a joint) never touches. The pairs are of shape rows; the
-    solver's bodies are their ``owner`` rows (``ci`` columns 2, 3)."""
+    solver's bodies are their ``owner`` rows (``ci`` columns 2, 3). ``rare``: None where no row is a
+    capsule or a chain segment (numba then drops their manifolds: see :func:`soft_step`)."""
     m = pairs.shape[0]
     compound = owner.size != moving.size  # (shape rows beyond the body rows: parts of compound bodies)
     ci = np.empty((m, 4), dtype=np.int64)  # the contact's pair slot, points the solver uses, its two bodies
@@ -374,17 +376,19 @@ def _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, u
                 nx, ny = -nx, -ny
         else:
             k, nx, ny = -1, 0.0, 0.0
-            if kind[a] == _CAPSULE and kind[b] == _CAPSULE:
-                k, nx, ny = capsule_capsule(wv, a, rr[a], b, rr[b], s_pair, out)
+            if rare is not None:
+                if kind[a] == _CAPSULE and kind[b] == _CAPSULE:
+                    k, nx, ny = capsule_capsule(wv, a, rr[a], b, rr[b], s_pair, out)
             if k < 0:
                 k, nx, ny = polygon_polygon(wv, wn, a, cnt[a], rr[a], b, cnt[b], rr[b], slop, s_pair, out, faces[a],
                                             faces[b])
-        if kind[a] == _CHAIN or kind[b] == _CHAIN:  # one-sided, ghost vertices: what the chain keeps
-            g, o = (a, b) if kind[a] == _CHAIN else (b, a)
-            f = 1.0 if g == a else -1.0
-            k, nx, ny = chain_segment(wv, wn, lv, g, o, cnt[o], rr[o], wc[o, 0], wc[o, 1], k, f * nx, f * ny,
-                                      s_pair, out)
-            nx, ny = f * nx, f * ny
+        if rare is not None:
+            if kind[a] == _CHAIN or kind[b] == _CHAIN:  # one-sided, ghost vertices: what the chain keeps
+                g, o = (a, b) if kind[a] == _CHAIN else (b, a)
+                f = 1.0 if g == a else -1.0
+                k, nx, ny = chain_segment(wv, wn, lv, g, o, cnt[o], rr[o], wc[o, 0], wc[o, 1], k, f * nx, f * ny,
+                                          s_pair, out)
+                nx, ny = f * nx, f * ny
         low = 0.0
         if k > 0:
             low = out[0, 2]
@@ -539,7 +543,7 @@ def _report(nc, ci, cp, pairs, slots, tnow, evd, entity, sensor, asleep, moving,
 
 @kernel
 def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, faces, driven, fat, pairs, slots,
-              rebuild, jint, jf, jimp, apart):
+              rebuild, jint, jf, jimp, apart, rare):
     """One step of ``params[_DT]`` over the rows (the pose and velocity columns modified in place).
 
     What changes only with the rows comes packed, as rows of three tables (see
@@ -559,8 +563,10 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     not modified: new ones are returned. ``jint, jf, jimp``: the joints, their parameters and their
     impulses from the last step (:mod:`framework.systems.soft_joints`; new impulses are returned),
     or three Nones for a scene without joints (then the joints' code is not compiled for it);
-    ``apart``: the sorted keys of the pairs that do not collide (a joint's bodies). See the module
-    docstring for the stages.
+    ``apart``: the sorted keys of the pairs that do not collide (a joint's bodies); ``rare``: None
+    for a scene with no capsule and no chain segment (then their manifolds are not compiled for it:
+    about 4 of the 24 seconds a new installation's first soft step compiles), else any integer.
+    See the module docstring for the stages.
 
     Returns ``(fat, pairs, slots, touch_i, touch_f, end_i, end_f, info, jimp)`` (few objects: each
     array returned to Python costs about a microsecond): the fat bounds, candidate pairs and their
@@ -674,7 +680,7 @@ def soft_step(params, x, y, rot, vx, vy, w, asleep, fprops, iprops, off, verts, 
     # --- narrow phase: manifolds -> contacts, prepared ---------------------------------------------
     nc, ci, cf, cp, tnow, evd = _narrow_phase(pairs, slots, moving, reach, spec, slop, response, rotation, use_friction,
                                               kind, cnt, rr, sensor, one_way, friction, restitution, faces, wc, lv,
-                                              wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity)
+                                              wv, wn, x, y, vx, vy, w, im, ii, apart, owner, entity, rare)
 
     # --- sub-steps ------------------------------------------------------------------------------
     h = dt / nsub if nsub > 0 else 0.0

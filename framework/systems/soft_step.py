@@ -342,16 +342,20 @@ def _by_entity(cols: tuple[np.ndarray, ...], contacts: StepContacts) -> tuple[tu
     return tuple(c[order] for c in out), contacts.take(order)
 
 
-_COMPILED: set[bool] = set()  # the kernel's variants called in this process (True: with joints)
+# the kernel's variants called in this process: (with joints, with capsules or chain segments)
+_COMPILED: set[tuple[bool, bool]] = set()
+_RARE = np.int64(1)  # (the kernel's ``rare``: capsules or chain segments in the scene; None: neither)
 COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 20 to 30 seconds, and again "
-                  "for the first scene with joints; later runs load it from numba's cache)")
+                  "for the first scene with joints, or with capsules or chains; later runs load it from numba's "
+                  "cache)")
 
 
-def _first_call(args: tuple[Any, ...], variant: bool) -> tuple[Any, ...]:
-    """The kernel's first call in this process for scenes with joints (``variant``) or without:
-    if it has not returned within a second (numba is compiling it, not loading it from its cache),
-    say so on stderr, once. (The two are compiled apart: a scene without joints compiles none of
-    the joints' code.)"""
+def _first_call(args: tuple[Any, ...], variant: tuple[bool, bool]) -> tuple[Any, ...]:
+    """The kernel's first call in this process for scenes with joints or without, with capsules or
+    chain segments or without (``variant``): if it has not returned within a second (numba is
+    compiling it, not loading it from its cache), say so on stderr, once. (The variants are
+    compiled apart: a scene without joints compiles none of the joints' code, one without capsules
+    and chains none of their manifolds'.)"""
     try:
         with notice_if_slow(COMPILE_NOTICE):
             return soft_step(*args)
@@ -374,6 +378,7 @@ class SoftStep(Stage):
         self._settings_key: tuple[Any, ...] | None = None
         self._cols: tuple[np.ndarray, ...] = ()
         self._kernel_tables: tuple[np.ndarray, ...] = ()
+        self._rare: np.int64 | None = None  # (the kernel's ``rare``, found with the tables)
         self._faces_key: tuple[int, int, int, bool] | None = None
         self._faces = np.zeros(0, dtype=np.int64)
         self._no_driven = np.zeros(0, dtype=np.bool_)
@@ -461,6 +466,8 @@ class SoftStep(Stage):
             n = store.n
             self._cols = tuple(c[name][:n] for name in _KERNEL_COLUMNS)
             self._kernel_tables = kernel_tables(store, key[-1])
+            kinds = self._kernel_tables[1][1]  # (each shape row's kind, a chain segment's its own code)
+            self._rare = _RARE if bool(((kinds == KIND_CAPSULE) | (kinds == CHAIN_KIND)).any()) else None
             self._tables_key = key
         return self._cols + self._kernel_tables + (self._internal_faces(),)
 
@@ -591,9 +598,9 @@ class SoftStep(Stage):
             self._pairs_key = key
         joints = self._joints()
         args = (self._settings(frame), *tables, self._driven(frame), self.fat, self.pairs, self.slots, rebuild,
-                *joints)
+                *joints, self._rare)
         jint = joints[0]
-        variant = jint is not None
+        variant = (jint is not None, self._rare is not None)
         out = soft_step(*args) if variant in _COMPILED else _first_call(args, variant)
         self.fat, self.pairs, self.slots, touch_i, touch_f, end_i, end_f, info, jimp = out
         if jint is not None:
