@@ -483,8 +483,11 @@ class SoftStep(Stage):
                         & ~store.one_way[:n])
             c = store.cols
             half = np.ascontiguousarray(verts[:n, 2, 0:2])  # an AABB's corner 2: its half extents
-            self._faces = internal_faces(c["x"][:n], c["y"][:n], c["rot"][:n], off[:n], half, iprops[8, :n],
-                                         eligible, iprops[2, :n], iprops[3, :n])
+            if np.count_nonzero(eligible) < 2:  # (one static box covers no face: nor is the pass compiled)
+                self._faces = np.zeros(n, dtype=np.int64)
+            else:
+                self._faces = internal_faces(c["x"][:n], c["y"][:n], c["rot"][:n], off[:n], half, iprops[8, :n],
+                                             eligible, iprops[2, :n], iprops[3, :n])
             if iprops.shape[1] > n:  # (the parts of compound bodies: no internal faces)
                 self._faces = np.concatenate([self._faces, np.zeros(iprops.shape[1] - n, dtype=np.int64)])
             self._faces_key = key
