@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from framework.events import pair_keys, sorted_member
+from framework.stable_sort import stable_argsort
 from framework.systems import gather
 from framework.systems import solve_columns as sc
 from framework.systems import solve_rounds as sr
 from framework.systems import solver_loops as loops
-from framework.systems.stable_sort import stable_argsort
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> None:

@@ -56,9 +56,9 @@ from ..collision.soft_manifold import (
     polygon_polygon,
 )
 from ..compiled import kernel, leaf
+from ..stable_sort import stable_argsort
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
-from .stable_sort import stable_argsort
 
 __all__ = ["CHAIN_KIND", "PARAMS", "SLOT", "internal_faces", "soft_step"]
 
@@ -171,7 +171,7 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, sp
 @kernel
 def _float_keys(v):
     """Integers in the order of the floats ``v`` (their bits, the negatives' flipped): one sort
-    (:func:`~framework.systems.stable_sort.stable_argsort` on integers) serves both."""
+    (:func:`~framework.stable_sort.stable_argsort` on integers) serves both."""
     k = (v + 0.0).view(np.int64)  # (+ 0.0: -0.0 becomes 0.0, its equal)
     for i in range(k.size):
         if k[i] < 0:

@@ -34,9 +34,9 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from ..stable_sort import stable_argsort
 from .gather import _np_max, _np_min
 from .solver_loops import warm_start
-from .stable_sort import stable_argsort
 
 __all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stays", "velocity_stays",
            "warm_impulses", "warm_pushes"]

@@ -30,8 +30,8 @@ import math
 import numpy as np
 
 from ..compiled import kernel, leaf
+from ..stable_sort import stable_argsort
 from .gather import _find, _np_max, _np_min, _row, solid_pair
-from .stable_sort import stable_argsort
 
 __all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "moved_candidates", "moved_immovable",
            "near_rows", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]

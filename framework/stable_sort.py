@@ -1,5 +1,5 @@
-"""A stable argsort, compiled: :func:`stable_argsort`, shared by the exact solve's rounds and the
-soft step's kernel.
+"""A stable argsort, compiled: :func:`stable_argsort`, shared by the exact solve's rounds, the broad
+phase's direct pairs and the soft step's kernel.
 
 A bottom-up merge sort: ``np.argsort(key, kind="stable")``'s answer (a stable sort's order is the
 only one), for floats (NaN last, as numpy) and integers alike, at a tenth of the compile time of
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..compiled import kernel
+from .compiled import kernel
 
 __all__ = ["stable_argsort"]
 
