@@ -14,7 +14,7 @@ from contextlib import contextmanager
 
 __all__ = ["FIRST_STEP_NOTICE", "notice_if_slow"]
 
-FIRST_STEP_NOTICE = ("framework: compiling the physics kernels for this scene (once per installation, 20 to 40 "
+FIRST_STEP_NOTICE = ("framework: compiling the physics kernels for this scene (once per installation, 15 to 30 "
                      "seconds; later runs load them from numba's cache)")
 
 
