@@ -33,7 +33,7 @@ from .collision.ray import raycast as _raycast
 from .collision.results import Vec2
 from .geometry import Geometry
 from .shapes import AABB, Capsule, Circle, Polygon, Segment
-from .store import STATIC
+from .store import STATIC, BodyStore
 from .systems.stage import Pipeline
 from .validation import InvalidValue, finite, vector2
 
@@ -157,28 +157,35 @@ def _shape_table(shapes: list[Any]) -> _Shapes:
     """Shapes (None: a row without a hitbox) as the batch kernels' columns: kind (0 box, 1 circle,
     2 polygon, 3 capsule, 4 segment, -1 none), the box's half sizes, a circle's or capsule's radius
     (and a capsule's length), the extent, and a polygon's or segment's points."""
-    n = len(shapes)
-    kind = np.full(n, -1, dtype=np.int8)
-    sa, sb, ext = np.zeros(n), np.zeros(n), np.zeros(n)
-    K = max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)])
-    local = np.zeros((n, K, 2))
-    cnt = np.zeros(n, dtype=np.int64)
+    table = _empty_table(len(shapes), max([4] + [len(s.points) for s in shapes if isinstance(s, Polygon)]))
     for r, shape in enumerate(shapes):
-        if isinstance(shape, AABB):
-            kind[r], sa[r], sb[r], ext[r] = 0, shape.half_width, shape.half_height, max(shape.width, shape.height)
-        elif isinstance(shape, Circle):
-            kind[r], sa[r], ext[r] = 1, shape.radius, shape.radius
-        elif isinstance(shape, Capsule):
-            kind[r], sa[r], sb[r], ext[r] = 3, shape.radius, shape.length, shape.bounding_radius
-        elif isinstance(shape, Polygon):
-            kind[r], cnt[r] = 2, len(shape.points)
-            local[r, : cnt[r]] = shape.points
-            ext[r] = max(max(abs(x), abs(y)) for x, y in shape.points)
-        elif isinstance(shape, Segment):  # (its two ends; a chain segment's one side: rays ask raycast)
-            kind[r], cnt[r] = 4, 2
-            local[r, :2] = (shape.a, shape.b)
-            ext[r] = max(abs(shape.a[0]), abs(shape.a[1]), abs(shape.b[0]), abs(shape.b[1]))
-    return _Shapes(kind, sa, sb, ext, local, cnt)
+        _fill_row(table, r, shape)
+    return table
+
+
+def _empty_table(n: int, k: int) -> _Shapes:
+    """A table of ``n`` rows without shapes, room for ``k`` points a row."""
+    return _Shapes(np.full(n, -1, dtype=np.int8), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, k, 2)),
+                   np.zeros(n, dtype=np.int64))
+
+
+def _fill_row(table: _Shapes, r: int, shape: Any) -> None:
+    """Row ``r`` of ``table``: ``shape``'s columns (see :func:`_shape_table`; None leaves it empty)."""
+    kind, sa, sb, ext, local, cnt = table
+    if isinstance(shape, AABB):
+        kind[r], sa[r], sb[r], ext[r] = 0, shape.half_width, shape.half_height, max(shape.width, shape.height)
+    elif isinstance(shape, Circle):
+        kind[r], sa[r], ext[r] = 1, shape.radius, shape.radius
+    elif isinstance(shape, Capsule):
+        kind[r], sa[r], sb[r], ext[r] = 3, shape.radius, shape.length, shape.bounding_radius
+    elif isinstance(shape, Polygon):
+        kind[r], cnt[r] = 2, len(shape.points)
+        local[r, : cnt[r]] = shape.points
+        ext[r] = max(max(abs(x), abs(y)) for x, y in shape.points)
+    elif isinstance(shape, Segment):  # (its two ends; a chain segment's one side: rays ask raycast)
+        kind[r], cnt[r] = 4, 2
+        local[r, :2] = (shape.a, shape.b)
+        ext[r] = max(abs(shape.a[0]), abs(shape.a[1]), abs(shape.b[0]), abs(shape.b[1]))
 
 
 class SpatialQueries:
@@ -435,25 +442,43 @@ class SpatialQueries:
         if cols is None:
             store = self.bodies.store
             cols = _shape_table([None if hb is None else hb.shape for hb in store.hitboxes[: store.n]])
-            self._shape_cols = (store.version, cols)
+            self._shape_cols = (store, store.version, cols)
         return cols
 
     def _shapes_of(self, rows: NDArray[np.intp]) -> tuple[_Shapes, NDArray[np.int64]]:
         """The live shapes of ``rows`` as columns, and where each row is in them: the scene's table
-        when it is current, else a table of these rows alone (a query after a spawn or a hitbox edit
-        does not measure every hitbox of the scene again)."""
+        when it is current; else, with no hitbox edit waiting, a table of the scene's rows kept until
+        its next structural change and filled row by row as queries ask for rows (a game's rays each
+        step: a table of their few rows made afresh for each ray cost more than the cast); with an
+        edit waiting, a table of these rows alone (a query after a spawn or a hitbox edit does not
+        measure every hitbox of the scene again)."""
         cols = self._cached_shapes()
+        at = np.ascontiguousarray(rows, dtype=np.int64)
         if cols is not None:
-            return cols, np.ascontiguousarray(rows, dtype=np.int64)
-        hitboxes = self.bodies.store.hitboxes
-        return _shape_table([hitboxes[r].shape for r in rows.tolist()]), np.arange(rows.size)
+            return cols, at
+        store = self.bodies.store
+        hitboxes = store.hitboxes
+        if store.dirty_hitboxes:
+            return _shape_table([hitboxes[r].shape for r in rows.tolist()]), np.arange(rows.size)
+        k = self.bodies.ensure_geometry().K  # (the most points of a polygon in the scene, at least 4)
+        kept: tuple[BodyStore, int, _Shapes, NDArray[np.bool_]] | None = getattr(self, "_row_shapes", None)
+        if (kept is None or kept[0] is not store or kept[1] != store.version or kept[2].kind.size != store.n
+                or kept[2].local.shape[1] != k):
+            kept = self._row_shapes = (store, store.version, _empty_table(store.n, k), np.zeros(store.n, dtype=bool))
+        _store, _version, table, filled = kept
+        for r in at[~filled[at]].tolist():
+            _fill_row(table, r, hitboxes[r].shape)
+            filled[r] = True
+        return table, at
 
     def _cached_shapes(self) -> _Shapes | None:
-        """The scene's shape table if it is current (no structural change, no hitbox edit waiting)."""
+        """The scene's shape table if it is current (no structural change, no hitbox edit waiting).
+        A table belongs to one store: a restored snapshot is another, whatever its count of changes
+        (two timelines from one snapshot reach the same count with other rows)."""
         store = self.bodies.store
-        cached: tuple[int, _Shapes] | None = getattr(self, "_shape_cols", None)
-        if cached is not None and cached[0] == store.version and not store.dirty_hitboxes:
-            return cached[1]
+        cached: tuple[BodyStore, int, _Shapes] | None = getattr(self, "_shape_cols", None)
+        if cached is not None and cached[0] is store and cached[1] == store.version and not store.dirty_hitboxes:
+            return cached[2]
         return None
 
     def _prepare(self) -> Geometry:

@@ -417,3 +417,25 @@ def _scene_hit(entity, shape, pose):
 
     h = raycast(shape, pose, (-4.0, 0.0), (1.0, 0.0))
     return None if h is None else SceneHit(entity, *h)
+
+
+def test_rays_after_a_restore_read_the_restored_shapes_not_a_table_of_another_timeline():
+    """The queries keep their shape tables until the store changes; a restored snapshot is another
+    store, even where its change count equals the one a table was made at: here two timelines from
+    one snapshot each despawn one body (the same count), leaving a different body in row 0."""
+    with Scene() as s:
+        box = s.spawn(Transform(0.0, 0.0), Hitbox(AABB(2.0, 2.0), body="static"))
+        ball = s.spawn(Transform(10.0, 0.0), Hitbox(Circle(0.5), body="static"))
+        s.step(1 / 60)
+        snap = s.snapshot()
+        s.despawn(box)
+        s.step(1 / 60)  # (row 0 is the ball's now)
+        assert [(h.entity, h.distance) for h in s.raycast_all((-4.0, 0.0), (1.0, 0.0))] == [(ball, 13.5)]
+        many = s.raycast_many(np.array([[-4.0, 0.0]]), np.array([[1.0, 0.0]]))
+        assert (int(many.entity[0]), float(many.distance[0])) == (ball, 13.5)
+        s.restore(snap)
+        s.despawn(ball)
+        s.step(1 / 60)  # (row 0 is the box's, at the same count of changes as above)
+        assert [(h.entity, h.distance) for h in s.raycast_all((-4.0, 0.0), (1.0, 0.0))] == [(box, 3.0)]
+        many = s.raycast_many(np.array([[-4.0, 0.0]]), np.array([[1.0, 0.0]]))
+        assert (int(many.entity[0]), float(many.distance[0])) == (box, 3.0)
