@@ -157,6 +157,8 @@ def sorted_members(a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[NDArray[
     than a binary search per key, which the tracker would otherwise pay twice per step."""
     if a.size == 0 or b.size == 0:
         return np.zeros(a.size, dtype=bool), np.zeros(b.size, dtype=bool)
+    if a.size == b.size and (a == b).all():  # (the same pairs as last step: a scene at rest)
+        return np.ones(a.size, dtype=bool), np.ones(b.size, dtype=bool)
     merged = np.concatenate([a, b])
     order = np.argsort(merged, kind="stable")
     twin = np.flatnonzero(merged[order[1:]] == merged[order[:-1]])
