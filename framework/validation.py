@@ -19,6 +19,8 @@ class InvalidValue(ValueError, TypeError):
 
 
 def _as_float(name: str, value: object) -> float:
+    if type(value) is float:  # (the common case, without the numbers.Real check's cost)
+        return value
     # bool is a Real in Python, but True as a coordinate is a bug, not a number.
     if isinstance(value, bool) or not isinstance(value, Real):
         # numpy scalars are registered as numbers.Real; anything else is refused.
