@@ -36,8 +36,7 @@ _INNER_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True, "no_c
 #: Python is built, a third less compiling on a new installation (measured on the character move).
 inner = njit(**_INNER_OPTIONS)
 
-# (``no_cfunc_wrapper`` is numba's own option too: without it numba also builds a C-callable wrapper
-# of every function, which nothing here calls; 7% of a new installation's compiling, measured)
+# (``no_cfunc_wrapper``, numba's own option too: see the module docstring)
 _KERNEL_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True}
 
 #: ``@kernel``: a compiled function called from Python (or from other compiled functions).

@@ -39,7 +39,7 @@ from ..compiled import kernel
 from .exact import BAND
 from .pieces import TIE
 from .py_hypot import hypot
-from .ray import closest_on_segment
+from .ray import closest_on_segment_compiled as _closest_on_segment
 from .tiebreak import DIR_TOL
 
 __all__ = ["hypot", "nearest_points", "points_inside", "rays_first", "ray_rows"]
@@ -49,11 +49,6 @@ _AABB, _CIRCLE, _POLYGON, _CAPSULE, _SEGMENT = 0, 1, 2, 3, 4
 _FAR = 500  # framework.collision.ray.FAR
 _NEAR = 1e-9  # the widening of the single queries' candidate boxes
 _SLACK = 1e-9  # relative margin of the skipping tests (rounding is below 1e-15 of the magnitudes)
-
-
-
-
-_closest_on_segment = kernel(closest_on_segment)  # (the single queries' own arithmetic, compiled)
 
 
 @kernel

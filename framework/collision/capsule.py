@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..compiled import kernel, leaf
 from ..shapes import AABB, Capsule, Circle, Polygon, Segment, Shape
 from .exact import BAND, TINY, Offset, float_approx, ratio_approx, rounded_exact
-from .ray import closest_on_segment
+from .ray import closest_on_segment_compiled as _on_segment  # (ray.py's, compiled for the kernels here)
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
 if TYPE_CHECKING:
@@ -159,10 +159,6 @@ def _pick(cd, cx, cy, m, size):
             if ki > kw:
                 w = i
     return shortest, cx[w], cy[w]
-
-
-# The point of a segment closest to a point: ray.py's function, compiled for the kernels here.
-_on_segment = kernel(closest_on_segment)
 
 
 @leaf

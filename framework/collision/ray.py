@@ -41,6 +41,7 @@ from fractions import Fraction
 from numbers import Real
 from typing import cast
 
+from ..compiled import kernel
 from ..shapes import AABB, Capsule, ChainSegment, Circle, Polygon, Segment, Shape
 from ..validation import InvalidValue, vector2
 from .exact import BAND, TINY, ratio_approx
@@ -245,6 +246,11 @@ def closest_on_segment(px: float, py: float, s0x: float, s0y: float, s1x: float,
     if t >= 1.0:
         return s1x, s1y
     return s0x + t * ex, s0y + t * ey
+
+
+#: :func:`closest_on_segment` compiled: the capsule kernels' and the batch queries' own arithmetic
+#: (one compiled copy for both).
+closest_on_segment_compiled = kernel(closest_on_segment)
 
 
 def safe_ldexp(x: float, e: int) -> float:

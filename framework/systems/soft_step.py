@@ -345,7 +345,7 @@ def _by_entity(cols: tuple[np.ndarray, ...], contacts: StepContacts) -> tuple[tu
 # the kernel's variants called in this process: (with joints, with capsules or chain segments)
 _COMPILED: set[tuple[bool, bool]] = set()
 _RARE = np.int64(1)  # (the kernel's ``rare``: capsules or chain segments in the scene; None: neither)
-COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 20 to 30 seconds, and again "
+COMPILE_NOTICE = ("framework: compiling the soft step (once per installation, about 20 seconds, and again "
                   "for the first scene with joints, or with capsules or chains; later runs load it from numba's "
                   "cache)")
 

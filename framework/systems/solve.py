@@ -355,7 +355,6 @@ class Solve:
                 return
         self._clear_of_statics(rounds)
 
-
     def _clear_of_statics(self, rounds: int) -> None:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over
         the contacts with immovable bodies alone, while one still overlaps: each pushes its body
@@ -400,11 +399,6 @@ class Solve:
         cs = self.cs
         push, dx, dy = columns.warm_pushes(self.a, self.b, cs.nx, cs.ny, share_a, share_b, push0, self.span, self.reach)
         return push, dx, dy
-
-    def _push_cap(self) -> F64Array:
-        """Per contact, the longest push worth remembering: the smaller half-thickness of its two
-        bodies (a push that long in one step is a body being pushed out of a heap, not resting)."""
-        return 2.0 * np.minimum(self.span[self.a], self.span[self.b])
 
     def _solve(self, order: IntpArray, tolerance: float | None = None, translate: bool = False) -> bool:
         """One run of the position solver over the contacts ``order``; the bodies are then placed.

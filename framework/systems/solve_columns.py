@@ -22,8 +22,8 @@ NaN last), so the same bits. Divisions follow numpy's rules (``error_model="nump
 ``inf``, not an exception).
 
 A fresh install compiles each of these on its first call, a few tenths of a second each whatever
-its size (cached after): so there are few of them, and small helpers are written out where they
-are used rather than called.
+its size (cached after): so there are few of them, and the only helpers are rules two passes
+share (:func:`push_cap`, :func:`_kept_still`).
 """
 
 from __future__ import annotations
@@ -34,16 +34,38 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from ..compiled import inner, leaf
 from ..stable_sort import stable_argsort
 from .gather import _np_max, _np_min
 from .solver_loops import warm_start
 
-__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "stays", "velocity_stays",
+__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "push_cap", "stays", "velocity_stays",
            "warm_impulses", "warm_pushes"]
 
 # (numpy's error model: a division by zero gives inf or NaN as numpy does; the options as compiled.kernel's)
 _COMPILED_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True, "error_model": "numpy"}
 _compiled = njit(**_COMPILED_OPTIONS)
+
+
+@leaf
+def push_cap(push, span_a, span_b):  # pragma: no cover - compiled
+    """A push as far as it is worth remembering for the next step: at most the smaller half-thickness
+    of its two bodies (twice their smaller ``span``; a push that long in one step is a body being
+    pushed out of a heap, not resting)."""
+    return _np_min(push, 2.0 * _np_min(span_a, span_b))
+
+
+@inner
+def _kept_still(b_on_a, a_on_b, share_a, share_b):  # pragma: no cover - compiled
+    """The shares with the lower body of the pairs ``b_on_a`` / ``a_on_b`` kept still (its share 0,
+    the upper body's 1), the others' as they are: ``(share_a, share_b)``."""
+    sa, sb = share_a.copy(), share_b.copy()
+    for i in range(sa.size):
+        if b_on_a[i]:
+            sa[i], sb[i] = 0.0, 1.0
+        elif a_on_b[i]:
+            sa[i], sb[i] = 1.0, 0.0
+    return sa, sb
 
 
 @_compiled
@@ -82,8 +104,6 @@ def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics
     return span, reach, wa, wb, share_a, share_b, immovable, order
 
 
-
-
 @_compiled
 def stays(order, a, b, nx, ny, gx, gy, g, share_a, share_b, immovable, rolling, n_bodies):  # pragma: no cover
     """Shock propagation (:meth:`Solve._shock_shares`): which pairs rest one on the other, ``b_on_a``
@@ -106,15 +126,11 @@ def stays(order, a, b, nx, ny, gx, gy, g, share_a, share_b, immovable, rolling, 
                 held[a[i]] = True
     b_on_a = np.empty(c, dtype=np.bool_)
     a_on_b = np.empty(c, dtype=np.bool_)
-    sa, sb = share_a.copy(), share_b.copy()
     for i in range(c):
         rests = not immovable[i] and not rolling[i]
         b_on_a[i] = rests and up[i] > 0.5 and held[a[i]]
         a_on_b[i] = rests and up[i] < -0.5 and held[b[i]]
-        if b_on_a[i]:  # (the lower body keeps still)
-            sa[i], sb[i] = 0.0, 1.0
-        elif a_on_b[i]:
-            sa[i], sb[i] = 1.0, 0.0
+    sa, sb = _kept_still(b_on_a, a_on_b, share_a, share_b)
     return b_on_a, a_on_b, sa, sb
 
 
@@ -128,7 +144,6 @@ def velocity_stays(a, b, nx, ny, vx, vy, gx, gy, dt, b_on_a0, a_on_b0, wa, wb, s
     c = a.size
     b_on_a = np.empty(c, dtype=np.bool_)
     a_on_b = np.empty(c, dtype=np.bool_)
-    sa, sb = share_a.copy(), share_b.copy()
     for i in range(c):
         p, q = a[i], b[i]
         resting_speed = 2.0 * abs(gx * nx[i] + gy * ny[i]) * dt
@@ -138,10 +153,7 @@ def velocity_stays(a, b, nx, ny, vx, vy, gx, gy, dt, b_on_a0, a_on_b0, wa, wb, s
         hits = closing > resting_speed
         b_on_a[i] = b_on_a0[i] and a_up <= resting_speed and not (hits and wb[i] < wa[i])
         a_on_b[i] = a_on_b0[i] and b_down <= resting_speed and not (hits and wa[i] < wb[i])
-        if b_on_a[i]:  # (the lower body keeps still)
-            sa[i], sb[i] = 0.0, 1.0
-        elif a_on_b[i]:
-            sa[i], sb[i] = 1.0, 0.0
+    sa, sb = _kept_still(b_on_a, a_on_b, share_a, share_b)
     return b_on_a, a_on_b, sa, sb
 
 
@@ -155,7 +167,7 @@ def warm_pushes(a, b, nx, ny, share_a, share_b, push0, span, reach):  # pragma: 
     push = np.empty(c)
     any_push = False
     for i in range(c):
-        push[i] = _np_min(push0[i], 2.0 * _np_min(span[a[i]], span[b[i]]))
+        push[i] = push_cap(push0[i], span[a[i]], span[b[i]])
         any_push = any_push or push[i] != 0.0
     finite = True
     for k in range(n):

@@ -5,7 +5,7 @@ the pairs it knows, picks the candidate pairs the broad phase and the static cac
 measures the contacts with immovable bodies again. Each of those was a handful of small numpy
 calls on a few dozen rows; here each is one loop:
 
-- :func:`number`: the local numbering of new bodies (:func:`framework.systems.solve._number`);
+- :func:`number`: the local numbering of new bodies;
 - :func:`turning_pairs`: whether a contact has a box or polygon that turns;
 - :func:`known_keys`: the sorted pair keys of two lists of pairs;
 - :func:`unknown_solid_pairs`: the pairs not among known keys that the response may act on;
@@ -32,6 +32,7 @@ import numpy as np
 from ..compiled import kernel, leaf
 from ..stable_sort import stable_argsort
 from .gather import _find, _np_max, _np_min, _row, solid_pair
+from .solve_columns import push_cap
 
 __all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "moved_candidates", "moved_immovable",
            "near_rows", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]
@@ -123,8 +124,6 @@ def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep
     return _at(ra, idx), _at(rb, idx), _at(ea, idx), _at(eb, idx)
 
 
-
-
 @kernel
 def near_rows(bodies, rows, reach, inv_mass, asleep, x, y, cx, cy):  # pragma: no cover - compiled
     """Of the local ``bodies`` (store ``rows``, ``reach``), those the response may move (``inv_mass >
@@ -182,6 +181,14 @@ def moved_immovable(immovable, moved, a, b, at_points, ra, rb):  # pragma: no co
     return check, _at(ra, check), _at(rb, check), _where(pts)
 
 
+@leaf
+def _shift(i, p, q, dx, dy, nx, ny, rn_a, rn_b, dturn):  # pragma: no cover - compiled
+    """``Solve._shift`` of contact ``i`` (bodies ``p``, ``q``): how far the solve has moved them apart
+    along its normal (and, for contacts at points, turned them: ``rn_a`` not empty)."""
+    shift = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]
+    if rn_a.size > 0:
+        shift += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
+    return shift
 
 
 @leaf
@@ -197,10 +204,7 @@ def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn
         i = check[j]
         if hit[j]:
             nx[i], ny[i] = rnx[j], rny[j]
-        p, q = a[i], b[i]
-        shift = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]  # (Solve._shift, along the normal now)
-        if rn_a.size > 0:
-            shift += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
+        shift = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn)  # (along the normal now)
         if hit[j]:
             depth[i] = rdepth[j] + shift
             dirty[i] = True
@@ -217,7 +221,7 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
     """What :meth:`Solve.record` keeps, sorted by pair key (stably: a pair's points in order): the
     contacts acted on (``touching`` or pushed) or ``near`` (empty: none), with ``(rows, keys, ea,
     eb, nx, ny, gap, push, capped push, impulse, tpush, timpulse, applied)``: the gap where the
-    bodies now stand (0 if they overlap), the push capped as :func:`Solve._push_cap` says, and
+    bodies now stand (0 if they overlap), the push capped as :func:`~framework.systems.solve_columns.push_cap` says, and
     whether the contact was acted on."""
     c = ea.size
     kept = np.zeros(c, dtype=np.bool_)
@@ -233,17 +237,12 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
     gap, capped, applied = np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_)
     for k in range(m):
         i = rows[k]
-        p, q = a[i], b[i]
-        shift = (dx[q] - dx[p]) * nx[i] + (dy[q] - dy[p]) * ny[i]  # (Solve._shift)
-        if rn_a.size > 0:
-            shift += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
+        shift = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn)
         gap[k] = _np_max(shift - depth[i], 0.0)
-        capped[k] = _np_min(push[i], 2.0 * _np_min(span[a[i]], span[b[i]]))
+        capped[k] = push_cap(push[i], span[a[i]], span[b[i]])
         applied[k] = touching[i] or push[i] > 0.0
     return (rows, keys, _at(ea, rows), _at(eb, rows), _at(nx, rows), _at(ny, rows), gap, _at(push, rows), capped,
             _at(impulse, rows), _at(tpush, rows), _at(timpulse, rows), applied)
-
-
 
 
 @kernel
