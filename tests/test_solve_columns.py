@@ -21,6 +21,19 @@ def _same(a: np.ndarray, b: np.ndarray) -> None:
     assert a.tobytes() == b.tobytes()
 
 
+def _contacts(rng: np.random.Generator, n: int, c: int) -> tuple[np.ndarray, ...]:
+    """``c`` contacts between ``n`` bodies, no body with itself, and their unit normals: ``(a, b, nx, ny)``."""
+    a = rng.integers(0, n, c)
+    b = (a + 1 + rng.integers(0, n - 1, c)) % n
+    return (a, b, *_normals(rng, c))
+
+
+def _normals(rng: np.random.Generator, c: int) -> tuple[np.ndarray, np.ndarray]:
+    """``c`` unit normals at random angles: ``(nx, ny)``."""
+    angle = rng.uniform(-np.pi, np.pi, c)
+    return np.cos(angle), np.sin(angle)
+
+
 def _floats(rng: np.random.Generator, n: int, specials: bool = True) -> np.ndarray:
     v = np.round(rng.normal(size=n), 1)  # (rounded: ties)
     if specials and n > 4:
@@ -88,10 +101,7 @@ def _lower_stays(b_on_a, a_on_b, share_a, share_b):
 def test_stays_are_the_numpy_shock_shares(seed: int) -> None:
     rng = np.random.default_rng(seed)
     n, c = 12, 25
-    a = rng.integers(0, n, c)
-    b = (a + 1 + rng.integers(0, n - 1, c)) % n
-    angle = rng.uniform(-np.pi, np.pi, c)
-    nx, ny = np.cos(angle), np.sin(angle)
+    a, b, nx, ny = _contacts(rng, n, c)
     share_a = np.where(rng.random(c) < 0.3, 0.0, rng.random(c))
     share_b = np.where(share_a == 0.0, 1.0, 1.0 - share_a)
     immovable = (share_a == 0.0) & (rng.random(c) < 0.7)
@@ -126,10 +136,7 @@ def test_stays_are_the_numpy_shock_shares(seed: int) -> None:
 def test_warm_pushes_are_the_numpy_warm_pushes(seed: int) -> None:
     rng = np.random.default_rng(seed)
     n, c = 10, 20
-    a = rng.integers(0, n, c)
-    b = (a + 1 + rng.integers(0, n - 1, c)) % n
-    angle = rng.uniform(-np.pi, np.pi, c)
-    nx, ny = np.cos(angle), np.sin(angle)
+    a, b, nx, ny = _contacts(rng, n, c)
     share_a = rng.random(c)
     share_b = 1.0 - share_a
     push0 = np.where(rng.random(c) < 0.3, 0.0, rng.random(c))
@@ -221,8 +228,8 @@ def test_apply_measures_is_the_numpy_update(rigid: bool) -> None:
     rng = np.random.default_rng(int(rigid))
     n, c = 10, 24
     a, b = rng.integers(0, n, c), rng.integers(0, n, c)
-    angle = rng.uniform(-np.pi, np.pi, c)
-    nx, ny, depth = np.cos(angle), np.sin(angle), rng.normal(size=c) * 0.01
+    nx, ny = _normals(rng, c)
+    depth = rng.normal(size=c) * 0.01
     dx, dy = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01
     rn_a, rn_b, dturn = (rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01) if rigid else (
         np.zeros(0), np.zeros(0), np.zeros(0))
@@ -257,8 +264,7 @@ def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
     n_rows, c = 30, 20
     rows, a, b = _scene(rng, n_rows, c)
     ra, rb = rows[a], rows[b]
-    angle = rng.uniform(-np.pi, np.pi, c)
-    nx, ny = np.cos(angle), np.sin(angle)
+    nx, ny = _normals(rng, c)
     svx, svy = _floats(rng, n_rows, specials=False), _floats(rng, n_rows, specials=False)
     vx, vy, u = sc.closing_speeds(rows, a, b, nx, ny, svx, svy)
     want_vx, want_vy = svx[rows].copy(), svy[rows].copy()
@@ -306,8 +312,8 @@ def test_recorded_is_the_numpy_record(rigid: bool) -> None:
     n, c = 10, 30
     a, b = rng.integers(0, n, c), rng.integers(0, n, c)
     ea, eb = rng.integers(0, 6, c), rng.integers(0, 6, c)  # (repeated pairs: a pair's points)
-    angle = rng.uniform(-np.pi, np.pi, c)
-    nx, ny, depth = np.cos(angle), np.sin(angle), rng.normal(size=c) * 0.01
+    nx, ny = _normals(rng, c)
+    depth = rng.normal(size=c) * 0.01
     dx, dy, span = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01, 0.01 * rng.random(n)
     rn_a, rn_b, dturn = (rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01) if rigid else (
         np.zeros(0), np.zeros(0), np.zeros(0))
