@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from framework.events import pair_keys, sorted_member
-from framework.stable_sort import stable_argsort
+from framework.stable_sort import sorted_ints, stable_argsort
 from framework.systems import gather
 from framework.systems import solve_columns as sc
 from framework.systems import solve_rounds as sr
@@ -50,6 +50,28 @@ def test_stable_argsort_is_numpys_stable_argsort(seed: int) -> None:
         _same(stable_argsort(key), np.argsort(key, kind="stable").astype(np.int64))
         ints = rng.integers(-3, 4, n).astype(np.int64) << 40  # (the soft step's keys: integers, many ties)
         _same(stable_argsort(ints), np.argsort(ints, kind="stable").astype(np.int64))
+        for runs in (1, 2, 3, 6):  # (a few runs in order, ties across them: NaN last in each)
+            cut = np.sort(rng.integers(0, n + 1, runs - 1))
+            for keys in (key, ints):
+                joined = np.concatenate([np.sort(p, kind="stable") for p in np.split(keys, cut)])
+                _same(stable_argsort(joined), np.argsort(joined, kind="stable").astype(np.int64))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_sorted_ints_is_numpys_sort(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for n in (0, 1, 2, 3, 7, 33, 200):
+        keys = rng.integers(-(2**62), 2**62, n)
+        _same(sorted_ints(keys), np.sort(keys))
+        ties = rng.integers(-3, 4, n).astype(np.int64) << 40
+        _same(sorted_ints(ties), np.sort(ties))
+        for runs in (1, 2, 3, 5):  # (a few sorted runs, as the solve's contacts come)
+            cut = np.sort(rng.integers(0, n + 1, runs - 1))
+            parts = np.split(keys, cut)
+            joined = np.concatenate([np.sort(p) for p in parts]) if n else keys
+            _same(sorted_ints(joined), np.sort(keys))
+    ordered = np.arange(5, dtype=np.int64)
+    assert sorted_ints(ordered) is ordered  # (in order already: no copy)
 
 
 def _scene(rng: np.random.Generator, n_rows: int, c: int):
@@ -191,6 +213,14 @@ def test_pair_picks_are_the_numpy_picks(seed: int) -> None:
     pa, pb = rng.integers(0, 45, 30), rng.integers(0, 45, 30)
     pea, peb = np.concatenate([ea[:5], rng.integers(0, 50, 25)]), np.concatenate([eb[:5], rng.integers(0, 50, 25)])
     cols = (kind, sensor, inv_mass, asleep, one_way, layer, mask, False)
+    keep = ~sorted_member(pair_keys(pea, peb), known) & (pa < n) & (pb < n)
+    ok = gather.solid_pairs_mask(pa[keep], pb[keep], *cols)
+    want = tuple(v[keep][ok] for v in (pa, pb, pea, peb))
+    for have, w in zip(sr.unknown_solid_pairs(pa, pb, pea, peb, known, n, *cols), want):
+        _same(have, w)
+    # the same pairs sorted by key, as the broad phase gives them: one walk along ``known``
+    order = np.argsort(pair_keys(pea, peb), kind="stable")
+    pa, pb, pea, peb = pa[order], pb[order], pea[order], peb[order]
     keep = ~sorted_member(pair_keys(pea, peb), known) & (pa < n) & (pb < n)
     ok = gather.solid_pairs_mask(pa[keep], pb[keep], *cols)
     want = tuple(v[keep][ok] for v in (pa, pb, pea, peb))

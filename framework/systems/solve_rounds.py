@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from ..compiled import kernel, leaf
-from ..stable_sort import stable_argsort
+from ..stable_sort import sorted_ints, stable_argsort
 from .gather import _find, _np_max, _np_min, _row, solid_pair
 from .solve_columns import push_cap
 
@@ -108,7 +108,7 @@ def known_keys(ea, eb, ca, cb):  # pragma: no cover - compiled
         keys[i] = (np.int64(ea[i]) << 32) | np.int64(eb[i])
     for i in range(ca.size):
         keys[ea.size + i] = (np.int64(ca[i]) << 32) | np.int64(cb[i])
-    return _at(keys, stable_argsort(keys))
+    return sorted_ints(keys)  # (the contacts come as a few sorted runs, the candidates as one)
 
 
 @kernel
@@ -117,8 +117,21 @@ def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep
     """The pairs ``(ra, rb, ea, eb)`` whose key is not in the sorted ``known``, both rows in the
     store's ``n``, that the response may act on (``gather.solid_pair``)."""
     ok = np.zeros(ra.size, dtype=np.bool_)
+    ascending = True  # (the broad phase's pairs come sorted by key: then one walk along ``known``)
+    for i in range(1, ra.size):
+        if ((np.int64(ea[i]) << 32) | np.int64(eb[i])) < ((np.int64(ea[i - 1]) << 32) | np.int64(eb[i - 1])):
+            ascending = False
+            break
+    j = 0
     for i in range(ra.size):
-        ok[i] = (ra[i] < n and rb[i] < n and _find(known, (np.int64(ea[i]) << 32) | np.int64(eb[i])) < 0
+        key = (np.int64(ea[i]) << 32) | np.int64(eb[i])
+        if ascending:
+            while j < known.size and known[j] < key:
+                j += 1
+            unknown = not (j < known.size and known[j] == key)
+        else:
+            unknown = _find(known, key) < 0
+        ok[i] = (ra[i] < n and rb[i] < n and unknown
                  and solid_pair(ra[i], rb[i], kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open))
     idx = _where(ok)
     return _at(ra, idx), _at(rb, idx), _at(ea, idx), _at(eb, idx)
