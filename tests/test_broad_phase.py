@@ -791,3 +791,48 @@ def test_movers_far_from_every_static_are_not_swept_against_them(monkeypatch, ga
     assert np.array_equal(got[0], exp[0]) and np.array_equal(got[1], exp[1])
     assert (len(swept) == 0) == (gap >= 0.0)
     assert bool((exp[1] >= 100).any()) == (gap < 0.0)  # (mover-tile pairs only when they overlap)
+
+
+def _direct_pairs_by_brute_force(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind):
+    """What ``direct_pairs`` answers, spelled out: each mover against every hitbox row that is
+    static, asleep or moving (a moving pair from its lower row), bounds strictly overlapping."""
+    movers = set(moving.tolist())
+    keys = []
+    for i in moving.tolist():
+        for r in range(kind.size):
+            if kind[r] < 0 or not (r in movers or body[r] == static_kind or asleep[r]) or r == i:
+                continue
+            if r in movers and r < i:
+                continue
+            if maxx[i] > minx[r] and maxx[r] > minx[i] and maxy[i] > miny[r] and maxy[r] > miny[i]:
+                a, b = sorted((int(entity[i]), int(entity[r])))
+                keys.append((a << 32) | b)
+    return np.sort(np.array(keys, dtype=np.int64))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_direct_pairs_tested_or_swept_are_the_brute_force_pairs(seed):
+    """Few movers are tested against every row, many are swept by left edge (movers against each
+    other; each against the still rows within the widest one to its left): the same sorted keys as
+    brute force, with touching boxes, wide static rows, movers without a hitbox and sleepers."""
+    from framework.collision.broad_phase import SWEEP_FROM, direct_pairs
+
+    rng = np.random.default_rng(seed)
+    swept = tested = 0
+    for trial in range(40):
+        n = int(rng.integers(1, 260))
+        kind = rng.integers(-1, 3, n)
+        body = rng.integers(0, 3, n)
+        asleep = rng.random(n) < 0.2
+        entity = rng.permutation(10 * n)[:n].astype(np.int64)
+        x, y = np.round(rng.random(n) * 20, 1), np.round(rng.random(n) * 20, 1)  # (tenths: many touch)
+        w, h = np.round(rng.random(n) * (3 if trial % 2 else 30), 1), np.round(rng.random(n) * 3, 1)
+        minx, maxx, miny, maxy = x - w, x + w, y - h, y + h
+        moving = np.flatnonzero((body != 1) & ~asleep).astype(np.int64)
+        got = direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1)
+        want = _direct_pairs_by_brute_force(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1)
+        assert got.tobytes() == want.tobytes(), trial
+        still = int(np.count_nonzero((kind >= 0) & (body != 1) & asleep | (kind >= 0) & (body == 1)))
+        swept += moving.size * (moving.size + still) > SWEEP_FROM
+        tested += moving.size * (moving.size + still) <= SWEEP_FROM
+    assert swept > 5 and tested > 5  # (both ways were taken)
