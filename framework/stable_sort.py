@@ -1,6 +1,6 @@
 """Compiled sorts: :func:`stable_argsort`, shared by the exact solve's rounds, the broad phase's
 direct pairs and the soft step's kernel; :func:`sorted_ints`, integer keys made of a few sorted runs
-(the solve's known pair keys).
+(the solve's known pair keys, the broad phase's pairs).
 
 Natural merge sorts: ``np.argsort(key, kind="stable")``'s answer (a stable sort's order is the
 only one), for floats (NaN last, as numpy) and integers alike, at a tenth of the compile time of
@@ -68,24 +68,32 @@ def stable_argsort(key):  # pragma: no cover - compiled
     return idx
 
 
+#: :func:`sorted_ints` merges the runs in order where there are at most this many, else sorts by
+#: radix (a pass over the keys per byte in which they differ: pair keys of a scene's entity ids,
+#: four or so, where merging single keys took a pass per doubling).
+MERGE_RUNS = 8
+
+
 @kernel
 def sorted_ints(keys):  # pragma: no cover - compiled
-    """The integers ``keys`` in ascending order (``np.sort(keys)``; integers: any sort's answer), by
-    a natural merge sort: the runs already in order are found first and merged pairwise, so keys made
-    of a few sorted runs (contacts listed by kind, then candidates) cost a pass per doubling of runs,
-    and keys in order cost one pass and no copy."""
+    """The integers ``keys`` (int64) in ascending order (``np.sort(keys)``; integers: any sort's
+    answer). Keys made of at most :data:`MERGE_RUNS` runs in order (contacts listed by kind, then
+    candidates) are merged, a pass per doubling of runs, and keys in order are returned as they
+    are; others are sorted by radix, a byte at a time (the bytes where all keys agree skipped)."""
     n = keys.size
-    starts = np.empty(n + 1, dtype=np.int64)  # where each run in order begins, then n
+    starts = np.empty(MERGE_RUNS + 2, dtype=np.int64)  # where each run in order begins, then n
     m = 0
     for i in range(n):
         if i == 0 or keys[i] < keys[i - 1]:
+            if m == MERGE_RUNS:
+                return _radix(keys)
             starts[m] = i
             m += 1
     if m <= 1:
         return keys
     starts[m] = n
     src = keys.copy()
-    dst = np.empty(n, dtype=keys.dtype)
+    dst = np.empty(n, dtype=np.int64)
     while m > 1:
         half = 0
         for r in range(0, m, 2):
@@ -112,5 +120,37 @@ def sorted_ints(keys):  # pragma: no cover - compiled
             half += 1
         starts[half] = n
         m = half
+        src, dst = dst, src
+    return src
+
+
+@kernel
+def _radix(keys):  # pragma: no cover - compiled
+    """``keys`` (int64) sorted by a least-significant-byte-first radix sort: a counting pass and a
+    placing pass per byte in which the keys differ (the top byte's sign bit flipped, so that
+    negative keys come first)."""
+    n = keys.size
+    differ = np.int64(0)
+    for i in range(n):
+        differ |= keys[i] ^ keys[0]
+    src, dst = keys.copy(), np.empty(n, dtype=np.int64)
+    count = np.empty(256, dtype=np.int64)
+    for shift in range(0, 64, 8):
+        if (differ >> shift) & 0xFF == 0:
+            continue
+        flip = 0x80 if shift == 56 else 0
+        for d in range(256):
+            count[d] = 0
+        for i in range(n):
+            count[((src[i] >> shift) & 0xFF) ^ flip] += 1
+        total = 0
+        for d in range(256):
+            c = count[d]
+            count[d] = total
+            total += c
+        for i in range(n):
+            d = ((src[i] >> shift) & 0xFF) ^ flip
+            dst[count[d]] = src[i]
+            count[d] += 1
         src, dst = dst, src
     return src

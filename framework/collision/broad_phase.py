@@ -436,12 +436,6 @@ DIRECT_PAIRS = 1 << 16
 SWEEP_FROM = 1 << 12
 
 
-@leaf
-def _overlap(i, r, minx, miny, maxx, maxy):  # pragma: no cover - compiled
-    """Whether the bounds of rows ``i`` and ``r`` strictly overlap (touching is no overlap)."""
-    return maxx[i] > minx[r] and maxx[r] > minx[i] and maxy[i] > miny[r] and maxy[r] > miny[i]
-
-
 @kernel
 def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind):  # pragma: no cover
     """The sorted pair keys (``entity a << 32 | entity b``, a < b) of every moving row (``moving``,
@@ -452,8 +446,9 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
     Few tests (:data:`SWEEP_FROM`): every mover against every such row. More: the movers sorted by
     their left edges are swept against each other (each one meets those whose left edge lies before
     its right edge), and each mover looks among the other rows, sorted by left edge too, only at
-    those whose left edge lies within the widest of them to its left. The pairs are the same; the
-    keys are sorted at the end."""
+    those whose left edge lies within the widest of them to its left. Either way the rows' bounds
+    are first laid side by side, in the order they are met, so that the inner loops read them in
+    turn; the keys are sorted at the end."""
     n = kind.size
     rank = np.full(n, -1, dtype=np.int64)  # a mover's place in ``moving``; -1 for the others
     for k in range(moving.size):
@@ -464,60 +459,75 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
         if kind[r] >= 0 and rank[r] < 0 and (body[r] == static_kind or asleep[r]):
             rows[c] = r
             c += 1
-    out = np.empty(16, dtype=np.int64)
-    m = 0
-    if moving.size * (moving.size + c) <= SWEEP_FROM:
-        for k in range(moving.size):
-            i = moving[k]
-            for q in range(k + 1, moving.size + c):
-                r = moving[q] if q < moving.size else rows[q - moving.size]
-                if kind[r] >= 0 and _overlap(i, r, minx, miny, maxx, maxy):
-                    out, m = _put(out, m, entity[i], entity[r])
-    else:
-        left = np.empty(moving.size)
-        for k in range(moving.size):
+    mv = moving.size
+    swept = mv * (mv + c) > SWEEP_FROM
+    # the movers' bounds side by side (by left edge when swept), then the still rows' (likewise)
+    at = np.empty(mv + c, dtype=np.int64)
+    for k in range(mv + c):
+        at[k] = moving[k] if k < mv else rows[k - mv]
+    widest = 0.0
+    if swept:
+        left = np.empty(mv)
+        for k in range(mv):
             left[k] = minx[moving[k]]
         order = stable_argsort(left)
-        for p in range(moving.size):
-            i = moving[order[p]]
-            for p2 in range(p + 1, moving.size):
-                r = moving[order[p2]]
-                if minx[r] >= maxx[i]:
-                    break
-                if kind[max(i, r)] >= 0 and _overlap(i, r, minx, miny, maxx, maxy):
-                    out, m = _put(out, m, entity[i], entity[r])
-        still = np.empty(c)
-        widest = 0.0
+        for k in range(mv):
+            at[k] = moving[order[k]]
+        left = np.empty(c)
         for q in range(c):
-            still[q] = minx[rows[q]]
+            left[q] = minx[rows[q]]
             widest = max(widest, maxx[rows[q]] - minx[rows[q]])
-        order = stable_argsort(still)
-        edges = np.empty(c)
+        order = stable_argsort(left)
         for q in range(c):
-            edges[q] = still[order[q]]
-        for k in range(moving.size):
-            i = moving[k]
-            # (a row whose left edge lies further left ends before this one begins; the margin
-            # covers the rounding of ``widest`` and of the difference)
-            reach = minx[i] - widest
-            q = lower_bound(edges, reach - (abs(reach) + widest) * 1e-12)
-            while q < c and edges[q] < maxx[i]:
-                r = rows[order[q]]
-                if _overlap(i, r, minx, miny, maxx, maxy):
-                    out, m = _put(out, m, entity[i], entity[r])
-                q += 1
-    return sorted_ints(out[:m])
-
-
-@kernel
-def _put(out, m, a, b):  # pragma: no cover - compiled
-    """``out`` (grown if full) with the key of the pair of entities ``a``, ``b`` at ``m``; and ``m + 1``."""
-    if a > b:
-        a, b = b, a
-    if m == out.size:
-        grown = np.empty(2 * m, dtype=np.int64)
+            at[mv + q] = rows[order[q]]
+    bx0, by0, bx1, by1 = np.empty(mv + c), np.empty(mv + c), np.empty(mv + c), np.empty(mv + c)
+    for k in range(mv + c):
+        r = at[k]
+        bx0[k], by0[k], bx1[k], by1[k] = minx[r], miny[r], maxx[r], maxy[r]
+    out = np.empty(max(16, 2 * mv), dtype=np.int64)
+    k, m = 0, 0
+    while True:
+        k, m = _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m)
+        if k == mv:
+            break
+        grown = np.empty(2 * out.size, dtype=np.int64)
         for q in range(m):  # (a loop: a slice assignment compiles numba's shape checks, seconds)
             grown[q] = out[q]
         out = grown
-    out[m] = (a << 32) | b
-    return out, m + 1
+    return sorted_ints(out[:m])
+
+
+@leaf
+def _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m):  # pragma: no cover
+    """:func:`direct_pairs`' keys of the movers from the ``k``-th on, written to ``out`` from ``m``
+    on: ``(mv, the keys' end)``, or where ``out`` was too small for a mover's keys, ``(that mover,
+    the keys' end before it)``. (Apart, without reference counting: numba counted the growing key
+    array's references in every test, five times the tests' own cost.)"""
+    while k < mv:
+        i = at[k]
+        ax0, ay0, ax1, ay1 = bx0[k], by0[k], bx1[k], by1[k]
+        # the movers after this one (in row order, or by left edge: then up to the first whose
+        # left edge is past this one's right edge), then the still rows (all, or those whose left
+        # edge lies between this one's left edge less the widest of them and its right edge; the
+        # margin covers the rounding of ``widest`` and of the difference)
+        first = mv
+        if swept:
+            reach = ax0 - widest
+            first = mv + lower_bound(bx0[mv:], reach - (abs(reach) + widest) * 1e-12)
+        j = m
+        for part in range(2):
+            lo, hi = (k + 1, mv) if part == 0 else (first, mv + c)
+            for q in range(lo, hi):
+                if swept and bx0[q] >= ax1:
+                    break
+                if ax1 > bx0[q] and bx1[q] > ax0 and ay1 > by0[q] and by1[q] > ay0:
+                    r = at[q]
+                    if q < mv and kind[max(i, r)] < 0:
+                        continue
+                    if j == out.size:
+                        return k, m
+                    out[j] = (min(entity[i], entity[r]) << 32) | max(entity[i], entity[r])
+                    j += 1
+        m = j
+        k += 1
+    return k, m
