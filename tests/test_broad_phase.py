@@ -813,8 +813,9 @@ def _direct_pairs_by_brute_force(moving, kind, body, asleep, entity, minx, miny,
 @pytest.mark.parametrize("seed", range(6))
 def test_direct_pairs_tested_or_swept_are_the_brute_force_pairs(seed):
     """Few movers are tested against every row, many are swept by left edge (movers against each
-    other; each against the still rows within the widest one to its left): the same sorted keys as
-    brute force, with touching boxes, wide static rows, movers without a hitbox and sleepers."""
+    other; each against the still rows within the widest one to its left): the same pairs, in the
+    order of their keys, as brute force, and their rows, with touching boxes, wide static rows,
+    movers without a hitbox and sleepers."""
     from framework.collision.broad_phase import SWEEP_FROM, direct_pairs
 
     rng = np.random.default_rng(seed)
@@ -829,9 +830,12 @@ def test_direct_pairs_tested_or_swept_are_the_brute_force_pairs(seed):
         w, h = np.round(rng.random(n) * (3 if trial % 2 else 30), 1), np.round(rng.random(n) * 3, 1)
         minx, maxx, miny, maxy = x - w, x + w, y - h, y + h
         moving = np.flatnonzero((body != 1) & ~asleep).astype(np.int64)
-        got = direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1)
+        lut = np.full(10 * n, -1, dtype=np.int64)
+        lut[entity] = np.arange(n)
+        ea, eb, ra, rb = direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1, lut)
         want = _direct_pairs_by_brute_force(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1)
-        assert got.tobytes() == want.tobytes(), trial
+        assert ((ea << 32) | eb).tobytes() == want.tobytes(), trial
+        assert (entity[ra] == ea).all() and (entity[rb] == eb).all()
         still = int(np.count_nonzero((kind >= 0) & (body != 1) & asleep | (kind >= 0) & (body == 1)))
         swept += moving.size * (moving.size + still) > SWEEP_FROM
         tested += moving.size * (moving.size + still) <= SWEEP_FROM

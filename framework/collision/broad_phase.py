@@ -437,11 +437,12 @@ SWEEP_FROM = 1 << 12
 
 
 @kernel
-def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind):  # pragma: no cover
-    """The sorted pair keys (``entity a << 32 | entity b``, a < b) of every moving row (``moving``,
-    sorted rows) with every other hitbox row whose bounds strictly overlap its own (touching is no
-    overlap): the static ones, the sleeping ones and the moving ones (each moving pair once, found
-    from its lower row: the higher one must have a hitbox).
+def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind, lut):  # pragma: no cover
+    """The pairs of every moving row (``moving``, sorted rows) with every other hitbox row whose
+    bounds strictly overlap its own (touching is no overlap): the static ones, the sleeping ones and
+    the moving ones (each moving pair once, found from its lower row: the higher one must have a
+    hitbox). As ``(entities a, entities b, rows a, rows b)``, a < b, sorted by pair key (``entity a
+    << 32 | entity b``), the rows looked up in ``lut`` (entity -> row, ``BodyStore.row_table``).
 
     Few tests (:data:`SWEEP_FROM`): every mover against every such row. More: the movers sorted by
     their left edges are swept against each other (each one meets those whose left edge lies before
@@ -494,7 +495,13 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
         for q in range(m):  # (a loop: a slice assignment compiles numba's shape checks, seconds)
             grown[q] = out[q]
         out = grown
-    return sorted_ints(out[:m])
+    keys = sorted_ints(out[:m])
+    ea, eb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+    ra, rb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+    for q in range(m):
+        ea[q], eb[q] = keys[q] >> 32, keys[q] & 0xFFFFFFFF
+        ra[q], rb[q] = lut[ea[q]], lut[eb[q]]
+    return ea, eb, ra, rb
 
 
 @leaf

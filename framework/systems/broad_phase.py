@@ -67,9 +67,8 @@ class BroadPhase(Stage):
                                                   movers, all_bounds)
         if way == "direct":
             c, n = store.cols, store.n
-            ea, eb = pair_parts(direct_pairs(movers, c["kind"][:n], c["body"][:n], c["asleep"][:n], c["entity"][:n],
-                                             *all_bounds, STATIC))
-            ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
+            ea, eb, ra, rb = direct_pairs(movers, c["kind"][:n], c["body"][:n], c["asleep"][:n], c["entity"][:n],
+                                          *all_bounds, STATIC, store.row_table())
             bodies.hash.enter_few(*bounds, store.entity[moving])  # (for the queries and the overlay)
         elif way == "plain":
             keys = self._hashed(bounds, store.entity[moving], frame.n_asleep)
@@ -84,11 +83,12 @@ class BroadPhase(Stage):
             keys, ra, rb = kept.overlapping(all_bounds)
             ea, eb = pair_parts(keys)
             bodies.hash.enter_few(*bounds, store.entity[moving])  # (the movers as they are, not fat)
-        keep = filter_layers(store, ra, rb)
+        keep = None if store.layers_all_meet() else filter_layers(store, ra, rb)
         if "events" not in self.pipeline.effects:
-            keep &= self._someone_reads(ra, rb)
-        frame.pairs = (ea[keep], eb[keep], ra[keep], rb[keep])
-        counters["candidate_pairs"] = int(keep.sum())
+            need = self._someone_reads(ra, rb)
+            keep = need if keep is None else keep & need
+        frame.pairs = (ea, eb, ra, rb) if keep is None else (ea[keep], eb[keep], ra[keep], rb[keep])
+        counters["candidate_pairs"] = int(frame.pairs[0].size)
         return True
 
     def _hashed(self, bounds: Bounds, ids: I64Array, asleep: int) -> I64Array:
