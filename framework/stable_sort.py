@@ -1,6 +1,6 @@
 """Compiled sorts: :func:`stable_argsort`, shared by the exact solve's rounds, the broad phase's
-direct pairs and the soft step's kernel; :func:`sorted_ints`, integer keys made of a few sorted runs
-(the solve's known pair keys, the broad phase's pairs).
+direct pairs and the soft step's kernel; for integer keys, :func:`argsort_ints` and :func:`sorted_ints`
+(pair keys: a few sorted runs are merged, others sorted by radix).
 
 Natural merge sorts: ``np.argsort(key, kind="stable")``'s answer (a stable sort's order is the
 only one), for floats (NaN last, as numpy) and integers alike, at a tenth of the compile time of
@@ -13,7 +13,7 @@ import numpy as np
 
 from .compiled import kernel, leaf
 
-__all__ = ["sorted_ints", "stable_argsort"]
+__all__ = ["argsort_ints", "sorted_ints", "stable_argsort"]
 
 
 @leaf
@@ -154,3 +154,52 @@ def _radix(keys):  # pragma: no cover - compiled
             count[d] += 1
         src, dst = dst, src
     return src
+
+
+@kernel
+def argsort_ints(keys):  # pragma: no cover - compiled
+    """``np.argsort(keys, kind="stable")`` of integers (int64): :func:`stable_argsort`'s natural
+    merge where the keys are at most :data:`MERGE_RUNS` runs in order, else a least-significant-byte-
+    first radix sort carrying each key's place (stable by construction; a pass per byte in which
+    the keys differ). Merging single keys of random order read them out of order, a pass per
+    doubling: 4,000 pair keys 345 us by merging, about a fifth of that by radix."""
+    n = keys.size
+    runs = 0
+    for i in range(n):
+        if i == 0 or keys[i] < keys[i - 1]:
+            runs += 1
+            if runs > MERGE_RUNS:
+                return _radix_argsort(keys)
+    return stable_argsort(keys)
+
+
+@kernel
+def _radix_argsort(keys):  # pragma: no cover - compiled
+    """:func:`argsort_ints` by radix (see :func:`_radix`): the keys and their places moved together."""
+    n = keys.size
+    differ = np.int64(0)
+    for i in range(n):
+        differ |= keys[i] ^ keys[0]
+    src_k, dst_k = keys.copy(), np.empty(n, dtype=np.int64)
+    src_i, dst_i = np.arange(n), np.empty(n, dtype=np.int64)
+    count = np.empty(256, dtype=np.int64)
+    for shift in range(0, 64, 8):
+        if (differ >> shift) & 0xFF == 0:
+            continue
+        flip = 0x80 if shift == 56 else 0
+        for d in range(256):
+            count[d] = 0
+        for i in range(n):
+            count[((src_k[i] >> shift) & 0xFF) ^ flip] += 1
+        total = 0
+        for d in range(256):
+            c = count[d]
+            count[d] = total
+            total += c
+        for i in range(n):
+            d = ((src_k[i] >> shift) & 0xFF) ^ flip
+            dst_k[count[d]], dst_i[count[d]] = src_k[i], src_i[i]
+            count[d] += 1
+        src_k, dst_k = dst_k, src_k
+        src_i, dst_i = dst_i, src_i
+    return src_i

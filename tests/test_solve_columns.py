@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from framework.events import pair_keys, sorted_member
-from framework.stable_sort import sorted_ints, stable_argsort
+from framework.stable_sort import argsort_ints, sorted_ints, stable_argsort
 from framework.systems import gather
 from framework.systems import solve_columns as sc
 from framework.systems import solve_rounds as sr
@@ -55,6 +55,18 @@ def test_stable_argsort_is_numpys_stable_argsort(seed: int) -> None:
             for keys in (key, ints):
                 joined = np.concatenate([np.sort(p, kind="stable") for p in np.split(keys, cut)])
                 _same(stable_argsort(joined), np.argsort(joined, kind="stable").astype(np.int64))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_argsort_ints_is_numpys_stable_argsort(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for n in (0, 1, 2, 3, 7, 33, 200, 3000):
+        for keys in (rng.integers(-(2**62), 2**62, n), rng.integers(-3, 4, n).astype(np.int64) << 40,
+                     rng.integers(0, 50, n).astype(np.int64) << 32 | rng.integers(0, 50, n)):  # (pair keys: ties)
+            _same(argsort_ints(keys), np.argsort(keys, kind="stable").astype(np.int64))
+            cut = np.sort(rng.integers(0, n + 1, 3))  # (four runs in order: merged)
+            joined = np.concatenate([np.sort(p, kind="stable") for p in np.split(keys, cut)])
+            _same(argsort_ints(joined), np.argsort(joined, kind="stable").astype(np.int64))
 
 
 @pytest.mark.parametrize("seed", range(8))

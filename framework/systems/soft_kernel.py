@@ -56,7 +56,7 @@ from ..collision.soft_manifold import (
     polygon_polygon,
 )
 from ..compiled import kernel, leaf
-from ..stable_sort import stable_argsort
+from ..stable_sort import argsort_ints
 from .soft_joints import prepare_joints, solve_joints, warm_start_joints
 from .softness import soft as _soft
 
@@ -99,7 +99,7 @@ def internal_faces(x, y, rot, off, half, cnt, eligible, layer, mask):
         box[r, 0], box[r, 1], box[r, 2], box[r, 3] = hx - half[r, 0], hy - half[r, 1], hx + half[r, 0], hy + half[r, 1]
         tol[r] = 1e-9 * (1.0 + abs(hx) + abs(hy) + half[r, 0] + half[r, 1])
         xs[k] = box[r, 0]
-    order = stable_argsort(_float_keys(xs))
+    order = argsort_ints(_float_keys(xs))
     for ii in range(m):
         i = rows[order[ii]]
         for jj in range(ii + 1, m):
@@ -171,7 +171,7 @@ def _world_shapes(x, y, rot, vx, vy, w, moving, driven, off, lv, ln, cnt, rr, sp
 @kernel
 def _float_keys(v):
     """Integers in the order of the floats ``v`` (their bits, the negatives' flipped): one sort
-    (:func:`~framework.stable_sort.stable_argsort` on integers) serves both."""
+    (:func:`~framework.stable_sort.argsort_ints`) serves both."""
     k = (v + 0.0).view(np.int64)  # (+ 0.0: -0.0 becomes 0.0, its equal)
     for i in range(k.size):
         if k[i] < 0:
@@ -189,16 +189,45 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity, owner):
     xs = np.empty(n)
     for i in range(n):
         xs[i] = fat[i, 0]
-    order = stable_argsort(_float_keys(xs))
+    order = argsort_ints(_float_keys(xs))
     cap = 4 * n + 16
     pa = np.empty(cap, dtype=np.int64)
     pb = np.empty(cap, dtype=np.int64)
-    m = 0
-    for ii in range(n):
+    start, m = 0, 0
+    while True:
+        start, m = _swept_pairs(start, order, fat, cnt, fixed, layer, mask, layers_open, entity, owner, pa, pb, m)
+        if start == n:
+            break
+        cap *= 2
+        na = np.empty(cap, dtype=np.int64)
+        nb = np.empty(cap, dtype=np.int64)
+        for q in range(m):
+            na[q], nb[q] = pa[q], pb[q]
+        pa, pb = na, nb
+    keys = np.empty(m, dtype=np.int64)
+    for k in range(m):
+        keys[k] = (entity[pa[k]] << 32) | entity[pb[k]]
+    srt = argsort_ints(keys)
+    pairs = np.empty((m, 3), dtype=np.int64)
+    for k in range(m):
+        pairs[k, 0], pairs[k, 1], pairs[k, 2] = pa[srt[k]], pb[srt[k]], keys[srt[k]]
+    return pairs
+
+
+@leaf
+def _swept_pairs(start, order, fat, cnt, fixed, layer, mask, layers_open, entity, owner, pa, pb,
+                 m):  # pragma: no cover - compiled
+    """:func:`_candidate_pairs`' sweep from the ``start``-th row in x order on, its pairs written to
+    ``pa, pb`` from ``m`` on: ``(n, the pairs' end)``, or where they were too small for a row's
+    pairs, ``(that row's place, the pairs' end before it)``. (Apart, without reference counting:
+    numba counted the growing arrays' references in every test.)"""
+    n = order.size
+    for ii in range(start, n):
         i = order[ii]
         if cnt[i] == 0:
             continue
         xmax = fat[i, 2]
+        j0 = m
         for jj in range(ii + 1, n):
             j = order[jj]
             if fat[j, 0] > xmax:
@@ -209,26 +238,15 @@ def _candidate_pairs(fat, cnt, fixed, layer, mask, layers_open, entity, owner):
                 continue
             if not layers_open and ((layer[i] & mask[j]) == 0 or (layer[j] & mask[i]) == 0):
                 continue
-            if m == cap:
-                cap *= 2
-                na = np.empty(cap, dtype=np.int64)
-                nb = np.empty(cap, dtype=np.int64)
-                for q in range(m):
-                    na[q], nb[q] = pa[q], pb[q]
-                pa, pb = na, nb
+            if j0 == pa.size:
+                return ii, m
             if entity[j] < entity[i]:
-                pa[m], pb[m] = j, i
+                pa[j0], pb[j0] = j, i
             else:
-                pa[m], pb[m] = i, j
-            m += 1
-    keys = np.empty(m, dtype=np.int64)
-    for k in range(m):
-        keys[k] = (entity[pa[k]] << 32) | entity[pb[k]]
-    srt = stable_argsort(keys)
-    pairs = np.empty((m, 3), dtype=np.int64)
-    for k in range(m):
-        pairs[k, 0], pairs[k, 1], pairs[k, 2] = pa[srt[k]], pb[srt[k]], keys[srt[k]]
-    return pairs
+                pa[j0], pb[j0] = i, j
+            j0 += 1
+        m = j0
+    return n, m
 
 
 @leaf
@@ -279,7 +297,7 @@ def _moved_pairs(fat, moved, cnt, fixed, layer, mask, layers_open, entity, pairs
     add_keys = np.empty(n_add, dtype=np.int64)
     for q in range(n_add):
         add_keys[q] = add[q, 2]
-    order = stable_argsort(add_keys)
+    order = argsort_ints(add_keys)
     out = np.empty((n_keep + n_add, 3), dtype=np.int64)
     i, k, o = 0, 0, 0
     while i < m or k < n_add:

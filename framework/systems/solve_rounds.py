@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from ..compiled import kernel, leaf
-from ..stable_sort import sorted_ints, stable_argsort
+from ..stable_sort import argsort_ints, sorted_ints
 from .gather import _find, _np_max, _np_min, _row, solid_pair
 from .solve_columns import push_cap
 
@@ -244,7 +244,7 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
     keys = np.empty(rows.size, dtype=np.int64)
     for k in range(rows.size):
         keys[k] = (np.int64(ea[rows[k]]) << 32) | np.int64(eb[rows[k]])
-    order = stable_argsort(keys)
+    order = argsort_ints(keys)
     rows, keys = _at(rows, order), _at(keys, order)
     m = rows.size
     gap, capped, applied = np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_)
