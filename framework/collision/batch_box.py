@@ -282,11 +282,11 @@ def _dd_overlap_1(dh, dl, rh, rl):  # pragma: no cover - compiled
 
 
 @leaf
-def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points, i, hit, nx, ny, depth, px, py,
-              extreme):  # pragma: no cover - compiled
-    """Row ``i`` of :func:`aabb_aabb_fast` but for extreme magnitudes (flagged in ``extreme``, for
-    the scaled exact kernel), into the output columns (zeros where there is no hit): the same
-    arithmetic in the same order as the numpy it replaced (so the same bits)."""
+def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points):  # pragma: no cover - compiled
+    """One row of :func:`aabb_aabb_fast` but for extreme magnitudes (flagged, for the scaled exact
+    kernel): ``(hit, nx, ny, depth, px, py, extreme)``, zeros where there is no hit; the same
+    arithmetic in the same order as the numpy it replaced (so the same bits). (Scalars in and out:
+    passing the seven output columns to it cost more than its arithmetic.)"""
     dx, dy = bx - ax, by - ay
     adx, ady = abs(dx), abs(dy)
     sx, sy = ahw + bhw, ahh + bhh
@@ -295,7 +295,6 @@ def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points, i, hit, nx, ny,
     band = (2.0**-48 if exact else 8.0 * BAND) * mag
     unclear = (abs(ox) <= band and oy >= -band) or (abs(oy) <= band and ox >= -band)
     ext = not (mag <= 1e150) or mag < 1e-150
-    extreme[i] = ext
     h = ox > 0.0 and oy > 0.0 and not unclear and not ext
     if exact and unclear and not ext:
         dxh, dxl = _two_sum_1(bx, -ax)
@@ -305,20 +304,21 @@ def _aabb_row(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points, i, hit, nx, ny,
         h = _less_1(dxh, dxl, rxh, rxl) and _less_1(dyh, dyl, ryh, ryl)
         ox, oy = _dd_overlap_1(dxh, dxl, rxh, rxl), _dd_overlap_1(dyh, dyl, ryh, ryl)
     if not h:
-        return
-    hit[i] = True
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, ext
+    nx = ny = depth = px = py = 0.0
     size = np.sqrt(ahw * ahw + ahh * ahh) + np.sqrt(bhw * bhw + bhh * bhh)
     lim = (ox if ox < oy else oy) + DEPTH_TOL * size
     if oy <= lim:
-        depth[i] = oy
-        ny[i] = 1.0 if sy - dy <= lim else -1.0
+        depth = oy
+        ny = 1.0 if sy - dy <= lim else -1.0
     else:
-        depth[i] = ox
-        nx[i] = 1.0 if sx - dx <= lim else -1.0
+        depth = ox
+        nx = 1.0 if sx - dx <= lim else -1.0
     if points:
         lo_x, hi_x = max(ax - ahw, bx - bhw), min(ax + ahw, bx + bhw)
         lo_y, hi_y = max(ay - ahh, by - bhh), min(ay + ahh, by + bhh)
-        px[i], py[i] = 0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)
+        px, py = 0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)
+    return True, nx, ny, depth, px, py, ext
 
 
 @kernel
@@ -334,8 +334,8 @@ def _aabb_rows(ax, ay, ahw, ahh, bx, by, bhw, bhh, exact, points):  # pragma: no
     n = ax.size
     hit, nx, ny, depth, px, py, extreme = _aabb_out(n)
     for i in range(n):
-        _aabb_row(ax[i], ay[i], ahw[i], ahh[i], bx[i], by[i], bhw[i], bhh[i], exact, points, i, hit, nx, ny, depth, px,
-                  py, extreme)
+        hit[i], nx[i], ny[i], depth[i], px[i], py[i], extreme[i] = _aabb_row(ax[i], ay[i], ahw[i], ahh[i], bx[i], by[i],
+                                                                             bhw[i], bhh[i], exact, points)
     return hit, nx, ny, depth, px, py, extreme
 
 
@@ -347,6 +347,6 @@ def _aabb_pairs(ra, rb, hx, hy, hw, hh, exact, points):  # pragma: no cover - co
     hit, nx, ny, depth, px, py, extreme = _aabb_out(n)
     for i in range(n):
         a, b = ra[i], rb[i]
-        _aabb_row(hx[a], hy[a], hw[a], hh[a], hx[b], hy[b], hw[b], hh[b], exact, points, i, hit, nx, ny, depth, px,
-                  py, extreme)
+        hit[i], nx[i], ny[i], depth[i], px[i], py[i], extreme[i] = _aabb_row(hx[a], hy[a], hw[a], hh[a], hx[b], hy[b],
+                                                                             hw[b], hh[b], exact, points)
     return hit, nx, ny, depth, px, py, extreme

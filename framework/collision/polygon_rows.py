@@ -268,8 +268,8 @@ def _polygon_pairs(settle):
                         hit[i] = True
                         nx[i], ny[i], depth[i], px[i], py[i] = nxi, nyi, dep, pxi, pyi
                     continue
-                _aabb_row(ax, ay, avx[1], avy[2], bx, by, bvx[1], bvy[2], exact, points, i, hit, nx, ny, depth, px, py,
-                          extreme)
+                hit[i], nx[i], ny[i], depth[i], px[i], py[i], extreme[i] = _aabb_row(ax, ay, avx[1], avy[2], bx, by,
+                                                                                     bvx[1], bvy[2], exact, points)
                 if exact and extreme[i]:
                     defer[i] = True
                 continue
