@@ -435,3 +435,21 @@ def test_moved_candidates_are_the_numpy_ones(immovable_only: bool) -> None:
     got = sr.moved_candidates(moved, table, ra, rb, immovable_only, inv_mass, asleep)
     for have, want in zip(got, (look, ra[look], rb[look])):
         _same(have, want)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_places_of_keys_in_a_table_walked_or_searched(seed: int) -> None:
+    """gather._places: each key's first place in the sorted table, or -1; keys in order by a walk,
+    others by binary search (the same answers)."""
+    rng = np.random.default_rng(seed)
+    table = np.sort(rng.integers(0, 40, 30)).astype(np.int64)  # (ties: the first place)
+    for keys in (np.sort(rng.integers(-5, 45, 25)), rng.integers(-5, 45, 25), np.zeros(0, dtype=np.int64)):
+        keys = keys.astype(np.int64)
+        out = np.empty(keys.size, dtype=np.int64)
+        gather._places(keys, table, out)
+        at = np.searchsorted(table, keys)
+        there = (at < table.size) & (table[np.minimum(at, table.size - 1)] == keys)
+        _same(out, np.where(there, at, -1).astype(np.int64))
+    out = np.empty(3, dtype=np.int64)
+    gather._places(np.array([1, 2, 3], dtype=np.int64), np.zeros(0, dtype=np.int64), out)
+    _same(out, np.full(3, -1, dtype=np.int64))

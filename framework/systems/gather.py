@@ -65,6 +65,25 @@ def _find(table, key):  # pragma: no cover - compiled
 
 
 @leaf
+def _places(keys, table, out):  # pragma: no cover - compiled
+    """``out[i]``: where ``keys[i]`` is in the sorted ``table`` (-1: not there), as :func:`_find`
+    of each; keys in order (a step's contacts, last step's pairs) by one walk along the table."""
+    ascending = True
+    for i in range(1, keys.size):
+        if keys[i] < keys[i - 1]:
+            ascending = False
+            break
+    j = 0
+    for i in range(keys.size):
+        if not ascending:
+            out[i] = _find(table, keys[i])
+            continue
+        while j < table.size and table[j] < keys[i]:
+            j += 1
+        out[i] = j if j < table.size and table[j] == keys[i] else -1
+
+
+@leaf
 def _row(lut, entity):  # pragma: no cover - compiled
     """The row of ``entity`` (-1: none), as ``BodyStore.rows_of``."""
     return lut[entity] if entity < lut.size else -1
@@ -93,9 +112,13 @@ def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush
         if stpush[j] != 0.0 or stimp[j] != 0.0:
             tangent = True  # (friction acted last step)
             break
+    at_kept = np.empty(m, dtype=np.int64)
+    at_now = np.empty(k, dtype=np.int64)
+    _places(now_keys, kept_keys, at_kept)
+    _places(kept_keys, now_keys, at_now)
     if k:
         for i in range(m):
-            at = _find(kept_keys, now_keys[i])
+            at = at_kept[i]
             if at >= 0:
                 push0[i], impulse0[i] = spush[at], simp[at]
                 if tangent:
@@ -105,7 +128,7 @@ def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush
     ora, orb = np.empty(k, dtype=np.int64), np.empty(k, dtype=np.int64)
     n_old = 0
     for j in range(k):
-        if m and _find(now_keys, kept_keys[j]) >= 0:
+        if at_now[j] >= 0:
             continue
         a, b = _row(lut, sa[j]), _row(lut, sb[j])
         if a < 0 or b < 0 or kind[a] < 0 or kind[b] < 0:
