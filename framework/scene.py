@@ -406,7 +406,10 @@ class Scene:
 
     def _next_entity(self) -> int:
         """The next id esper gives out in this scene's world."""
-        count = re.fullmatch(r"count\((-?\d+)\)", repr(esper._entity_count))
+        text = repr(esper._entity_count)  # ("count(7)": esper's itertools.count; read, not advanced)
+        if text.startswith("count(") and text[6:-1].isdigit():
+            return int(text[6:-1])
+        count = re.fullmatch(r"count\((-?\d+)\)", text)
         return int(count.group(1)) if count is not None else 0
 
     def exists(self, entity: int) -> bool:
