@@ -90,6 +90,12 @@ def _place(rows, x, y, ox, oy, kind, hw, hh, radius, cos, sin, local, slot, worl
         miny[r], maxy[r] = ly - _ulp(ly), hy_ + _ulp(hy_)
 
 
+def _ulp_of(v: float) -> float:
+    """:func:`_ulp` of a Python float (the same arithmetic)."""
+    step = abs(v) * 2.0**-52
+    return _TINY if step < _TINY else step
+
+
 @kernel
 def _ulp(v):  # pragma: no cover - compiled
     """:func:`_ulp_step` of one float (NaN stays NaN, as ``np.maximum`` keeps it)."""
@@ -173,6 +179,15 @@ class Geometry:
         placements): :func:`_place` of that row alone (a full update costs some thirty numpy calls
         however few rows moved). The geometry must have been current before the move (its sines
         and cosines are the row's)."""
+        c = store.cols
+        if c["kind"][row] == KIND_AABB and not self.has_offset:  # (a box: its origin is its position)
+            # :func:`_place`'s arithmetic on Python floats (the same IEEE doubles, so the same bits):
+            # a call of the compiled pass with its 23 arguments cost more than this
+            x, y, hw, hh = float(c["x"][row]), float(c["y"][row]), float(c["hw"][row]), float(c["hh"][row])
+            lx, hx, ly, hy = x - hw, x + hw, y - hh, y + hh
+            self.minx[row], self.maxx[row] = lx - _ulp_of(lx), hx + _ulp_of(hx)
+            self.miny[row], self.maxy[row] = ly - _ulp_of(ly), hy + _ulp_of(hy)
+            return
         self._place_rows(store, np.array([row], dtype=np.int64))
 
     def _compute(self, store: BodyStore, rows: IntpArray, full: bool, sel: slice | IntpArray | None = None) -> None:
