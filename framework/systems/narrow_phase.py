@@ -41,6 +41,7 @@ from ..frame import StepFrame
 from ..geometry import Geometry
 from ..store import STATIC, BodyStore
 from .movement import integrate_rows
+from .sleeping_contacts import kept_contacts
 from .stage import Stage
 
 __all__ = ["NarrowPhase", "filter_layers", "pair_contacts"]
@@ -341,20 +342,13 @@ class NarrowPhase(Stage):
         an awake solid body, and bring them up to date."""
         store = self.bodies.store
         prev = self.tracker.active
-        pa, pb = self.bodies.rows_of(prev.a), self.bodies.rows_of(prev.b)
-        ok = (pa >= 0) & (pb >= 0)
-        idle = store.asleep | (store.body == STATIC)
-        frozen = np.flatnonzero(ok & idle[np.maximum(pa, 0)] & idle[np.maximum(pb, 0)])
-        if frozen.size:
-            merged = [np.concatenate([x, y[frozen]]) for x, y in zip(contacts, prev)]
-            order = np.lexsort((merged[1], merged[0]))
-            contacts = StepContacts(*(m[order] for m in merged))
-            rows = (np.concatenate([rows[0], pa[frozen]])[order], np.concatenate([rows[1], pb[frozen]])[order])
-        a_, b_ = rows
-        solid = ~(store.sensor[a_] | store.sensor[b_])
-        wake_b = solid & store.asleep[b_] & ~store.asleep[a_] & (store.body[a_] != STATIC)
-        wake_a = solid & store.asleep[a_] & ~store.asleep[b_] & (store.body[b_] != STATIC)
-        woken = distinct(np.concatenate([b_[wake_b], a_[wake_a]]))
+        # (one compiled pass, sleeping_contacts.kept_contacts: the contacts kept, merged by pair,
+        # and the sleepers to wake)
+        merged, ints, floats, woken = kept_contacts(*contacts, *rows, *prev, store.row_table(), store.asleep,
+                                                   store.body, store.sensor, STATIC)
+        if merged:
+            contacts = StepContacts(ints[0], ints[1], *floats)
+            rows = (ints[2], ints[3])
         if woken.size:
             store.wake(woken)
             contacts, rows = self._catch_up_woken(woken, frame.dt, contacts, rows)
