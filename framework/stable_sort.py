@@ -1,6 +1,6 @@
 """Compiled sorts: :func:`stable_argsort`, shared by the exact solve's rounds, the broad phase's
-direct pairs and the soft step's kernel; for integer keys, :func:`argsort_ints` and :func:`sorted_ints`
-(pair keys: a few sorted runs are merged, others sorted by radix).
+direct pairs and the soft step's kernel; for integer keys, :func:`argsort_ints` (pair keys: a few
+sorted runs are merged, others sorted by radix).
 
 Natural merge sorts: ``np.argsort(key, kind="stable")``'s answer (a stable sort's order is the
 only one), for floats (NaN last, as numpy) and integers alike, at a tenth of the compile time of
@@ -13,7 +13,7 @@ import numpy as np
 
 from .compiled import kernel, leaf
 
-__all__ = ["argsort_ints", "sorted_ints", "stable_argsort"]
+__all__ = ["argsort_ints", "stable_argsort"]
 
 
 @leaf
@@ -68,92 +68,10 @@ def stable_argsort(key):  # pragma: no cover - compiled
     return idx
 
 
-#: :func:`sorted_ints` merges the runs in order where there are at most this many, else sorts by
+#: :func:`argsort_ints` merges the runs in order where there are at most this many, else sorts by
 #: radix (a pass over the keys per byte in which they differ: pair keys of a scene's entity ids,
 #: four or so, where merging single keys took a pass per doubling).
 MERGE_RUNS = 8
-
-
-@kernel
-def sorted_ints(keys):  # pragma: no cover - compiled
-    """The integers ``keys`` (int64) in ascending order (``np.sort(keys)``; integers: any sort's
-    answer). Keys made of at most :data:`MERGE_RUNS` runs in order (contacts listed by kind, then
-    candidates) are merged, a pass per doubling of runs, and keys in order are returned as they
-    are; others are sorted by radix, a byte at a time (the bytes where all keys agree skipped)."""
-    n = keys.size
-    starts = np.empty(MERGE_RUNS + 2, dtype=np.int64)  # where each run in order begins, then n
-    m = 0
-    for i in range(n):
-        if i == 0 or keys[i] < keys[i - 1]:
-            if m == MERGE_RUNS:
-                return _radix(keys)
-            starts[m] = i
-            m += 1
-    if m <= 1:
-        return keys
-    starts[m] = n
-    src = keys.copy()
-    dst = np.empty(n, dtype=np.int64)
-    while m > 1:
-        half = 0
-        for r in range(0, m, 2):
-            lo, mid = starts[r], starts[r + 1]
-            hi = starts[r + 2] if r + 2 <= m else mid
-            i, j, k = lo, mid, lo
-            while i < mid and j < hi:
-                if src[j] < src[i]:
-                    dst[k] = src[j]
-                    j += 1
-                else:
-                    dst[k] = src[i]
-                    i += 1
-                k += 1
-            while i < mid:
-                dst[k] = src[i]
-                i += 1
-                k += 1
-            while j < hi:
-                dst[k] = src[j]
-                j += 1
-                k += 1
-            starts[half] = lo
-            half += 1
-        starts[half] = n
-        m = half
-        src, dst = dst, src
-    return src
-
-
-@kernel
-def _radix(keys):  # pragma: no cover - compiled
-    """``keys`` (int64) sorted by a least-significant-byte-first radix sort: a counting pass and a
-    placing pass per byte in which the keys differ (the top byte's sign bit flipped, so that
-    negative keys come first)."""
-    n = keys.size
-    differ = np.int64(0)
-    for i in range(n):
-        differ |= keys[i] ^ keys[0]
-    src, dst = keys.copy(), np.empty(n, dtype=np.int64)
-    count = np.empty(256, dtype=np.int64)
-    for shift in range(0, 64, 8):
-        if (differ >> shift) & 0xFF == 0:
-            continue
-        flip = 0x80 if shift == 56 else 0
-        for d in range(256):
-            count[d] = 0
-        for i in range(n):
-            count[((src[i] >> shift) & 0xFF) ^ flip] += 1
-        total = 0
-        for d in range(256):
-            c = count[d]
-            count[d] = total
-            total += c
-        for i in range(n):
-            d = ((src[i] >> shift) & 0xFF) ^ flip
-            dst[count[d]] = src[i]
-            count[d] += 1
-        src, dst = dst, src
-    return src
 
 
 @kernel
@@ -175,7 +93,9 @@ def argsort_ints(keys):  # pragma: no cover - compiled
 
 @kernel
 def _radix_argsort(keys):  # pragma: no cover - compiled
-    """:func:`argsort_ints` by radix (see :func:`_radix`): the keys and their places moved together."""
+    """:func:`argsort_ints` by a least-significant-byte-first radix sort: a counting pass and a
+    placing pass per byte in which the keys differ (the top byte's sign bit flipped, so that
+    negative keys come first), the keys and their places moved together."""
     n = keys.size
     differ = np.int64(0)
     for i in range(n):

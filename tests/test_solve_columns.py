@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from framework.events import pair_keys, sorted_member
-from framework.stable_sort import argsort_ints, sorted_ints, stable_argsort
+from framework.stable_sort import argsort_ints, stable_argsort
 from framework.systems import gather
 from framework.systems import solve_columns as sc
 from framework.systems import solve_rounds as sr
@@ -67,23 +67,6 @@ def test_argsort_ints_is_numpys_stable_argsort(seed: int) -> None:
             cut = np.sort(rng.integers(0, n + 1, 3))  # (four runs in order: merged)
             joined = np.concatenate([np.sort(p, kind="stable") for p in np.split(keys, cut)])
             _same(argsort_ints(joined), np.argsort(joined, kind="stable").astype(np.int64))
-
-
-@pytest.mark.parametrize("seed", range(8))
-def test_sorted_ints_is_numpys_sort(seed: int) -> None:
-    rng = np.random.default_rng(seed)
-    for n in (0, 1, 2, 3, 7, 33, 200):
-        keys = rng.integers(-(2**62), 2**62, n)
-        _same(sorted_ints(keys), np.sort(keys))
-        ties = rng.integers(-3, 4, n).astype(np.int64) << 40
-        _same(sorted_ints(ties), np.sort(ties))
-        for runs in (1, 2, 3, 5):  # (a few sorted runs, as the solve's contacts come)
-            cut = np.sort(rng.integers(0, n + 1, runs - 1))
-            parts = np.split(keys, cut)
-            joined = np.concatenate([np.sort(p) for p in parts]) if n else keys
-            _same(sorted_ints(joined), np.sort(keys))
-    ordered = np.arange(5, dtype=np.int64)
-    assert sorted_ints(ordered) is ordered  # (in order already: no copy)
 
 
 def _scene(rng: np.random.Generator, n_rows: int, c: int):

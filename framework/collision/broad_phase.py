@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..arrays import distinct
 from ..compiled import kernel, leaf
-from ..stable_sort import sorted_ints, stable_argsort
+from ..stable_sort import argsort_ints, stable_argsort
 from ..validation import InvalidValue, finite, positive
 from . import grid
 from .box_rows import lower_bound
@@ -455,7 +455,7 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
     for k in range(moving.size):
         rank[moving[k]] = k
     rows = np.empty(n, dtype=np.int64)  # the rows a mover may pair with that do not move
-    c = 0
+    c = np.int64(0)  # (not a literal 0: _pairs_from would compile twice)
     for r in range(n):
         if kind[r] >= 0 and rank[r] < 0 and (body[r] == static_kind or asleep[r]):
             rows[c] = r
@@ -486,7 +486,7 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
         r = at[k]
         bx0[k], by0[k], bx1[k], by1[k] = minx[r], miny[r], maxx[r], maxy[r]
     out = np.empty(max(16, 2 * mv), dtype=np.int64)
-    k, m = 0, 0
+    k, m = np.int64(0), np.int64(0)  # (np.int64: literal 0s would compile _pairs_from twice)
     while True:
         k, m = _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m)
         if k == mv:
@@ -495,11 +495,12 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
         for q in range(m):  # (a loop: a slice assignment compiles numba's shape checks, seconds)
             grown[q] = out[q]
         out = grown
-    keys = sorted_ints(out[:m])
+    order = argsort_ints(out[:m])
     ea, eb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
     ra, rb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
     for q in range(m):
-        ea[q], eb[q] = keys[q] >> 32, keys[q] & 0xFFFFFFFF
+        key = out[order[q]]
+        ea[q], eb[q] = key >> 32, key & 0xFFFFFFFF
         ra[q], rb[q] = lut[ea[q]], lut[eb[q]]
     return ea, eb, ra, rb
 

@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from ..compiled import kernel, leaf
-from ..stable_sort import argsort_ints, sorted_ints
+from ..stable_sort import argsort_ints
 from .gather import _find, _np_max, _np_min, _row, solid_pair
 from .solve_columns import push_cap
 
@@ -108,7 +108,7 @@ def known_keys(ea, eb, ca, cb):  # pragma: no cover - compiled
         keys[i] = (np.int64(ea[i]) << 32) | np.int64(eb[i])
     for i in range(ca.size):
         keys[ea.size + i] = (np.int64(ca[i]) << 32) | np.int64(cb[i])
-    return sorted_ints(keys)  # (the contacts come as a few sorted runs, the candidates as one)
+    return _at(keys, argsort_ints(keys))  # (the contacts come as a few sorted runs, the candidates as one)
 
 
 @kernel
