@@ -76,20 +76,9 @@ def rows_within(rows, minx, miny, maxx, maxy, x0, y0, x1, y1, layer, sensor, mas
 @kernel
 def rows_near(kind, minx, miny, maxx, maxy, x0, y0, x1, y1, layer, sensor, mask, skip_rows, entity,
               skip_entities):  # pragma: no cover - compiled
-    """:func:`rows_within` of :func:`rows_meeting`'s rows in one pass: the rows with a hitbox whose
-    bounds strictly overlap the box that block a body of ``mask`` and are skipped by neither list,
-    in row order (the character controller's candidates, where the rows are few enough for a pass)."""
-    out = np.empty(kind.size, dtype=np.intp)
-    m = 0
-    for r in range(kind.size):
-        if not (kind[r] >= 0 and minx[r] < x1 and maxx[r] > x0 and miny[r] < y1 and maxy[r] > y0):
-            continue
-        if (layer[r] & mask) == 0 or sensor[r]:
-            continue
-        if skip_rows.size and holds(skip_rows, r):
-            continue
-        if skip_entities.size and holds(skip_entities, entity[r]):
-            continue
-        out[m] = r
-        m += 1
-    return out[:m]
+    """:func:`rows_within` of :func:`rows_meeting`'s rows, in one call from Python: the rows with a
+    hitbox whose bounds strictly overlap the box that block a body of ``mask`` and are skipped by
+    neither list, in row order (the character controller's candidates, where the rows are few
+    enough for a pass)."""
+    return rows_within(rows_meeting(kind, minx, miny, maxx, maxy, x0, y0, x1, y1), minx, miny, maxx, maxy, x0, y0,
+                       x1, y1, layer, sensor, mask, skip_rows, entity, skip_entities)

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..compiled import kernel
 from ..stable_sort import argsort_ints
+from .solve_rounds import _where
 
 __all__ = ["kept_contacts"]
 
@@ -66,22 +67,13 @@ def kept_contacts(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, pa, pb, pnx, pny
                 floats[3, o], floats[4, o] = ppx[j], ppy[j]
     # the sleepers an awake solid body that is not static touches
     wake = np.zeros(asleep.size, dtype=np.bool_)
-    n_wake = 0
     for o in range(total):
         a = ints[2, o] if n_frozen else cra[o]
         b = ints[3, o] if n_frozen else crb[o]
         if sensor[a] or sensor[b]:
             continue
-        if asleep[a] and not asleep[b] and body[b] != static and not wake[a]:  # (a woken by b)
+        if asleep[a] and not asleep[b] and body[b] != static:  # (a woken by b)
             wake[a] = True
-            n_wake += 1
-        if asleep[b] and not asleep[a] and body[a] != static and not wake[b]:
+        if asleep[b] and not asleep[a] and body[a] != static:
             wake[b] = True
-            n_wake += 1
-    woken = np.empty(n_wake, dtype=np.int64)
-    n_wake = 0
-    for r in range(asleep.size):
-        if wake[r]:
-            woken[n_wake] = r
-            n_wake += 1
-    return n_frozen > 0, ints, floats, woken
+    return n_frozen > 0, ints, floats, _where(wake)
