@@ -407,6 +407,38 @@ def test_candidate_pairs_kept_between_steps_are_those_a_full_sweep_finds():
     assert incremental >= 10
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_the_sweep_finds_every_overlapping_pair_of_a_heap(seed):
+    """The sort-and-sweep (its pairs written by a helper that hands back when its arrays are full:
+    a heap of 60 rows on one spot has far more pairs than its first guess of 4 per row) finds the
+    pairs brute force finds, sorted by key, with fixed rows, one owner's shapes and touching bounds."""
+    from framework.systems.soft_kernel import _candidate_pairs
+
+    rng = np.random.default_rng(seed)
+    n = 60
+    x0, y0 = np.round(rng.random(n), 2), np.round(rng.random(n), 2)
+    fat = np.stack([x0, y0, x0 + np.round(rng.random(n), 2) + 0.5, y0 + 1.0], axis=1)  # (a heap: most overlap)
+    cnt = np.where(rng.random(n) < 0.05, 0, 4)
+    fixed = rng.random(n) < 0.2
+    owner = np.arange(n)
+    owner[1] = owner[0]  # (two shapes of one body never pair)
+    entity = rng.permutation(5 * n)[:n].astype(np.int64)
+    layer = mask = np.ones(n, dtype=np.int64)
+    got = _candidate_pairs(fat, cnt, fixed, layer, mask, True, entity, owner)
+    want = []
+    for i in range(n):
+        for j in range(i + 1, n):
+            if cnt[i] == 0 or cnt[j] == 0 or (fixed[i] and fixed[j]) or owner[i] == owner[j]:
+                continue
+            if fat[j, 0] > fat[i, 2] or fat[i, 0] > fat[j, 2] or fat[j, 1] > fat[i, 3] or fat[i, 1] > fat[j, 3]:
+                continue
+            a, b = (i, j) if entity[i] < entity[j] else (j, i)
+            want.append((a, b, (int(entity[a]) << 32) | int(entity[b])))
+    want.sort(key=lambda t: t[2])
+    assert len(want) > 4 * n + 16  # (the helper's arrays grew)
+    assert got.tolist() == [list(t) for t in want]
+
+
 def test_a_snapshot_restored_continues_bit_for_bit():
     s, ents = _mixed_pile(13)
     for _ in range(40):
