@@ -90,12 +90,6 @@ def _place(rows, x, y, ox, oy, kind, hw, hh, radius, cos, sin, local, slot, worl
         miny[r], maxy[r] = ly - _ulp(ly), hy_ + _ulp(hy_)
 
 
-def _ulp_of(v: float) -> float:
-    """:func:`_ulp` of a Python float (the same arithmetic)."""
-    step = abs(v) * 2.0**-52
-    return _TINY if step < _TINY else step
-
-
 @kernel
 def _ulp(v):  # pragma: no cover - compiled
     """:func:`_ulp_step` of one float (NaN stays NaN, as ``np.maximum`` keeps it)."""
@@ -181,12 +175,13 @@ class Geometry:
         and cosines are the row's)."""
         c = store.cols
         if c["kind"][row] == KIND_AABB and not self.has_offset:  # (a box: its origin is its position)
-            # :func:`_place`'s arithmetic on Python floats (the same IEEE doubles, so the same bits):
-            # a call of the compiled pass with its 23 arguments cost more than this
+            # :func:`_place`'s arithmetic on Python floats (the same IEEE doubles, so the same bits;
+            # :func:`_ulp`'s own Python): a call of the compiled pass with its 23 arguments cost more
+            ulp = _ulp.py_func
             x, y, hw, hh = float(c["x"][row]), float(c["y"][row]), float(c["hw"][row]), float(c["hh"][row])
             lx, hx, ly, hy = x - hw, x + hw, y - hh, y + hh
-            self.minx[row], self.maxx[row] = lx - _ulp_of(lx), hx + _ulp_of(hx)
-            self.miny[row], self.maxy[row] = ly - _ulp_of(ly), hy + _ulp_of(hy)
+            self.minx[row], self.maxx[row] = lx - ulp(lx), hx + ulp(hx)
+            self.miny[row], self.maxy[row] = ly - ulp(ly), hy + ulp(hy)
             return
         self._place_rows(store, np.array([row], dtype=np.int64))
 

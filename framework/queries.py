@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from .casting import ShapeHit, cast_rows, shape_bounds, touch_point
 from .collision import batch, collide, time_of_impact
 from .collision import batch_queries as bq
-from .collision.box_rows import rows_meeting
+from .collision.box_rows import rows_meeting, rows_near, rows_within
 from .collision.broad_phase import DIRECT_QUERY
 from .collision.distance import Distance, point_distance
 from .collision.distance import distance as shape_distance
@@ -201,9 +201,7 @@ class SpatialQueries:
         by one vectorised test over their current bounds."""
         bodies = self.bodies
         store = bodies.store
-        geom = bodies.ensure_geometry()
-        self.pipeline.frame.counters["rehashed"] = (self.pipeline.frame.counters.get("rehashed", 0)
-                                                    + bodies.sync_static())
+        geom = self._synced_geometry()
         if store.n <= DIRECT_QUERY:  # one compiled pass over every row's bounds (the same rows)
             found: NDArray[np.intp] = rows_meeting(store.kind, geom.minx, geom.miny, geom.maxx, geom.maxy, float(minx),
                                                    float(miny), float(maxx), float(maxy))
@@ -212,6 +210,35 @@ class SpatialQueries:
         mv = np.flatnonzero((store.kind >= 0) & (store.body != STATIC))
         hit = (geom.minx[mv] < maxx) & (geom.maxx[mv] > minx) & (geom.miny[mv] < maxy) & (geom.maxy[mv] > miny)
         return np.concatenate([st, mv[hit]])
+
+    def _blocking_rows(self, box: tuple[float, float, float, float], mask: int, skip_rows: NDArray[np.int64],
+                       skip_entities: NDArray[np.int64]) -> NDArray[np.intp]:
+        """:meth:`_candidate_rows` of ``box`` that block a body of ``mask`` (their layer meets it, not
+        sensors; ``mask < 0``: no such test) and are in neither sorted list, in their order (the
+        character controller's candidates): where the rows are few enough for a pass, the look-up
+        and the filter in one (:func:`~framework.collision.box_rows.rows_near`)."""
+        store = self.bodies.store
+        c = store.cols
+        if store.n <= DIRECT_QUERY and mask >= 0:
+            geom = self._synced_geometry()
+            near: NDArray[np.intp] = rows_near(store.kind, geom.minx, geom.miny, geom.maxx, geom.maxy, float(box[0]),
+                                               float(box[1]), float(box[2]), float(box[3]), c["layer"], c["sensor"],
+                                               mask, skip_rows, c["entity"], skip_entities)
+            return near
+        rows = self._candidate_rows(*box)
+        geom = self.bodies.geometry
+        found: NDArray[np.intp] = rows_within(rows, geom.minx, geom.miny, geom.maxx, geom.maxy, *box, c["layer"],
+                                              c["sensor"], mask, skip_rows, c["entity"], skip_entities)
+        return found
+
+    def _synced_geometry(self) -> Geometry:
+        """The geometry, current, with the static hash brought up to date (counted in the frame's
+        ``rehashed``): what every look-up of candidate rows starts from."""
+        bodies = self.bodies
+        geom = bodies.ensure_geometry()
+        counters = self.pipeline.frame.counters
+        counters["rehashed"] = counters.get("rehashed", 0) + bodies.sync_static()
+        return geom
 
     def _parts(self, mask: int) -> list[tuple[int, Any, tuple[float, float, float]]]:
         """The other shapes of the compound bodies (:class:`~framework.components.Parts`) whose

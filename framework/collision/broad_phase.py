@@ -464,8 +464,6 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
     swept = mv * (mv + c) > SWEEP_FROM
     # the movers' bounds side by side (by left edge when swept), then the still rows' (likewise)
     at = np.empty(mv + c, dtype=np.int64)
-    for k in range(mv + c):
-        at[k] = moving[k] if k < mv else rows[k - mv]
     widest = 0.0
     if swept:
         left = np.empty(mv)
@@ -481,6 +479,9 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
         order = stable_argsort(left)
         for q in range(c):
             at[mv + q] = rows[order[q]]
+    else:
+        for k in range(mv + c):
+            at[k] = moving[k] if k < mv else rows[k - mv]
     bx0, by0, bx1, by1 = np.empty(mv + c), np.empty(mv + c), np.empty(mv + c), np.empty(mv + c)
     for k in range(mv + c):
         r = at[k]

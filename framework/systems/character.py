@@ -22,8 +22,7 @@ from ..arrays import IntpArray
 from ..casting import cast_rows, overlapping_rows, shape_bounds, touch_point
 from ..character import CharacterController
 from ..collision import collide
-from ..collision.box_rows import rows_near, rows_within
-from ..collision.broad_phase import DIRECT_QUERY
+from ..collision.box_rows import rows_within
 from ..collision.kinds import KIND_AABB
 from ..components import Velocity
 from ..frame import StepFrame
@@ -350,21 +349,12 @@ class CharacterStage(Stage):
         store, geom = self.bodies.store, self.bodies.ensure_geometry()
         b = mv.box
         skip_rows = np.array(sorted(mv.ignore | {mv.row}), dtype=np.int64) if mv.ignore else mv.own
-        c = store.cols
-        if mv.rows is not None and b is not None and (b[0] <= box[0] and b[1] <= box[1] and box[2] <= b[2]
-                                                      and box[3] <= b[3]):
-            source, mask, drop = mv.rows, -1, _NONE  # (already filtered by layers, sensors and drops)
-        elif store.n <= DIRECT_QUERY and mv.mask >= 0:  # (one pass over the rows: the query's and the filter's)
-            counters = self.pipeline.frame.counters
-            counters["rehashed"] = counters.get("rehashed", 0) + self.bodies.sync_static()
-            near: IntpArray = rows_near(store.kind, geom.minx, geom.miny, geom.maxx, geom.maxy, float(box[0]),
-                                        float(box[1]), float(box[2]), float(box[3]), c["layer"], c["sensor"], mv.mask,
-                                        skip_rows, c["entity"], self._dropped(mv))
-            return near
-        else:
-            source, mask, drop = self.queries._candidate_rows(*box), mv.mask, self._dropped(mv)
-        return rows_within(source, geom.minx, geom.miny, geom.maxx, geom.maxy, *box, c["layer"], c["sensor"], mask,
-                           skip_rows, c["entity"], drop)
+        if not (mv.rows is not None and b is not None and (b[0] <= box[0] and b[1] <= box[1] and box[2] <= b[2]
+                                                           and box[3] <= b[3])):
+            return self.queries._blocking_rows(box, mv.mask, skip_rows, self._dropped(mv))
+        c = store.cols  # (from the gathered candidates, already filtered by layers, sensors and drops)
+        return rows_within(mv.rows, geom.minx, geom.miny, geom.maxx, geom.maxy, *box, c["layer"], c["sensor"], -1,
+                           skip_rows, c["entity"], _NONE)
 
     @staticmethod
     def _dropped(mv: _Move) -> IntpArray:

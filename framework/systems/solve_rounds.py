@@ -31,7 +31,7 @@ import numpy as np
 
 from ..compiled import kernel, leaf
 from ..stable_sort import argsort_ints
-from .gather import _find, _np_max, _np_min, _row, solid_pair
+from .gather import _find, _np_max, _np_min, _places, _row, solid_pair
 from .solve_columns import push_cap
 
 __all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "moved_candidates", "moved_immovable",
@@ -116,22 +116,14 @@ def unknown_solid_pairs(ra, rb, ea, eb, known, n, kind, sensor, inv_mass, asleep
                         layers_open):  # pragma: no cover - compiled
     """The pairs ``(ra, rb, ea, eb)`` whose key is not in the sorted ``known``, both rows in the
     store's ``n``, that the response may act on (``gather.solid_pair``)."""
-    ok = np.zeros(ra.size, dtype=np.bool_)
-    ascending = True  # (the broad phase's pairs come sorted by key: then one walk along ``known``)
-    for i in range(1, ra.size):
-        if ((np.int64(ea[i]) << 32) | np.int64(eb[i])) < ((np.int64(ea[i - 1]) << 32) | np.int64(eb[i - 1])):
-            ascending = False
-            break
-    j = 0
+    keys = np.empty(ra.size, dtype=np.int64)
     for i in range(ra.size):
-        key = (np.int64(ea[i]) << 32) | np.int64(eb[i])
-        if ascending:
-            while j < known.size and known[j] < key:
-                j += 1
-            unknown = not (j < known.size and known[j] == key)
-        else:
-            unknown = _find(known, key) < 0
-        ok[i] = (ra[i] < n and rb[i] < n and unknown
+        keys[i] = (np.int64(ea[i]) << 32) | np.int64(eb[i])
+    at = np.empty(ra.size, dtype=np.int64)
+    _places(keys, known, at)  # (the broad phase's pairs come sorted by key: one walk along ``known``)
+    ok = np.zeros(ra.size, dtype=np.bool_)
+    for i in range(ra.size):
+        ok[i] = (ra[i] < n and rb[i] < n and at[i] < 0
                  and solid_pair(ra[i], rb[i], kind, sensor, inv_mass, asleep, one_way, layer, mask, layers_open))
     idx = _where(ok)
     return _at(ra, idx), _at(rb, idx), _at(ea, idx), _at(eb, idx)
