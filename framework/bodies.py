@@ -56,6 +56,14 @@ class Bodies:
             self.geometry.move_row(store, row)
             self._geometry_stamp = (store.motion, store.writes, store.version, store.n)
 
+    def placed_boxes(self) -> None:
+        """Moving rows were placed by a compiled pass that kept their bounds as :meth:`place_row`
+        does (the character stage's whole move), the geometry current before it: the move
+        counted, the geometry still current."""
+        store = self.store
+        store.motion += 1
+        self._geometry_stamp = (store.motion, store.writes, store.version, store.n)
+
     def sync_static(self) -> int:
         """Hash the static bodies again if the static set changed (waking the sleepers: the level
         changed under them); return how many were hashed (0: the hash was current)."""

@@ -14,7 +14,7 @@ import pytest
 from test_character import DT, T, character, floor_row, hill_level, scene_with
 
 import framework.systems.character as character_stage
-from framework import AABB, Hitbox, Scene, Transform, Velocity
+from framework import AABB, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.character import CharacterController
 from framework.systems.character_kernel import hypot
 
@@ -101,9 +101,11 @@ def test_boxes_level_same_bits_and_compiled(seed, monkeypatch):
     assert _same_bits(_boxes_level, lambda: _walker(seed), 400, monkeypatch) > 500
 
 
-def _moving_platform(one_way: bool) -> Callable[[], Scene]:
+def _moving_platform(one_way: bool, solver: str = "exact") -> Callable[[], Scene]:
     def build() -> Scene:
-        s = scene_with(floor_row(20))
+        s = Scene(gravity=(0.0, -1024.0), solver=solver)
+        for x, y, shape in floor_row(20):
+            s.spawn(Transform(x, y), Hitbox(shape, body="static"))
         s.spawn(Transform(200.0, 100.0), Velocity(), Hitbox(AABB(96.0, 16.0), body="kinematic", one_way=one_way))
         character(s, 200.0, 108.0)
         character(s, 120.0, 32.0)
@@ -112,8 +114,9 @@ def _moving_platform(one_way: bool) -> Callable[[], Scene]:
     return build
 
 
+@pytest.mark.parametrize("solver", ["exact", "soft"])
 @pytest.mark.parametrize("one_way", [False, True])
-def test_moving_platform_same_bits_and_compiled(one_way, monkeypatch):
+def test_moving_platform_same_bits_and_compiled(one_way, solver, monkeypatch):
     def make_drive() -> Drive:
         walk = _walker(4)
 
@@ -128,7 +131,7 @@ def test_moving_platform_same_bits_and_compiled(one_way, monkeypatch):
 
         return drive
 
-    assert _same_bits(_moving_platform(one_way), make_drive, 300, monkeypatch) > 300
+    assert _same_bits(_moving_platform(one_way, solver), make_drive, 300, monkeypatch) > 300
 
 
 @pytest.mark.parametrize("solver", ["exact", "soft"])
@@ -229,6 +232,43 @@ def test_a_character_walks_the_same_beside_a_character(monkeypatch):
             s.get(e, Velocity).x = 128.0 if i == 0 else -128.0
 
     _same_bits(build, lambda: drive, 150, monkeypatch)
+
+
+def test_the_whole_move_is_one_compiled_call(monkeypatch):
+    """A box character among boxes, not dropping through anything, is moved by one compiled call
+    (:func:`~framework.systems.character_kernel.move_character`): no Python gathering of its
+    candidates, no Python move; where the whole move hands back (a turning floor) the Python
+    move decides, with the same bits."""
+    def no_python_move(*args: object) -> None:
+        raise AssertionError("the Python move ran")
+
+    s = scene_with(floor_row(16))
+    e = character(s, 100.0, 32.0)
+    with monkeypatch.context() as m:
+        m.setattr(character_stage.CharacterStage, "_move", no_python_move)
+        for k in range(120):
+            s.get(e, Velocity).x = 128.0 if k < 60 else -96.0
+            s.step(DT)
+    stage = s._stages["character"]  # type: ignore[attr-defined]
+    assert stage.fast_moves == 120 and not stage.fallbacks
+    assert s.get(e, CharacterController).on_floor
+
+    def turning_board() -> Scene:
+        s = scene_with(floor_row(16))
+        board = Polygon([(-64.0, -4.0), (64.0, -4.0), (64.0, 4.0), (-64.0, 4.0)])
+        s.spawn(Transform(200.0, 100.0), Velocity(0.0, 0.0, 0.25), Hitbox(board, body="kinematic"))
+        character(s, 200.0, 104.0)
+        return s
+
+    def walk(s: Scene, k: int) -> None:
+        for e, _c in s.query(CharacterController):
+            s.get(e, Velocity).x = 32.0
+
+    s = turning_board()
+    for _ in range(30):
+        s.step(DT)
+    assert s._stages["character"].fallbacks.get("standing on a turning floor", 0) > 0  # type: ignore[attr-defined]
+    _same_bits(turning_board, lambda: walk, 60, monkeypatch)
 
 
 def test_hand_backs_are_counted_by_reason():

@@ -6,7 +6,11 @@ few); each cast is a handful of exact time-of-impact tests against the nearby hi
 The Python move here is the reference. A box among boxes (the body and every hitbox near it
 axis-aligned boxes: a tile level's player and walkers) moves instead by one compiled call,
 :mod:`.character_kernel`, with the same bits; it hands back to the Python move whatever it does
-not decide itself (see there). :data:`FAST` = False turns it off.
+not decide itself (see there). :data:`FAST` = False turns it off. Where the scene's rows are few
+enough for a pass and the body drops through nothing, that call is the whole move (undoing the
+movement stage's move, the skin, the ride, the candidates, the move, the placing:
+:meth:`CharacterStage._move_whole`); otherwise the stage gathers the candidates and the call
+makes the move from there.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from ..casting import cast_rows, overlapping_rows, shape_bounds, touch_point
 from ..character import CharacterController
 from ..collision import collide
 from ..collision.box_rows import rows_within
+from ..collision.broad_phase import DIRECT_QUERY
 from ..collision.kinds import KIND_AABB
 from ..components import Velocity
 from ..frame import StepFrame
@@ -115,10 +120,61 @@ class CharacterStage(Stage):
             row = store.row_of.get(e)
             if row is None or store.hitboxes[row] is None:
                 continue
-            if moved and row < frame.start_x.size:
+            undo = moved and row < frame.start_x.size
+            if FAST and self._fast(row, ctrl):
+                if self._move_whole(frame, e, row, ctrl, moved, undo):
+                    continue
+            elif undo:
                 self.bodies.place_row(row, frame.start_x[row], frame.start_y[row])  # undo movement: ours to move
             self._move(frame, e, row, ctrl, moved)
         frame.counters["characters"] = len(found)
+        return True
+
+    def _fast(self, row: int, ctrl: CharacterController) -> bool:
+        """Whether the whole move of ``row`` may be one compiled call (:meth:`_move_whole`): a box
+        without offset, in a scene of rows few enough for a pass, neither dropping through one-way
+        platforms nor asked to; the geometry made current (as the move would)."""
+        store = self.bodies.store
+        if store.cols["kind"][row] != KIND_AABB or store.n > DIRECT_QUERY or ctrl.drop_through or ctrl.dropping:
+            return False
+        mask = ctrl.solid_mask if ctrl.solid_mask is not None else store.cols["mask"][row]
+        return mask >= 0 and not self.queries._synced_geometry().has_offset
+
+    def _move_whole(self, frame: StepFrame, entity: int, row: int, ctrl: CharacterController, moved: bool,
+                    undo: bool) -> bool:
+        """:meth:`_move` (and the undo of the movement stage's move before it) as one compiled
+        call, :func:`~.character_kernel.move_character`, for the bodies :meth:`_fast` admits: the
+        same bits. False where it hands the move back (then only the undo was done)."""
+        kernel = _compiled_move()
+        if not self._outputs:
+            self._outputs = kernel.outputs()
+        store, geom = self.bodies.store, self.bodies.geometry
+        c = store.cols
+        hb = store.hitboxes[row]
+        assert hb is not None  # (run() moves only rows with a hitbox)
+        gx, gy = self.pipeline.active_gravity()
+        snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
+        fnx, fny = ctrl.floor_normal
+        cfg = np.array([math.nan if ctrl.skin is None else ctrl.skin, ctrl.floor_cos, ctrl.gravity_scale,
+                        ctrl.step_height, snap, math.tan(math.radians(ctrl.max_floor_angle)), fnx, fny, frame.dt,
+                        gx, gy])
+        mask = ctrl.solid_mask if ctrl.solid_mask is not None else int(hb.mask)
+        floor_row = self._row_of(ctrl.floor_entity)
+        ctrl.crushed = False
+        st, si, push_r, push_n = self._outputs
+        reason = kernel.move_character(
+            row, undo, moved, self.pipeline.solver == "soft", cfg, mask, -1 if floor_row is None else floor_row,
+            ctrl.on_floor, ctrl.max_slides, _RIDE_SLIDES, frame.start_x, frame.start_y, geom.hx, geom.hy, c["vx"],
+            c["vy"], c["w"], c["has_vel"], c["body"], c["asleep"], c["kind"], geom.minx, geom.miny, geom.maxx,
+            geom.maxy, c["hw"], c["hh"], c["one_way"], c["entity"], c["bound"], c["layer"], c["sensor"], st, si,
+            push_r, push_n)
+        if undo or not reason:
+            self.bodies.placed_boxes()
+        if reason:
+            why = kernel.REASONS[reason]
+            self.fallbacks[why] = self.fallbacks.get(why, 0) + 1
+            return False
+        self._moved(entity, ctrl, frame.dt)
         return True
 
     def _move(self, frame: StepFrame, entity: int, row: int, ctrl: CharacterController, moved: bool) -> None:
@@ -175,7 +231,7 @@ class CharacterStage(Stage):
             carried = (carried[0] + (c * dx - s * dy - dx), carried[1] + (s * dx + c * dy - dy))
         self._gather(mv, ctrl, carried, vx, vy, dt, size)
         if FAST and store.cols["kind"][row] == KIND_AABB and self._move_box(
-                mv, ctrl, vel, carried, vx, vy, dt, floor_row, was_on_floor, ride_after, ox, oy):
+                mv, ctrl, entity, carried, vx, vy, dt, floor_row, was_on_floor, ride_after, ox, oy):
             return
         if carried != (0.0, 0.0) and floor_row is not None and not ride_after:
             self._ride(mv, floor_row, carried)
@@ -233,14 +289,14 @@ class CharacterStage(Stage):
         vx, vy = self._unblocked(mv, vx, vy)
         ctrl.on_ceiling = mv.ceiling
         if ctrl.push_mass > 0.0 and dt > 0.0:
-            self._push(mv, ctrl.push_mass, mx / dt, my / dt)
+            self._push(mv.pushed, ctrl.push_mass, mx / dt, my / dt)
         self.bodies.place_row(row, mv.x - ox, mv.y - oy)
         if vel.x != vx:
             vel.x = vx
         if vel.y != vy:
             vel.y = vy
 
-    def _move_box(self, mv: _Move, ctrl: CharacterController, vel: Velocity, carried: tuple[float, float],
+    def _move_box(self, mv: _Move, ctrl: CharacterController, entity: int, carried: tuple[float, float],
                   vx: float, vy: float, dt: float, floor_row: int | None, was_on_floor: bool, ride_after: bool,
                   ox: float, oy: float) -> bool:
         """The rest of ``_move`` (its candidates gathered) by the compiled move, for a box among
@@ -265,23 +321,34 @@ class CharacterStage(Stage):
             why = kernel.REASONS[reason]
             self.fallbacks[why] = self.fallbacks.get(why, 0) + 1
             return False
+        self.bodies.place_row(row, float(st[0]) - ox, float(st[1]) - oy)
+        self._moved(entity, ctrl, dt)
+        return True
+
+    def _moved(self, entity: int, ctrl: CharacterController, dt: float) -> None:
+        """After a compiled move: the controller's state, the pushes and the velocity from its
+        outcome (the stage's outputs)."""
+        st, si, push_r, push_n = self._outputs
+        store = self.bodies.store
         self.fast_moves += 1
-        x, y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()
+        _x, _y, fnx, fny, wnx, wny, vx, vy, mx, my = st.tolist()
         floor, wall = int(si[0]), int(si[1])
         # (the state, not settings: written past the settings' check)
         ctrl.__dict__.update(on_floor=floor >= 0, floor_normal=(fnx, fny) if floor >= 0 else (0.0, 0.0),
-                             floor_entity=int(c["entity"][floor]) if floor >= 0 else None, on_wall=wall >= 0,
-                             wall_normal=(wnx, wny) if wall >= 0 else (0.0, 0.0), on_ceiling=bool(si[2]))
+                             floor_entity=int(store.cols["entity"][floor]) if floor >= 0 else None,
+                             on_wall=wall >= 0, wall_normal=(wnx, wny) if wall >= 0 else (0.0, 0.0),
+                             on_ceiling=bool(si[2]))
         pushed = int(si[4])
         if ctrl.push_mass > 0.0 and dt > 0.0 and pushed:
-            mv.pushed = [(r, nx, ny) for r, (nx, ny) in zip(push_r[:pushed].tolist(), push_n[:pushed].tolist())]
-            self._push(mv, ctrl.push_mass, mx / dt, my / dt)
-        self.bodies.place_row(row, x - ox, y - oy)
-        if vel.x != vx:
-            vel.x = vx
-        if vel.y != vy:
-            vel.y = vy
-        return True
+            self._push([(r, nx, ny) for r, (nx, ny) in zip(push_r[:pushed].tolist(), push_n[:pushed].tolist())],
+                       ctrl.push_mass, mx / dt, my / dt)
+        row = store.row_of[entity]
+        if store.cols["vx"][row] != vx or store.cols["vy"][row] != vy:  # (the Velocity's values, read faster)
+            vel: Velocity = esper.component_for_entity(entity, Velocity)
+            if vel.x != vx:
+                vel.x = vx
+            if vel.y != vy:
+                vel.y = vy
 
     # --- moving ----------------------------------------------------------------------------
 
@@ -620,11 +687,11 @@ class CharacterStage(Stage):
             top -= float(store.cols["y"][r] - frame.start_y[r])
         return start_bottom >= top - 1e-6 * (abs(top) + _extent(mv.shape)[1])
 
-    def _push(self, mv: _Move, mass: float, vx: float, vy: float) -> None:
+    def _push(self, pushed: list[tuple[int, float, float]], mass: float, vx: float, vy: float) -> None:
         """Dynamic bodies walked into get the impulse of a body of ``mass`` moving at ``(vx, vy)``
         meeting them (perfectly inelastic, along the contact normal)."""
         store = self.bodies.store
-        for r, nx, ny in mv.pushed:
+        for r, nx, ny in pushed:
             vn = -(vx * nx + vy * ny)  # the body's speed into the other one
             other = -(float(store.cols["vx"][r]) * nx + float(store.cols["vy"][r]) * ny)
             if vn <= other:

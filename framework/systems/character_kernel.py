@@ -9,11 +9,14 @@ whose every gathered candidate is an axis-aligned box. It repeats the Python cod
 the same order (casts by slabs, :func:`~framework.casting._box_sweep`; hits taken in the order of
 ``(fraction, entity)``; ``math.hypot`` as CPython computes it), so the bits are the same.
 
+:func:`move_character` is the stage's whole move in that call (its candidates looked up in the
+call too, the body placed); :func:`move_box` the move from the candidates the stage gathered.
+
 What it does not decide it hands back (a reason, :data:`REASONS`), and the Python move runs instead,
 unchanged: a candidate that is not a box, a cast or overlap test reaching beyond the gathered
 region, a cast starting inside a candidate or touching a one-way platform (``time_of_impact`` and
 ``collide`` decide those), a body overlapping something at the start (depenetration), too many
-surfaces met.
+surfaces met, a floor that turns under the body (:func:`move_character`).
 
 Compiling it costs about 7 to 10 seconds once per installation (measured on a busy two-core
 machine; numba's cache keeps it); the stage imports this module only when a scene first has a box
@@ -27,18 +30,20 @@ import math
 import numpy as np
 
 from ..arrays import F64Array, I64Array, IntpArray
+from ..collision.box_rows import rows_near
 from ..collision.kinds import KIND_AABB
 from ..collision.py_hypot import hypot
 from ..compiled import inner, kernel
-from ..store import DYNAMIC
+from ..geometry import _ulp
+from ..store import DYNAMIC, STATIC
 
-__all__ = ["REASONS", "move_box", "outputs"]
+__all__ = ["REASONS", "move_box", "move_character", "outputs"]
 
 #: ``move_box``'s status when the Python move must decide instead: its first reason (0: moved).
-REGION, STARTS_INSIDE, ONE_WAY_TOUCH, OVERLAP, FULL, NOT_A_BOX = range(1, 7)
+REGION, STARTS_INSIDE, ONE_WAY_TOUCH, OVERLAP, FULL, NOT_A_BOX, TURNING_FLOOR = range(1, 8)
 #: The reasons' names, by status (the stage counts its hand-backs by them).
 REASONS = ("", "beyond the gathered region", "a cast starting inside a box", "touching a one-way platform",
-           "overlapping a box", "too many surfaces", "a candidate not a box")
+           "overlapping a box", "too many surfaces", "a candidate not a box", "standing on a turning floor")
 
 # The body's settings (``me``): half extents, skin, cos(max floor angle), bounding radius, the
 # gathered region's box.
@@ -493,6 +498,14 @@ def outputs() -> tuple[F64Array, I64Array, IntpArray, F64Array]:
 @kernel
 def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r,
              push_n):  # pragma: no cover - compiled
+    """The stage's ``_move`` from its ride on, the candidates gathered by the stage (:func:`_move`;
+    :func:`move_character` gathers them itself): 0, or the reason it hands the move back."""
+    return _move(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r, push_n)
+
+
+@inner
+def _move(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r,
+          push_n):  # pragma: no cover - compiled
     """The stage's ``_move`` from its ride on (the candidates gathered): 0, or the reason it hands
     the move back (``REGION`` ...).
     ``world``: the gathered rows, then the geometry's bounds and origins and the store's columns
@@ -564,3 +577,75 @@ def move_box(world, me, go, floor_row, was_on_floor, ride_after, max_slides, rid
     vx, vy = _unblocked(world, me, st, si, hits_r, hits_n, vx, vy)
     st[6], st[7] = vx, vy
     return si[BAILED]
+
+
+# The settings :func:`move_character` reads (``cfg``): the controller's skin (NaN: the default one),
+# cos(max floor angle), gravity scale, step height, snap length, tan(max floor angle), the floor
+# normal it stood on; the step's dt and gravity.
+C_SKIN, C_COSF, C_GSCALE, C_STEP, C_SNAP, C_TAN, C_FNX, C_FNY, C_DT, C_GX, C_GY = range(11)
+
+
+@inner
+def _place_box(row, px, py, x, y, hw, hh, minx, miny, maxx, maxy):  # pragma: no cover - compiled
+    """``Bodies.place_row`` of a box without offset: its position, and its bounds as
+    :func:`framework.geometry._place` computes them (the same arithmetic, so the same bits)."""
+    x[row], y[row] = px, py
+    lx, ux, ly, uy = px - hw[row], px + hw[row], py - hh[row], py + hh[row]
+    minx[row], maxx[row] = lx - _ulp(lx), ux + _ulp(ux)
+    miny[row], maxy[row] = ly - _ulp(ly), uy + _ulp(uy)
+
+
+@kernel
+def move_character(row, undo, moved, soft, cfg, mask, floor_row, was_on_floor, max_slides, ride_slides, start_x,
+                   start_y, x, y, vx, vy, w, has_vel, body, asleep, kind, minx, miny, maxx, maxy, hw, hh, one_way,
+                   entity, bound, layer, sensor, st, si, push_r, push_n):  # pragma: no cover - compiled
+    """The stage's whole ``_move`` of a box character without offset in a scene of few enough rows
+    for a pass (``DIRECT_QUERY``), neither dropping through a platform nor asked to: put back
+    where the movement stage found it (``undo``), its skin, what its floor carries, its candidates
+    (:func:`~framework.collision.box_rows.rows_near` of the reach ``_gather`` computes), the move
+    (:func:`_move`) and, if that decided it, the body placed where it ends. 0, or the reason it
+    hands the move back to the Python code (then only the ``undo`` was done). The stage's Python
+    arithmetic, in its order: the same bits. The geometry must be current (``hx`` is ``x``)."""
+    if undo:
+        _place_box(row, start_x[row], start_y[row], x, y, hw, hh, minx, miny, maxx, maxy)
+    x0, y0, ahw, ahh = x[row], y[row], hw[row], hh[row]
+    ew, eh = (0.0 + ahw) - (0.0 - ahw), (0.0 + ahh) - (0.0 - ahh)  # (_extent: shape_bounds at the origin)
+    size = eh if eh < ew else ew
+    skin = cfg[C_SKIN]
+    if skin != skin:  # (default_skin; Python's max)
+        a, b = size * 2.0**-40, (abs(x0) + abs(y0)) * 2.0**-44
+        skin = b if b > a else a
+    dt = cfg[C_DT]
+    cx = cy = 0.0
+    ride_after = False
+    if was_on_floor and floor_row >= 0:
+        f = floor_row
+        going = has_vel[f] and body[f] != STATIC and not asleep[f]
+        pivot = False
+        if moved and f < start_x.size:
+            cx, cy, pivot = x[f] - start_x[f], y[f] - start_y[f], True
+        elif going and soft:
+            cx, cy, pivot, ride_after = vx[f] * dt, vy[f] * dt, True, True
+        if going and pivot and w[f] * dt != 0.0:
+            return TURNING_FLOOR
+    # _gather: the reach of every cast this step
+    vx0, vy0, gx, gy, gscale = vx[row], vy[row], cfg[C_GX], cfg[C_GY], cfg[C_GSCALE]
+    own = (abs(vx0) + abs(vy0) + (abs(gx) + abs(gy)) * abs(gscale) * dt) * dt
+    carry = abs(cx) + abs(cy)
+    reach = (2.0 * carry + own * (1.0 + cfg[C_TAN]) + 2.0 * cfg[C_STEP] + cfg[C_SNAP] + 0.5 * size + 8.0 * skin)
+    b0, b1, b2, b3 = x0 - ahw - reach, y0 - ahh - reach, x0 + ahw + reach, y0 + ahh + reach
+    own_row = np.full(1, row, dtype=np.int64)
+    cand = rows_near(kind, minx, miny, maxx, maxy, b0, b1, b2, b3, layer, sensor, mask, own_row, entity,
+                     own_row[:0])
+    me = np.empty(9)
+    me[HW], me[HH], me[SKIN], me[COSF], me[RAD] = ahw, ahh, skin, cfg[C_COSF], bound[row]
+    me[GB0], me[GB1], me[GB2], me[GB3] = b0, b1, b2, b3
+    go = np.empty(15)
+    go[0], go[1], go[2], go[3], go[4], go[5], go[6] = x0, y0, cx, cy, vx0, vy0, dt
+    go[7], go[8], go[9], go[10], go[11], go[12] = gx, gy, gscale, cfg[C_STEP], cfg[C_SNAP], cfg[C_TAN]
+    go[13], go[14] = cfg[C_FNX], cfg[C_FNY]
+    world = (cand, minx, miny, maxx, maxy, x, y, hw, hh, one_way, body, entity, bound, kind)
+    status = _move(world, me, go, floor_row, was_on_floor, ride_after, max_slides, ride_slides, st, si, push_r, push_n)
+    if status == 0:
+        _place_box(row, st[X], st[Y], x, y, hw, hh, minx, miny, maxx, maxy)
+    return status
