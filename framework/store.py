@@ -563,15 +563,17 @@ class BodyStore:
         # Static rows change only through game code's writes: check those and the rows that move.
         rows = self.active()[2]
         sel = self.active_sel()[2]
-        if self.written:
-            extra = [self.row_of[e] for e in self.written if e in self.row_of]
-            rows = sel = np.union1d(rows, np.array(extra, dtype=np.int64))
+        extra = np.array([self.row_of[e] for e in self.written if e in self.row_of], dtype=np.int64) \
+            if self.written else None
         if not self.bad and not self.dirty_hitboxes:
             c, n = self.cols, self.n
-            if rows_sound(c["x"][:n], c["y"][:n], c["rot"][:n], c["vx"][:n], c["vy"][:n], c["w"][:n], rows,
-                          MAX_COORD):
+            xs, ys, rot, vx, vy, w = c["x"][:n], c["y"][:n], c["rot"][:n], c["vx"][:n], c["vy"][:n], c["w"][:n]
+            if rows_sound(xs, ys, rot, vx, vy, w, rows, MAX_COORD) and (
+                    extra is None or rows_sound(xs, ys, rot, vx, vy, w, extra, MAX_COORD)):
                 self.written.clear()
                 return
+        if extra is not None:  # (a row found wrong below is named once, in row order)
+            rows = sel = np.union1d(rows, extra)
         problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
         cols = ("x", "y", "rot", "vx", "vy", "w")
         # First all six at once: the sum of finite values is finite unless it overflows, which

@@ -6,13 +6,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from framework import AABB, Hitbox, Scene, Transform, Velocity
 from framework.arrays import distinct
-from framework.events import sorted_members
+from framework.events import pair_keys
 from framework.geometry import widen_down, widen_up
+from framework.pair_tracking import track_pairs
 from framework.store import as_selector
 
 ints = st.lists(st.integers(-(2**40), 2**40), max_size=200)
@@ -24,12 +25,26 @@ def test_distinct_is_np_unique(values):
     assert np.array_equal(distinct(a), np.unique(a))
 
 
-@given(st.sets(st.integers(0, 300), max_size=120), st.sets(st.integers(0, 300), max_size=120))
-def test_sorted_members_is_isin_both_ways(a, b):
-    a = np.array(sorted(a), dtype=np.int64)
-    b = np.array(sorted(b), dtype=np.int64)
-    in_b, in_a = sorted_members(a, b)
-    assert np.array_equal(in_b, np.isin(a, b)) and np.array_equal(in_a, np.isin(b, a))
+pairs = st.sets(st.tuples(st.integers(0, 40), st.integers(0, 2**32 - 1)), max_size=80)
+
+
+@settings(deadline=None)  # (the first example compiles the merge)
+@given(pairs, pairs, st.booleans(), st.randoms(use_true_random=False))
+def test_track_pairs_is_isin_both_ways(now, last, in_order, rng):
+    """The tracker's merge (sorted keys, the pipeline's) and its sort (keys in any order) say
+    which pairs were there last step and where the gone ones were, as np.isin does."""
+    now_l, last_l = sorted(now), sorted(last)
+    if not in_order:
+        rng.shuffle(now_l)
+        rng.shuffle(last_l)
+    a = np.array([p[0] for p in now_l], dtype=np.int64)
+    b = np.array([p[1] for p in now_l], dtype=np.int64)
+    last_keys = pair_keys(np.array([p[0] for p in last_l], dtype=np.int64),
+                          np.array([p[1] for p in last_l], dtype=np.int64))
+    keys, was, gone = track_pairs(a, b, last_keys)
+    assert np.array_equal(keys, pair_keys(a, b))
+    assert np.array_equal(was, np.isin(keys, last_keys))
+    assert np.array_equal(gone, np.flatnonzero(~np.isin(last_keys, keys)))
 
 
 finite = st.floats(allow_nan=False, allow_infinity=False)
@@ -61,6 +76,7 @@ def test_a_selector_selects_the_same_rows(rows):
     assert np.array_equal(col[sel], col[rows])
 
 
+@settings(deadline=None)  # (run alone on a new installation, the first example compiles the step)
 @given(st.lists(st.tuples(st.integers(1, 15), st.integers(0, 15)), min_size=1, max_size=8))
 def test_layers_all_meet_only_when_every_pair_does(layers):
     with Scene(effects=("detection",)) as s:

@@ -33,8 +33,10 @@ from ..collision.kinds import (
     KIND_SEGMENT,
     PAIRS,
     POLYGON_CIRCLE,
+    POLYGONS,
     pair_code,
 )
+from ..collision.pair_classes import classify_pairs
 from ..collision.polygon_rows import polygon_pairs, polygon_pairs_settled
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
@@ -50,6 +52,7 @@ __all__ = ["NarrowPhase", "filter_layers", "pair_contacts"]
 _PAIR_NAME = [rule.name for rule in PAIRS.values()]
 _PAIR_FAMILY = np.array([rule.family for rule in PAIRS.values()], dtype=np.int64)
 _PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
+_FAMILIES = (BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS, CAPSULES)
 
 
 def filter_layers(store: BodyStore, ra: IntpArray, rb: IntpArray) -> BoolArray:
@@ -142,25 +145,33 @@ def _pair_contacts(
         rule = PAIRS[k, k]
         if counts is not None:
             counts[rule.name] = counts.get(rule.name, 0) + P
-        fams = [rule.family]
+        fams, family = [rule.family], None
     else:
-        code = pair_code(store.kind[ra].astype(np.int64), store.kind[rb].astype(np.int64))
-        if counts is not None:
-            n_of = np.bincount(code, minlength=len(PAIRS))
-            for c in np.flatnonzero(n_of).tolist():
-                name = _PAIR_NAME[c]
-                counts[name] = counts.get(name, 0) + int(n_of[c])
         # One kernel call per family of pairs, not per ordered pair of kinds: a box is a polygon
         # to the polygon kernels, and a circle may be either shape of a polygon-circle pair (the
         # kernel flips the normal per row). Per-call overhead dominates the response's small batches.
-        family = _PAIR_FAMILY[code]
-        fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
+        # (The codes, their counts and the families: one compiled pass, classify_pairs.)
+        code, n_of, present = classify_pairs(store.kind, ra, rb)
+        if present >= 0:
+            fams = [f for f in _FAMILIES if present >> f & 1]
+            family = _PAIR_FAMILY[code] if len(fams) > 1 else None
+        else:  # (a row without a hitbox: numpy's arithmetic, as before, says what happens)
+            code = pair_code(store.kind[ra].astype(np.int64), store.kind[rb].astype(np.int64))
+            n_of = np.bincount(code, minlength=len(PAIRS)) if counts is not None else n_of
+            family = _PAIR_FAMILY[code]
+            fams = [int(family[0])] if (family == family[0]).all() else distinct(family).tolist()
+            family = family if len(fams) > 1 else None
+        if counts is not None:
+            for c, k in enumerate(n_of.tolist()):
+                if k:
+                    name = _PAIR_NAME[c]
+                    counts[name] = counts.get(name, 0) + k
     hx, hy = geom.hx, geom.hy
     if len(fams) > 1:
         hit = np.zeros(P, dtype=bool)
         nx, ny, depth, px, py = (np.zeros(P) for _ in range(5))
     for f in fams:
-        idx = np.flatnonzero(family == f) if len(fams) > 1 else None
+        idx = np.flatnonzero(family == f) if family is not None else None
         a, b = (ra[idx], rb[idx]) if idx is not None else (ra, rb)
         if f == BOXES:  # (the rows' columns read in the compiled pass)
             res = aabb_pairs_fast(a, b, hx, hy, store.cols["hw"], store.cols["hh"], exact=not remeasure,
