@@ -830,10 +830,11 @@ class Scene:
         """Remove the joints whose force or torque this step was above their ``break_force`` or
         ``break_torque`` (and their entities, if that was all they held); what broke, by entity."""
         stage = self._stages.get("soft_step")
-        if not isinstance(stage, SoftStep):
+        joints = joint_components()
+        if not joints or not isinstance(stage, SoftStep):
             return []
         broken = []
-        for e, j in breakable(joint_components()):
+        for e, j in breakable(joints):
             fx, fy, torque = stage.reaction(e, j)
             if math.hypot(fx, fy) > j.break_force or abs(torque) > j.break_torque:
                 broken.append(JointBroken(e, j.a, j.b, j, Vec2(float(fx), float(fy)), float(torque)))

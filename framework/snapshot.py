@@ -45,7 +45,7 @@ __all__ = ["SNAPSHOT_VERSION", "Snapshot", "restore", "take"]
 SNAPSHOT_VERSION = 1
 # Pipeline fields that belong to the scene object, not its state.
 _PIPELINE_OWN = ("bodies", "renderer", "view", "wanted_pairs")
-_STAGE_OWN = ("pipeline", "bodies", "priority")
+_STAGE_OWN = ("pipeline", "bodies", "priority", "wanted_for")
 _SCENE_FIELDS = ("frame", "time", "_totals")
 
 

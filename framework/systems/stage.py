@@ -69,14 +69,21 @@ class Stage(esper.Processor):
         self.pipeline = pipeline
         self.bodies = pipeline.bodies
         self.priority = PRIORITY.get(self.name, 0)
+        self.wanted_for: tuple[Any, Any, bool] = (None, None, False)  # (effects, solver, wanted()) last seen
 
     def wanted(self) -> bool:
-        """Whether the scene's effects (and its solver mode) call for this stage."""
+        """Whether the scene's effects (and its solver mode) call for this stage. (It may depend on
+        nothing else: :meth:`process` asks again only when the effects or the solver change.)"""
         return self.needs <= self.pipeline.effects and self.solver in (None, self.pipeline.solver)
 
     def process(self, dt: float) -> None:  # esper's entry point
-        frame = self.pipeline.frame
-        if not self.wanted():
+        pipe = self.pipeline
+        frame = pipe.frame
+        effects, solver, wanted = self.wanted_for
+        if effects is not pipe.effects or solver is not pipe.solver:  # (most stages of a scene are idle)
+            wanted = self.wanted()
+            self.wanted_for = (pipe.effects, pipe.solver, wanted)
+        if not wanted:
             return
         t0 = time.perf_counter()
         if self.run(frame):
