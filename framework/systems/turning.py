@@ -28,8 +28,9 @@ import numpy as np
 
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray
 from ..collision.batch_manifold import pair_manifolds
+from ..collision.box_rows import lower_bound
 from ..collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
-from ..events import pair_keys
+from ..compiled import kernel
 from ..frame import Points
 from ..geometry import Geometry
 from ..store import BodyStore
@@ -78,66 +79,112 @@ def expand(cs: Contacts, store: BodyStore, geom: Geometry, points: Points, margi
     """``cs`` (:class:`~framework.systems.solve.Contacts`) with every pair that has a turning
     polygon replaced by its manifold points (points within ``margin`` times the smaller body's
     size of touching), warm started from last step's ``points`` (``frame.points``), and every
-    row's lever arms set (``cs.arms``)."""
-    ra, rb = cs.ra, cs.rb
-    turn = turning_polygons(store, ra) | turning_polygons(store, rb)
-    round_ = ((store.kind[ra] == KIND_CIRCLE) | (store.kind[rb] == KIND_CIRCLE) | (store.kind[ra] == KIND_CAPSULE)
-              | (store.kind[rb] == KIND_CAPSULE))
-    clip = np.flatnonzero(turn & ~round_)
-    n_pts, px, py, sep = manifold_points(store, geom, ra[clip], rb[clip], cs.nx[clip], cs.ny[clip], margin)
-    # rows: every pair once (a pair with no manifold point keeps its own row if it overlaps), then
-    # each clipped pair's second point
-    count = np.ones(cs.size, dtype=np.int64)
-    count[clip] = np.where(n_pts == 0, cs.alive0[clip].astype(np.int64), n_pts)
-    src = np.repeat(np.arange(cs.size), count)
-    slot = np.arange(src.size) - np.repeat(np.cumsum(count) - count, count)
-    out = cs.take(src)
-    out.slot = slot
-    # the clipped pairs' points
-    at = np.full(cs.size, -1, dtype=np.int64)
-    at[clip] = np.arange(clip.size)
-    c = at[src]
-    has = c >= 0
-    has[has] = n_pts[c[has]] > 0
-    k, s = c[has], slot[has]
-    out.px[has], out.py[has] = px[k, s], py[k, s]
-    out.depth[has] = -sep[k, s]
-    # kept pairs with a circle (or a capsule): the point on its rim facing the other body
-    rim = ~out.alive0 & ~has
-    if rim.any():
-        ka, kb = store.kind[out.ra], store.kind[out.rb]
-        ca = rim & ((ka == KIND_CIRCLE) | ((ka == KIND_CAPSULE) & (kb != KIND_CIRCLE)))
-        cb = rim & ~ca
-        for m, rows, sign in ((ca, out.ra, 1.0), (cb, out.rb, -1.0)):
-            r = rows[m]
-            nx, ny = sign * out.nx[m], sign * out.ny[m]
-            cx, cy = store.x[r], store.y[r]
-            cap = store.kind[r] == KIND_CAPSULE
-            if cap.any():
-                # the end of the capsule's segment farther along the normal (its middle if square on)
-                ux, uy = geom.cap_ux[r], geom.cap_uy[r]
-                along = np.sign(ux * nx + uy * ny)
-                cx = np.where(cap, geom.hx[r] + along * ux, cx)
-                cy = np.where(cap, geom.hy[r] + along * uy, cy)
-            out.px[m] = cx + store.radius[r] * nx
-            out.py[m] = cy + store.radius[r] * ny
-    _warm_points(out, count[src], points)
-    out.arms = (out.px - store.x[out.ra], out.py - store.y[out.ra], out.px - store.x[out.rb], out.py - store.y[out.rb])
-    return out
+    row's lever arms set (``cs.arms``). Two compiled passes around the manifolds (which pairs are
+    clipped; then the rows, their points, the rims of round bodies, the warm starts and the arms)
+    where numpy took some sixty calls: a pair with no manifold point keeps its own row if it
+    overlaps; a kept pair with a circle or a capsule gets the point on its rim facing the other
+    body; each point is warm started from last step's value of the same pair and slot, or (a pair
+    that had another number of points) its pair's, shared evenly."""
+    c = store.cols
+    clip, gaps = _clipped(cs.ra, cs.rb, c["kind"], c["inv_inertia"], c["bound"], margin, KIND_POLYGON, KIND_CIRCLE,
+                          KIND_CAPSULE)
+    n_pts, px, py, sep = pair_manifolds(cs.ra[clip], cs.rb[clip], cs.nx[clip], cs.ny[clip], gaps, c["kind"], geom.hx,
+                                        geom.hy, c["hw"], c["hh"], geom.poly_slot, geom.world_poly, geom.count)
+    ints, floats, alive0 = _expanded(cs.ra, cs.rb, cs.ea, cs.eb, cs.nx, cs.ny, cs.depth, cs.alive0, cs.push0,
+                                     cs.impulse0, cs.tpush0, cs.timpulse0, cs.px, cs.py, clip, n_pts, px, py, sep,
+                                     c["kind"], c["x"], c["y"], c["radius"], geom.hx, geom.hy, geom.cap_ux,
+                                     geom.cap_uy, *points[:6], KIND_CIRCLE, KIND_CAPSULE)
+    ra, rb, ea, eb, slot = ints
+    nx, ny, depth, push0, impulse0, tpush0, timpulse0, opx, opy, rax, ray, rbx, rby = floats
+    return type(cs)(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, opx, opy, slot,
+                    arms=(rax, ray, rbx, rby))
 
 
-def _warm_points(cs: Contacts, n_points: I64Array, points: Points) -> None:
-    """Each point's warm start: last step's values of the same pair and slot, or (a pair that had
-    another number of points) its pair's, shared evenly."""
-    keys = pair_keys(cs.ea, cs.eb)
-    pk, pslot, *values = points[:6]
-    found = np.zeros(cs.size, dtype=bool)
-    if pk.size:  # (sorted by pair, then slot: a pair's slots follow each other)
-        at = np.minimum(np.searchsorted(pk, keys) + cs.slot, pk.size - 1)
-        found = (pk[at] == keys) & (pslot[at] == cs.slot)
-    split = ~found
-    columns = (cs.push0, cs.impulse0, cs.tpush0, cs.timpulse0)
-    for col, last in zip(columns, values):
-        if found.any():
-            col[found] = last[at[found]]
-        col[split] = col[split] / n_points[split]
+@kernel
+def _clipped(ra, rb, kind, inv_inertia, bound, margin, polygon, circle, capsule):  # pragma: no cover - compiled
+    """The pairs with a turning polygon and no round body (circle or capsule), whose manifolds
+    are clipped, and each one's gap: ``margin`` times the smaller body's bound."""
+    clip = np.empty(ra.size, dtype=np.int64)
+    m = 0
+    for i in range(ra.size):
+        a, b = ra[i], rb[i]
+        turn = (kind[a] == polygon and inv_inertia[a] > 0.0) or (kind[b] == polygon and inv_inertia[b] > 0.0)
+        round_ = kind[a] == circle or kind[b] == circle or kind[a] == capsule or kind[b] == capsule
+        if turn and not round_:
+            clip[m] = i
+            m += 1
+    clip = clip[:m]
+    gaps = np.empty(m)
+    for q in range(m):
+        a, b = ra[clip[q]], rb[clip[q]]
+        gaps[q] = margin * (bound[b] if bound[b] < bound[a] else bound[a])
+    return clip, gaps
+
+
+@kernel
+def _expanded(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, px, py, clip, n_pts, mpx,
+              mpy, msep, kind, x, y, radius, hx, hy, cap_ux, cap_uy, pk, pslot, lpush, limp, ltpush, ltimp, circle,
+              capsule):  # pragma: no cover - compiled
+    """The rows of :func:`expand` (see there), as ``(ints, floats, alive0)``: rows ``ra, rb, ea,
+    eb, slot`` and ``nx, ny, depth, push0, impulse0, tpush0, timpulse0, px, py`` and the arms
+    ``rax, ray, rbx, rby`` (two arrays and a mask: each array handed back to Python costs)."""
+    C = ra.size
+    at = np.full(C, -1, dtype=np.int64)  # each pair's place among the clipped ones
+    for q in range(clip.size):
+        at[clip[q]] = q
+    count = np.ones(C, dtype=np.int64)
+    total = 0
+    for i in range(C):
+        q = at[i]
+        if q >= 0:
+            count[i] = (1 if alive0[i] else 0) if n_pts[q] == 0 else n_pts[q]
+        total += count[i]
+    ints = np.empty((5, total), dtype=np.int64)
+    floats = np.empty((13, total))
+    alive = np.empty(total, dtype=np.bool_)
+    o = 0
+    for i in range(C):
+        q = at[i]
+        for s in range(count[i]):
+            ints[0, o], ints[1, o], ints[2, o], ints[3, o], ints[4, o] = ra[i], rb[i], ea[i], eb[i], s
+            alive[o] = alive0[i]
+            floats[0, o], floats[1, o], floats[2, o] = nx[i], ny[i], depth[i]
+            floats[3, o], floats[4, o], floats[5, o], floats[6, o] = push0[i], impulse0[i], tpush0[i], timpulse0[i]
+            floats[7, o], floats[8, o] = px[i], py[i]
+            has = q >= 0 and n_pts[q] > 0
+            if has:  # the manifold's point
+                floats[7, o], floats[8, o] = mpx[q, s], mpy[q, s]
+                floats[2, o] = -msep[q, s]
+            elif not alive[o]:  # a kept pair: the point on a round body's rim facing the other one
+                a, b = ra[i], rb[i]
+                ka, kb = kind[a], kind[b]
+                if ka == circle or (ka == capsule and kb != circle):
+                    r, sx, sy = a, 1.0 * nx[i], 1.0 * ny[i]
+                else:
+                    r, sx, sy = b, -1.0 * nx[i], -1.0 * ny[i]
+                cx, cy = x[r], y[r]
+                if kind[r] == capsule:  # the end of its segment farther along the normal (its middle if square on)
+                    ux, uy = cap_ux[r], cap_uy[r]
+                    along = np.sign(ux * sx + uy * sy)
+                    cx, cy = hx[r] + along * ux, hy[r] + along * uy
+                floats[7, o], floats[8, o] = cx + radius[r] * sx, cy + radius[r] * sy
+            # the warm start: last step's same pair and slot, else the pair's shared evenly
+            key = (ea[i] << 32) | eb[i]
+            found = False
+            w = 0
+            if pk.size:
+                w = lower_bound(pk, key) + s
+                if w > pk.size - 1:
+                    w = pk.size - 1
+                found = pk[w] == key and pslot[w] == s
+            if found:
+                floats[3, o], floats[4, o], floats[5, o], floats[6, o] = lpush[w], limp[w], ltpush[w], ltimp[w]
+            else:
+                n = count[i]
+                floats[3, o], floats[4, o] = floats[3, o] / n, floats[4, o] / n
+                floats[5, o], floats[6, o] = floats[5, o] / n, floats[6, o] / n
+            a, b = ra[i], rb[i]
+            floats[9, o], floats[10, o] = floats[7, o] - x[a], floats[8, o] - y[a]
+            floats[11, o], floats[12, o] = floats[7, o] - x[b], floats[8, o] - y[b]
+            o += 1
+    return ints, floats, alive
