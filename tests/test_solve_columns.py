@@ -284,6 +284,56 @@ def test_apply_measures_is_the_numpy_update(rigid: bool) -> None:
 
 
 @pytest.mark.parametrize("seed", range(6))
+def test_measured_points_are_the_numpy_update(seed: int) -> None:
+    """``Solve._measure_points``' pairs (np.unique of the keys) and its depths and flags, compiled
+    (solve_rounds.pairs_of, points_measured), against the numpy they replaced: pairs measured with
+    as many, fewer or no points, separations with ties, -0.0 and NaN."""
+    rng = np.random.default_rng(seed)
+    n, c = 8, 30
+    a, b = rng.integers(0, n, c), rng.integers(0, n, c)
+    ea, eb = rng.integers(1, 5, c).astype(np.int64), rng.integers(5, 9, c).astype(np.int64)  # (pairs repeat)
+    nx, ny = _normals(rng, c)
+    depth = _floats(rng, c) * 0.01
+    dx, dy = rng.normal(size=n) * 0.01, rng.normal(size=n) * 0.01
+    rn_a, rn_b, dturn = rng.normal(size=c), rng.normal(size=c), rng.normal(size=n) * 0.01
+    slot = rng.integers(0, 3, c).astype(np.int64)
+    bound = rng.uniform(0.5, 2.0, n).round(1)
+    ra, rb = rng.integers(0, n, c), rng.integers(0, n, c)
+    check = rng.permutation(c)[:18]
+    keys = pair_keys(ea[check], eb[check])
+    _u, first, pair = np.unique(keys, return_index=True, return_inverse=True)
+    got_first, got_pair = sr.pairs_of(check, ea, eb)
+    _same(got_first, first.astype(np.int64))
+    _same(got_pair, pair.astype(np.int64))
+    rows = first.size
+    n_pts = rng.integers(0, 3, rows).astype(np.int64)
+    sep = _floats(rng, 2 * rows).reshape(rows, 2) * 1e-6
+    tol, slack_k = 1e-9, 1e-7
+    dirty = rng.random(c) < 0.2
+    want_dirty, want_depth = dirty.copy(), depth.copy()
+    got_depth = depth.copy()
+    over = sr.points_measured(check, pair, n_pts, sep, slot, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, got_depth, dirty,
+                              tol, ra, rb, bound, slack_k)
+    had = np.bincount(pair, minlength=rows)
+    same = n_pts[pair] == had[pair]
+    sl = np.minimum(slot[check], 1)
+    deepest = np.where(n_pts > 1, sep.min(axis=1), sep[:, 0])
+    now = np.where(same, sep[pair, sl], deepest[pair])
+    apart = n_pts[pair] == 0
+    shift = (dx[b[check]] - dx[a[check]]) * nx[check] + (dy[b[check]] - dy[a[check]]) * ny[check]
+    shift += rn_b[check] * dturn[b[check]] - rn_a[check] * dturn[a[check]]
+    with np.errstate(invalid="ignore"):  # (inf - inf: NaN, as the compiled pass makes it)
+        new = np.where(apart, np.minimum(want_depth[check], shift), shift - now)
+        want_dirty[check[np.abs(new - want_depth[check]) > tol]] = True
+    want_depth[check] = new
+    deep = (-now > slack_k * (1.0 + np.minimum(bound[ra], bound[rb]))[check]) & ~apart
+    want_dirty[check[deep]] = True
+    _same(got_depth, want_depth)
+    _same(dirty, want_dirty)
+    assert over == bool(deep.any())
+
+
+@pytest.mark.parametrize("seed", range(6))
 def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
     rng = np.random.default_rng(seed)
     n_rows, c = 30, 20

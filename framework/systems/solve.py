@@ -495,17 +495,17 @@ class Solve:
         if check.size == 0:
             return False
         cs, store = self.cs, self.store
-        keys = pair_keys(cs.ea[check], cs.eb[check])
-        _u, first, pair = np.unique(keys, return_index=True, return_inverse=True)
+        first, pair = rounds.pairs_of(check, cs.ea, cs.eb)  # (np.unique of the pair keys, compiled)
         rows = check[first]
         r = self.stage.remeasure(cs.ra[rows], cs.rb[rows])
         turned = r.hit & (r.nx * cs.nx[rows] + r.ny * cs.ny[rows] < 1.0 - 1e-9)
         nx, ny = np.where(turned, r.nx, cs.nx[rows]), np.where(turned, r.ny, cs.ny[rows])
         n_pts, px, py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], nx, ny, KEEP_GAP)
-        had = np.bincount(pair, minlength=rows.size)
-        same = n_pts[pair] == had[pair]
-        slot = np.minimum(cs.slot[check], 1)
-        if turned.any():  # (the new normal, and where the points are now)
+        any_turned = bool(turned.any())
+        if any_turned:  # (the new normal, and where the points are now)
+            had = np.bincount(pair, minlength=rows.size)
+            same = n_pts[pair] == had[pair]
+            slot = np.minimum(cs.slot[check], 1)
             t = check[turned[pair]]
             cs.nx[t], cs.ny[t] = nx[pair[turned[pair]]], ny[pair[turned[pair]]]
             ok = turned[pair] & same & (n_pts[pair] > 0)
@@ -516,19 +516,15 @@ class Solve:
             rax[moved], ray[moved] = px[k, q] - store.x[ra], py[k, q] - store.y[ra]
             rbx[moved], rby[moved] = px[k, q] - store.x[rb], py[k, q] - store.y[rb]
             self._arms()
-        deepest = np.where(n_pts > 1, sep.min(axis=1), sep[:, 0])
-        now = np.where(same, sep[pair, slot], deepest[pair])
-        apart = n_pts[pair] == 0  # no point within the margin: apart, no longer pushed along
-        shift = self._shift(check)
-        depth = np.where(apart, np.minimum(cs.depth[check], shift), shift - now)
-        self.dirty[check[np.abs(depth - cs.depth[check]) > self.tolerance]] = True
-        cs.depth[check] = depth
-        if turned.any():
+        # (the depths, where the bodies now stand and are turned, and which contacts to look at
+        # again: one compiled pass, solve_rounds.points_measured; the slack as _slack() says)
+        over = rounds.points_measured(check, pair, n_pts, sep, cs.slot, self.a, self.b, cs.nx, cs.ny, self.dx, self.dy,
+                                      self.rn_a, self.rn_b, self.dturn, cs.depth, self.dirty, self.tolerance, cs.ra,
+                                      cs.rb, store.bound, POINT_SLACK)
+        if any_turned:
             self.dirty[check[turned[pair]]] = True
             self._recolumn()
-        over = (-now > self._slack()[check]) & ~apart
-        self.dirty[check[over]] = True
-        return bool(over.any())
+        return bool(over)
 
     def _slack(self) -> F64Array:
         """Contacts at points: per contact, the overlap of a point measured again that is left to

@@ -221,6 +221,61 @@ def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn
 
 
 @kernel
+def pairs_of(check, ea, eb):  # pragma: no cover - compiled
+    """The pairs of contacts ``check`` (a pair's points are contacts of one pair of entities):
+    ``np.unique(keys, return_index=True, return_inverse=True)``'s index and inverse of their pair
+    keys, the first of each pair in key order and each contact's pair."""
+    m = check.size
+    keys = np.empty(m, dtype=np.int64)
+    for i in range(m):
+        keys[i] = (ea[check[i]] << 32) | eb[check[i]]
+    order = np.argsort(keys, kind="mergesort")  # (stable: the first of equal keys first, as np.unique)
+    first = np.empty(m, dtype=np.int64)
+    pair = np.empty(m, dtype=np.int64)
+    u = -1
+    for t in range(m):
+        i = order[t]
+        if t == 0 or keys[i] != keys[order[t - 1]]:
+            u += 1
+            first[u] = i
+        pair[i] = u
+    return first[: u + 1], pair
+
+
+@kernel
+def points_measured(check, pair, n_pts, sep, slot, a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, depth, dirty, tolerance,
+                    ra, rb, bound, point_slack):  # pragma: no cover - compiled
+    """``Solve._measure_points``' depths of the contacts at points ``check`` measured again
+    (``n_pts, sep``: each pair's points and their separations, ``pair``: each contact's pair),
+    written in place (relative to where the solve began): a pair measured with as many points as
+    it has keeps each point's separation, otherwise all take its deepest; a pair with no point
+    within the margin keeps its depth or the gap its shift opened, whichever is less. A contact
+    whose depth changed by more than ``tolerance``, or left deeper than the slack, is looked at
+    again (``dirty``). Whether one was left deeper than the slack."""
+    had = np.zeros(n_pts.size, dtype=np.int64)
+    for j in range(check.size):
+        had[pair[j]] += 1
+    over = False
+    for j in range(check.size):
+        i, p = check[j], pair[j]
+        s = slot[i] if slot[i] < 1 else 1
+        if n_pts[p] == had[p]:
+            now = sep[p, s]
+        else:
+            now = _np_min(sep[p, 0], sep[p, 1]) if n_pts[p] > 1 else sep[p, 0]
+        apart = n_pts[p] == 0
+        shift = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn)
+        d = _np_min(depth[i], shift) if apart else shift - now
+        if abs(d - depth[i]) > tolerance:
+            dirty[i] = True
+        depth[i] = d
+        if -now > point_slack * (1.0 + _np_min(bound[ra[i]], bound[rb[i]])) and not apart:
+            dirty[i] = True
+            over = True
+    return over
+
+
+@kernel
 def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse, tpush,
              timpulse):  # pragma: no cover - compiled
     """What :meth:`Solve.record` keeps, sorted by pair key (stably: a pair's points in order): the
