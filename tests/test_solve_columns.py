@@ -331,6 +331,17 @@ def test_measured_points_are_the_numpy_update(seed: int) -> None:
     _same(got_depth, want_depth)
     _same(dirty, want_dirty)
     assert over == bool(deep.any())
+    # (and the rounds' test of what is left overlapping: every contact's separation, numpy's way)
+    immovable = rng.random(c) < 0.6
+    for flags in (dirty, np.ones(c, dtype=bool), np.zeros(c, dtype=bool)):
+        with np.errstate(invalid="ignore"):
+            every = np.arange(c)
+            sep = (dx[b] - dx[a]) * nx + (dy[b] - dy[a]) * ny
+            sep += rn_b[every] * dturn[b] - rn_a[every] * dturn[a]
+            sep -= got_depth
+            want = bool(((sep < -(slack_k * (1.0 + np.minimum(bound[ra], bound[rb])))) & flags & immovable).any())
+        assert sr.pending_points(a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, got_depth, flags, immovable, ra, rb, bound,
+                                 slack_k) == want
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -49,7 +49,7 @@ from . import solve_columns as columns
 from . import solve_rounds as rounds
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
-from .solve_rounds import apply_measures, known_keys, moved_immovable, number, turning_pairs
+from .solve_rounds import apply_measures, known_keys, moved_immovable, number, pending_points, turning_pairs
 from .turning import expand, turning_polygons
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
@@ -350,10 +350,18 @@ class Solve:
             grew = self._late_contacts() or grew
             # (where bodies turn, points against immovable bodies measured again may be left
             # overlapping, to look at; overlaps between moving bodies wait for the next step)
-            pending = self.rigid and bool(((self._separations() < -self._slack()) & self.dirty & self.immovable).any())
+            pending = self.rigid and self._pending()
             if not (held_back or overlapping or grew or pending):
                 return
         self._clear_of_statics(rounds)
+
+    def _pending(self) -> bool:
+        """Contacts at points: whether one with an immovable body, to be looked at again, is left
+        overlapping by more than its slack (:meth:`_slack`) where the bodies now stand. (One
+        compiled pass, ``solve_rounds.pending_points``.)"""
+        cs = self.cs
+        return bool(pending_points(self.a, self.b, cs.nx, cs.ny, self.dx, self.dy, self.rn_a, self.rn_b, self.dturn,
+                                   cs.depth, self.dirty, self.immovable, cs.ra, cs.rb, self.store.bound, POINT_SLACK))
 
     def _clear_of_statics(self, rounds: int) -> None:
         """After the rounds ran out with an overlap left (a heap spawned on one spot), rounds over

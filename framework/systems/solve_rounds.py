@@ -276,6 +276,20 @@ def points_measured(check, pair, n_pts, sep, slot, a, b, nx, ny, dx, dy, rn_a, r
 
 
 @kernel
+def pending_points(a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, depth, dirty, immovable, ra, rb, bound,
+                   point_slack):  # pragma: no cover - compiled
+    """Whether a contact with an immovable body that is to be looked at again (``dirty``) is left
+    overlapping by more than its slack (``Solve._slack``) where the bodies now stand:
+    ``((Solve._separations() < -Solve._slack()) & dirty & immovable).any()`` in one pass."""
+    for i in range(a.size):
+        if dirty[i] and immovable[i]:
+            sep = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn) - depth[i]
+            if sep < -(point_slack * (1.0 + _np_min(bound[ra[i]], bound[rb[i]]))):
+                return True
+    return False
+
+
+@kernel
 def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse, tpush,
              timpulse):  # pragma: no cover - compiled
     """What :meth:`Solve.record` keeps, sorted by pair key (stably: a pair's points in order): the
