@@ -21,7 +21,7 @@ from typing import Any
 
 from numba import njit
 
-__all__ = ["inner", "kernel", "leaf"]
+__all__ = ["inner", "kernel", "leaf", "numpy_kernel"]
 
 # (``_nrt`` is numba's own switch for its reference counting; its type stubs do not list it)
 _LEAF_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True, "_nrt": False}
@@ -41,3 +41,7 @@ _KERNEL_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True}
 
 #: ``@kernel``: a compiled function called from Python (or from other compiled functions).
 kernel = njit(**_KERNEL_OPTIONS)
+
+#: ``@numpy_kernel``: a :data:`kernel` whose arithmetic errors are numpy's (``1/0`` is inf, ``0/0``
+#: NaN, not a ``ZeroDivisionError``): for passes that restate numpy code, bit for bit.
+numpy_kernel = njit(**_KERNEL_OPTIONS, error_model="numpy")

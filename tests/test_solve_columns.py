@@ -345,6 +345,62 @@ def test_measured_points_are_the_numpy_update(seed: int) -> None:
 
 
 @pytest.mark.parametrize("seed", range(6))
+def test_friction_columns_limits_and_clip_are_the_numpy_ones(seed: int) -> None:
+    """Friction's columns (arms, k, shares, turns), limits and clip, compiled, against the numpy
+    they replaced: circles and boxes, sleepers, given arms and inertias or the store's, shares
+    that keep a lower body still, values beyond the bounds, -0.0 and NaN."""
+    from framework.systems import friction as fr
+
+    rng = np.random.default_rng(seed)
+    n, c = 9, 25
+    ra, rb = rng.integers(0, n, c), rng.integers(0, n, c)
+    kind = rng.integers(0, 3, n).astype(np.int8)
+    radius, inv_inertia = rng.uniform(0.2, 1.0, n).round(2), rng.uniform(0.0, 2.0, n).round(1)
+    asleep = rng.random(n) < 0.2
+    wa, wb = rng.uniform(0.0, 1.0, c).round(1), rng.uniform(0.0, 1.0, c).round(1)
+    wb[wa == 0.0] += 0.5  # (no pair of two immovable bodies: k > 0)
+    given_arms, given_inertia = (_floats(rng, c, False), _floats(rng, c, False)), (rng.uniform(0, 1, c),
+                                                                                  rng.uniform(0, 1, c))
+    for arms in (None, given_arms):
+        for inertia in (None, given_inertia):
+            for rotation in (False, True):
+                cols, turns = fr._columns(ra, rb, wa, wb, kind, radius, asleep, inv_inertia,
+                                          *(arms if arms is not None else (fr._NONE, fr._NONE)),
+                                          *(inertia if inertia is not None else (fr._NONE, fr._NONE)),
+                                          arms is not None, inertia is not None, rotation, 1)
+                if arms is None:
+                    arm_a = np.where(kind[ra] == 1, radius[ra], 0.0)
+                    arm_b = np.where(kind[rb] == 1, -radius[rb], 0.0)
+                else:
+                    arm_a, arm_b = arms
+                if inertia is not None:
+                    ia, ib = inertia
+                elif rotation:
+                    ia, ib = np.where(asleep[ra], 0.0, inv_inertia[ra]), np.where(asleep[rb], 0.0, inv_inertia[rb])
+                else:
+                    ia = ib = np.zeros(c)
+                k = wa + wb + ia * arm_a * arm_a + ib * arm_b * arm_b
+                inv = 1.0 / k
+                for got, want in zip(cols, (arm_a, arm_b, k, wa * inv, wb * inv, ia * arm_a * inv, ib * arm_b * inv)):
+                    _same(got, want)
+                assert turns == bool(ia.any() or ib.any())
+    mu, k = rng.uniform(0.0, 1.0, c).round(1), rng.uniform(0.5, 2.0, c)
+    share_a, share_b = np.where(rng.random(c) < 0.3, 0.0, wa), np.where(rng.random(c) < 0.3, 0.0, wb)
+    for turning in (None, (rng.uniform(0, 1, c), rng.uniform(0, 1, c))):
+        ka, kb = (wa, wb) if turning is None else (wa + turning[0], wb + turning[1])
+        lower_a, lower_b = (share_a == 0.0) & (wa > 0.0), (share_b == 0.0) & (wb > 0.0)
+        with np.errstate(divide="ignore"):  # (a lower body's partner immovable: inf, as numpy makes it)
+            want = mu * (k / np.where(lower_a, kb, np.where(lower_b, ka, ka + kb)))
+        got = fr._limits(share_a, share_b, wa, wb, *(turning if turning is not None else (fr._NONE, fr._NONE)),
+                         turning is not None, mu, k)
+        _same(got, want)
+    value, normal, limits = _floats(rng, c) * 3.0, _floats(rng, c), _floats(rng, c)
+    with np.errstate(invalid="ignore"):
+        bound = limits * normal
+        _same(fr._clip(value, normal, limits), np.clip(value, -bound, bound))
+
+
+@pytest.mark.parametrize("seed", range(6))
 def test_velocity_passes_are_the_numpy_velocity_start(seed: int) -> None:
     rng = np.random.default_rng(seed)
     n_rows, c = 30, 20

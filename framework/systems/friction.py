@@ -27,8 +27,10 @@ import numpy as np
 
 from ..arrays import F64Array, IntpArray
 from ..collision.kinds import KIND_CIRCLE
+from ..compiled import kernel, numpy_kernel
 from ..frame import StepFrame
 from ..store import STATIC, BodyStore
+from .gather import _np_max, _np_min
 from .solver_loops import warm_start
 
 __all__ = ["NO_FRICTION_POSITIONS", "NO_FRICTION_VELOCITIES", "Friction"]
@@ -48,23 +50,16 @@ class Friction:
                  inertia: tuple[F64Array, F64Array] | None = None) -> None:
         self.mu = mu
         self.wa, self.wb = wa, wb
-        if arms is None:
-            self.arm_a = np.where(store.kind[ra] == KIND_CIRCLE, store.radius[ra], 0.0)
-            self.arm_b = np.where(store.kind[rb] == KIND_CIRCLE, -store.radius[rb], 0.0)
-        else:  # (contacts at points: see framework.systems.turning)
-            self.arm_a, self.arm_b = arms
-        if inertia is not None:
-            ia, ib = inertia
-        elif rotation:
-            ia = np.where(store.asleep[ra], 0.0, store.inv_inertia[ra])
-            ib = np.where(store.asleep[rb], 0.0, store.inv_inertia[rb])
-        else:
-            ia = ib = np.zeros(ra.size)
-        self.k = wa + wb + ia * self.arm_a * self.arm_a + ib * self.arm_b * self.arm_b
-        inv = 1.0 / self.k
-        self.tshare_a, self.tshare_b = wa * inv, wb * inv
-        self.turn_a, self.turn_b = ia * self.arm_a * inv, ib * self.arm_b * inv
-        self.turns = bool(ia.any() or ib.any())
+        # (one compiled pass, _columns: the arms (a circle's radius where none are given: contacts
+        # at points bring theirs, see framework.systems.turning), each body's inverse inertia (a
+        # sleeper's 0; none without rotation), k, the shares and the turns)
+        c = store.cols
+        cols, turns = _columns(ra, rb, wa, wb, c["kind"], c["radius"], c["asleep"], c["inv_inertia"],
+                               _NONE if arms is None else arms[0], _NONE if arms is None else arms[1],
+                               _NONE if inertia is None else inertia[0], _NONE if inertia is None else inertia[1],
+                               arms is not None, inertia is not None, rotation, KIND_CIRCLE)
+        self.arm_a, self.arm_b, self.k, self.tshare_a, self.tshare_b, self.turn_a, self.turn_b = cols
+        self.turns = bool(turns)
 
     @classmethod
     def of(cls, store: BodyStore, ra: IntpArray, rb: IntpArray, wa: F64Array, wb: F64Array,
@@ -89,14 +84,9 @@ class Friction:
         the bodies is ``1 / k_normal`` of impulse with ``k_normal = w_a + w_b + i_a rn_a^2 + i_b
         rn_b^2``; leaving the angular part out made the bound on a turning box ``1 + m (w/2)^2 / I``
         times too strong (2.5 times for a square)."""
-        wa, wb = self.wa, self.wb
-        lower_a = (share_a == 0.0) & (wa > 0.0)  # a keeps still although it could move
-        lower_b = (share_b == 0.0) & (wb > 0.0)
-        ka, kb = wa, wb
-        if turning is not None:
-            ka, kb = wa + turning[0], wb + turning[1]
-        k_normal = np.where(lower_a, kb, np.where(lower_b, ka, ka + kb))
-        return self.mu * (self.k / k_normal)
+        limits: F64Array = _limits(share_a, share_b, self.wa, self.wb, _NONE if turning is None else turning[0],
+                                   _NONE if turning is None else turning[1], turning is not None, self.mu, self.k)
+        return limits
 
     def start(self, frame: StepFrame, store: BodyStore, rows: IntpArray, x: F64Array, y: F64Array,
               before: Friction | None = None) -> None:
@@ -118,8 +108,8 @@ class Friction:
 
     def clip(self, value: F64Array, normal: F64Array, limits: F64Array) -> F64Array:
         """Tangential values (last step's, as a warm start) within the limits of the normal ones."""
-        bound = limits * normal
-        return np.clip(value, -bound, bound)
+        clipped: F64Array = _clip(value, normal, limits)
+        return clipped
 
     def spread(self, a: IntpArray, b: IntpArray, nx: F64Array, ny: F64Array, value: F64Array,
                n_bodies: int) -> tuple[F64Array, F64Array, F64Array]:
@@ -144,3 +134,62 @@ class Friction:
         turned = np.flatnonzero(self.dturn != 0.0)
         if turned.size:
             store.rot[rows[turned]] = self.rot0[turned] + self.dturn[turned]
+
+
+@numpy_kernel
+def _columns(ra, rb, wa, wb, kind, radius, asleep, inv_inertia, arms_a, arms_b, inertia_a, inertia_b, has_arms,
+             has_inertia, rotation, circle):  # pragma: no cover - compiled
+    """:class:`Friction`'s columns ``(arm_a, arm_b, k, tshare_a, tshare_b, turn_a, turn_b)`` as the
+    rows of one array, and whether a body turns: numpy's arithmetic, in its order."""
+    out = np.empty((7, ra.size))
+    turns = False
+    for i in range(ra.size):
+        a, b = ra[i], rb[i]
+        if has_arms:
+            arm_a, arm_b = arms_a[i], arms_b[i]
+        else:
+            arm_a = radius[a] if kind[a] == circle else 0.0
+            arm_b = -radius[b] if kind[b] == circle else 0.0
+        if has_inertia:
+            ia, ib = inertia_a[i], inertia_b[i]
+        elif rotation:
+            ia = 0.0 if asleep[a] else inv_inertia[a]
+            ib = 0.0 if asleep[b] else inv_inertia[b]
+        else:
+            ia = ib = 0.0
+        k = wa[i] + wb[i] + ia * arm_a * arm_a + ib * arm_b * arm_b
+        inv = 1.0 / k
+        out[0, i], out[1, i], out[2, i] = arm_a, arm_b, k
+        out[3, i], out[4, i] = wa[i] * inv, wb[i] * inv
+        out[5, i], out[6, i] = ia * arm_a * inv, ib * arm_b * inv
+        turns = turns or ia != 0.0 or ib != 0.0
+    return out, turns
+
+
+@numpy_kernel
+def _limits(share_a, share_b, wa, wb, turning_a, turning_b, turning, mu, k):  # pragma: no cover - compiled
+    """:meth:`Friction.limits` (see there): numpy's arithmetic, in its order."""
+    out = np.empty(mu.size)
+    for i in range(mu.size):
+        ka, kb = wa[i], wb[i]
+        if turning:
+            ka, kb = wa[i] + turning_a[i], wb[i] + turning_b[i]
+        if share_a[i] == 0.0 and wa[i] > 0.0:  # a keeps still although it could move
+            k_normal = kb
+        elif share_b[i] == 0.0 and wb[i] > 0.0:
+            k_normal = ka
+        else:
+            k_normal = ka + kb
+        out[i] = mu[i] * (k[i] / k_normal)
+    return out
+
+
+@kernel
+def _clip(value, normal, limits):  # pragma: no cover - compiled
+    """``np.clip(value, -bound, bound)`` with ``bound = limits * normal`` (numpy's clip: the max,
+    then the min, NaN kept)."""
+    out = np.empty(value.size)
+    for i in range(value.size):
+        bound = limits[i] * normal[i]
+        out[i] = _np_min(_np_max(value[i], -bound), bound)
+    return out

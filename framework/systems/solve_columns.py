@@ -29,12 +29,10 @@ share (:func:`push_cap`, :func:`_kept_still`).
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
-from numba import njit
 
-from ..compiled import inner, leaf
+from ..compiled import inner, leaf, numpy_kernel
 from ..stable_sort import stable_argsort
 from .gather import _np_max, _np_min
 from .solver_loops import warm_start
@@ -42,9 +40,8 @@ from .solver_loops import warm_start
 __all__ = ["bounce_hits", "closing_speeds", "contact_columns", "push_cap", "stays", "velocity_stays",
            "warm_impulses", "warm_pushes"]
 
-# (numpy's error model: a division by zero gives inf or NaN as numpy does; the options as compiled.kernel's)
-_COMPILED_OPTIONS: dict[str, Any] = {"cache": True, "no_cfunc_wrapper": True, "error_model": "numpy"}
-_compiled = njit(**_COMPILED_OPTIONS)
+# (numpy's error model: a division by zero gives inf or NaN as numpy does)
+_compiled = numpy_kernel
 
 
 @leaf
