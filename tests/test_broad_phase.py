@@ -832,8 +832,14 @@ def test_direct_pairs_tested_or_swept_are_the_brute_force_pairs(seed):
         moving = np.flatnonzero((body != 1) & ~asleep).astype(np.int64)
         lut = np.full(10 * n, -1, dtype=np.int64)
         lut[entity] = np.arange(n)
-        ea, eb, ra, rb = direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1, lut)
+        layers_open = trial % 3 != 0  # (else random layers and masks: the pairs whose layers meet)
+        layer = np.ones(n, dtype=np.int64) if layers_open else 1 << rng.integers(0, 3, n)
+        mask = np.full(n, -1, dtype=np.int64) if layers_open else rng.integers(0, 8, n)
+        ea, eb, ra, rb = direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1, lut, layer, mask,
+                                      layers_open)
         want = _direct_pairs_by_brute_force(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, 1)
+        wa, wb = lut[want >> 32], lut[want & 0xFFFFFFFF]
+        want = want[((layer[wa] & mask[wb]) != 0) & ((layer[wb] & mask[wa]) != 0)]
         assert ((ea << 32) | eb).tobytes() == want.tobytes(), trial
         assert (entity[ra] == ea).all() and (entity[rb] == eb).all()
         still = int(np.count_nonzero((kind >= 0) & (body != 1) & asleep | (kind >= 0) & (body == 1)))

@@ -234,17 +234,17 @@ class SpatialHash:
         cells), without pairing them: the caller paired them itself
         (:func:`direct_pairs`), from the geometry's bounds (float64 columns, never inverted: not
         checked again here, a step's broad phase calls this every step)."""
-        f64 = np.float64
-        self._enter((np.asarray(minx, f64), np.asarray(miny, f64), np.asarray(maxx, f64), np.asarray(maxy, f64)),
-                    ids, None)
+        b = np.array((minx, miny, maxx, maxy), dtype=np.float64)  # (the four copied at once, kept as they are)
+        self._enter((b[0], b[1], b[2], b[3]), ids, None, copied=True)
 
-    def _enter(self, b: Bounds, ids: ArrayLike, strips: StripSweep | None) -> None:
+    def _enter(self, b: Bounds, ids: ArrayLike, strips: StripSweep | None, copied: bool = False) -> None:
         """Take the moving bodies of a step: swept into ``strips``, or (None) kept as they are,
-        a few paired directly; the cell size chosen from them if none was yet."""
+        a few paired directly (``copied``: ``b`` is the caller's copy, kept); the cell size chosen
+        from them if none was yet."""
         mids = _as_ids(ids, b[0].shape[0])
         self._choose_cell(b)
-        self._moving = strips if strips is not None else _FewBodies((b[0].copy(), b[1].copy(), b[2].copy(),
-                                                                     b[3].copy()))
+        self._moving = strips if strips is not None else _FewBodies(b if copied else (b[0].copy(), b[1].copy(),
+                                                                                      b[2].copy(), b[3].copy()))
         self._moving_cells = None
         self._queries = 0
         self._moving_ids = mids.copy()
@@ -437,12 +437,14 @@ SWEEP_FROM = 1 << 12
 
 
 @kernel
-def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind, lut):  # pragma: no cover
+def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, static_kind, lut, layer, mask,
+                 layers_open):  # pragma: no cover
     """The pairs of every moving row (``moving``, sorted rows) with every other hitbox row whose
     bounds strictly overlap its own (touching is no overlap): the static ones, the sleeping ones and
     the moving ones (each moving pair once, found from its lower row: the higher one must have a
-    hitbox). As ``(entities a, entities b, rows a, rows b)``, a < b, sorted by pair key (``entity a
-    << 32 | entity b``), the rows looked up in ``lut`` (entity -> row, ``BodyStore.row_table``).
+    hitbox), whose layers and masks let them meet (unless ``layers_open``: every pair does). As
+    ``(entities a, entities b, rows a, rows b)``, a < b, sorted by pair key (``entity a << 32 |
+    entity b``), the rows looked up in ``lut`` (entity -> row, ``BodyStore.row_table``).
 
     Few tests (:data:`SWEEP_FROM`): every mover against every such row. More: the movers sorted by
     their left edges are swept against each other (each one meets those whose left edge lies before
@@ -489,7 +491,8 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
     out = np.empty(max(16, 2 * mv), dtype=np.int64)
     k, m = np.int64(0), np.int64(0)  # (np.int64: literal 0s would compile _pairs_from twice)
     while True:
-        k, m = _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m)
+        k, m = _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m, layer, mask,
+                           layers_open)
         if k == mv:
             break
         grown = np.empty(2 * out.size, dtype=np.int64)
@@ -507,7 +510,8 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
 
 
 @leaf
-def _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m):  # pragma: no cover
+def _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, out, m, layer, mask,
+                layers_open):  # pragma: no cover
     """:func:`direct_pairs`' keys of the movers from the ``k``-th on, written to ``out`` from ``m``
     on: ``(mv, the keys' end)``, or where ``out`` was too small for a mover's keys, ``(that mover,
     the keys' end before it)``. (Apart, without reference counting: numba counted the growing key
@@ -532,6 +536,8 @@ def _pairs_from(k, mv, c, swept, widest, at, bx0, by0, bx1, by1, kind, entity, o
                 if ax1 > bx0[q] and bx1[q] > ax0 and ay1 > by0[q] and by1[q] > ay0:
                     r = at[q]
                     if q < mv and kind[max(i, r)] < 0:
+                        continue
+                    if not layers_open and ((layer[i] & mask[r]) == 0 or (layer[r] & mask[i]) == 0):
                         continue
                     if j == out.size:
                         return k, m

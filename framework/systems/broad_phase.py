@@ -62,13 +62,14 @@ class BroadPhase(Stage):
             store.sleep_dirty = False
         counters["asleep"] = frame.n_asleep = int(np.count_nonzero(store.asleep[store.active_sel()[2]]))
         all_bounds = (geom.minx, geom.miny, geom.maxx, geom.maxy)
+        open_layers = store.layers_all_meet()
         kept = self.kept
         way = "direct" if direct else kept.choose((store.version, store.static_epoch, store.sleep_epoch, store.n),
                                                   movers, all_bounds)
         if way == "direct":
             c, n = store.cols, store.n
             ea, eb, ra, rb = direct_pairs(movers, c["kind"][:n], c["body"][:n], c["asleep"][:n], c["entity"][:n],
-                                          *all_bounds, STATIC, store.row_table())
+                                          *all_bounds, STATIC, store.row_table(), c["layer"], c["mask"], open_layers)
             bodies.hash.enter_few(*bounds, store.entity[moving])  # (for the queries and the overlay)
         elif way == "plain":
             keys = self._hashed(bounds, store.entity[moving], frame.n_asleep)
@@ -83,7 +84,7 @@ class BroadPhase(Stage):
             keys, ra, rb = kept.overlapping(all_bounds)
             ea, eb = pair_parts(keys)
             bodies.hash.enter_few(*bounds, store.entity[moving])  # (the movers as they are, not fat)
-        keep = None if store.layers_all_meet() else filter_layers(store, ra, rb)
+        keep = None if open_layers or way == "direct" else filter_layers(store, ra, rb)  # (direct: filtered)
         if "events" not in self.pipeline.effects:
             need = self._someone_reads(ra, rb)
             keep = need if keep is None else keep & need
