@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import kernel
+from .compiled import kernel, leaf
+from .stable_sort import argsort_ints
 
 __all__ = ["track_pairs"]
 
 
-@kernel
+@leaf
 def _increasing(keys):  # pragma: no cover - compiled
     for i in range(1, keys.size):
         if not keys[i - 1] < keys[i]:
@@ -45,8 +46,12 @@ def track_pairs(a, b, last):  # pragma: no cover - compiled
                 i += 1
                 j += 1
     elif n and m:
-        merged = np.concatenate((keys, last))
-        order = np.argsort(merged, kind="mergesort")
+        merged = np.empty(n + m, dtype=np.int64)
+        for i in range(n):
+            merged[i] = keys[i]
+        for j in range(m):
+            merged[n + j] = last[j]
+        order = argsort_ints(merged)  # (stable; the project's sort: no second sort to compile)
         for t in range(n + m - 1):
             if merged[order[t + 1]] == merged[order[t]]:
                 if order[t] < n:

@@ -229,7 +229,7 @@ def pairs_of(check, ea, eb):  # pragma: no cover - compiled
     keys = np.empty(m, dtype=np.int64)
     for i in range(m):
         keys[i] = (ea[check[i]] << 32) | eb[check[i]]
-    order = np.argsort(keys, kind="mergesort")  # (stable: the first of equal keys first, as np.unique)
+    order = argsort_ints(keys)  # (stable: the first of equal keys first, as np.unique's)
     first = np.empty(m, dtype=np.int64)
     pair = np.empty(m, dtype=np.int64)
     u = -1

@@ -30,7 +30,7 @@ from ..arrays import BoolArray, F64Array, I64Array, IntpArray
 from ..collision.batch_manifold import pair_manifolds
 from ..collision.box_rows import lower_bound
 from ..collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
-from ..compiled import kernel
+from ..compiled import inner, kernel
 from ..frame import Points
 from ..geometry import Geometry
 from ..store import BodyStore
@@ -86,21 +86,18 @@ def expand(cs: Contacts, store: BodyStore, geom: Geometry, points: Points, margi
     body; each point is warm started from last step's value of the same pair and slot, or (a pair
     that had another number of points) its pair's, shared evenly."""
     c = store.cols
-    clip, gaps = _clipped(cs.ra, cs.rb, c["kind"], c["inv_inertia"], c["bound"], margin, KIND_POLYGON, KIND_CIRCLE,
-                          KIND_CAPSULE)
-    n_pts, px, py, sep = pair_manifolds(cs.ra[clip], cs.rb[clip], cs.nx[clip], cs.ny[clip], gaps, c["kind"], geom.hx,
-                                        geom.hy, c["hw"], c["hh"], geom.poly_slot, geom.world_poly, geom.count)
     ints, floats, alive0 = _expanded(cs.ra, cs.rb, cs.ea, cs.eb, cs.nx, cs.ny, cs.depth, cs.alive0, cs.push0,
-                                     cs.impulse0, cs.tpush0, cs.timpulse0, cs.px, cs.py, clip, n_pts, px, py, sep,
-                                     c["kind"], c["x"], c["y"], c["radius"], geom.hx, geom.hy, geom.cap_ux,
-                                     geom.cap_uy, *points[:6], KIND_CIRCLE, KIND_CAPSULE)
+                                     cs.impulse0, cs.tpush0, cs.timpulse0, cs.px, cs.py, margin, c["kind"],
+                                     c["inv_inertia"], c["bound"], c["x"], c["y"], c["radius"], c["hw"], c["hh"],
+                                     geom.hx, geom.hy, geom.cap_ux, geom.cap_uy, geom.poly_slot, geom.world_poly,
+                                     geom.count, *points[:6], KIND_POLYGON, KIND_CIRCLE, KIND_CAPSULE)
     ra, rb, ea, eb, slot = ints
     nx, ny, depth, push0, impulse0, tpush0, timpulse0, opx, opy, rax, ray, rbx, rby = floats
     return type(cs)(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, opx, opy, slot,
                     arms=(rax, ray, rbx, rby))
 
 
-@kernel
+@inner
 def _clipped(ra, rb, kind, inv_inertia, bound, margin, polygon, circle, capsule):  # pragma: no cover - compiled
     """The pairs with a turning polygon and no round body (circle or capsule), whose manifolds
     are clipped, and each one's gap: ``margin`` times the smaller body's bound."""
@@ -122,12 +119,21 @@ def _clipped(ra, rb, kind, inv_inertia, bound, margin, polygon, circle, capsule)
 
 
 @kernel
-def _expanded(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, px, py, clip, n_pts, mpx,
-              mpy, msep, kind, x, y, radius, hx, hy, cap_ux, cap_uy, pk, pslot, lpush, limp, ltpush, ltimp, circle,
-              capsule):  # pragma: no cover - compiled
+def _expanded(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, px, py, margin, kind,
+              inv_inertia, bound, x, y, radius, hw, hh, hx, hy, cap_ux, cap_uy, poly_slot, world_poly, count, pk, pslot,
+              lpush, limp, ltpush, ltimp, polygon, circle, capsule):  # pragma: no cover - compiled
     """The rows of :func:`expand` (see there), as ``(ints, floats, alive0)``: rows ``ra, rb, ea,
     eb, slot`` and ``nx, ny, depth, push0, impulse0, tpush0, timpulse0, px, py`` and the arms
-    ``rax, ray, rbx, rby`` (two arrays and a mask: each array handed back to Python costs)."""
+    ``rax, ray, rbx, rby`` (two arrays and a mask: each array handed back to Python costs). The
+    clipped pairs' manifolds (:func:`_clipped`, then
+    :func:`~framework.collision.batch_manifold.pair_manifolds`) first."""
+    clip, gaps = _clipped(ra, rb, kind, inv_inertia, bound, margin, polygon, circle, capsule)
+    cra, crb, cnx, cny = np.empty(clip.size, dtype=np.int64), np.empty(clip.size, dtype=np.int64), \
+        np.empty(clip.size), np.empty(clip.size)
+    for q in range(clip.size):
+        cra[q], crb[q], cnx[q], cny[q] = ra[clip[q]], rb[clip[q]], nx[clip[q]], ny[clip[q]]
+    n_pts, mpx, mpy, msep = pair_manifolds(cra, crb, cnx, cny, gaps, kind, hx, hy, hw, hh, poly_slot, world_poly,
+                                           count)
     C = ra.size
     at = np.full(C, -1, dtype=np.int64)  # each pair's place among the clipped ones
     for q in range(clip.size):
