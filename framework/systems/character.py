@@ -137,8 +137,7 @@ class CharacterStage(Stage):
         store = self.bodies.store
         if store.cols["kind"][row] != KIND_AABB or store.n > DIRECT_QUERY or ctrl.drop_through or ctrl.dropping:
             return False
-        mask = ctrl.solid_mask if ctrl.solid_mask is not None else store.cols["mask"][row]
-        return mask >= 0 and not self.queries._synced_geometry().has_offset
+        return _solid_mask(ctrl, store, row) >= 0 and not self.queries._synced_geometry().has_offset
 
     def _move_whole(self, frame: StepFrame, entity: int, row: int, ctrl: CharacterController, moved: bool,
                     undo: bool) -> bool:
@@ -150,15 +149,13 @@ class CharacterStage(Stage):
             self._outputs = kernel.outputs()
         store, geom = self.bodies.store, self.bodies.geometry
         c = store.cols
-        hb = store.hitboxes[row]
-        assert hb is not None  # (run() moves only rows with a hitbox)
         gx, gy = self.pipeline.active_gravity()
         snap = ctrl.snap_length if ctrl.snap_length is not None else ctrl.step_height
         fnx, fny = ctrl.floor_normal
         cfg = np.array([math.nan if ctrl.skin is None else ctrl.skin, ctrl.floor_cos, ctrl.gravity_scale,
                         ctrl.step_height, snap, math.tan(math.radians(ctrl.max_floor_angle)), fnx, fny, frame.dt,
                         gx, gy])
-        mask = ctrl.solid_mask if ctrl.solid_mask is not None else int(hb.mask)
+        mask = _solid_mask(ctrl, store, row)
         floor_row = self._row_of(ctrl.floor_entity)
         ctrl.crushed = False
         st, si, push_r, push_n = self._outputs
@@ -188,7 +185,7 @@ class CharacterStage(Stage):
         x0, y0 = float(geom.hx[row]), float(geom.hy[row])
         size = min(_extent(shape))
         skin = ctrl.skin if ctrl.skin is not None else default_skin(size, x0, y0)
-        mask = ctrl.solid_mask if ctrl.solid_mask is not None else int(hb.mask)
+        mask = _solid_mask(ctrl, store, row)
         mv = _Move(shape, x0, y0, float(store.cols["rot"][row]), row, mask, skin, ctrl.floor_cos, ctrl.dropping)
         mv.own = np.array([row], dtype=np.int64)
         vel: Velocity = esper.component_for_entity(entity, Velocity)
@@ -717,6 +714,16 @@ def _compiled_move() -> Any:
 
         _KERNEL = character_kernel
     return _KERNEL
+
+
+def _solid_mask(ctrl: CharacterController, store: Any, row: int) -> int:
+    """The layers that block the body of ``row``: its controller's ``solid_mask``, else its hitbox's
+    mask."""
+    if ctrl.solid_mask is not None:
+        return ctrl.solid_mask
+    hb = store.hitboxes[row]
+    assert hb is not None  # (the stage moves only rows with a hitbox)
+    return int(hb.mask)
 
 
 def default_skin(size: float, x: float, y: float) -> float:

@@ -36,7 +36,7 @@ from ..collision.kinds import (
     POLYGONS,
     pair_code,
 )
-from ..collision.pair_classes import classify_pairs
+from ..collision.pair_classes import FAMILY_OF_CODE, classify_pairs
 from ..collision.polygon_rows import polygon_pairs, polygon_pairs_settled
 from ..events import PairTracker, StepContacts
 from ..frame import StepFrame
@@ -50,7 +50,7 @@ __all__ = ["NarrowPhase", "filter_layers", "pair_contacts"]
 
 # The shape-pair table as columns indexed by pair code: counter name, kernel family, flipped.
 _PAIR_NAME = [rule.name for rule in PAIRS.values()]
-_PAIR_FAMILY = np.array([rule.family for rule in PAIRS.values()], dtype=np.int64)
+_PAIR_FAMILY = FAMILY_OF_CODE
 _PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
 _FAMILIES = (BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS, CAPSULES)
 

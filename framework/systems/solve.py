@@ -357,7 +357,7 @@ class Solve:
 
     def _pending(self) -> bool:
         """Contacts at points: whether one with an immovable body, to be looked at again, is left
-        overlapping by more than its slack (:meth:`_slack`) where the bodies now stand. (One
+        overlapping by more than its slack (``solve_rounds._slack``) where the bodies now stand. (One
         compiled pass, ``solve_rounds.pending_points``.)"""
         cs = self.cs
         return bool(pending_points(self.a, self.b, cs.nx, cs.ny, self.dx, self.dy, self.rn_a, self.rn_b, self.dturn,
@@ -525,7 +525,7 @@ class Solve:
             rbx[moved], rby[moved] = px[k, q] - store.x[rb], py[k, q] - store.y[rb]
             self._arms()
         # (the depths, where the bodies now stand and are turned, and which contacts to look at
-        # again: one compiled pass, solve_rounds.points_measured; the slack as _slack() says)
+        # again: one compiled pass, solve_rounds.points_measured; the slack: solve_rounds._slack)
         over = rounds.points_measured(check, pair, n_pts, sep, cs.slot, self.a, self.b, cs.nx, cs.ny, self.dx, self.dy,
                                       self.rn_a, self.rn_b, self.dturn, cs.depth, self.dirty, self.tolerance, cs.ra,
                                       cs.rb, store.bound, POINT_SLACK)
@@ -533,13 +533,6 @@ class Solve:
             self.dirty[check[turned[pair]]] = True
             self._recolumn()
         return bool(over)
-
-    def _slack(self) -> F64Array:
-        """Contacts at points: per contact, the overlap of a point measured again that is left to
-        the next step rather than given another round (second order: what a turn's arc adds),
-        ``POINT_SLACK`` times one plus the smaller body's size."""
-        store, cs = self.store, self.cs
-        return POINT_SLACK * (1.0 + np.minimum(store.bound[cs.ra], store.bound[cs.rb]))
 
     def _set_candidates(self, candidates: Pairs) -> None:
         self.candidates = candidates

@@ -90,12 +90,17 @@ def number(table, ra, rb, first):  # pragma: no cover - compiled
 
 
 @leaf
+def turning_pair(p, q, kind, inv_inertia, polygon):  # pragma: no cover - compiled
+    """Whether rows ``p`` or ``q`` are of kind ``polygon`` and turn (``inv_inertia > 0``), as
+    ``turning.turning_polygons`` of either row."""
+    return (kind[p] == polygon and inv_inertia[p] > 0.0) or (kind[q] == polygon and inv_inertia[q] > 0.0)
+
+
+@leaf
 def turning_pairs(ra, rb, kind, inv_inertia, polygon):  # pragma: no cover - compiled
-    """Whether a pair ``(ra, rb)`` has a body of kind ``polygon`` that turns (``inv_inertia > 0``),
-    as ``turning.turning_polygons`` of either row."""
+    """Whether a pair ``(ra, rb)`` has a body of kind ``polygon`` that turns (:func:`turning_pair`)."""
     for i in range(ra.size):
-        p, q = ra[i], rb[i]
-        if (kind[p] == polygon and inv_inertia[p] > 0.0) or (kind[q] == polygon and inv_inertia[q] > 0.0):
+        if turning_pair(ra[i], rb[i], kind, inv_inertia, polygon):
             return True
     return False
 
@@ -220,6 +225,14 @@ def apply_measures(check, hit, rnx, rny, rdepth, a, b, nx, ny, depth, dx, dy, rn
     return any_hit, over
 
 
+@leaf
+def _slack(i, ra, rb, bound, point_slack):  # pragma: no cover - compiled
+    """Contacts at points: the overlap of contact ``i``'s point measured again that is left to the
+    next step rather than given another round (second order: what a turn's arc adds),
+    ``point_slack`` times one plus the smaller body's size."""
+    return point_slack * (1.0 + _np_min(bound[ra[i]], bound[rb[i]]))
+
+
 @kernel
 def pairs_of(check, ea, eb):  # pragma: no cover - compiled
     """The pairs of contacts ``check`` (a pair's points are contacts of one pair of entities):
@@ -269,7 +282,7 @@ def points_measured(check, pair, n_pts, sep, slot, a, b, nx, ny, dx, dy, rn_a, r
         if abs(d - depth[i]) > tolerance:
             dirty[i] = True
         depth[i] = d
-        if -now > point_slack * (1.0 + _np_min(bound[ra[i]], bound[rb[i]])) and not apart:
+        if -now > _slack(i, ra, rb, bound, point_slack) and not apart:
             dirty[i] = True
             over = True
     return over
@@ -279,12 +292,12 @@ def points_measured(check, pair, n_pts, sep, slot, a, b, nx, ny, dx, dy, rn_a, r
 def pending_points(a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, depth, dirty, immovable, ra, rb, bound,
                    point_slack):  # pragma: no cover - compiled
     """Whether a contact with an immovable body that is to be looked at again (``dirty``) is left
-    overlapping by more than its slack (``Solve._slack``) where the bodies now stand:
-    ``((Solve._separations() < -Solve._slack()) & dirty & immovable).any()`` in one pass."""
+    overlapping by more than its slack (:func:`_slack`) where the bodies now stand:
+    ``((Solve._separations() < -slack) & dirty & immovable).any()`` in one pass."""
     for i in range(a.size):
         if dirty[i] and immovable[i]:
             sep = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn) - depth[i]
-            if sep < -(point_slack * (1.0 + _np_min(bound[ra[i]], bound[rb[i]]))):
+            if sep < -_slack(i, ra, rb, bound, point_slack):
                 return True
     return False
 

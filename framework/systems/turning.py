@@ -34,6 +34,7 @@ from ..compiled import inner, kernel
 from ..frame import Points
 from ..geometry import Geometry
 from ..store import BodyStore
+from .solve_rounds import turning_pair
 
 if TYPE_CHECKING:  # (solve imports this module)
     from .solve import Contacts
@@ -79,8 +80,8 @@ def expand(cs: Contacts, store: BodyStore, geom: Geometry, points: Points, margi
     """``cs`` (:class:`~framework.systems.solve.Contacts`) with every pair that has a turning
     polygon replaced by its manifold points (points within ``margin`` times the smaller body's
     size of touching), warm started from last step's ``points`` (``frame.points``), and every
-    row's lever arms set (``cs.arms``). Two compiled passes around the manifolds (which pairs are
-    clipped; then the rows, their points, the rims of round bodies, the warm starts and the arms)
+    row's lever arms set (``cs.arms``). One compiled pass (which pairs are clipped, their
+    manifolds, the rows, their points, the rims of round bodies, the warm starts and the arms)
     where numpy took some sixty calls: a pair with no manifold point keeps its own row if it
     overlaps; a kept pair with a circle or a capsule gets the point on its rim facing the other
     body; each point is warm started from last step's value of the same pair and slot, or (a pair
@@ -105,7 +106,7 @@ def _clipped(ra, rb, kind, inv_inertia, bound, margin, polygon, circle, capsule)
     m = 0
     for i in range(ra.size):
         a, b = ra[i], rb[i]
-        turn = (kind[a] == polygon and inv_inertia[a] > 0.0) or (kind[b] == polygon and inv_inertia[b] > 0.0)
+        turn = turning_pair(a, b, kind, inv_inertia, polygon)
         round_ = kind[a] == circle or kind[b] == circle or kind[a] == capsule or kind[b] == capsule
         if turn and not round_:
             clip[m] = i
