@@ -90,7 +90,9 @@ def test_contact_columns_are_the_numpy_columns(seed: int) -> None:
     for statics, (gx, gy) in ((True, (0.0, -10.0)), (False, (3.0, -4.0)), (True, (0.0, 0.0))):
         g = math.hypot(gx, gy)
         with np.errstate(divide="ignore", invalid="ignore"):
-            got = sc.contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g)
+            per_body, per_contact, got_immovable, got_order = sc.contact_columns(
+                rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g)
+            got = (per_body[0], per_body[0] if statics else per_body[1], *per_contact, got_immovable, got_order)
             half = np.where(hw[rows] > 0.0, np.minimum(hw[rows], hh[rows]), 0.5 * bound[rows])
             span = 0.5 * half
             reach = span if statics else np.full(rows.size, np.inf)
@@ -105,7 +107,9 @@ def test_contact_columns_are_the_numpy_columns(seed: int) -> None:
                 up_a = -(x[ra] * gx + y[ra] * gy) / g
                 up_b = -(x[rb] * gx + y[rb] * gy) / g
                 order = np.argsort(np.where(immovable, -np.inf, np.minimum(up_a, up_b)), kind="stable")
-        for have, want in zip(got, (span, reach, wa, wb, *shares, immovable, order.astype(np.int64))):
+        wants = (span, reach, wa, wb, *shares, immovable, order.astype(np.int64))
+        assert len(got) == len(wants)
+        for have, want in zip(got, wants):
             _same(have, want)
 
 
@@ -463,8 +467,9 @@ def test_recorded_is_the_numpy_record(rigid: bool) -> None:
     push = np.where(rng.random(c) < 0.5, 0.0, 0.02 * rng.random(c))
     near = rng.random(c) < 0.3 if rigid else np.zeros(0, dtype=bool)
     impulse, tpush, timpulse = rng.random(c), rng.random(c), rng.random(c)
-    got = sr.recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse,
-                      tpush, timpulse)
+    ints, floats, applied = sr.recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn,
+                                        span, impulse, tpush, timpulse)
+    got = (*ints, *floats, applied)
     acted = touching | (push > 0.0)
     kept = acted | near if rigid else acted
     rows = np.flatnonzero(kept)
@@ -478,6 +483,7 @@ def test_recorded_is_the_numpy_record(rigid: bool) -> None:
     capped = np.minimum(push, 2.0 * np.minimum(span[a], span[b]))
     want = (rows, keys, ea[rows], eb[rows], nx[rows], ny[rows], np.maximum(sep[rows], 0.0), push[rows], capped[rows],
             impulse[rows], tpush[rows], timpulse[rows], acted[rows])
+    assert len(got) == len(want)
     for have, w in zip(got, want):
         _same(have, w)
 

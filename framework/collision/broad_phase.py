@@ -235,7 +235,15 @@ class SpatialHash:
         (:func:`direct_pairs`), from the geometry's bounds (float64 columns, never inverted: not
         checked again here, a step's broad phase calls this every step)."""
         b = np.array((minx, miny, maxx, maxy), dtype=np.float64)  # (the four copied at once, kept as they are)
-        self._enter((b[0], b[1], b[2], b[3]), ids, None, copied=True)
+        if self._cell is None or not isinstance(ids, np.ndarray) or ids.dtype != _I64 or ids.shape != b[0].shape:
+            self._enter((b[0], b[1], b[2], b[3]), ids, None, copied=True)
+            return
+        # (the step's own call: int64 ids, one per body, a cell size chosen: _enter without its checks)
+        self._moving = _FewBodies((b[0], b[1], b[2], b[3]))
+        self._moving_cells = None
+        self._queries = 0
+        self._moving_ids = ids.copy()
+        self.rehashed_last = b[0].shape[0]
 
     def _enter(self, b: Bounds, ids: ArrayLike, strips: StripSweep | None, copied: bool = False) -> None:
         """Take the moving bodies of a step: swept into ``strips``, or (None) kept as they are,

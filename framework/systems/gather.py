@@ -93,11 +93,12 @@ def _row(lut, entity):  # pragma: no cover - compiled
 def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush, simp, ssep, stpush, stimp, lut,
            kind, layer, mask, layers_open, bound, radius, inv_inertia, friction, hw, hh, x, y, sx, sy, hx, hy, minx,
            miny, maxx, maxy, rolling, keep_gap, box_kind, circle_kind):  # pragma: no cover - compiled
-    """The contacts of the solve: ``(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0,
-    timpulse0, px, py)``, this step's contacts (``c*``: entities, normal, depth, point, rows) first,
-    then last step's pairs kept (``s*``: the frame's support). ``lut``: entity -> row; ``sx, sy``:
-    where the rows started the step (rows spawned since have none); ``rolling``: friction turns
-    circles (the friction and rotation effects)."""
+    """The contacts of the solve: ``(ints, floats, alive0)``, the rows of ``ints`` ``ra, rb, ea, eb``,
+    of ``floats`` ``nx, ny, depth, push0, impulse0, tpush0, timpulse0, px, py``; this step's
+    contacts (``c*``: entities, normal, depth, point, rows) first, then last step's pairs kept
+    (``s*``: the frame's support). ``lut``: entity -> row; ``sx, sy``: where the rows started the
+    step (rows spawned since have none); ``rolling``: friction turns circles (the friction and
+    rotation effects)."""
     m, k = ca.size, sa.size
     now_keys = np.empty(m, dtype=np.int64)
     for i in range(m):
@@ -222,13 +223,15 @@ def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush
             elif along_y and was_x and oy > 0.0:
                 nx[i], ny[i], depth[i] = 0.0, (-1.0 if (cy0 if cy0 != 0.0 else cy) < 0.0 else 1.0), oy
     # this step's contacts, then the pairs kept
+    # (as two blocks, the rows of which are the columns: each array handed back costs the caller)
     t = m + n_keep
-    ra, rb, ea, eb = (np.empty(t, dtype=np.int64), np.empty(t, dtype=np.int64), np.empty(t, dtype=np.int64),
-                      np.empty(t, dtype=np.int64))
-    onx, ony, odepth = np.empty(t), np.empty(t), np.empty(t)
+    ints, floats = np.empty((4, t), dtype=np.int64), np.empty((9, t))
+    ra, rb, ea, eb = ints[0], ints[1], ints[2], ints[3]
+    onx, ony, odepth, opush, oimp, otpush, otimp, opx, opy = (floats[0], floats[1], floats[2], floats[3], floats[4],
+                                                              floats[5], floats[6], floats[7], floats[8])
     alive0 = np.zeros(t, dtype=np.bool_)
-    opush, oimp, otpush, otimp = np.empty(t), np.empty(t), np.empty(t), np.empty(t)
-    opx, opy = np.zeros(t), np.zeros(t)
+    opx[:] = 0.0
+    opy[:] = 0.0
     for i in range(m):
         ra[i], rb[i], ea[i], eb[i] = cra[i], crb[i], ca[i], cb[i]
         onx[i], ony[i], odepth[i], alive0[i] = nx[i], ny[i], depth[i], True
@@ -243,7 +246,7 @@ def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush
         onx[o], ony[o], odepth[o] = knx[j], kny[j], gaps[q]
         opush[o], oimp[o], otpush[o], otimp[o] = spush[j], simp[j], stpush[j], stimp[j]
         o += 1
-    return ra, rb, ea, eb, onx, ony, odepth, alive0, opush, oimp, otpush, otimp, opx, opy
+    return ints, floats, alive0
 
 
 @leaf

@@ -333,10 +333,13 @@ class NarrowPhase(Stage):
             live = (store.kind[ra] >= 0) & (store.kind[rb] >= 0)
             ea, eb, ra, rb = ea[live], eb[live], ra[live], rb[live]
             geom.update(store)
-        res = pair_contacts(store, geom, ra, rb, frame.counters["narrow_tests"])
-        h = np.flatnonzero(res.hit)
-        contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
-        rows = (ra[h], rb[h])
+        if ra.size == 0:  # (no candidates: nothing to measure)
+            h, contacts, rows = ra, StepContacts.empty(), (ra, rb)
+        else:
+            res = pair_contacts(store, geom, ra, rb, frame.counters["narrow_tests"])
+            h = np.flatnonzero(res.hit)
+            contacts = StepContacts(ea[h], eb[h], res.nx[h], res.ny[h], res.depth[h], res.px[h], res.py[h])
+            rows = (ra[h], rb[h])
         if frame.n_asleep:
             contacts, rows = self._keep_sleepers(frame, contacts, rows)
         frame.contacts, frame.contact_rows = contacts, rows

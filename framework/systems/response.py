@@ -123,14 +123,16 @@ class Response(Stage):
         sa, sb, snx, sny, spush, simp, ssep, stpush, stimp = (
             np.asarray(v, dtype=i64 if k < 2 else f64) for k, v in enumerate(frame.support))
         effects = self.pipeline.effects
-        out = gather(
+        ints, floats, alive0 = gather(
             np.asarray(c.a, dtype=i64), np.asarray(c.b, dtype=i64), c.nx, c.ny, c.depth, c.px, c.py,
             np.asarray(ra, dtype=i64), np.asarray(rb, dtype=i64), sa, sb, snx, sny, spush, simp, ssep, stpush, stimp,
             store.row_table(), col["kind"], col["layer"], col["mask"], store.layers_all_meet(), col["bound"],
             col["radius"], col["inv_inertia"], col["friction"], col["hw"], col["hh"], col["x"], col["y"],
             frame.start_x, frame.start_y, geom.hx, geom.hy, geom.minx, geom.miny, geom.maxx, geom.maxy,
             "friction" in effects and "rotation" in effects, KEEP_GAP, KIND_AABB, KIND_CIRCLE)
-        return Contacts(*out)
+        ra, rb, ea, eb = ints
+        nx, ny, depth, push0, impulse0, tpush0, timpulse0, px, py = floats
+        return Contacts(ra, rb, ea, eb, nx, ny, depth, alive0, push0, impulse0, tpush0, timpulse0, px, py)
 
     def _solid(self, frame: StepFrame, cs: Contacts) -> BoolArray:
         """Mask of the contacts the response acts on."""

@@ -193,10 +193,13 @@ class Solve:
         # the position solver, nothing to be pushed through without statics; a sleeper keeps still;
         # the order: see the note on self.order below)
         gx, gy = self.gravity
-        (self.span, self.reach, wa, wb, self.share_a, self.share_b, self.immovable,
-         self.order) = columns.contact_columns(
+        statics = bool(self.stage.bodies.n_static)
+        per_body, per_contact, self.immovable, self.order = columns.contact_columns(
             self.rows, cs.ra, cs.rb, store.hw, store.hh, store.bound, store.asleep, store.inv_mass, store.x, store.y,
-            bool(self.stage.bodies.n_static), gx, gy, self.g)
+            statics, gx, gy, self.g)
+        self.span, reach = per_body
+        self.reach = self.span if statics else reach
+        wa, wb, self.share_a, self.share_b = per_contact
         self.wa, self.wb = wa, wb
         arms = inertia = None
         self.turn_shares = None  # (contacts at points: how far a unit turns each body, shared by inverse mass)
@@ -873,9 +876,11 @@ class Solve:
             turns = (self.rn_a, self.rn_b, self.dturn)
         # (one compiled pass: the contacts acted on (touching or pushed) and kept, sorted by pair;
         # their gaps where the bodies now stand, and their pushes capped as _warm_pushes caps them)
-        (rows, keys, ea, eb, nx, ny, gap, pushed, push, impulse, tpush, timpulse, applied) = rounds.recorded(
+        ints, floats, applied = rounds.recorded(
             self.touching, self.push, near, cs.ea, cs.eb, cs.nx, cs.ny, self.a, self.b, self.dx, self.dy, cs.depth,
             *turns, self.span, self.impulse, self.tpush, self.timpulse)
+        rows, keys, ea, eb = ints
+        nx, ny, gap, pushed, push, impulse, tpush, timpulse = floats
         if self.fpos is None:
             tpush = np.zeros(rows.size)
         else:

@@ -67,21 +67,27 @@ def _kept_still(b_on_a, a_on_b, share_a, share_b):  # pragma: no cover - compile
 
 @_compiled
 def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g):  # pragma: no cover
-    """The columns of :meth:`Solve._columns` (and its ``order``): per body (``rows``) its
-    ``span`` (half its half-thickness) and ``reach`` (the span with statics, else infinite); per
-    contact ``(ra, rb)`` its bodies' inverse masses ``wa, wb`` (a sleeper's 0), the shares of a
-    push by them, whether a body is immovable, and the contacts' order from the bottom of a pile
-    up (immovable first; along gravity ``(gx, gy)`` of length ``g``; in pair order without)."""
+    """The columns of :meth:`Solve._columns` (and its ``order``), as ``(per_body, per_contact,
+    immovable, order)``: per body (``rows``, the rows of ``per_body``) its ``span`` (half its
+    half-thickness) and ``reach`` (with statics: the span, not written; else infinite); per contact
+    ``(ra, rb)`` (the rows of ``per_contact``) its bodies' inverse masses ``wa, wb`` (a sleeper's
+    0) and the shares of a push by them; whether a body is immovable, and the contacts' order from
+    the bottom of a pile up (immovable first; along gravity ``(gx, gy)`` of length ``g``; in pair
+    order without)."""
     n = rows.size
-    span = np.empty(n)
+    # (the float columns as the rows of two blocks, per body and per contact: each array handed
+    # back costs the caller; the reach with statics is the span itself, the caller's to take)
+    per_body = np.empty((2, n))
+    span = per_body[0]
     for k in range(n):
         r = rows[k]
         half = _np_min(hw[r], hh[r]) if hw[r] > 0.0 else 0.5 * bound[r]
         span[k] = 0.5 * half
-    reach = span if statics else np.full(n, np.inf)
+    if not statics:
+        per_body[1, :] = np.inf
     c = ra.size
-    wa, wb = np.empty(c), np.empty(c)
-    share_a, share_b = np.empty(c), np.empty(c)
+    per_contact = np.empty((4, c))
+    wa, wb, share_a, share_b = per_contact[0], per_contact[1], per_contact[2], per_contact[3]
     immovable = np.empty(c, dtype=np.bool_)
     height = np.empty(c)
     for i in range(c):
@@ -98,7 +104,7 @@ def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics
             else:
                 height[i] = _np_min(-(x[p] * gx + y[p] * gy) / g, -(x[q] * gx + y[q] * gy) / g)
     order = stable_argsort(height) if g != 0.0 else np.arange(c)
-    return span, reach, wa, wb, share_a, share_b, immovable, order
+    return per_body, per_contact, immovable, order
 
 
 @_compiled

@@ -306,9 +306,10 @@ def pending_points(a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, depth, dirty, immova
 def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn_b, dturn, span, impulse, tpush,
              timpulse):  # pragma: no cover - compiled
     """What :meth:`Solve.record` keeps, sorted by pair key (stably: a pair's points in order): the
-    contacts acted on (``touching`` or pushed) or ``near`` (empty: none), with ``(rows, keys, ea,
-    eb, nx, ny, gap, push, capped push, impulse, tpush, timpulse, applied)``: the gap where the
-    bodies now stand (0 if they overlap), the push capped as :func:`~framework.systems.solve_columns.push_cap` says, and
+    contacts acted on (``touching`` or pushed) or ``near`` (empty: none), as ``(ints, floats,
+    applied)``: the rows of ``ints`` ``rows, keys, ea, eb``, of ``floats`` ``nx, ny, gap, push,
+    capped push, impulse, tpush, timpulse``: the gap where the bodies now stand (0 if they
+    overlap), the push capped as :func:`~framework.systems.solve_columns.push_cap` says; and
     whether the contact was acted on."""
     c = ea.size
     kept = np.zeros(c, dtype=np.bool_)
@@ -321,15 +322,20 @@ def recorded(touching, push, near, ea, eb, nx, ny, a, b, dx, dy, depth, rn_a, rn
     order = argsort_ints(keys)
     rows, keys = _at(rows, order), _at(keys, order)
     m = rows.size
-    gap, capped, applied = np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_)
+    # (as two blocks, the rows of which are the columns: each array handed back costs the caller)
+    ints, floats = np.empty((4, m), dtype=np.int64), np.empty((8, m))
+    applied = np.empty(m, dtype=np.bool_)
     for k in range(m):
         i = rows[k]
+        ints[0, k], ints[1, k], ints[2, k], ints[3, k] = i, keys[k], ea[i], eb[i]
         shift = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn)
-        gap[k] = _np_max(shift - depth[i], 0.0)
-        capped[k] = push_cap(push[i], span[a[i]], span[b[i]])
+        floats[0, k], floats[1, k] = nx[i], ny[i]
+        floats[2, k] = _np_max(shift - depth[i], 0.0)
+        floats[3, k] = push[i]
+        floats[4, k] = push_cap(push[i], span[a[i]], span[b[i]])
+        floats[5, k], floats[6, k], floats[7, k] = impulse[i], tpush[i], timpulse[i]
         applied[k] = touching[i] or push[i] > 0.0
-    return (rows, keys, _at(ea, rows), _at(eb, rows), _at(nx, rows), _at(ny, rows), gap, _at(push, rows), capped,
-            _at(impulse, rows), _at(tpush, rows), _at(timpulse, rows), applied)
+    return ints, floats, applied
 
 
 @kernel
