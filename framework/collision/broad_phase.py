@@ -451,8 +451,9 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
     bounds strictly overlap its own (touching is no overlap): the static ones, the sleeping ones and
     the moving ones (each moving pair once, found from its lower row: the higher one must have a
     hitbox), whose layers and masks let them meet (unless ``layers_open``: every pair does). As
-    ``(entities a, entities b, rows a, rows b)``, a < b, sorted by pair key (``entity a << 32 |
-    entity b``), the rows looked up in ``lut`` (entity -> row, ``BodyStore.row_table``).
+    the rows of one int64 block, ``(entities a, entities b, rows a, rows b)``, a < b, sorted by
+    pair key (``entity a << 32 | entity b``), the rows looked up in ``lut`` (entity -> row,
+    ``BodyStore.row_table``).
 
     Few tests (:data:`SWEEP_FROM`): every mover against every such row. More: the movers sorted by
     their left edges are swept against each other (each one meets those whose left edge lies before
@@ -508,13 +509,12 @@ def direct_pairs(moving, kind, body, asleep, entity, minx, miny, maxx, maxy, sta
             grown[q] = out[q]
         out = grown
     order = argsort_ints(out[:m])
-    ea, eb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
-    ra, rb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+    pairs = np.empty((4, m), dtype=np.int64)  # (one block, its rows the columns: one array handed back)
     for q in range(m):
         key = out[order[q]]
-        ea[q], eb[q] = key >> 32, key & 0xFFFFFFFF
-        ra[q], rb[q] = lut[ea[q]], lut[eb[q]]
-    return ea, eb, ra, rb
+        a, b = key >> 32, key & 0xFFFFFFFF
+        pairs[0, q], pairs[1, q], pairs[2, q], pairs[3, q] = a, b, lut[a], lut[b]
+    return pairs
 
 
 @leaf

@@ -44,13 +44,13 @@ def _polygon_circle_pairs(settle):
                              exact):
         # pragma: no cover - compiled
         """``polygon_circle`` of the polygon rows ``poly[i]`` and circle rows ``circ[i]`` (``flip[i]``:
-        the circle is shape A of the pair, normals from it): the six contact columns, ``defer``
-        and ``pending`` (as :func:`~framework.collision.polygon_rows.polygon_pairs`)."""
+        the circle is shape A of the pair, normals from it): the contact columns, ``defer`` and
+        ``pending``, as ``(floats, flags)`` (as :func:`~framework.collision.polygon_rows.polygon_pairs`)."""
         n = poly.size
-        hit = np.zeros(n, dtype=np.bool_)
-        nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-        defer = np.zeros(n, dtype=np.bool_)
-        pending = np.zeros(n, dtype=np.bool_)
+        # (the columns as the rows of two blocks: each array handed back costs the caller)
+        floats, flags = np.zeros((5, n)), np.zeros((3, n), dtype=np.bool_)
+        nx, ny, depth, px, py = floats[0], floats[1], floats[2], floats[3], floats[4]
+        hit, defer, pending = flags[0], flags[1], flags[2]
         vx, vy, ex, ey = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
         s, ln, cd, cnx, cny = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
         for i in range(n):
@@ -142,7 +142,7 @@ def _polygon_circle_pairs(settle):
                 dep = r - dist
                 pxi, pyi = vx[vi], vy[vi]
             put_row(i, nxi, nyi, dep, pxi, pyi, e, ax, ay, hit, nx, ny, depth, px, py, defer)
-        return hit, nx, ny, depth, px, py, defer, pending
+        return floats, flags
 
     return polygon_circle_pairs
 
@@ -158,15 +158,16 @@ def _circle_pairs(settle):
 
     @kernel
     def circle_pairs(ra_rows, rb_rows, hx, hy, radius, exact):  # pragma: no cover - compiled
-        """``circle_circle`` of the circle rows ``(ra_rows[i], rb_rows[i])``: the six contact columns,
+        """``circle_circle`` of the circle rows ``(ra_rows[i], rb_rows[i])``: the contact columns,
         ``defer``, the rows left to the numpy kernel (touching to rounding where the exact decision
         on floats, :func:`~framework.collision.exact_sign.circles_excess`, cannot be made; a contact
-        beyond float64's range) and ``pending``, the rows left to the settling variant."""
+        beyond float64's range) and ``pending``, the rows left to the settling variant, as
+        ``(floats, flags)`` (as :func:`~framework.collision.polygon_rows.polygon_pairs`)."""
         n = ra_rows.size
-        hit = np.zeros(n, dtype=np.bool_)
-        nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-        defer = np.zeros(n, dtype=np.bool_)
-        pending = np.zeros(n, dtype=np.bool_)
+        # (the columns as the rows of two blocks: each array handed back costs the caller)
+        floats, flags = np.zeros((5, n)), np.zeros((3, n), dtype=np.bool_)
+        nx, ny, depth, px, py = floats[0], floats[1], floats[2], floats[3], floats[4]
+        hit, defer, pending = flags[0], flags[1], flags[2]
         for i in range(n):
             a, b = ra_rows[i], rb_rows[i]
             ax, ay, bx, by, ar, br = hx[a], hy[a], hx[b], hy[b], radius[a], radius[b]
@@ -204,7 +205,7 @@ def _circle_pairs(settle):
             hi = dist + rb if dist + rb < ra else ra
             mid = 0.5 * (lo + hi)
             put_row(i, nxi, nyi, dep, nxi * mid, nyi * mid, e, ax, ay, hit, nx, ny, depth, px, py, defer)
-        return hit, nx, ny, depth, px, py, defer, pending
+        return floats, flags
 
     return circle_pairs
 

@@ -240,14 +240,15 @@ def _polygon_pairs(settle):
     @kernel
     def polygon_pairs(ra, rb, hx, hy, kind, hw, hh, world_poly, poly_slot, count, k, exact, points):
         # pragma: no cover - compiled
-        """``polygon_polygon`` of the pairs of rows ``(ra[i], rb[i])`` (module docstring): the six
-        contact columns, ``defer`` (the rows left to the numpy kernel) and ``pending`` (the rows
-        left to the settling variant)."""
+        """``polygon_polygon`` of the pairs of rows ``(ra[i], rb[i])`` (module docstring), as
+        ``(floats, flags)``: the rows of ``floats`` the contact columns ``nx, ny, depth, px, py``,
+        of ``flags`` ``hit``, ``defer`` (the rows left to the numpy kernel) and ``pending`` (the
+        rows left to the settling variant)."""
         n = ra.size
-        hit = np.zeros(n, dtype=np.bool_)
-        nx, ny, depth, px, py = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-        defer = np.zeros(n, dtype=np.bool_)
-        pending = np.zeros(n, dtype=np.bool_)
+        # (the columns as the rows of two blocks: each array handed back costs the caller)
+        floats, flags = np.zeros((5, n)), np.zeros((3, n), dtype=np.bool_)
+        nx, ny, depth, px, py = floats[0], floats[1], floats[2], floats[3], floats[4]
+        hit, defer, pending = flags[0], flags[1], flags[2]
         extreme = np.zeros(n, dtype=np.bool_)
         avx, avy, bvx, bvy = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
         ux, uy, fwd, bwd = np.empty(2 * k), np.empty(2 * k), np.empty(2 * k), np.empty(2 * k)
@@ -353,7 +354,7 @@ def _polygon_pairs(settle):
                     bvy[j] += dy
                 pxi, pyi = _overlap_point(avx, avy, ac, bvx, bvy, bc, nxi, nyi, dep, sz, exa, eya, exb, eyb, na, nb)
             put_row(i, nxi, nyi, dep, pxi, pyi, e, ax, ay, hit, nx, ny, depth, px, py, defer)
-        return hit, nx, ny, depth, px, py, defer, pending
+        return floats, flags
 
     return polygon_pairs
 

@@ -198,10 +198,10 @@ def _with_deferred(cols: tuple[Any, ...], settle: Callable[[IntpArray], tuple[An
     where contacts must be exact) answered by ``settle(rows)``, the pass's settling variant (whose
     exact functions compile only when a scene first has such a row), then its rows marked ``defer``
     by ``answer(rows)``, the numpy kernel (a row's answer does not depend on its batch)."""
-    hit, nx, ny, depth, px, py, defer, pending = cols
+    (nx, ny, depth, px, py), (hit, defer, pending) = cols
     if pending.any():
         p = np.flatnonzero(pending)
-        hit[p], nx[p], ny[p], depth[p], px[p], py[p], defer[p], _ = settle(p)
+        (nx[p], ny[p], depth[p], px[p], py[p]), (hit[p], defer[p], _) = settle(p)
     if defer.any():
         d = np.flatnonzero(defer)
         hit[d], nx[d], ny[d], depth[d], px[d], py[d] = answer(d)
