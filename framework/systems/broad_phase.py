@@ -76,6 +76,11 @@ class BroadPhase(Stage):
             ea, eb = pair_parts(keys)
             ra, rb = bodies.rows_of(ea), bodies.rows_of(eb)
         else:
+            if way == "update":
+                asleep = frame.n_asleep
+                if not kept.update(all_bounds, store.cols["entity"], bodies.hash.cell_size,
+                                   lambda fat, ids: self._still_pairs(fat, ids, asleep), store.row_table()):
+                    way = "build"
             if way == "build":
                 fat = kept.fat(movers, all_bounds)
                 keys = self._hashed(fat, store.entity[moving], frame.n_asleep)
@@ -103,6 +108,15 @@ class BroadPhase(Stage):
             if sa.size:
                 keys = np.concatenate([keys, pair_keys(sa, sb)])
                 keys.sort()
+        return keys
+
+    def _still_pairs(self, bounds: Bounds, ids: I64Array, asleep: int) -> I64Array:
+        """The pair keys of the bodies ``bounds`` (``ids`` their entities) with the statics and
+        (``asleep``: there are some) the sleepers, by the spatial hashes (not sorted)."""
+        bodies = self.bodies
+        keys = pair_keys(*bodies.hash.static_pairs(*bounds, ids))
+        if asleep:
+            keys = np.concatenate([keys, pair_keys(*bodies.sleep_hash.static_pairs(*bounds, ids))])
         return keys
 
     def _someone_reads(self, ra: IntpArray, rb: IntpArray) -> BoolArray:
