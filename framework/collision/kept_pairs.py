@@ -147,12 +147,14 @@ def _grid_candidates(left, moving, fx0, fy0, fx1, fy1, cell, entity, most_cells)
 
 
 @kernel
-def _merged(keys, ra, rb, stay, more, lut):  # pragma: no cover - compiled
-    """The candidates ``keys, ra, rb`` (sorted by key) where ``stay``, merged with the pair keys
-    ``more`` (sorted, none of them among those): ``(keys, ra, rb)``, sorted by key, the rows of
-    ``more``'s looked up in ``lut`` (entity -> row, ``BodyStore.row_table``)."""
+def _merged(keys, ra, rb, gone, more, lut):  # pragma: no cover - compiled
+    """The candidates ``keys, ra, rb`` (sorted by key) of neither of whose rows ``gone`` is set,
+    merged with the pair keys ``more`` (sorted, none of them among those): ``(keys, ra, rb)``, sorted
+    by key, the rows of ``more``'s looked up in ``lut`` (entity -> row, ``BodyStore.row_table``)."""
+    stay = np.empty(keys.size, dtype=np.bool_)
     m = 0
     for k in range(keys.size):
+        stay[k] = not (gone[ra[k]] or gone[rb[k]])
         if stay[k]:
             m += 1
     t = m + more.size
@@ -281,10 +283,9 @@ class KeptPairs:
             return False
         gone = np.zeros(entity.size, dtype=bool)
         gone[rows] = True
-        stay = ~(gone[self._ra] | gone[self._rb])
         more = others((fx0[left], fy0[left], fx1[left], fy1[left]), entity[rows])
         new = np.sort(np.concatenate([mine, more]))
-        self._keys, self._ra, self._rb = _merged(self._keys, self._ra, self._rb, stay, new, lut)
+        self._keys, self._ra, self._rb = _merged(self._keys, self._ra, self._rb, gone, new, lut)
         self._built_last = False
         self.updates += 1
         return True

@@ -29,6 +29,8 @@ from .stage import Stage
 
 __all__ = ["BroadPhase"]
 
+_NO_KEYS = np.zeros(0, dtype=np.int64)
+
 
 class BroadPhase(Stage):
     """Fill ``frame.pairs`` (entities a < b and their rows) and ``frame.n_asleep``."""
@@ -114,7 +116,7 @@ class BroadPhase(Stage):
         """The pair keys of the bodies ``bounds`` (``ids`` their entities) with the statics and
         (``asleep``: there are some) the sleepers, by the spatial hashes (not sorted)."""
         bodies = self.bodies
-        keys = pair_keys(*bodies.hash.static_pairs(*bounds, ids))
+        keys = pair_keys(*bodies.hash.static_pairs(*bounds, ids)) if bodies.n_static else _NO_KEYS
         if asleep:
             keys = np.concatenate([keys, pair_keys(*bodies.sleep_hash.static_pairs(*bounds, ids))])
         return keys
