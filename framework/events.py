@@ -150,9 +150,6 @@ def sorted_member(keys: NDArray[np.int64], table: NDArray[np.int64]) -> NDArray[
     return sorted_find(keys, table)[1]
 
 
-_NO_KEYS = np.zeros(0, dtype=np.int64)  # (empty: nothing can write to it)
-
-
 class PairTracker:
     """Turns each step's overlapping pairs into started / ongoing / ended events."""
 
@@ -163,7 +160,7 @@ class PairTracker:
     def update(self, now: StepContacts) -> tuple[NDArray[np.bool_], NDArray[np.bool_], StepContacts]:
         """Record this step's pairs; return (started mask over ``now``, ongoing mask, ended pairs)."""
         if now.a.size == 0 and self.keys.size == 0:  # (nothing touches, nor did: no merge to make)
-            self.active, self.keys = now, _NO_KEYS
+            self.active = now  # (the keys: still none)
             return np.zeros(0, dtype=bool), np.zeros(0, dtype=bool), StepContacts.empty()
         keys, was, gone = track_pairs(now.a, now.b, self.keys)  # (one compiled merge)
         ended = self.active.take(gone) if gone.size else StepContacts.empty()

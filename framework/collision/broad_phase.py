@@ -239,11 +239,7 @@ class SpatialHash:
             self._enter((b[0], b[1], b[2], b[3]), ids, None, copied=True)
             return
         # (the step's own call: int64 ids, one per body, a cell size chosen: _enter without its checks)
-        self._moving = _FewBodies((b[0], b[1], b[2], b[3]))
-        self._moving_cells = None
-        self._queries = 0
-        self._moving_ids = ids.copy()
-        self.rehashed_last = b[0].shape[0]
+        self._take_moving(_FewBodies((b[0], b[1], b[2], b[3])), ids)
 
     def _enter(self, b: Bounds, ids: ArrayLike, strips: StripSweep | None, copied: bool = False) -> None:
         """Take the moving bodies of a step: swept into ``strips``, or (None) kept as they are,
@@ -251,12 +247,18 @@ class SpatialHash:
         from them if none was yet."""
         mids = _as_ids(ids, b[0].shape[0])
         self._choose_cell(b)
-        self._moving = strips if strips is not None else _FewBodies(b if copied else (b[0].copy(), b[1].copy(),
-                                                                                      b[2].copy(), b[3].copy()))
+        self._take_moving(strips if strips is not None else _FewBodies(b if copied else (b[0].copy(), b[1].copy(),
+                                                                                         b[2].copy(), b[3].copy())),
+                          mids)
+
+    def _take_moving(self, moving: StripSweep | _FewBodies, ids: NDArray[np.int64]) -> None:
+        """The step's moving bodies ``moving`` (a copy of ``ids`` their ids) in place of the last
+        step's, with nothing indexed for queries yet."""
+        self._moving = moving
         self._moving_cells = None
         self._queries = 0
-        self._moving_ids = mids.copy()
-        self.rehashed_last = b[0].shape[0]
+        self._moving_ids = ids.copy()
+        self.rehashed_last = moving.n
 
     def static_pairs(
         self, minx: ArrayLike, miny: ArrayLike, maxx: ArrayLike, maxy: ArrayLike, ids: ArrayLike,

@@ -225,13 +225,11 @@ def gather(ca, cb, cnx, cny, cdepth, cpx, cpy, cra, crb, sa, sb, snx, sny, spush
     # this step's contacts, then the pairs kept
     # (as two blocks, the rows of which are the columns: each array handed back costs the caller)
     t = m + n_keep
-    ints, floats = np.empty((4, t), dtype=np.int64), np.empty((9, t))
+    ints, floats = np.empty((4, t), dtype=np.int64), np.zeros((9, t))  # (a kept pair's point: 0)
     ra, rb, ea, eb = ints[0], ints[1], ints[2], ints[3]
     onx, ony, odepth, opush, oimp, otpush, otimp, opx, opy = (floats[0], floats[1], floats[2], floats[3], floats[4],
                                                               floats[5], floats[6], floats[7], floats[8])
     alive0 = np.zeros(t, dtype=np.bool_)
-    opx[:] = 0.0
-    opy[:] = 0.0
     for i in range(m):
         ra[i], rb[i], ea[i], eb[i] = cra[i], crb[i], ca[i], cb[i]
         onx[i], ony[i], odepth[i], alive0[i] = nx[i], ny[i], depth[i], True

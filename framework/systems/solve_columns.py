@@ -69,22 +69,20 @@ def _kept_still(b_on_a, a_on_b, share_a, share_b):  # pragma: no cover - compile
 def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g):  # pragma: no cover
     """The columns of :meth:`Solve._columns` (and its ``order``), as ``(per_body, per_contact,
     immovable, order)``: per body (``rows``, the rows of ``per_body``) its ``span`` (half its
-    half-thickness) and ``reach`` (with statics: the span, not written; else infinite); per contact
-    ``(ra, rb)`` (the rows of ``per_contact``) its bodies' inverse masses ``wa, wb`` (a sleeper's
-    0) and the shares of a push by them; whether a body is immovable, and the contacts' order from
-    the bottom of a pile up (immovable first; along gravity ``(gx, gy)`` of length ``g``; in pair
-    order without)."""
+    half-thickness) and an infinite ``reach`` (with statics the reach is the span: the caller's to
+    take); per contact ``(ra, rb)`` (the rows of ``per_contact``) its bodies' inverse masses ``wa,
+    wb`` (a sleeper's 0) and the shares of a push by them; whether a body is immovable, and the
+    contacts' order from the bottom of a pile up (immovable first; along gravity ``(gx, gy)`` of
+    length ``g``; in pair order without)."""
     n = rows.size
     # (the float columns as the rows of two blocks, per body and per contact: each array handed
     # back costs the caller; the reach with statics is the span itself, the caller's to take)
-    per_body = np.empty((2, n))
+    per_body = np.full((2, n), np.inf)
     span = per_body[0]
     for k in range(n):
         r = rows[k]
         half = _np_min(hw[r], hh[r]) if hw[r] > 0.0 else 0.5 * bound[r]
         span[k] = 0.5 * half
-    if not statics:
-        per_body[1, :] = np.inf
     c = ra.size
     per_contact = np.empty((4, c))
     wa, wb, share_a, share_b = per_contact[0], per_contact[1], per_contact[2], per_contact[3]
