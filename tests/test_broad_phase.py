@@ -593,6 +593,58 @@ def test_moving_pairs_false_gives_only_moving_static_pairs():
     assert np.array_equal(h.query_box(0.0, 0.0, 50.0, 50.0), before)
 
 
+odd_box = st.sampled_from([(math.nan, 0.0, 1.0, 1.0), (1.0, 1.0, math.inf, math.inf),
+                           (-math.inf, -math.inf, 0.5, 0.5), (-1e300, -4.0, 1e300, 4.0), (-30.0, -30.0, 30.0, 30.0),
+                           (2.0, 2.0, 2.0, 2.0)])
+
+
+@settings(max_examples=300, deadline=None)
+@given(scenes(), scenes(), cells, st.booleans(), st.lists(odd_box, max_size=3))
+def test_static_pairs_are_the_brute_force_pairs(statics, queries, cell, sparse, odd):
+    """``static_pairs`` (each box looking in the statics' cells it covers, one compiled pass) gives
+    exactly brute force's box-static pairs: boxes on cell borders, touching, copied, wider than the
+    large limit, not finite; statics in a dense table of cells or (one static far away: a grid too
+    sparse for one) found by search; large statics among the small ones."""
+    sb, _ = statics
+    qb, _ = queries
+    if sparse:  # a static 1e6 cells away: the used cells are searched, not tabled
+        sb = tuple(np.append(v, w) for v, w in zip(sb, (1e6, 1e6, 1e6 + 1.0, 1e6 + 1.0), strict=True))
+    qb = tuple(np.append(v, [o[k] for o in odd]) for k, v in enumerate(qb))
+    n_s, n_q = sb[0].size, qb[0].size
+    h = SpatialHash(cell if cell is not None else 1.0)
+    h.set_static(*sb, np.arange(n_s, dtype=np.int64) + 1000)
+    a, b = h.static_pairs(*qb, np.arange(n_q, dtype=np.int64))
+    both = tuple(np.concatenate([q, s]) for q, s in zip(qb, sb, strict=True))
+    i, j = brute_force_pairs(*both, static=np.arange(n_q + n_s) >= n_q)
+    cross = j >= n_q  # (brute force pairs the boxes among themselves too)
+    assert np.array_equal(a, i[cross]) and np.array_equal(b, j[cross] + 1000 - n_q)
+
+
+@pytest.mark.parametrize("far", [False, True])
+def test_static_pairs_of_tiles_a_large_static_and_a_far_one(far):
+    """Hand case of ``static_pairs``' two ways of finding a cell (a table; a search where one static
+    1e6 cells away leaves the grid too sparse for a table) and of its large statics: 200 unit tiles
+    edge to edge, a static 500 wide, boxes on tile borders, touching tiles, spanning many cells."""
+    tx = np.arange(200, dtype=np.float64) - 100.0
+    sb = [tx, np.full(200, -1.0), tx + 1.0, np.zeros(200)]
+    extra = [(-250.0, -10.0, 250.0, -9.0)] + ([(1e6, 1e6, 1e6 + 1.0, 1e6 + 1.0)] if far else [])
+    sb = [np.append(v, [e[k] for e in extra]) for k, v in enumerate(sb)]
+    h = SpatialHash(1.0)
+    h.set_static(*sb, np.arange(sb[0].size, dtype=np.int64) + 1000)
+    assert (h._static.dense.size == 0) == far and h._static.large.size == 1
+    qb = boxes((0.0, -0.5, 1.0, 0.5),  # on tile borders: one tile
+               (0.5, 0.0, 1.5, 1.0),  # touching two tiles from above: none
+               (-3.25, -9.5, 3.25, -0.25),  # over the large static and seven tiles
+               (-90.0, -2.0, 90.0, 2.0),  # past the large limit: tested against every static
+               (1e6 + 0.5, 1e6 + 0.5, 1e6 + 0.75, 1e6 + 0.75))  # inside the far static (if any)
+    a, b = h.static_pairs(*qb, np.arange(5, dtype=np.int64))
+    both = tuple(np.concatenate([q, s]) for q, s in zip(qb, sb, strict=True))
+    i, j = brute_force_pairs(*both, static=np.arange(5 + sb[0].size) >= 5)
+    cross = j >= 5  # (brute force pairs the boxes among themselves too)
+    assert np.array_equal(a, i[cross]) and np.array_equal(b, j[cross] + 1000 - 5)
+    assert np.bincount(a, minlength=5).tolist() == [1, 0, 9, 180, int(far)]
+
+
 @pytest.mark.parametrize("large", [False, True])
 def test_near_statics_never_misses_a_static_pair(large):
     rng = np.random.default_rng(3)

@@ -37,6 +37,7 @@ from ..validation import InvalidValue, finite, positive
 from . import grid
 from .box_rows import lower_bound
 from .grid import Bounds, CellIndex, StripSweep, as_bounds, overlap_pairs, strict_overlap, subset
+from .static_cells import static_cross
 
 __all__ = ["SpatialHash", "brute_force_pairs"]
 
@@ -276,14 +277,17 @@ class SpatialHash:
     def _near_static_pairs(
         self, b: Bounds, ids: NDArray[np.int64], out_a: list[NDArray[np.int64]], out_b: list[NDArray[np.int64]],
     ) -> None:
-        """Append the pairs of the bodies ``b`` (ids ``ids``) with the statics: only the bodies near
-        a static are swept against them."""
-        if b[0].shape[0] == 0 or self._static.n == 0:
+        """Append the pairs of the bodies ``b`` (ids ``ids``) with the statics: each body looks in
+        the statics' cells it covers (one compiled pass, :func:`~.static_cells.static_cross`)."""
+        stat = self._static
+        if b[0].shape[0] == 0 or stat.n == 0:
             return
-        near = np.flatnonzero(self._near_statics(b))
-        if near.size:
-            nb = subset(b, near)
-            self._cross_static(StripSweep(nb, self._choose_cell(nb)), nb, ids[near], out_a, out_b)
+        # (one compiled pass over the statics' cells: static_cells.static_cross)
+        i, s = static_cross(*(np.ascontiguousarray(v) for v in b), stat.cell, stat.x0, stat.y0, stat.wx, stat.wy,
+                            stat.ukey, stat.bound, stat.dense, stat.body, *stat.ebounds, stat.large, *stat.bounds)
+        if i.size:
+            out_a.append(ids[i])
+            out_b.append(self._static_ids[s])
 
     def outside_statics(self, minx: float, miny: float, maxx: float, maxy: float) -> bool:
         """Whether the box surely meets no static body: it lies outside the box around every static

@@ -348,6 +348,12 @@ class CellIndex:
     def entries(self) -> int:
         return self.key.shape[0]
 
+    @property
+    def dense(self) -> NDArray[np.int64]:
+        """The table cell key -> number of the used cell (-1: empty), or an empty array where the
+        grid is too sparse for one (the used cells' keys ``ukey`` are then searched)."""
+        return _EMPTY_I if self._dense is None else self._dense
+
     # for query flags f = 0..3: the code range [_LO[f], _HI[f]) of the partners (see __init__)
     _LO = np.array([2, 2, 1, 0], dtype=_I64)
     _HI = np.array([3, 4, 3, 4], dtype=_I64)
