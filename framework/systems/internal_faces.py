@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from ..arrays import BoolArray, F64Array, I64Array, IntpArray, distinct
 from ..collision.broad_phase import SpatialHash
-from ..compiled import kernel
+from ..compiled import kernel, leaf
 from ..geometry import Geometry
 from ..store import KIND_AABB, STATIC, BodyStore
 
@@ -165,58 +165,81 @@ class InternalFaces:
         normals like (-1, 4e-11)) leaves through the face it is the normal of; a corner's (a circle
         or a polygon's corner off the box's corner) through the two faces that meet there: if one
         of them is covered, the corner is that face's end (a ball rolling over the seam of two tiles
-        is on the floor, not on a bump)."""
+        is on the floor, not on a bump). (One compiled pass, :func:`covered_exits`; asked again once
+        the faces of boxes met for the first time are known.)"""
         c = store.cols
-        # (one compiled pass: the candidates, their static boxes, and whether one of those may have a
-        # covered face: its bits not yet known, or known and not 0)
-        cand, t, maybe = static_box_contacts(ra, rb, among, c["body"], c["kind"], STATIC, KIND_AABB,
-                                             self._table(store), _UNKNOWN)
-        if cand.size == 0 or not maybe:
-            return None  # (no box here has a covered face: a floor of one piece)
-        static_a = store.body[ra[cand]] == STATIC
-        faces = self.masks(store, geom, hash_, rows_of, t)
-        if not faces.any():
-            return None  # (no box here has a covered face: a floor of one piece)
-        m = np.where(static_a, rb[cand], ra[cand])  # the body pushed out of it
-        sgn = np.where(static_a, 1.0, -1.0)  # the body moves along sgn * n
-        px, py = nx[cand] * sgn, ny[cand] * sgn
-        cov_x = (faces & np.where(px < 0, LEFT, RIGHT).astype(np.uint8)) != 0
-        cov_y = (faces & np.where(py < 0, DOWN, UP).astype(np.uint8)) != 0
-        along_x = np.abs(py) <= AXIS_TOLERANCE
-        along_y = ~along_x & (np.abs(px) <= AXIS_TOLERANCE)
-        corner = ~(along_x | along_y)
-        # the covered face it leaves through: its axis's; at a corner, the covered one of the two
-        # (both covered: the one nearer the normal)
-        use_x = along_x | (corner & np.where(cov_x != cov_y, cov_x, np.abs(px) >= np.abs(py)))
-        bad = np.where(use_x, cov_x, cov_y)
-        if not bad.any():
-            return None
-        px, py = np.where(use_x, np.sign(px), 0.0), np.where(use_x, 0.0, np.sign(py))
-        return cand[bad], t[bad], m[bad], sgn[bad], faces[bad], px[bad], py[bad]
+        table = self._table(store)
+        while True:
+            ints, floats, todo = covered_exits(ra, rb, among, nx, ny, c["body"], c["kind"], STATIC, KIND_AABB, table,
+                                               _UNKNOWN, AXIS_TOLERANCE)
+            if todo.size == 0:
+                break
+            self.masks(store, geom, hash_, rows_of, todo)  # (their faces, into the table)
+        if ints.shape[1] == 0:
+            return None  # (no push here leaves a box through a covered face)
+        cand, t, m, faces = ints
+        sgn, px, py = floats
+        return cand, t, m, sgn, faces, px, py
 
 
 @kernel
-def static_box_contacts(ra, rb, among, body, kind, static, box, faces, unknown):  # pragma: no cover - compiled
-    """The indices, in order, of the contacts ``among`` these between a static body and one that is
-    not, the static one a box (``InternalFaces._through_covered``'s candidates), those boxes' rows,
-    and whether one of them may have a covered face (its bits in ``faces`` are ``unknown`` or not
-    0): ``(indices, box rows, maybe)``."""
-    out = np.empty(ra.size, dtype=np.int64)
-    boxes = np.empty(ra.size, dtype=np.int64)
-    n = 0
-    maybe = False
-    for i in range(ra.size):
+def covered_exits(ra, rb, among, nx, ny, body, kind, static, box, faces, unknown, tolerance):
+    # pragma: no cover - compiled
+    """``InternalFaces._through_covered`` over the contacts ``among`` these: those between a static
+    box and a body that is not static whose push (normal ``nx, ny``, the body moving along ``sign *
+    n``) leaves the box through a face its bits in ``faces`` say is covered, as ``(ints, floats,
+    todo)``: the rows of ``ints`` (index, box row, body row, the box's face bits), of ``floats``
+    (sign, push x, push y). Where some such box's bits are not known yet (``unknown``), nothing but
+    ``todo``, those boxes' rows (with repeats), for the caller to work out first."""
+    n = ra.size
+    idx = np.empty(n, dtype=np.int64)
+    todo = np.empty(n, dtype=np.int64)
+    k = w = 0
+    for i in range(n):
         if not among[i]:
             continue
         a, b = ra[i], rb[i]
         static_a, static_b = body[a] == static, body[b] == static
         t = a if static_a else b
         if static_a != static_b and kind[t] == box:
-            out[n] = i
-            boxes[n] = t
-            n += 1
-            maybe = maybe or faces[t] != 0
-    return out[:n], boxes[:n], maybe
+            if faces[t] == unknown:
+                todo[w] = t
+                w += 1
+            elif faces[t] != 0:  # (a box with no covered face re-aims nothing)
+                idx[k] = i
+                k += 1
+    if w:
+        k = 0  # (the boxes' faces first)
+    ints, floats = np.empty((4, k), dtype=np.int64), np.empty((3, k))
+    m = 0
+    for j in range(k):
+        i = idx[j]
+        static_a = body[ra[i]] == static
+        t, mover = (ra[i], rb[i]) if static_a else (rb[i], ra[i])
+        sgn = 1.0 if static_a else -1.0
+        px, py = nx[i] * sgn, ny[i] * sgn
+        f = faces[t]
+        cov_x = (f & (LEFT if px < 0 else RIGHT)) != 0
+        cov_y = (f & (DOWN if py < 0 else UP)) != 0
+        along_x = abs(py) <= tolerance
+        along_y = not along_x and abs(px) <= tolerance
+        # the covered face it leaves through: its axis's; at a corner, the covered one of the two
+        # (both covered: the one nearer the normal)
+        use_x = along_x or (not along_y and (cov_x if cov_x != cov_y else abs(px) >= abs(py)))
+        if not (cov_x if use_x else cov_y):
+            continue
+        ints[0, m], ints[1, m], ints[2, m], ints[3, m] = i, t, mover, f
+        floats[0, m] = sgn
+        floats[1, m] = _sign(px) if use_x else 0.0
+        floats[2, m] = 0.0 if use_x else _sign(py)
+        m += 1
+    return ints[:, :m], floats[:, :m], todo[:w]
+
+
+@leaf
+def _sign(x):  # pragma: no cover - compiled
+    """``np.sign`` of a float (0.0 for either zero, as numpy; numba's keeps -0.0)."""
+    return 1.0 if x > 0.0 else -1.0 if x < 0.0 else x if x != x else 0.0
 
 
 def _extent(store: BodyStore, geom: Geometry, rows: IntpArray) -> tuple[F64Array, F64Array, F64Array, F64Array]:

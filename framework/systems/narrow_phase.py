@@ -31,11 +31,13 @@ from ..collision.kinds import (
     KIND_CIRCLE,
     KIND_POLYGON,
     KIND_SEGMENT,
+    KINDS,
     PAIRS,
     POLYGON_CIRCLE,
     POLYGONS,
     pair_code,
 )
+from ..collision.measure_rows import measure_rows
 from ..collision.pair_classes import FAMILY_OF_CODE, classify_pairs
 from ..collision.polygon_rows import polygon_pairs, polygon_pairs_settled
 from ..events import PairTracker, StepContacts
@@ -52,6 +54,7 @@ __all__ = ["NarrowPhase", "filter_layers", "pair_contacts"]
 _PAIR_NAME = [rule.name for rule in PAIRS.values()]
 _PAIR_FAMILY = FAMILY_OF_CODE
 _PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
+_N_KINDS = np.int64(len(KINDS))
 _FAMILIES = (BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS, CAPSULES)
 
 
@@ -139,6 +142,37 @@ def _pair_contacts(
     P = ra.size
     if P == 0:
         return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))
+    if remeasure and counts is None:  # (the solve's re-measures: every family in one compiled call)
+        res = _measured_at_once(store, geom, ra, rb)
+        if res is not None:
+            return res
+    return _by_families(store, geom, ra, rb, counts, remeasure)
+
+
+def _measured_at_once(store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray) -> batch.ContactArrays | None:
+    """The pairs ``(ra, rb)`` of boxes, polygons and circles measured again (``remeasure``) in one
+    compiled call (:func:`~framework.collision.measure_rows.measure_rows`, the families' own
+    kernels), the rows those leave to their numpy or settling variants answered as
+    :func:`_by_families` answers them (a row's answer does not depend on its batch); None where a
+    pair has another shape (a capsule) or a row no hitbox."""
+    a, b = np.ascontiguousarray(ra, dtype=np.int64), np.ascontiguousarray(rb, dtype=np.int64)
+    floats, flags, ok = measure_rows(a, b, store.kind, _N_KINDS, _PAIR_FAMILY, _PAIR_FLIP, geom.hx, geom.hy, store.hw,
+                                     store.hh, store.radius, geom.world_poly, geom.poly_slot, geom.count, geom.K,
+                                     False, False)
+    if not ok:
+        return None
+    hit, left = flags
+    nx, ny, depth, px, py = floats
+    if left.any():
+        d = np.flatnonzero(left)
+        hit[d], nx[d], ny[d], depth[d], px[d], py[d] = _by_families(store, geom, a[d], b[d], None, True)
+    return batch.ContactArrays(hit, nx, ny, depth, px, py)
+
+
+def _by_families(store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray, counts: dict[str, int] | None,
+                 remeasure: bool) -> batch.ContactArrays:
+    """:func:`_pair_contacts` family by family: one kernel call per family of pairs present."""
+    P = ra.size
     kinds = store.kinds_present()
     if len(kinds) == 1 and not kinds & {KIND_POLYGON, KIND_CAPSULE, KIND_SEGMENT}:  # boxes alone, or circles alone
         k = next(iter(kinds))
