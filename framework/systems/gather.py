@@ -299,12 +299,16 @@ def solid_pair(a, b, kind, sensor, inv_mass, asleep, one_way, layer, mask, layer
 
 
 @kernel
-def centres_inside(ra, rb, hit, body, kind, static, box, hx, hy, minx, maxx, miny, maxy):  # pragma: no cover
+def centres_inside(ra, rb, hit, body, kind, static, box, hx, hy, minx, maxx, miny, maxy, faces):
+    # pragma: no cover - compiled
     """The contacts (``hit``) between one static box and a body of another kind of row whose
     hitbox origin lies strictly inside the box's bounds: their indices, in order (the candidates of
-    ``Response._deep_inside``)."""
+    ``Response._deep_inside``); and whether some contact between a static box and a body that is
+    not static has a box whose face bits in ``faces`` are not 0, or not known yet (one may leave it
+    through a covered face: ``InternalFaces.redirect`` has work)."""
     out = np.empty(ra.size, dtype=np.int64)
     n = 0
+    covered = False
     for i in range(ra.size):
         if not hit[i]:
             continue
@@ -314,8 +318,10 @@ def centres_inside(ra, rb, hit, body, kind, static, box, hx, hy, minx, maxx, min
         if static_a == static_b:
             continue
         s, m = (b, a) if static_b else (a, b)
+        if body[m] != static and faces[s] != 0:  # (not known yet: not 0 either)
+            covered = True
         cx, cy = hx[m], hy[m]
         if minx[s] < cx and cx < maxx[s] and miny[s] < cy and cy < maxy[s]:
             out[n] = i
             n += 1
-    return out[:n]
+    return out[:n], covered

@@ -48,13 +48,13 @@ class InternalFaces:
     def masks(self, store: BodyStore, geom: Geometry, hash_: SpatialHash, rows_of: RowsOf,
               rows: IntpArray) -> NDArray[np.uint8]:
         """Face bits of the static AABB ``rows`` (0 for rows of other kinds)."""
-        self._table(store)
+        self.table(store)
         todo = distinct(rows[self._mask[rows] == _UNKNOWN])
         if todo.size:
             self._mask[todo] = self._compute(store, geom, hash_, rows_of, todo)
         return self._mask[rows]
 
-    def _table(self, store: BodyStore) -> NDArray[np.uint8]:
+    def table(self, store: BodyStore) -> NDArray[np.uint8]:
         """The face bits per row, as far as known (``_UNKNOWN``: not yet), for the current statics."""
         key = (store.version, store.static_epoch, store.n)
         if key != self._key:
@@ -168,7 +168,7 @@ class InternalFaces:
         is on the floor, not on a bump). (One compiled pass, :func:`covered_exits`; asked again once
         the faces of boxes met for the first time are known.)"""
         c = store.cols
-        table = self._table(store)
+        table = self.table(store)
         while True:
             ints, floats, todo = covered_exits(ra, rb, among, nx, ny, c["body"], c["kind"], STATIC, KIND_AABB, table,
                                                _UNKNOWN, AXIS_TOLERANCE)

@@ -55,6 +55,7 @@ _PAIR_NAME = [rule.name for rule in PAIRS.values()]
 _PAIR_FAMILY = FAMILY_OF_CODE
 _PAIR_FLIP = np.array([rule.flip for rule in PAIRS.values()])
 _N_KINDS = np.int64(len(KINDS))
+_BOXES_ALONE = frozenset({KIND_AABB})
 _FAMILIES = (BOXES, CIRCLES, POLYGON_CIRCLE, POLYGONS, CAPSULES)
 
 
@@ -142,7 +143,9 @@ def _pair_contacts(
     P = ra.size
     if P == 0:
         return batch.ContactArrays(np.zeros(0, dtype=bool), *(np.zeros(0) for _ in range(5)))
-    if remeasure and counts is None:  # (the solve's re-measures: every family in one compiled call)
+    if remeasure and counts is None and store.kinds_present() != _BOXES_ALONE:
+        # (the solve's re-measures: every family in one compiled call; boxes alone are one lean
+        # kernel call already)
         res = _measured_at_once(store, geom, ra, rb)
         if res is not None:
             return res

@@ -222,16 +222,22 @@ class Response(Stage):
         b = self.bodies
         if b.n_static == 0:
             return
-        body = b.store.body
-        if not ((body[ra] == STATIC).any() or (body[rb] == STATIC).any()):  # (both re-aim only pushes off statics)
-            return
-        self._deep_inside(ra, rb, nx, ny, depth, hit)
-        rank = depth.copy()
-        self.internal_faces.redirect(b.store, b.geometry, b.hash, b.rows_of, ra, rb, nx, ny, depth, hit, rank)
+        store, geom = b.store, b.geometry  # (the callers' measures brought the origins up to date)
+        c = store.cols
+        # (one compiled pass: the contacts with one static box whose body's centre is inside it, and
+        # whether a box met may have a covered face; both re-aim only pushes off static boxes)
+        inside, covered = centres_inside(ra, rb, hit, c["body"], c["kind"], STATIC, KIND_AABB, geom.hx, geom.hy,
+                                         geom.minx, geom.maxx, geom.miny, geom.maxy, self.internal_faces.table(store))
+        if inside.size:
+            self._deep_inside(ra, rb, nx, ny, depth, inside)
+        if covered:
+            rank = depth.copy()
+            self.internal_faces.redirect(store, geom, b.hash, b.rows_of, ra, rb, nx, ny, depth, hit, rank)
 
     def _deep_inside(self, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array, depth: F64Array,
-                     hit: BoolArray) -> None:
-        """Re-aim (in place) the pushes of movable bodies whose centre lies inside a static AABB.
+                     pick: IntpArray) -> None:
+        """Re-aim (in place) the pushes of the contacts ``pick``, of movable bodies whose centre lies
+        inside a static AABB (``gather.centres_inside``).
 
         The least push out of a slab is through its nearer face: a box spawned or teleported into
         the middle of a floor one unit thick was pushed out of its bottom (the tie between top and
@@ -245,12 +251,6 @@ class Response(Stage):
         :mod:`~framework.systems.internal_faces`, which runs after this.)"""
         store = self.bodies.store
         geom = self.bodies.geometry  # (the callers' measures brought the origins up to date)
-        c = store.cols
-        # (one compiled pass: the contacts with one static box whose body's centre is inside it)
-        pick = centres_inside(ra, rb, hit, c["body"], c["kind"], STATIC, KIND_AABB, geom.hx, geom.hy, geom.minx,
-                              geom.maxx, geom.miny, geom.maxy)
-        if pick.size == 0:
-            return
         flip = (store.body[rb[pick]] == STATIC) & (store.kind[rb[pick]] == KIND_AABB)  # the box is b: push negated
         s = np.where(flip, rb[pick], ra[pick])
         m = np.where(flip, ra[pick], rb[pick])
