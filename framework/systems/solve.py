@@ -50,7 +50,7 @@ from . import solve_rounds as rounds
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
 from .solve_rounds import apply_measures, known_keys, moved_immovable, number, pending_points, turning_pairs
-from .turning import expand, turning_polygons
+from .turning import expand, turned_normals, turning_polygons
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
 
@@ -508,11 +508,11 @@ class Solve:
         cs, store = self.cs, self.store
         first, pair = rounds.pairs_of(check, cs.ea, cs.eb)  # (np.unique of the pair keys, compiled)
         rows = check[first]
-        r = self.stage.remeasure(cs.ra[rows], cs.rb[rows])
-        turned = r.hit & (r.nx * cs.nx[rows] + r.ny * cs.ny[rows] < 1.0 - 1e-9)
-        nx, ny = np.where(turned, r.nx, cs.nx[rows]), np.where(turned, r.ny, cs.ny[rows])
-        n_pts, px, py, sep = self.stage.remeasure_points(cs.ra[rows], cs.rb[rows], nx, ny, KEEP_GAP)
-        any_turned = bool(turned.any())
+        ra, rb = cs.ra[rows], cs.rb[rows]
+        r = self.stage.remeasure(ra, rb)
+        # (one compiled pass: the pairs that overlap along another normal now, and the normals)
+        (nx, ny), turned, any_turned = turned_normals(rows, r.hit, r.nx, r.ny, cs.nx, cs.ny)
+        n_pts, px, py, sep = self.stage.remeasure_points(ra, rb, nx, ny, KEEP_GAP)
         if any_turned:  # (the new normal, and where the points are now)
             had = np.bincount(pair, minlength=rows.size)
             same = n_pts[pair] == had[pair]

@@ -34,12 +34,13 @@ from ..compiled import inner, kernel
 from ..frame import Points
 from ..geometry import Geometry
 from ..store import BodyStore
+from .gather import _np_min
 from .solve_rounds import turning_pair
 
 if TYPE_CHECKING:  # (solve imports this module)
     from .solve import Contacts
 
-__all__ = ["expand", "manifold_points", "turning_polygons"]
+__all__ = ["expand", "manifold_points", "turned_normals", "turning_polygons"]
 
 
 def turning_polygons(store: BodyStore, rows: IntpArray) -> BoolArray:
@@ -47,20 +48,55 @@ def turning_polygons(store: BodyStore, rows: IntpArray) -> BoolArray:
     return (store.kind[rows] == KIND_POLYGON) & (store.inv_inertia[rows] > 0.0)
 
 
+@kernel
+def _margins(ra, rb, gap, bound, kind, circle, capsule):  # pragma: no cover - compiled
+    """For :func:`manifold_points`: each pair's margin (``gap`` times the smaller body's size, as
+    numpy's ``gap * np.minimum``), whether it has a round body (a circle or a capsule: no outline
+    to clip), and whether any has."""
+    margin = np.empty(ra.size)
+    round_ = np.zeros(ra.size, dtype=np.bool_)
+    anyone = False
+    for i in range(ra.size):
+        a, b = ra[i], rb[i]
+        margin[i] = gap * _np_min(bound[a], bound[b])
+        round_[i] = kind[a] == capsule or kind[b] == capsule or kind[a] == circle or kind[b] == circle
+        anyone = anyone or round_[i]
+    return margin, round_, anyone
+
+
+@kernel
+def turned_normals(rows, hit, rnx, rny, nx, ny):  # pragma: no cover - compiled
+    """For the solve's points measured again: the contacts ``rows`` (normals ``nx[rows], ny[rows]``)
+    whose pair, measured again (``hit``, ``rnx``, ``rny``, one per row), overlaps along another
+    normal (turned past rounding): ``(normals, turned, any turned)``, the normals (new where turned)
+    as the rows of one block."""
+    m = rows.size
+    normals = np.empty((2, m))
+    turned = np.zeros(m, dtype=np.bool_)
+    anyone = False
+    for k in range(m):
+        r = rows[k]
+        turned[k] = hit[k] and rnx[k] * nx[r] + rny[k] * ny[r] < 1.0 - 1e-9
+        if turned[k]:
+            normals[0, k], normals[1, k] = rnx[k], rny[k]
+            anyone = True
+        else:
+            normals[0, k], normals[1, k] = nx[r], ny[r]
+    return normals, turned, anyone
+
+
 def manifold_points(store: BodyStore, geom: Geometry, ra: IntpArray, rb: IntpArray, nx: F64Array, ny: F64Array,
                     gap: float) -> tuple[I64Array, F64Array, F64Array, F64Array]:
     """:func:`pair_manifolds` of the box and polygon pairs ``(ra, rb)`` along ``(nx, ny)``, from
     the step's geometry, keeping the points less than ``gap`` times the smaller body's size
     apart: ``(count, px, py, sep)``."""
-    margin = gap * np.minimum(store.bound[ra], store.bound[rb])
-    round_ = ((store.kind[ra] == KIND_CAPSULE) | (store.kind[rb] == KIND_CAPSULE) | (store.kind[ra] == KIND_CIRCLE)
-              | (store.kind[rb] == KIND_CIRCLE))
-    caps = np.flatnonzero(round_)
-    if caps.size == 0:
+    margin, round_, any_round = _margins(ra, rb, gap, store.bound, store.kind, KIND_CIRCLE, KIND_CAPSULE)
+    if not any_round:
         return pair_manifolds(ra, rb, nx, ny, margin, store.kind, geom.hx, geom.hy, store.hw, store.hh,
                               geom.poly_slot, geom.world_poly, geom.count)
     # A pair with a circle or a capsule has no outline to clip: its one point is the narrow
     # phase's, where they overlap (none where they do not).
+    caps = np.flatnonzero(round_)
     rest = np.flatnonzero(~round_)
     n_pts, px, py, sep = (np.zeros(ra.size, dtype=np.int64), np.zeros((ra.size, 2)), np.zeros((ra.size, 2)),
                           np.zeros((ra.size, 2)))
