@@ -20,6 +20,7 @@ found it, and the exception says so.
 
 from __future__ import annotations
 
+from operator import itemgetter
 from typing import Any
 
 import esper
@@ -34,6 +35,10 @@ __all__ = ["StepRollback"]
 # the character controller's state, written by each step (its settings are the game's)
 _CONTROLLER_STATE = ("drop_through", "on_floor", "floor_normal", "floor_entity", "on_wall", "wall_normal",
                      "on_ceiling", "crushed")
+
+
+# the columns of ROW_STATE, out of the store's table in one call
+_STATE_COLUMNS = itemgetter(*ROW_STATE)
 
 
 @kernel
@@ -60,7 +65,7 @@ class StepRollback:
         # (BodyStore.begin_undo): the pipeline never moves them, so a level's tiles cost nothing
         c = store.cols
         self.rows = store.active()[2]
-        self.kept = _keep(self.rows, *(c[name] for name in ROW_STATE))
+        self.kept = _keep(self.rows, *_STATE_COLUMNS(c))
         store.begin_undo()
         self.frame = scene._pipeline.frame
         tracker = scene.tracker

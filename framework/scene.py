@@ -594,9 +594,9 @@ class Scene:
         if isinstance(characters, CharacterStage) and characters.wanted():
             characters.check()
         movers = store.active()[0]
-        c, n = store.cols, store.n
+        c = store.cols  # (the columns whole: the pass reads only the movers' rows)
         gx, gy = self._pipeline.active_gravity()
-        if motion_within(c["x"][:n], c["y"][:n], c["vx"][:n], c["vy"][:n], movers, dt, gx, gy, MAX_COORD) >= 0:
+        if motion_within(c["x"], c["y"], c["vx"], c["vy"], movers, dt, gx, gy, MAX_COORD) >= 0:
             check_motion(store.entity[movers], store.x[movers], store.y[movers], store.vx[movers], store.vy[movers],
                          dt, (gx, gy))
         before = StepRollback(self)

@@ -562,16 +562,16 @@ class BodyStore:
         Changes nothing, so a failed step leaves the scene exactly as it was."""
         # Static rows change only through game code's writes: check those and the rows that move.
         rows = self.active()[2]
-        sel = self.active_sel()[2]
         extra = np.array([self.row_of[e] for e in self.written if e in self.row_of], dtype=np.int64) \
             if self.written else None
         if not self.bad and not self.dirty_hitboxes:
-            c, n = self.cols, self.n
-            xs, ys, rot, vx, vy, w = c["x"][:n], c["y"][:n], c["rot"][:n], c["vx"][:n], c["vy"][:n], c["w"][:n]
+            c = self.cols  # (the columns whole: the pass reads only the rows asked, all below n)
+            xs, ys, rot, vx, vy, w = c["x"], c["y"], c["rot"], c["vx"], c["vy"], c["w"]
             if rows_sound(xs, ys, rot, vx, vy, w, rows, MAX_COORD) and (
                     extra is None or rows_sound(xs, ys, rot, vx, vy, w, extra, MAX_COORD)):
                 self.written.clear()
                 return
+        sel = self.active_sel()[2]
         if extra is not None:  # (a row found wrong below is named once, in row order)
             rows = sel = np.union1d(rows, extra)
         problems: list[tuple[int, str, object]] = [(e, col, v) for (e, col), v in self.bad.items()]
