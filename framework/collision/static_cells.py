@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..compiled import inner, kernel, leaf
+from .box_rows import lower_bound
 from .grid import CELL_LIMIT, LARGE_CELLS
 
 __all__ = ["static_cross"]
@@ -53,14 +54,8 @@ def _unique_cell(ukey, dense, key):  # pragma: no cover - compiled
     """The number of the cell ``key`` among the used cells (-1: none there)."""
     if dense.size:
         return dense[key]
-    lo, hi = 0, ukey.size
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if ukey[mid] < key:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo if lo < ukey.size and ukey[lo] == key else -1
+    u = lower_bound(ukey, key)
+    return u if u < ukey.size and ukey[u] == key else -1
 
 
 @inner
