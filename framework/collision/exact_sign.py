@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ..compiled import inner, kernel
+from ..compiled import kernel, leaf
 from .batch_box import _two_sum_1 as _two_sum
 from .exact import TINY
 from .py_hypot import hypot
@@ -34,7 +34,7 @@ _LO, _HI = 2.0**-300, 2.0**300
 _SPLIT = 134217729.0  # 2**27 + 1 (Dekker's split of a double into two 26-bit halves)
 
 
-@inner
+@leaf
 def _two_product(a, b):  # pragma: no cover - compiled
     p = a * b
     c = _SPLIT * a
@@ -46,7 +46,7 @@ def _two_product(a, b):  # pragma: no cover - compiled
     return p, al * bl - (((p - ah * bh) - al * bh) - ah * bl)
 
 
-@inner
+@leaf
 def _grow(e, m, b):  # pragma: no cover - compiled
     """Add the double ``b`` to the expansion ``e[:m]`` (non-overlapping, increasing magnitude),
     exactly, in place (zeros dropped); returns the new length."""
@@ -63,7 +63,7 @@ def _grow(e, m, b):  # pragma: no cover - compiled
     return j
 
 
-@inner
+@leaf
 def _add_product(e, m, a_hi, a_lo, b_hi, b_lo, sign):  # pragma: no cover - compiled
     """``e += sign * (a_hi + a_lo) * (b_hi + b_lo)`` exactly; returns the new length."""
     for x in (a_hi, a_lo):
@@ -78,7 +78,7 @@ def _add_product(e, m, a_hi, a_lo, b_hi, b_lo, sign):  # pragma: no cover - comp
     return m
 
 
-@inner
+@leaf
 def _sign(e, m):  # pragma: no cover - compiled
     """The sign of the expansion's sum: its largest part's."""
     if m == 0:
@@ -86,14 +86,14 @@ def _sign(e, m):  # pragma: no cover - compiled
     return 1 if e[m - 1] > 0.0 else -1
 
 
-@inner
+@leaf
 def _project(e, ux_h, ux_l, uy_h, uy_l, x, y):  # pragma: no cover - compiled
     """``e = u . (x, y)`` exactly (``u`` two two-term sums); returns its length."""
     m = _add_product(e, 0, ux_h, ux_l, x, 0.0, 1.0)
     return _add_product(e, m, uy_h, uy_l, y, 0.0, 1.0)
 
 
-@inner
+@leaf
 def _copy_add(dst, src, m, other, n, sign):  # pragma: no cover - compiled
     """``dst = src[:m] + sign * other[:n]`` exactly; returns its length."""
     for i in range(m):
@@ -103,7 +103,7 @@ def _copy_add(dst, src, m, other, n, sign):  # pragma: no cover - compiled
     return m
 
 
-@inner
+@leaf
 def _extreme(vx, vy, c, ux_h, ux_l, uy_h, uy_l, want, best, cur, tmp):  # pragma: no cover - compiled
     """The exact max (``want`` 1) or min (-1) over the first ``c`` vertices of their projections on
     ``u``, into ``best``; returns its length. Only the vertices whose float projection is within a
@@ -137,13 +137,13 @@ def _extreme(vx, vy, c, ux_h, ux_l, uy_h, uy_l, want, best, cur, tmp):  # pragma
     return nb
 
 
-@inner
+@leaf
 def _fits(v):  # pragma: no cover - compiled
     a = abs(v)
     return a == 0.0 or (a >= _LO and a <= _HI)
 
 
-@inner
+@leaf
 def _offset(ox, oy, qx, qy, k):  # pragma: no cover - compiled
     """The exact offset ``(q - o) * 2**-k`` as two two-part sums ``(x_hi, x_lo, y_hi, y_lo)``,
     after whether it is exact: False where a scaled coordinate lost bits below the smallest float
@@ -157,7 +157,7 @@ def _offset(ox, oy, qx, qy, k):  # pragma: no cover - compiled
     return exact, x_hi, x_lo, y_hi, y_lo
 
 
-@inner
+@leaf
 def _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy):  # pragma: no cover - compiled
     """Whether the offset's parts and both outlines' slots are all in :func:`_fits`'s range."""
     if not (_fits(ex_h) and _fits(ex_l) and _fits(ey_h) and _fits(ey_l)):
@@ -227,13 +227,13 @@ def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # prag
 _LO4, _HI4 = 2.0**-200, 2.0**200
 
 
-@inner
+@leaf
 def _fits4(v):  # pragma: no cover - compiled
     a = abs(v)
     return a == 0.0 or (a >= _LO4 and a <= _HI4)
 
 
-@inner
+@leaf
 def _mul(dst, m, a, na, b, nb, sign):  # pragma: no cover - compiled
     """``dst[:m] += sign * a[:na] * b[:nb]`` exactly; returns the new length."""
     for i in range(na):
@@ -244,7 +244,7 @@ def _mul(dst, m, a, na, b, nb, sign):  # pragma: no cover - compiled
     return m
 
 
-@inner
+@leaf
 def _diff(dst, a, na, b):  # pragma: no cover - compiled
     """``dst = a[:na] - b`` (``b`` a double) exactly; returns its length."""
     for i in range(na):
@@ -252,7 +252,7 @@ def _diff(dst, a, na, b):  # pragma: no cover - compiled
     return _grow(dst, na, -b)
 
 
-@inner
+@leaf
 def _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s):  # pragma: no cover - compiled
     """Edge ``i``'s exact ``(ey (cx - x0) - ex (cy - y0))`` into ``s`` (the centre's distance
     outside its line, times its length), its parts into ``wx, wy, ex, ey``: their lengths."""
@@ -390,7 +390,7 @@ def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f): 
 
 # --- exact depths of overlapping polygons ---------------------------------------------------------
 
-@inner
+@leaf
 def _steps(hi):  # pragma: no cover - compiled
     """The gaps from ``hi`` (normal, nonzero) to the next double up and down."""
     m, ex = math.frexp(abs(hi))
@@ -399,13 +399,13 @@ def _steps(hi):  # pragma: no cover - compiled
     return (gap, toward) if hi > 0.0 else (toward, gap)
 
 
-@inner
+@leaf
 def _even(v):  # pragma: no cover - compiled
     m, _ex = math.frexp(abs(v))
     return int(m * 9007199254740992.0) % 2 == 0  # (the 53-bit significand's last bit)
 
 
-@inner
+@leaf
 def _rounded(e, m, tmp, tmp2):  # pragma: no cover - compiled
     """The expansion's sum correctly rounded (to nearest, ties to even), as Python's int division
     rounds it, and whether that was found (False far from 1, where the gaps below are not exact)."""

@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from ..compiled import inner, kernel
+from ..compiled import kernel, leaf
 from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
@@ -51,7 +51,7 @@ __all__ = ["polygon_pairs", "polygon_pairs_settled"]
 
 
 
-@inner
+@leaf
 def _outline(r, kind, hw, hh, world_poly, poly_slot, count, vx, vy):  # pragma: no cover - compiled
     """Row ``r``'s outline about its hitbox origin into ``vx, vy`` (``K`` slots, the padding
     repeating the last vertex, as ``batch_common.outline_rows`` writes it); returns its count."""
@@ -71,7 +71,7 @@ def _outline(r, kind, hw, hh, world_poly, poly_slot, count, vx, vy):  # pragma: 
     return c
 
 
-@inner
+@leaf
 def _centred_box(vx, vy, c):  # pragma: no cover - compiled
     """``batch_polygon._centred_boxes`` of one outline."""
     if vx.size < 4:
@@ -80,14 +80,14 @@ def _centred_box(vx, vy, c):  # pragma: no cover - compiled
             and vy[1] == vy[0] and vy[0] == -vy[2] and vy[3] == vy[2])
 
 
-@inner
+@leaf
 def _norm(x, y):  # pragma: no cover - compiled
     """``batch_common.norm`` of one vector."""
     n = np.sqrt(x * x + y * y)
     return math.hypot(x, y) if n < 1e-150 else n
 
 
-@inner
+@leaf
 def _edges(v, e):  # pragma: no cover - compiled
     """``batch_common.edges`` of one outline coordinate into ``e``."""
     k = v.size
@@ -96,7 +96,7 @@ def _edges(v, e):  # pragma: no cover - compiled
     e[k - 1] = v[0] - v[k - 1]
 
 
-@inner
+@leaf
 def _extent(vx, vy):  # pragma: no cover - compiled
     """``batch_common.extent`` of one outline."""
     mx = abs(vx[0])
@@ -109,7 +109,7 @@ def _extent(vx, vy):  # pragma: no cover - compiled
     return mx if mx > my else my
 
 
-@inner
+@leaf
 def _radius(vx, vy):  # pragma: no cover - compiled
     """The root of the largest squared vertex length (``_frame``'s bounding radius)."""
     m = vx[0] * vx[0] + vy[0] * vy[0]
@@ -120,7 +120,7 @@ def _radius(vx, vy):  # pragma: no cover - compiled
     return np.sqrt(m)
 
 
-@inner
+@leaf
 def _project(ux, uy, vx, vy):  # pragma: no cover - compiled
     """Min and max of an outline's vertices projected on axis ``u`` (``batch_polygon._extent``)."""
     lo = ux * vx[0] + uy * vy[0]
@@ -134,7 +134,7 @@ def _project(ux, uy, vx, vy):  # pragma: no cover - compiled
     return lo, hi
 
 
-@inner
+@leaf
 def _inside(x, y, ox, oy, ex, ey, en, tol):  # pragma: no cover - compiled
     """``batch_point._inside`` of one point against one outline (vertices ``o``, edges ``e``,
     their lengths ``en``)."""
@@ -146,7 +146,7 @@ def _inside(x, y, ox, oy, ex, ey, en, tol):  # pragma: no cover - compiled
     return True
 
 
-@inner
+@leaf
 def _within_segment(x, y, ox, oy, tol):  # pragma: no cover - compiled
     """``batch_point._within_segment`` of one point and a segment (an outline of two points)."""
     ex, ey = ox[1] - ox[0], oy[1] - oy[0]
@@ -155,7 +155,7 @@ def _within_segment(x, y, ox, oy, tol):  # pragma: no cover - compiled
     return along >= -slack and along <= ex * ex + ey * ey + slack
 
 
-@inner
+@leaf
 def _overlap_point(avx, avy, ac, bvx, bvy, bc, nx, ny, depth, size, exa, eya, exb, eyb, na, nb):
     # pragma: no cover - compiled
     """``batch_point.overlap_point`` of one pair (B at its offset): the mean of the vertices of

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from ..compiled import inner
+from ..compiled import inner, leaf
 from .exact import TINY
 from .tiebreak import DEPTH_TOL, DIR_TOL
 
@@ -20,7 +20,7 @@ __all__ = ["BIG", "frame_row", "pick_row", "put_row", "world_row"]
 BIG = 1e300
 
 
-@inner
+@leaf
 def frame_row(ax, ay, bx, by, reach):  # pragma: no cover - compiled
     """``batch_common.frame`` of one pair: ``(dx, dy, k)``, the offset of b from a scaled by
     ``2**-k`` so that it and ``reach`` are about 1 (``reach`` not NaN)."""
@@ -31,7 +31,7 @@ def frame_row(ax, ay, bx, by, reach):  # pragma: no cover - compiled
     return math.ldexp(hdx, 1 - k), math.ldexp(hdy, 1 - k), k
 
 
-@inner
+@leaf
 def world_row(depth, px, py, k, ax, ay):  # pragma: no cover - compiled
     """``batch_common.finish`` of one contact: ``(finite, depth, px, py)`` unscaled and moved to
     the world (the depth at least the smallest float); ``finite`` False where a value is beyond
@@ -43,7 +43,7 @@ def world_row(depth, px, py, k, ax, ay):  # pragma: no cover - compiled
 
 
 
-@inner
+@leaf
 def put_row(i, nx_i, ny_i, depth_i, px_i, py_i, k, ax, ay, hit, nx, ny, depth, px, py, defer):
     # pragma: no cover - compiled
     """Row ``i``'s contact (scaled, frame ``k`` at ``(ax, ay)``) into the output columns as
