@@ -26,9 +26,13 @@ from .exact import TINY
 from .py_hypot import hypot
 from .row_frame import pick_row
 
-__all__ = ["APART", "OVERLAP", "UNSURE", "polygons_apart"]
+__all__ = ["APART", "OVERLAP", "SCRATCH", "UNSURE", "apart_in", "depths_in", "polygon_depths", "polygons_apart"]
 
 APART, OVERLAP, UNSURE = 0, 1, 2
+
+#: Doubles of scratch :func:`apart_in` and :func:`depths_in` work in (expansions of up to 64 parts,
+#: their sums of up to 256).
+SCRATCH = 1024
 
 _LO, _HI = 2.0**-300, 2.0**300
 _SPLIT = 134217729.0  # 2**27 + 1 (Dekker's split of a double into two 26-bit halves)
@@ -179,13 +183,18 @@ def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # prag
     ``need [2 K]``: per axis slot (A's edges, then B's), which overlaps the floats left in doubt
     (1 forward, 2 backward, 3 both); the others are positive beyond the floats' error, and only a
     separation or touch (an overlap <= 0) on some axis makes the pair apart."""
+    return apart_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need, np.empty(SCRATCH))
+
+
+@leaf
+def apart_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need, w):  # pragma: no cover - compiled
+    """:func:`polygons_apart` working in the scratch ``w`` (:data:`SCRATCH` doubles: a row pass
+    makes it once for all its rows)."""
     exact, ex_h, ex_l, ey_h, ey_l = _offset(ox, oy, qx, qy, k)
     if not (exact and _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy)):
         return UNSURE
-    size = 64
-    cur, tmp = np.empty(size), np.empty(size)
-    lo, hi = np.empty(size), np.empty(size)
-    out, ud = np.empty(4 * size), np.empty(size)
+    cur, tmp, lo, hi, ud = w[0:64], w[64:128], w[128:192], w[192:256], w[256:320]
+    out = w[320:576]
     kk = avx.size
     for c in range(2 * kk):
         if need[c] == 0:
@@ -444,13 +453,17 @@ def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # 
     forward and backward overlaps, correctly rounded, into ``fwd`` and ``bwd`` (padding slots are
     left alone), as :mod:`~framework.collision.batch_polygon` writes the integers' ones; False
     where an input is outside the exact range or a rounding could not be settled."""
+    return depths_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd, np.empty(SCRATCH))
+
+
+@leaf
+def depths_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd, w):  # pragma: no cover - compiled
+    """:func:`polygon_depths` working in the scratch ``w`` (:data:`SCRATCH` doubles)."""
     exact, ex_h, ex_l, ey_h, ey_l = _offset(ox, oy, qx, qy, k)
     if not (exact and _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy)):
         return False
-    size = 64
-    cur, tmp, tmp2 = np.empty(size), np.empty(4 * size), np.empty(4 * size)
-    lo, hi = np.empty(size), np.empty(size)
-    out, ud = np.empty(4 * size), np.empty(size)
+    cur, lo, hi, ud = w[0:64], w[64:128], w[128:192], w[192:256]
+    tmp, tmp2, out = w[256:512], w[512:768], w[768:1024]
     kk = avx.size
     for c in range(2 * kk):
         vx, vy = (avx, avy) if c < kk else (bvx, bvy)

@@ -43,7 +43,7 @@ from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
 from .exact import BAND, TINY
-from .exact_sign import APART, OVERLAP, polygon_depths, polygons_apart
+from .exact_sign import APART, OVERLAP, SCRATCH, apart_in, depths_in
 from .kinds import KIND_AABB
 from .row_frame import BIG, frame_row, pick_row, put_row
 
@@ -255,6 +255,7 @@ def _polygon_pairs(settle):
         need = np.zeros(2 * k, dtype=np.int64)
         cd, cx, cy = np.empty(4 * k), np.empty(4 * k), np.empty(4 * k)
         exa, eya, exb, eyb, na, nb = np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k)
+        scratch = np.empty(SCRATCH if settle else 0)  # (the exact decisions' working space, for every row)
         for i in range(n):
             a, b = ra[i], rb[i]
             ac = _outline(a, kind, hw, hh, world_poly, poly_slot, count, avx, avy)
@@ -319,11 +320,11 @@ def _polygon_pairs(settle):
                 if not exact:
                     continue
                 if settle:
-                    verdict = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need)
+                    verdict = apart_in(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need, scratch)
                     if verdict == APART:
                         continue
-                    if not (verdict == OVERLAP and polygon_depths(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd,
-                                                                  bwd)):
+                    if not (verdict == OVERLAP and depths_in(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd, bwd,
+                                                             scratch)):
                         defer[i] = True
                         continue
                 else:  # (left to the settling variant)
