@@ -20,19 +20,22 @@ import math
 
 import numpy as np
 
-from ..compiled import kernel, leaf
+from ..compiled import inner, kernel, leaf
 from .batch_box import _two_sum_1 as _two_sum
 from .exact import TINY
 from .py_hypot import hypot
 from .row_frame import pick_row
 
-__all__ = ["APART", "OVERLAP", "SCRATCH", "UNSURE", "apart_in", "depths_in", "polygon_depths", "polygons_apart"]
+__all__ = ["APART", "OVERLAP", "SCRATCH", "SCRATCH_CIRCLE", "UNSURE", "apart_in", "contact_in", "depths_in",
+           "polygon_circle_contact", "polygon_depths", "polygons_apart"]
 
 APART, OVERLAP, UNSURE = 0, 1, 2
 
 #: Doubles of scratch :func:`apart_in` and :func:`depths_in` work in (expansions of up to 64 parts,
 #: their sums of up to 256).
 SCRATCH = 1024
+#: ... and :func:`contact_in` (expansions of up to 32, 128, 512 and 1,024 parts).
+SCRATCH_CIRCLE = 3208
 
 _LO, _HI = 2.0**-300, 2.0**300
 _SPLIT = 134217729.0  # 2**27 + 1 (Dekker's split of a double into two 26-bit halves)
@@ -284,8 +287,17 @@ def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f): 
     the contact (in the scaled frame) where :data:`OVERLAP`, as the integers give it bit for bit;
     else :data:`APART` or :data:`UNSURE` (a float outside the range where these products are exact,
     or a rounding not settled)."""
-    cx = np.empty(2)
-    cy = np.empty(2)
+    return contact_in(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f, np.empty(SCRATCH_CIRCLE))
+
+
+@inner
+def contact_in(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f, w):  # pragma: no cover - compiled
+    """:func:`polygon_circle_contact` working in the scratch ``w`` (:data:`SCRATCH_CIRCLE` doubles:
+    a row pass makes it once for all its rows)."""
+    cx, cy, rr = w[0:2], w[2:4], w[4:6]
+    wx, wy, ex, ey = w[8:40], w[40:72], w[72:104], w[104:136]
+    s, t, e2, best = w[136:264], w[264:392], w[392:520], w[520:648]
+    num, tmp, tmp2 = w[648:1160], w[1160:2184], w[2184:3208]
     exact, cx[1], cx[0], cy[1], cy[0] = _offset(ox, oy, qx, qy, k)  # (expansions: smaller part first)
     if not exact or not (_fits4(cx[0]) and _fits4(cx[1]) and _fits4(cy[0]) and _fits4(cy[1]) and _fits4(r)):
         return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -294,11 +306,6 @@ def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f): 
             return UNSURE, 0.0, 0.0, 0.0, 0.0, 0.0
     ncx = _grow(cx, 0, cx[0]) if cx[1] == 0.0 else 2  # (drop a zero part)
     ncy = _grow(cy, 0, cy[0]) if cy[1] == 0.0 else 2
-    size_e = 32
-    wx, wy, ex, ey = np.empty(size_e), np.empty(size_e), np.empty(size_e), np.empty(size_e)
-    s, t, e2, num = np.empty(4 * size_e), np.empty(4 * size_e), np.empty(4 * size_e), np.empty(16 * size_e)
-    tmp, tmp2 = np.empty(32 * size_e), np.empty(32 * size_e)
-    rr = np.empty(2)
     rr[1], rr[0] = _two_product(r, r)
     nrr = 2
     # Inside (or on the boundary): every edge's line has the centre on its inner side.
@@ -368,7 +375,6 @@ def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f): 
         dist = fs / ln
         return OVERLAP, f * nx, f * ny, (depth if depth > TINY else TINY), cx0 - nx * dist, cy0 - ny * dist
     # The nearest vertex (the first of equals), exactly.
-    best = np.empty(4 * size_e)
     nb = 0
     jb = -1
     for j in range(c):
