@@ -205,14 +205,14 @@ def test_exact_apart_decision_matches_the_integers(pair, k) -> None:
     :func:`~framework.collision.exact_sign.polygon_depths` rounds the integers' overlaps bit for
     bit."""
     from framework.collision.exact import float_rounded, polygon_polygon_exact
-    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygon_depths, polygons_apart
+    from framework.collision.exact_sign import APART, OVERLAP, SCRATCH, UNSURE, polygon_depths, polygons_apart
 
     a, b, (ox, oy, qx, qy) = pair
     kk = 8
     avx, avy = (np.array([p[j] for p in a] + [a[-1][j]] * (kk - len(a))) for j in (0, 1))
     bvx, bvy = (np.array([p[j] for p in b] + [b[-1][j]] * (kk - len(b))) for j in (0, 1))
     need = np.full(2 * kk, 3, dtype=np.int64)
-    got = polygons_apart(avx, avy, len(a), bvx, bvy, 3, ox, oy, qx, qy, k, need)
+    got = polygons_apart(avx, avy, len(a), bvx, bvy, 3, ox, oy, qx, qy, k, need, np.empty(SCRATCH))
     want = polygon_polygon_exact(a, b, (ox, oy, qx, qy, k))
     values = [abs(v) for v in (*avx, *avy, *bvx, *bvy, ox, oy, qx, qy, qx - ox, qy - oy) if v != 0.0]
     if got == UNSURE:  # (only with a coordinate beyond the range where products are exact)
@@ -225,7 +225,7 @@ def test_exact_apart_decision_matches_the_integers(pair, k) -> None:
     # A's real edges, then B's, padding slots skipped).
     found, u = want
     fwd, bwd = np.full(2 * kk, np.nan), np.full(2 * kk, np.nan)
-    assert polygon_depths(avx, avy, len(a), bvx, bvy, 3, ox, oy, qx, qy, k, fwd, bwd)
+    assert polygon_depths(avx, avy, len(a), bvx, bvy, 3, ox, oy, qx, qy, k, fwd, bwd, np.empty(SCRATCH))
     valid = ~np.isnan(fwd)
     expect = np.array([(float_rounded(fw, u), float_rounded(bw, u)) for fw, bw in found.values()])
     assert valid.sum() == len(found)
@@ -320,13 +320,14 @@ def test_exact_polygon_circle_contact_matches_the_integers(case, f) -> None:
     :func:`framework.collision.batch_circle._polygon_circle_exact`'s answer (integers) bit for bit:
     circles touching faces and vertices to the last bit, nudged an ulp either way, and inside."""
     from framework.collision.batch_circle import _polygon_circle_exact
-    from framework.collision.exact_sign import APART, OVERLAP, UNSURE, polygon_circle_contact
+    from framework.collision.exact_sign import APART, OVERLAP, SCRATCH_CIRCLE, UNSURE, polygon_circle_contact
 
     pts, r, (ox, oy, qx, qy) = case
     kk = 8
     vx, vy = (np.array([p[j] for p in pts] + [pts[-1][j]] * (kk - len(pts))) for j in (0, 1))
     cx, cy, size = qx - ox, qy - oy, 2.0
-    verdict, *got = polygon_circle_contact(vx, vy, len(pts), ox, oy, qx, qy, 0, r, cx, cy, size, f)
+    verdict, *got = polygon_circle_contact(vx, vy, len(pts), ox, oy, qx, qy, 0, r, cx, cy, size, f,
+                                           np.empty(SCRATCH_CIRCLE))
     want = _polygon_circle_exact(pts, (ox, oy, qx, qy, 0), r, cx, cy, size, f)
     values = [abs(v) for v in (*vx, *vy, r, ox, oy, qx, qy, qx - ox, qy - oy) if v != 0.0]
     if verdict == UNSURE:

@@ -91,7 +91,7 @@ def test_contact_columns_are_the_numpy_columns(seed: int) -> None:
         g = math.hypot(gx, gy)
         with np.errstate(divide="ignore", invalid="ignore"):
             per_body, per_contact, got_immovable, got_order = sc.contact_columns(
-                rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g)
+                rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, gx, gy, g)
             got = (per_body[0], per_body[0] if statics else per_body[1], *per_contact, got_immovable, got_order)
             half = np.where(hw[rows] > 0.0, np.minimum(hw[rows], hh[rows]), 0.5 * bound[rows])
             span = 0.5 * half

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..compiled import kernel
 from .exact import BAND, TINY
-from .exact_sign import APART, SCRATCH_CIRCLE, UNSURE, circles_excess, contact_in
+from .exact_sign import APART, SCRATCH_CIRCLE, UNSURE, circles_excess, polygon_circle_contact
 from .polygon_rows import _edges, _extent, _norm, _outline, _radius
 from .row_frame import BIG, frame_row, pick_row, put_row
 
@@ -115,8 +115,8 @@ def _polygon_circle_pairs(settle):
             if unclear and exact:
                 # Touching to rounding: the exact decision and contact, on the floats (exact_sign).
                 if settle:
-                    verdict, nxi, nyi, dep, pxi, pyi = contact_in(vx, vy, c, ax, ay, bx, by, e, r, cx, cy, size, f,
-                                                                  scratch)
+                    verdict, nxi, nyi, dep, pxi, pyi = polygon_circle_contact(vx, vy, c, ax, ay, bx, by, e, r, cx, cy,
+                                                                              size, f, scratch)
                     if verdict == UNSURE:
                         defer[i] = True
                         continue

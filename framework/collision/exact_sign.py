@@ -20,21 +20,21 @@ import math
 
 import numpy as np
 
-from ..compiled import inner, kernel, leaf
+from ..compiled import kernel, leaf
 from .batch_box import _two_sum_1 as _two_sum
 from .exact import TINY
 from .py_hypot import hypot
 from .row_frame import pick_row
 
-__all__ = ["APART", "OVERLAP", "SCRATCH", "SCRATCH_CIRCLE", "UNSURE", "apart_in", "contact_in", "depths_in",
-           "polygon_circle_contact", "polygon_depths", "polygons_apart"]
+__all__ = ["APART", "OVERLAP", "SCRATCH", "SCRATCH_CIRCLE", "UNSURE", "polygon_circle_contact", "polygon_depths",
+           "polygons_apart"]
 
 APART, OVERLAP, UNSURE = 0, 1, 2
 
-#: Doubles of scratch :func:`apart_in` and :func:`depths_in` work in (expansions of up to 64 parts,
-#: their sums of up to 256).
+#: Doubles of scratch :func:`polygons_apart` and :func:`polygon_depths` work in (expansions of up
+#: to 64 parts, their sums of up to 256).
 SCRATCH = 1024
-#: ... and :func:`contact_in` (expansions of up to 32, 128, 512 and 1,024 parts).
+#: ... and :func:`polygon_circle_contact` (expansions of up to 32, 128, 512 and 1,024 parts).
 SCRATCH_CIRCLE = 3208
 
 _LO, _HI = 2.0**-300, 2.0**300
@@ -175,8 +175,8 @@ def _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy):  # pragma: no cov
     return True
 
 
-@kernel
-def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # pragma: no cover - compiled
+@leaf
+def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need, w):  # pragma: no cover - compiled
     """:func:`~framework.collision.exact.polygon_polygon_exact`'s decision on floats: outlines A
     (``ac`` vertices ``avx, avy``, scaled, about the origin, padded to ``K`` slots as the batch
     kernels pad them) and B (about its own origin, at the exact offset ``(q - o) * 2**-k``):
@@ -185,14 +185,8 @@ def polygons_apart(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need):  # prag
 
     ``need [2 K]``: per axis slot (A's edges, then B's), which overlaps the floats left in doubt
     (1 forward, 2 backward, 3 both); the others are positive beyond the floats' error, and only a
-    separation or touch (an overlap <= 0) on some axis makes the pair apart."""
-    return apart_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need, np.empty(SCRATCH))
-
-
-@leaf
-def apart_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, need, w):  # pragma: no cover - compiled
-    """:func:`polygons_apart` working in the scratch ``w`` (:data:`SCRATCH` doubles: a row pass
-    makes it once for all its rows)."""
+    separation or touch (an overlap <= 0) on some axis makes the pair apart. ``w``: :data:`SCRATCH`
+    doubles to work in (a row pass makes them once for all its rows)."""
     exact, ex_h, ex_l, ey_h, ey_l = _offset(ox, oy, qx, qy, k)
     if not (exact and _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy)):
         return UNSURE
@@ -279,21 +273,15 @@ def _seps(vx, vy, c, cx, ncx, cy, ncy, i, wx, wy, ex, ey, s):  # pragma: no cove
 
 
 @kernel
-def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f):  # pragma: no cover - compiled
+def polygon_circle_contact(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f, w):  # pragma: no cover - compiled
     """:func:`~framework.collision.batch_circle._polygon_circle_exact` on floats: the outline
     (``c`` vertices ``vx, vy``, scaled, about the origin) and the circle of radius ``r`` (scaled)
     at the exact offset ``(q - o) * 2**-k`` (``cx0, cy0``: that offset in floats, ``size`` the
     tie-break's scale, ``f`` -1 where the circle is shape A): ``(verdict, nx, ny, depth, px, py)``,
     the contact (in the scaled frame) where :data:`OVERLAP`, as the integers give it bit for bit;
     else :data:`APART` or :data:`UNSURE` (a float outside the range where these products are exact,
-    or a rounding not settled)."""
-    return contact_in(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f, np.empty(SCRATCH_CIRCLE))
-
-
-@inner
-def contact_in(vx, vy, c, ox, oy, qx, qy, k, r, cx0, cy0, size, f, w):  # pragma: no cover - compiled
-    """:func:`polygon_circle_contact` working in the scratch ``w`` (:data:`SCRATCH_CIRCLE` doubles:
-    a row pass makes it once for all its rows)."""
+    or a rounding not settled). ``w``: :data:`SCRATCH_CIRCLE` doubles to work in (a row pass makes
+    them once for all its rows)."""
     cx, cy, rr = w[0:2], w[2:4], w[4:6]
     wx, wy, ex, ey = w[8:40], w[40:72], w[72:104], w[104:136]
     s, t, e2, best = w[136:264], w[264:392], w[392:520], w[520:648]
@@ -453,18 +441,13 @@ def _rounded(e, m, tmp, tmp2):  # pragma: no cover - compiled
     return 0.0, False
 
 
-@kernel
-def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd):  # pragma: no cover - compiled
+@leaf
+def polygon_depths(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd, w):  # pragma: no cover - compiled
     """For overlapping outlines (as :func:`polygons_apart` takes them): every axis slot's exact
     forward and backward overlaps, correctly rounded, into ``fwd`` and ``bwd`` (padding slots are
     left alone), as :mod:`~framework.collision.batch_polygon` writes the integers' ones; False
-    where an input is outside the exact range or a rounding could not be settled."""
-    return depths_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd, np.empty(SCRATCH))
-
-
-@leaf
-def depths_in(avx, avy, ac, bvx, bvy, bc, ox, oy, qx, qy, k, fwd, bwd, w):  # pragma: no cover - compiled
-    """:func:`polygon_depths` working in the scratch ``w`` (:data:`SCRATCH` doubles)."""
+    where an input is outside the exact range or a rounding could not be settled. ``w``:
+    :data:`SCRATCH` doubles to work in."""
     exact, ex_h, ex_l, ey_h, ey_l = _offset(ox, oy, qx, qy, k)
     if not (exact and _polygons_fit(ex_h, ex_l, ey_h, ey_l, avx, avy, bvx, bvy)):
         return False

@@ -36,6 +36,7 @@ def measure_rows(ra, rb, kind, n_kinds, family_of_code, flip_of_code, hx, hy, hw
     n = ra.size
     floats, flags = np.zeros((5, n)), np.zeros((2, n), dtype=np.bool_)
     family = np.empty(n, dtype=np.int64)
+    flipped = np.empty(n, dtype=np.bool_)  # (a polygon-circle pair whose circle is A: normals from it)
     sizes = np.zeros(4, dtype=np.int64)
     for i in range(n):
         ka, kb = np.int64(kind[ra[i]]), np.int64(kind[rb[i]])
@@ -44,7 +45,7 @@ def measure_rows(ra, rb, kind, n_kinds, family_of_code, flip_of_code, hx, hy, hw
         f = family_of_code[ka * n_kinds + kb]
         if f > POLYGONS:
             return floats, flags, False
-        family[i] = f
+        family[i], flipped[i] = f, flip_of_code[ka * n_kinds + kb]
         sizes[f] += 1
     for f in range(4):
         m = sizes[f]
@@ -56,8 +57,8 @@ def measure_rows(ra, rb, kind, n_kinds, family_of_code, flip_of_code, hx, hy, hw
         for i in range(n):
             if family[i] == f:
                 at[j], a[j], b[j] = i, ra[i], rb[i]
-                if f == POLYGON_CIRCLE:  # (the polygon first; flipped: the circle is A, normals from it)
-                    flip[j] = flip_of_code[np.int64(kind[ra[i]]) * n_kinds + np.int64(kind[rb[i]])]
+                if f == POLYGON_CIRCLE:  # (the polygon first)
+                    flip[j] = flipped[i]
                     if flip[j]:
                         a[j], b[j] = rb[i], ra[i]
                 j += 1

@@ -43,7 +43,7 @@ from .batch_box import _aabb_row
 from .box_pair_row import aabb_exact_row
 from .collide import POINT_TOL
 from .exact import BAND, TINY
-from .exact_sign import APART, OVERLAP, SCRATCH, apart_in, depths_in
+from .exact_sign import APART, OVERLAP, SCRATCH, polygon_depths, polygons_apart
 from .kinds import KIND_AABB
 from .row_frame import BIG, frame_row, pick_row, put_row
 
@@ -320,11 +320,11 @@ def _polygon_pairs(settle):
                 if not exact:
                     continue
                 if settle:
-                    verdict = apart_in(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need, scratch)
+                    verdict = polygons_apart(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, need, scratch)
                     if verdict == APART:
                         continue
-                    if not (verdict == OVERLAP and depths_in(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd, bwd,
-                                                             scratch)):
+                    if not (verdict == OVERLAP and polygon_depths(avx, avy, ac, bvx, bvy, bc, ax, ay, bx, by, e, fwd,
+                                                                  bwd, scratch)):
                         defer[i] = True
                         continue
                 else:  # (left to the settling variant)

@@ -196,7 +196,7 @@ class Solve:
         statics = bool(self.stage.bodies.n_static)
         per_body, per_contact, self.immovable, self.order = columns.contact_columns(
             self.rows, cs.ra, cs.rb, store.hw, store.hh, store.bound, store.asleep, store.inv_mass, store.x, store.y,
-            statics, gx, gy, self.g)
+            gx, gy, self.g)
         self.span, reach = per_body
         self.reach = self.span if statics else reach
         wa, wb, self.share_a, self.share_b = per_contact

@@ -66,7 +66,7 @@ def _kept_still(b_on_a, a_on_b, share_a, share_b):  # pragma: no cover - compile
 
 
 @_compiled
-def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, statics, gx, gy, g):  # pragma: no cover
+def contact_columns(rows, ra, rb, hw, hh, bound, asleep, inv_mass, x, y, gx, gy, g):  # pragma: no cover
     """The columns of :meth:`Solve._columns` (and its ``order``), as ``(per_body, per_contact,
     immovable, order)``: per body (``rows``, the rows of ``per_body``) its ``span`` (half its
     half-thickness) and an infinite ``reach`` (with statics the reach is the span: the caller's to
