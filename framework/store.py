@@ -69,6 +69,24 @@ _FIELD_NAMES = {
 
 
 @kernel
+def _pair_friction(friction, ra, rb):  # pragma: no cover - compiled
+    """:meth:`BodyStore.pair_friction` in one pass (numpy's answers: where both are given, neither
+    is NaN and ``max(f, 0) = f``, -0.0 included)."""
+    out = np.empty(ra.size)
+    for i in range(ra.size):
+        fa, fb = friction[ra[i]], friction[rb[i]]
+        if fa >= 0.0 and fb >= 0.0:
+            out[i] = np.sqrt(fa * fb)
+        elif fa >= 0.0:
+            out[i] = fa
+        elif fb >= 0.0:
+            out[i] = fb
+        else:
+            out[i] = 0.0
+    return out
+
+
+@kernel
 def _move_rows(rows, x, y, rot, vx, vy, w, dt):  # pragma: no cover - compiled
     """:meth:`BodyStore.move_by_velocity`'s arithmetic, row by row (a rotation only where ``w``
     is not 0: adding 0 would turn a rotation of -0.0 into 0.0)."""
@@ -265,10 +283,8 @@ class BodyStore:
     def pair_friction(self, ra: NDArray[np.intp], rb: NDArray[np.intp]) -> NDArray[np.float64]:
         """The friction coefficient of each pair ``(ra, rb)``: ``sqrt(f_a * f_b)`` where both
         hitboxes give one, the one given where one does, 0 where neither does."""
-        fa, fb = self.friction[ra], self.friction[rb]
-        given_a, given_b = fa >= 0.0, fb >= 0.0
-        both = np.sqrt(np.maximum(fa, 0.0) * np.maximum(fb, 0.0))
-        return np.where(given_a & given_b, both, np.where(given_a, fa, np.where(given_b, fb, 0.0)))
+        mu: NDArray[np.float64] = _pair_friction(self.cols["friction"], ra, rb)
+        return mu
 
     def movable(self, rows: NDArray[np.intp]) -> NDArray[np.bool_]:
         """Mask of ``rows`` the response may move: a finite mass (``inv_mass > 0``), and awake."""

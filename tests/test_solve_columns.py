@@ -154,6 +154,68 @@ def test_stays_are_the_numpy_shock_shares(seed: int) -> None:
 
 
 @pytest.mark.parametrize("seed", range(8))
+def test_rigid_shares_and_lever_arms_are_the_numpy_ones(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n, c = 12, 25
+    a, b, nx, ny = _contacts(rng, n, c)
+    rows = rng.permutation(40)[:n]
+    ra, rb = rows[a], rows[b]
+    # the shares, some bodies kept still, some contacts without mass or arm (1/0: inf and NaN)
+    still_a, still_b = rng.random(c) < 0.3, rng.random(c) < 0.3
+    wa, wb = np.where(rng.random(c) < 0.2, 0.0, rng.random(c)), np.where(rng.random(c) < 0.2, 0.0, rng.random(c))
+    ia, ib = _floats(rng, c, specials=False) ** 2, _floats(rng, c, specials=False) ** 2
+    rn_a, rn_b = _floats(rng, c), _floats(rng, c)
+    w_a, w_b = np.where(still_a, 0.0, wa), np.where(still_b, 0.0, wb)
+    i_a, i_b = np.where(still_a, 0.0, ia), np.where(still_b, 0.0, ib)
+    with np.errstate(all="ignore"):
+        inv = 1.0 / (w_a + w_b + i_a * rn_a * rn_a + i_b * rn_b * rn_b)
+        want = (w_a * inv, w_b * inv, i_a * rn_a * inv, i_b * rn_b * inv)
+    for have, expected in zip(sc.rigid_shares(still_a, still_b, wa, wb, ia, ib, rn_a, rn_b), want):
+        _same(have, expected)
+    # the lever arms, with a deep contact or two (arms 0, -0.0 kept) and arms that changed
+    rax, ray, rbx, rby = (_floats(rng, c) for _ in range(4))
+    depth = np.where(rng.random(c) < 0.2, 5.0, _floats(rng, c, specials=False))
+    span = rng.random(n)
+    asleep, inv_inertia = rng.random(40) < 0.2, np.where(rng.random(40) < 0.3, 0.0, rng.random(40))
+    kind = rng.integers(0, 3, 40)
+    k = c - 5  # (the contacts the arms were known for)
+    old_a, old_b, dturn = _floats(rng, k), _floats(rng, k), _floats(rng, n, specials=False)
+    flat = depth <= np.minimum(span[a], span[b])
+    with np.errstate(all="ignore"):  # (0 times inf: NaN, as the pass gives)
+        want_rn = (flat * (rax * ny - ray * nx), flat * (rbx * ny - rby * nx))
+        want_rt = (flat * (rax * nx + ray * ny), flat * (rbx * nx + rby * ny))
+    turning = ((kind[ra] == 2) & (inv_inertia[ra] > 0.0)) | ((kind[rb] == 2) & (inv_inertia[rb] > 0.0))
+    for turned in (False, True):
+        d = depth.copy()
+        got = sc.lever_arms(ra, rb, rax, ray, rbx, rby, nx, ny, d, a, b, span, asleep, inv_inertia, kind, 2,
+                            old_a if turned else np.zeros(0), old_b if turned else np.zeros(0),
+                            dturn if turned else np.zeros(0), turned)
+        want_depth = depth.copy()
+        if turned:
+            with np.errstate(all="ignore"):
+                before = old_b * dturn[b[:k]] - old_a * dturn[a[:k]]
+                want_depth[:k] += want_rn[1][:k] * dturn[b[:k]] - want_rn[0][:k] * dturn[a[:k]] - before
+        want = (np.where(asleep[ra], 0.0, inv_inertia[ra]), np.where(asleep[rb], 0.0, inv_inertia[rb]), *want_rn,
+                *want_rt, turning)
+        for have, expected in zip(got, want):
+            _same(have, expected)
+        _same(d, want_depth)
+
+
+def test_pair_friction_is_the_numpy_rule() -> None:
+    from framework.store import _pair_friction
+
+    friction = np.array([0.5, -1.0, 0.0, 0.25, np.nan, 2.0, -0.5])
+    ra, rb = (np.array(p, dtype=np.int64) for p in zip(*[(i, j) for i in range(7) for j in range(7)]))
+    fa, fb = friction[ra], friction[rb]
+    with np.errstate(invalid="ignore"):
+        given_a, given_b = fa >= 0.0, fb >= 0.0
+        both = np.sqrt(np.maximum(fa, 0.0) * np.maximum(fb, 0.0))
+    want = np.where(given_a & given_b, both, np.where(given_a, fa, np.where(given_b, fb, 0.0)))
+    _same(_pair_friction(friction, ra, rb), want)
+
+
+@pytest.mark.parametrize("seed", range(8))
 def test_warm_pushes_are_the_numpy_warm_pushes(seed: int) -> None:
     rng = np.random.default_rng(seed)
     n, c = 10, 20

@@ -50,7 +50,7 @@ from . import solve_rounds as rounds
 from . import solver_loops as solver
 from .friction import NO_FRICTION_POSITIONS, NO_FRICTION_VELOCITIES, Friction
 from .solve_rounds import apply_measures, known_keys, moved_immovable, number, pending_points, turning_pairs
-from .turning import expand, turned_normals, turning_polygons
+from .turning import expand, turned_normals
 
 __all__ = ["Contacts", "Pairs", "Solve", "bounce_speed"]
 
@@ -231,35 +231,27 @@ class Solve:
         nx)``) from each body's centre to the point, and which contacts have a turning polygon
         (their points are measured again by :meth:`_measure_points`)."""
         store, cs = self.store, self.cs
-        # (arms that change during the solve keep every contact's separation where it is: a
-        # contact's depth is relative to where the solve began, through its arms)
-        turned_by = None
-        if getattr(self, "dturn", None) is not None and getattr(self, "rn_a", None) is not None:
-            k = self.rn_a.size
-            turned_by = self.rn_b * self.dturn[self.b[:k]] - self.rn_a * self.dturn[self.a[:k]]
+        # (one compiled pass, solve_columns.lever_arms. A deep overlap (a fast hit, a heap spawned on
+        # one spot) moves its bodies without turning them: its points say little about where the
+        # bodies met, a turn by its push would be far off the arc the linear separations follow,
+        # and one point of a face that hit a face would set the body spinning. Arms that change
+        # during the solve keep every contact's separation where it is: a contact's depth is
+        # relative to where the solve began, through its arms.)
+        turned = getattr(self, "dturn", None) is not None and getattr(self, "rn_a", None) is not None
         rax, ray, rbx, rby = cs.arms
-        self.ia = np.where(store.asleep[cs.ra], 0.0, store.inv_inertia[cs.ra])
-        self.ib = np.where(store.asleep[cs.rb], 0.0, store.inv_inertia[cs.rb])
-        # A deep overlap (a fast hit, a heap spawned on one spot) moves its bodies without turning
-        # them: its points say little about where the bodies met, a turn by its push would be far
-        # off the arc the linear separations follow, and one point of a face that hit a face
-        # would set the body spinning.
-        flat = cs.depth <= np.minimum(self.span[self.a], self.span[self.b])
-        self.rn_a, self.rn_b = flat * (rax * cs.ny - ray * cs.nx), flat * (rbx * cs.ny - rby * cs.nx)
-        self.rt_a, self.rt_b = flat * (rax * cs.nx + ray * cs.ny), flat * (rbx * cs.nx + rby * cs.ny)
-        self.at_points = turning_polygons(store, cs.ra) | turning_polygons(store, cs.rb)
-        if turned_by is not None:
-            k = turned_by.size
-            cs.depth[:k] += self.rn_b[:k] * self.dturn[self.b[:k]] - self.rn_a[:k] * self.dturn[self.a[:k]] - turned_by
+        c = store.cols
+        self.ia, self.ib, self.rn_a, self.rn_b, self.rt_a, self.rt_b, self.at_points = columns.lever_arms(
+            cs.ra, cs.rb, rax, ray, rbx, rby, cs.nx, cs.ny, cs.depth, self.a, self.b, self.span, c["asleep"],
+            c["inv_inertia"], c["kind"], KIND_POLYGON, self.rn_a if turned else _NO_FLOATS,
+            self.rn_b if turned else _NO_FLOATS, self.dturn if turned else _NO_FLOATS, turned)
 
     def _rigid_shares(self, still_a: BoolArray, still_b: BoolArray) -> tuple[Any, ...]:
         """Contacts at points: how far a unit of push (impulse) moves and turns each body, the
         bodies ``still_*`` keeping still: ``(share_a, share_b, (turn_a, turn_b))``."""
-        rn_a, rn_b = self.rn_a, self.rn_b
-        wa, wb = np.where(still_a, 0.0, self.wa), np.where(still_b, 0.0, self.wb)
-        ia, ib = np.where(still_a, 0.0, self.ia), np.where(still_b, 0.0, self.ib)
-        inv = 1.0 / (wa + wb + ia * rn_a * rn_a + ib * rn_b * rn_b)
-        return wa * inv, wb * inv, (ia * rn_a * inv, ib * rn_b * inv)
+        # (one compiled pass, solve_columns.rigid_shares)
+        share_a, share_b, turn_a, turn_b = columns.rigid_shares(still_a, still_b, self.wa, self.wb, self.ia, self.ib,
+                                                                self.rn_a, self.rn_b)
+        return share_a, share_b, (turn_a, turn_b)
 
     def _angular(self) -> tuple[F64Array, F64Array] | None:
         """Contacts at points: each body's angular part of the normal effective inverse mass."""

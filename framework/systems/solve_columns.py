@@ -37,8 +37,8 @@ from ..stable_sort import stable_argsort
 from .gather import _np_max, _np_min
 from .solver_loops import warm_start
 
-__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "push_cap", "stays", "velocity_stays",
-           "warm_impulses", "warm_pushes"]
+__all__ = ["bounce_hits", "closing_speeds", "contact_columns", "lever_arms", "push_cap", "rigid_shares", "stays",
+           "velocity_stays", "warm_impulses", "warm_pushes"]
 
 # (numpy's error model: a division by zero gives inf or NaN as numpy does)
 _compiled = numpy_kernel
@@ -239,3 +239,48 @@ def bounce_hits(warm, u, ra, rb, restitution, nx, ny, gx, gy, dt, alive0):  # pr
             resting_speed = 2.0 * abs(g_n[i]) * dt
             hits[i] = rest[i] > 0.0 and -u[i] > resting_speed and alive0[i]
     return hits, rest, g_n
+
+
+@_compiled
+def rigid_shares(still_a, still_b, wa, wb, ia, ib, rn_a, rn_b):  # pragma: no cover - compiled
+    """:meth:`Solve._rigid_shares`: contacts at points, how far a unit of push (impulse) moves and
+    turns each body, the bodies ``still_*`` keeping still (their inverse mass ``w`` and inertia
+    ``i`` taken as 0): ``(share_a, share_b, turn_a, turn_b)``."""
+    c = wa.size
+    share_a, share_b, turn_a, turn_b = np.empty(c), np.empty(c), np.empty(c), np.empty(c)
+    for i in range(c):
+        wa_i, ia_i = (0.0, 0.0) if still_a[i] else (wa[i], ia[i])
+        wb_i, ib_i = (0.0, 0.0) if still_b[i] else (wb[i], ib[i])
+        inv = 1.0 / (wa_i + wb_i + ia_i * rn_a[i] * rn_a[i] + ib_i * rn_b[i] * rn_b[i])
+        share_a[i], share_b[i] = wa_i * inv, wb_i * inv
+        turn_a[i], turn_b[i] = ia_i * rn_a[i] * inv, ib_i * rn_b[i] * inv
+    return share_a, share_b, turn_a, turn_b
+
+
+@_compiled
+def lever_arms(ra, rb, rax, ray, rbx, rby, nx, ny, depth, a, b, span, asleep, inv_inertia, kind, polygon, rn_a0,
+               rn_b0, dturn, turned):  # pragma: no cover - compiled
+    """:meth:`Solve._arms`: each contact's bodies' inverse inertias (a sleeper's 0), lever arms
+    across the normal (``rn = r x n``) and along the contact (``rt``), 0 for a deep overlap (depth
+    over the smaller span), and whether a body is a turning polygon: ``(ia, ib, rn_a, rn_b, rt_a,
+    rt_b, at_points)``. ``turned``: the arms changed during the solve (the old ones ``rn_*0``,
+    turns ``dturn``); each such contact's depth is moved in place by what the turns make of the
+    change, so its separation stays where it is."""
+    c = ra.size
+    ia, ib = np.empty(c), np.empty(c)
+    rn_a, rn_b, rt_a, rt_b = np.empty(c), np.empty(c), np.empty(c), np.empty(c)
+    at_points = np.empty(c, dtype=np.bool_)
+    for i in range(c):
+        p, q = ra[i], rb[i]
+        ia[i] = 0.0 if asleep[p] else inv_inertia[p]
+        ib[i] = 0.0 if asleep[q] else inv_inertia[q]
+        flat = 1.0 if depth[i] <= _np_min(span[a[i]], span[b[i]]) else 0.0
+        rn_a[i], rn_b[i] = flat * (rax[i] * ny[i] - ray[i] * nx[i]), flat * (rbx[i] * ny[i] - rby[i] * nx[i])
+        rt_a[i], rt_b[i] = flat * (rax[i] * nx[i] + ray[i] * ny[i]), flat * (rbx[i] * nx[i] + rby[i] * ny[i])
+        at_points[i] = ((kind[p] == polygon) and inv_inertia[p] > 0.0) or ((kind[q] == polygon)
+                                                                             and inv_inertia[q] > 0.0)
+    if turned:
+        for i in range(rn_a0.size):
+            before = rn_b0[i] * dturn[b[i]] - rn_a0[i] * dturn[a[i]]
+            depth[i] += rn_b[i] * dturn[b[i]] - rn_a[i] * dturn[a[i]] - before
+    return ia, ib, rn_a, rn_b, rt_a, rt_b, at_points
