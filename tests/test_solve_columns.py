@@ -202,6 +202,21 @@ def test_rigid_shares_and_lever_arms_are_the_numpy_ones(seed: int) -> None:
         _same(d, want_depth)
 
 
+@pytest.mark.parametrize("rigid", [False, True])
+def test_separations_are_the_numpy_ones(rigid: bool) -> None:
+    rng = np.random.default_rng(5)
+    n, c = 12, 25
+    a, b, nx, ny = _contacts(rng, n, c)
+    dx, dy, depth = _floats(rng, n), _floats(rng, n), _floats(rng, c)
+    rn_a, rn_b, dturn = (_floats(rng, c), _floats(rng, c), _floats(rng, n)) if rigid else (np.zeros(0),) * 3
+    with np.errstate(all="ignore"):
+        shift = (dx[b] - dx[a]) * nx + (dy[b] - dy[a]) * ny
+        if rigid:
+            shift += rn_b * dturn[b] - rn_a * dturn[a]
+        want = shift - depth
+    _same(sr.separations(a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, depth), want)
+
+
 def test_pair_friction_is_the_numpy_rule() -> None:
     from framework.store import _pair_friction
 

@@ -464,7 +464,10 @@ class Solve:
 
     def _separations(self) -> F64Array:
         """Every contact's separation where the bodies now stand, along its normal (linear)."""
-        return self._shift(np.arange(self.cs.size)) - self.cs.depth
+        cs = self.cs
+        turns = (self.rn_a, self.rn_b, self.dturn) if self.rigid else (_NO_FLOATS,) * 3
+        seps: F64Array = rounds.separations(self.a, self.b, cs.nx, cs.ny, self.dx, self.dy, *turns, cs.depth)
+        return seps
 
     def _measure_immovable(self) -> bool:
         """Measure the pushed contacts with immovable bodies again; their depths (relative to where
@@ -880,7 +883,10 @@ class Solve:
         values: tuple[F64Array, ...] = (pushed, push, impulse, tpush, timpulse)
         if self.rigid:
             frame.points = (keys, cs.slot[rows], values[1], values[2], values[3], values[4], cs.px[rows], cs.py[rows])
-            first = np.flatnonzero(np.diff(keys, prepend=keys[:1] - 1))  # (each pair's first point)
+            starts = np.empty(keys.size, dtype=bool)  # (each pair's first point)
+            starts[:1] = True
+            np.not_equal(keys[1:], keys[:-1], out=starts[1:])
+            first = np.flatnonzero(starts)
             ea, eb, nx, ny = ea[first], eb[first], nx[first], ny[first]
             if first.size:
                 gap = np.minimum.reduceat(gap, first)

@@ -35,7 +35,7 @@ from .gather import _find, _np_max, _np_min, _places, _row, solid_pair
 from .solve_columns import push_cap
 
 __all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "moved_candidates", "moved_immovable",
-           "near_rows", "number", "place", "recorded", "turning_pairs", "unknown_solid_pairs"]
+           "near_rows", "number", "place", "recorded", "separations", "turning_pairs", "unknown_solid_pairs"]
 
 
 @kernel
@@ -199,6 +199,16 @@ def _shift(i, p, q, dx, dy, nx, ny, rn_a, rn_b, dturn):  # pragma: no cover - co
     if rn_a.size > 0:
         shift += rn_b[i] * dturn[q] - rn_a[i] * dturn[p]
     return shift
+
+
+@kernel
+def separations(a, b, nx, ny, dx, dy, rn_a, rn_b, dturn, depth):  # pragma: no cover - compiled
+    """``Solve._separations``: every contact's separation where the bodies now stand, along its
+    normal (its shift less its depth; turns count for contacts at points: ``rn_a`` not empty)."""
+    out = np.empty(depth.size)
+    for i in range(depth.size):
+        out[i] = _shift(i, a[i], b[i], dx, dy, nx, ny, rn_a, rn_b, dturn) - depth[i]
+    return out
 
 
 @leaf
