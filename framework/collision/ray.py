@@ -408,8 +408,12 @@ def _clip_exact(
 
 
 def _signed_float(t: Fraction) -> float:
-    """``t`` as a float, never rounded to 0 unless it is 0."""
-    f = float(t)
+    """``t`` as a float, never rounded to 0 unless it is 0, and infinite beyond float's range (a face
+    all but parallel to a ray whose direction has a subnormal component: 0.5 / 5e-324)."""
+    try:
+        f = float(t)
+    except OverflowError:
+        return math.inf if t > 0 else -math.inf
     if f == 0.0 and t != 0:
         return math.copysign(TINY, t)
     return f
