@@ -454,14 +454,6 @@ class Solve:
         elif self.fpos is not None and self.fpos.turns:
             self.fpos.place_turns(self.store, self.rows)
 
-    def _shift(self, idx: IntpArray) -> F64Array:
-        """How far the solve has moved the bodies of contacts ``idx`` apart along their normals."""
-        cs, a, b = self.cs, self.a[idx], self.b[idx]
-        shift = (self.dx[b] - self.dx[a]) * cs.nx[idx] + (self.dy[b] - self.dy[a]) * cs.ny[idx]
-        if self.rigid:
-            shift += self.rn_b[idx] * self.dturn[b] - self.rn_a[idx] * self.dturn[a]
-        return shift
-
     def _separations(self) -> F64Array:
         """Every contact's separation where the bodies now stand, along its normal (linear)."""
         cs = self.cs

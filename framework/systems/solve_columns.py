@@ -23,7 +23,7 @@ NaN last), so the same bits. Divisions follow numpy's rules (``error_model="nump
 
 A fresh install compiles each of these on its first call, a few tenths of a second each whatever
 its size (cached after): so there are few of them, and the only helpers are rules two passes
-share (:func:`push_cap`, :func:`_kept_still`).
+share (:func:`push_cap`, :func:`_kept_still`, :func:`turning_pair`).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from .gather import _np_max, _np_min
 from .solver_loops import warm_start
 
 __all__ = ["bounce_hits", "closing_speeds", "contact_columns", "lever_arms", "push_cap", "rigid_shares", "stays",
-           "velocity_stays", "warm_impulses", "warm_pushes"]
+           "turning_pair", "velocity_stays", "warm_impulses", "warm_pushes"]
 
 # (numpy's error model: a division by zero gives inf or NaN as numpy does)
 _compiled = numpy_kernel
@@ -50,6 +50,13 @@ def push_cap(push, span_a, span_b):  # pragma: no cover - compiled
     of its two bodies (twice their smaller ``span``; a push that long in one step is a body being
     pushed out of a heap, not resting)."""
     return _np_min(push, 2.0 * _np_min(span_a, span_b))
+
+
+@leaf
+def turning_pair(p, q, kind, inv_inertia, polygon):  # pragma: no cover - compiled
+    """Whether rows ``p`` or ``q`` are of kind ``polygon`` and turn (``inv_inertia > 0``), as
+    ``turning.turning_polygons`` of either row."""
+    return (kind[p] == polygon and inv_inertia[p] > 0.0) or (kind[q] == polygon and inv_inertia[q] > 0.0)
 
 
 @inner
@@ -277,8 +284,7 @@ def lever_arms(ra, rb, rax, ray, rbx, rby, nx, ny, depth, a, b, span, asleep, in
         flat = 1.0 if depth[i] <= _np_min(span[a[i]], span[b[i]]) else 0.0
         rn_a[i], rn_b[i] = flat * (rax[i] * ny[i] - ray[i] * nx[i]), flat * (rbx[i] * ny[i] - rby[i] * nx[i])
         rt_a[i], rt_b[i] = flat * (rax[i] * nx[i] + ray[i] * ny[i]), flat * (rbx[i] * nx[i] + rby[i] * ny[i])
-        at_points[i] = ((kind[p] == polygon) and inv_inertia[p] > 0.0) or ((kind[q] == polygon)
-                                                                             and inv_inertia[q] > 0.0)
+        at_points[i] = turning_pair(p, q, kind, inv_inertia, polygon)
     if turned:
         for i in range(rn_a0.size):
             before = rn_b0[i] * dturn[b[i]] - rn_a0[i] * dturn[a[i]]

@@ -32,7 +32,7 @@ import numpy as np
 from ..compiled import kernel, leaf
 from ..stable_sort import argsort_ints
 from .gather import _find, _np_max, _np_min, _places, _row, solid_pair
-from .solve_columns import push_cap
+from .solve_columns import push_cap, turning_pair
 
 __all__ = ["apply_measures", "far_bodies", "kept_static_pairs", "known_keys", "moved_candidates", "moved_immovable",
            "near_rows", "number", "place", "recorded", "separations", "turning_pairs", "unknown_solid_pairs"]
@@ -87,13 +87,6 @@ def number(table, ra, rb, first):  # pragma: no cover - compiled
     for k in range(2 * c):
         local[k] = table[ra[k] if k < c else rb[k - c]]
     return new, local
-
-
-@leaf
-def turning_pair(p, q, kind, inv_inertia, polygon):  # pragma: no cover - compiled
-    """Whether rows ``p`` or ``q`` are of kind ``polygon`` and turn (``inv_inertia > 0``), as
-    ``turning.turning_polygons`` of either row."""
-    return (kind[p] == polygon and inv_inertia[p] > 0.0) or (kind[q] == polygon and inv_inertia[q] > 0.0)
 
 
 @leaf

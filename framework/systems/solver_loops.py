@@ -337,11 +337,11 @@ def solve_positions_rigid(order, a, b, nx, ny, sep0, share_a, share_b, nturn_a, 
             if not friction:
                 continue
             tx, ty = -ny[i], nx[i]
-            slip = ((mx[ib] + dx[ib] - mx[ia] - dx[ia]) * tx + (my[ib] + dy[ib] - my[ia] - dy[ia]) * ty
-                    + arm_b[i] * (mturn[ib] + dturn[ib]) - arm_a[i] * (mturn[ia] + dturn[ia]))
+            slip = 0.0  # (after FRICTION_PASSES passes of this run: kept within its limit only)
+            if it < FRICTION_PASSES:
+                slip = ((mx[ib] + dx[ib] - mx[ia] - dx[ia]) * tx + (my[ib] + dy[ib] - my[ia] - dy[ia]) * ty
+                        + arm_b[i] * (mturn[ib] + dturn[ib]) - arm_a[i] * (mturn[ia] + dturn[ia]))
             limit = mu[i] * push[i]
-            if it >= FRICTION_PASSES:  # (followed enough for this run: kept within its limit only)
-                slip = 0.0
             new = min(max(tpush[i] - slip, -limit), limit)
             change = new - tpush[i]
             if change == 0.0:

@@ -35,7 +35,7 @@ from ..frame import Points
 from ..geometry import Geometry
 from ..store import BodyStore
 from .gather import _np_min
-from .solve_rounds import turning_pair
+from .solve_columns import turning_pair
 
 if TYPE_CHECKING:  # (solve imports this module)
     from .solve import Contacts
