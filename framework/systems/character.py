@@ -162,7 +162,7 @@ class CharacterStage(Stage):
         reason = kernel.move_character(
             row, undo, moved, self.pipeline.solver == "soft", cfg, mask, -1 if floor_row is None else floor_row,
             ctrl.on_floor, ctrl.max_slides, _RIDE_SLIDES, frame.start_x, frame.start_y, geom.hx, geom.hy, c["vx"],
-            c["vy"], c["w"], c["has_vel"], c["body"], c["asleep"], c["kind"], geom.minx, geom.miny, geom.maxx,
+            c["vy"], c["w"], c["has_vel"], c["body"], c["asleep"], store.kind, geom.minx, geom.miny, geom.maxx,
             geom.maxy, c["hw"], c["hh"], c["one_way"], c["entity"], c["bound"], c["layer"], c["sensor"], st, si,
             push_r, push_n)
         if undo or not reason:

@@ -605,7 +605,10 @@ def move_character(row, undo, moved, soft, cfg, mask, floor_row, was_on_floor, m
     (:func:`~framework.collision.box_rows.rows_near` of the reach ``_gather`` computes), the move
     (:func:`_move`) and, if that decided it, the body placed where it ends. 0, or the reason it
     hands the move back to the Python code (then only the ``undo`` was done). The stage's Python
-    arithmetic, in its order: the same bits. The geometry must be current (``hx`` is ``x``)."""
+    arithmetic, in its order: the same bits. The geometry must be current (``hx`` is ``x``), and
+    ``kind`` the live rows only (``store.kind``, as long as the geometry's bounds): the candidates
+    come from a pass over it, and a column's rows past the live ones (kept from despawned bodies)
+    would read bounds past the geometry's end (memory that differs from run to run)."""
     if undo:
         _place_box(row, start_x[row], start_y[row], x, y, hw, hh, minx, miny, maxx, maxy)
     x0, y0, ahw, ahh = x[row], y[row], hw[row], hh[row]
