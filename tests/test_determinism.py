@@ -1,5 +1,5 @@
-"""Determinism: the same recorded input gives bit-identical state and events, run after run and
-whatever ``PYTHONHASHSEED`` is.
+"""Determinism: the same recorded input gives bit-identical state and events, run after run,
+whatever ``PYTHONHASHSEED`` is and whatever fresh memory holds.
 
 A small game (a player driven by a replay, random bodies from the replay's seed, coins a handler
 despawns, bullets with continuous detection spawned by a system, a one-way platform, layers,
@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 GAME = textwrap.dedent('''
-    import hashlib, sys
+    import hashlib, os, sys
     import numpy as np
     from framework import AABB, Circle, Hitbox, Polygon, Scene, Transform, Velocity
     from framework.input import Input
@@ -30,7 +30,7 @@ GAME = textwrap.dedent('''
 
     def game(replay):
         rng = np.random.default_rng(replay.seed)
-        s = Scene(gravity=(0.0, -10.0), substeps=2)
+        s = Scene(gravity=(0.0, -10.0), substeps=2, solver=os.environ.get("GAME_SOLVER", "exact"))
         for i in range(30):
             s.spawn(Transform(float(i), 0.0), Hitbox(AABB(1.0, 1.0), body="static"))
         s.spawn(Transform(-0.5, 4.0), Hitbox(AABB(1.0, 8.0), body="static"))
@@ -80,10 +80,10 @@ GAME = textwrap.dedent('''
 ''')
 
 
-def run_game(tmp_path: Path, hash_seed: str, replay_file: Path | None = None) -> str:
+def run_game(tmp_path: Path, hash_seed: str, replay_file: Path | None = None, **env_vars: str) -> str:
     script = tmp_path / "game.py"
     script.write_text(GAME)
-    env = dict(os.environ, PYTHONHASHSEED=hash_seed)
+    env = dict(os.environ, PYTHONHASHSEED=hash_seed, **env_vars)
     args = [sys.executable, str(script)] + ([str(replay_file)] if replay_file else [])
     root = Path(__file__).resolve().parents[1]
     out = subprocess.run(args, capture_output=True, text=True, env=env, cwd=root, timeout=120)
@@ -110,3 +110,15 @@ def test_replay_file_reproduces_the_recorded_run(tmp_path):
     path = tmp_path / "session.replay"
     Replay(pattern, dt=1 / 60, seed=2024).save(path)
     assert run_game(tmp_path, "777", path) == run_game(tmp_path, "0")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("solver", ["exact", "soft"])
+def test_same_bytes_whatever_fresh_memory_holds(tmp_path, solver):
+    """A kernel that read memory it had not written (an ``np.empty`` slot) would step by whatever
+    that memory held. glibc's ``MALLOC_PERTURB_`` fills memory as it is handed out and freed (the
+    compiled kernels' arrays come from malloc): three fillings, one run each, the same digests."""
+    runs = [run_game(tmp_path, "0", GAME_SOLVER=solver, **({"MALLOC_PERTURB_": fill} if fill else {}))
+            for fill in ("", "85", "170")]
+    assert runs[0].count("\n") == 4
+    assert runs[1] == runs[0] and runs[2] == runs[0]
