@@ -11,10 +11,16 @@ import pytest
 import framework.systems.solve as solve_module
 from framework import AABB, Capsule, Circle, Hitbox, Polygon, Scene, Transform, Velocity
 from framework.bench import regimes
-from framework.collision.kinds import KIND_CAPSULE, KIND_CIRCLE
+from framework.collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
 from framework.events import pair_keys
 from framework.systems import turning
-from framework.systems.turning import manifold_points, turning_polygons
+from framework.systems.turning import manifold_points
+
+
+def turning_polygons(store, rows):
+    """Mask of ``rows`` that are boxes or polygons contacts turn (the numpy rule the compiled
+    ``solve_columns.turning_pair`` replaced)."""
+    return (store.kind[rows] == KIND_POLYGON) & (store.inv_inertia[rows] > 0.0)
 
 
 def _expand_numpy(cs, store, geom, points, margin):

@@ -54,8 +54,8 @@ def push_cap(push, span_a, span_b):  # pragma: no cover - compiled
 
 @leaf
 def turning_pair(p, q, kind, inv_inertia, polygon):  # pragma: no cover - compiled
-    """Whether rows ``p`` or ``q`` are of kind ``polygon`` and turn (``inv_inertia > 0``), as
-    ``turning.turning_polygons`` of either row."""
+    """Whether row ``p`` or row ``q`` is of kind ``polygon`` (a box or a polygon that contacts turn)
+    and turns (``inv_inertia > 0``)."""
     return (kind[p] == polygon and inv_inertia[p] > 0.0) or (kind[q] == polygon and inv_inertia[q] > 0.0)
 
 

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..arrays import BoolArray, F64Array, I64Array, IntpArray
+from ..arrays import F64Array, I64Array, IntpArray
 from ..collision.batch_manifold import pair_manifolds
 from ..collision.box_rows import lower_bound
 from ..collision.kinds import KIND_CAPSULE, KIND_CIRCLE, KIND_POLYGON
@@ -40,12 +40,7 @@ from .solve_columns import turning_pair
 if TYPE_CHECKING:  # (solve imports this module)
     from .solve import Contacts
 
-__all__ = ["expand", "manifold_points", "turned_normals", "turning_polygons"]
-
-
-def turning_polygons(store: BodyStore, rows: IntpArray) -> BoolArray:
-    """Mask of ``rows`` that are boxes or polygons contacts turn."""
-    return (store.kind[rows] == KIND_POLYGON) & (store.inv_inertia[rows] > 0.0)
+__all__ = ["expand", "manifold_points", "turned_normals"]
 
 
 @kernel
